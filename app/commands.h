@@ -1,0 +1,37 @@
+#pragma once
+// Each subcommand of `arview` lives in its own file app/cmd_<name>.cpp and registers itself
+// here. A callback reports failure by throwing; main() turns the exception into one line on
+// stderr and a non-zero exit.
+
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace arview::app {
+
+// Thrown by a command to exit with a specific code after its message.
+struct CommandError : std::runtime_error {
+  explicit CommandError(const std::string& message, int exit_code = 1)
+      : std::runtime_error(message), code(exit_code) {}
+  int code;
+};
+
+// For subcommands that a later issue fills in: says so plainly and exits non-zero.
+[[noreturn]] void NotBuiltYet(const std::string& command);
+
+void AddCalibrateCommand(CLI::App& app);
+void AddImportCommand(CLI::App& app);
+void AddSynthCommand(CLI::App& app);
+void AddRecordCommand(CLI::App& app);
+void AddMapCommand(CLI::App& app);
+void AddTrackCommand(CLI::App& app);
+void AddEvalCommand(CLI::App& app);
+void AddAnimCommand(CLI::App& app);
+void AddPlaceCommand(CLI::App& app);
+void AddRenderCommand(CLI::App& app);
+void AddReplayCommand(CLI::App& app);
+void AddRunCommand(CLI::App& app);
+void AddDemoCommand(CLI::App& app);
+
+}  // namespace arview::app

@@ -1,0 +1,71 @@
+// arview: one binary, one subcommand per job (see ../shared/DESIGN.md, "The command line").
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "app/commands.h"
+
+namespace arview::app {
+
+void NotBuiltYet(const std::string& command) {
+  throw CommandError("'arview " + command + "' is not built yet in this version of arview", 3);
+}
+
+}  // namespace arview::app
+
+namespace {
+
+// CLI11 messages may span lines; the contract is one clear line on stderr.
+std::string OneLine(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace arview::app;
+  CLI::App app{"arview: marker-less augmented reality with view-adaptive characters", "arview"};
+  app.require_subcommand(1);
+  app.fallthrough(false);
+  app.get_formatter()->column_width(34);
+  app.set_version_flag("--version", "arview 0.1.0");
+
+  AddCalibrateCommand(app);
+  AddImportCommand(app);
+  AddSynthCommand(app);
+  AddRecordCommand(app);
+  AddMapCommand(app);
+  AddTrackCommand(app);
+  AddEvalCommand(app);
+  AddAnimCommand(app);
+  AddPlaceCommand(app);
+  AddRenderCommand(app);
+  AddReplayCommand(app);
+  AddRunCommand(app);
+  AddDemoCommand(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "arview: " << OneLine(e.what()) << " (see 'arview --help')\n";
+    return e.get_exit_code() != 0 ? e.get_exit_code() : 2;
+  } catch (const CommandError& e) {
+    std::cerr << "arview: " << OneLine(e.what()) << "\n";
+    return e.code;
+  } catch (const std::exception& e) {
+    std::cerr << "arview: " << OneLine(e.what()) << "\n";
+    return 1;
+  }
+  return 0;
+}

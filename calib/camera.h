@@ -1,0 +1,68 @@
+#pragma once
+// The camera model shared by every module: pinhole + OpenCV radial-tangential distortion
+// (k1, k2, p1, p2, k3), in OpenCV's pixel convention (centre of the top-left pixel at 0,0).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace arview::calib {
+
+// A camera file or camera value that cannot be used; the message names the file and field.
+struct CameraError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Applies OpenCV's radial-tangential distortion to normalised image coordinates (x, y).
+// Templated so that Ceres cost functions project through exactly the same model.
+// dist = {k1, k2, p1, p2, k3}.
+template <typename T, typename D>
+inline void DistortNormalized(const D* dist, const T& x, const T& y, T* xd, T* yd) {
+  const T r2 = x * x + y * y;
+  const T radial = T(1) + r2 * (T(dist[0]) + r2 * (T(dist[1]) + r2 * T(dist[4])));
+  const T xy2 = T(2) * x * y;
+  *xd = x * radial + T(dist[2]) * xy2 + T(dist[3]) * (r2 + T(2) * x * x);
+  *yd = y * radial + T(dist[2]) * (r2 + T(2) * y * y) + T(dist[3]) * xy2;
+}
+
+struct Camera {
+  int width = 0;
+  int height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::array<double, 5> dist{0, 0, 0, 0, 0};  // k1, k2, p1, p2, k3 (OpenCV order)
+
+  static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
+
+  bool HasDistortion() const;
+  cv::Matx33d K() const;
+  Eigen::Matrix3d KEigen() const;
+  cv::Mat DistCoeffs() const;  // 1x5 CV_64F, OpenCV order
+  cv::Size Size() const { return {width, height}; }
+  Camera WithoutDistortion() const;
+
+  // A point in camera coordinates (z > 0 in front) to a distorted pixel.
+  Eigen::Vector2d Project(const Eigen::Vector3d& point_camera) const;
+  // Normalised undistorted coordinates to a distorted pixel.
+  Eigen::Vector2d NormalizedToPixel(const Eigen::Vector2d& normalized) const;
+  // A distorted pixel to normalised undistorted coordinates (inverts the distortion by
+  // Gauss-Newton to 1e-12, far tighter than cv::undistortPoints' fixed 5 iterations).
+  Eigen::Vector2d PixelToNormalized(const Eigen::Vector2d& pixel) const;
+  // A distorted pixel to the unit bearing vector OpenGV takes.
+  Eigen::Vector3d Unproject(const Eigen::Vector2d& pixel) const;
+  // A distorted pixel to where an ideal pinhole camera with the same K would see it.
+  Eigen::Vector2d UndistortPixel(const Eigen::Vector2d& pixel) const;
+  bool InImage(const Eigen::Vector2d& pixel, double border = 0) const;
+
+  // Throws CameraError naming `source` and the offending field.
+  void Validate(const std::string& source) const;
+};
+
+// OpenCV FileStorage YAML with the names of OpenCV's calibration sample.
+Camera LoadCamera(const std::filesystem::path& path);
+void SaveCamera(const Camera& camera, const std::filesystem::path& path);
+
+}  // namespace arview::calib

@@ -1,0 +1,112 @@
+#include "calib/camera.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+namespace arview::calib {
+namespace {
+
+Camera DistortedCamera() {
+  Camera c = Camera::Pinhole(640, 480, 535.9, 536.1, 342.3, 235.6);
+  c.dist = {-0.27, 0.05, 0.0012, -0.0004, 0.12};
+  return c;
+}
+
+TEST(Camera, ProjectMatchesOpenCvProjectPoints) {
+  const Camera c = DistortedCamera();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  std::vector<cv::Point3d> pts;
+  for (int i = 0; i < 200; ++i) pts.emplace_back(u(rng), u(rng), 1.0 + std::abs(u(rng)) * 3);
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(pts, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), c.K(), c.DistCoeffs(), expected);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector2d p = c.Project({pts[i].x, pts[i].y, pts[i].z});
+    EXPECT_NEAR(p.x(), expected[i].x, 1e-9);
+    EXPECT_NEAR(p.y(), expected[i].y, 1e-9);
+  }
+}
+
+TEST(Camera, UnprojectInvertsProjectAcrossTheImage) {
+  const Camera c = DistortedCamera();
+  for (int y = 0; y < c.height; y += 40) {
+    for (int x = 0; x < c.width; x += 40) {
+      const Eigen::Vector3d bearing = c.Unproject({x, y});
+      EXPECT_NEAR(bearing.norm(), 1.0, 1e-12);
+      const Eigen::Vector2d back = c.Project(bearing);
+      EXPECT_NEAR(back.x(), x, 1e-8);
+      EXPECT_NEAR(back.y(), y, 1e-8);
+    }
+  }
+}
+
+TEST(Camera, UndistortPixelAgreesWithOpenCv) {
+  const Camera c = DistortedCamera();
+  std::vector<cv::Point2d> in{{100, 80}, {320, 240}, {600, 450}, {20, 400}};
+  std::vector<cv::Point2d> out;
+  cv::undistortPoints(in, out, c.K(), c.DistCoeffs(), cv::noArray(), c.K(),
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14));
+  for (size_t i = 0; i < in.size(); ++i) {
+    const Eigen::Vector2d u = c.UndistortPixel({in[i].x, in[i].y});
+    EXPECT_NEAR(u.x(), out[i].x, 1e-4);
+    EXPECT_NEAR(u.y(), out[i].y, 1e-4);
+  }
+}
+
+TEST(Camera, SaveLoadRoundTrip) {
+  const Camera c = DistortedCamera();
+  const auto path = std::filesystem::temp_directory_path() / "arview_camera_roundtrip.yaml";
+  SaveCamera(c, path);
+  const Camera d = LoadCamera(path);
+  EXPECT_EQ(d.width, 640);
+  EXPECT_EQ(d.height, 480);
+  EXPECT_DOUBLE_EQ(d.fx, c.fx);
+  EXPECT_DOUBLE_EQ(d.cy, c.cy);
+  for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(d.dist[i], c.dist[i]);
+  std::filesystem::remove(path);
+}
+
+void WriteFile(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+std::string LoadError(const std::string& yaml) {
+  const auto path = std::filesystem::temp_directory_path() / "arview_camera_bad.yaml";
+  WriteFile(path, yaml);
+  try {
+    LoadCamera(path);
+  } catch (const CameraError& e) {
+    std::filesystem::remove(path);
+    return e.what();
+  }
+  std::filesystem::remove(path);
+  return "";
+}
+
+const char* kGood =
+    "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+    "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n";
+
+TEST(Camera, LoadRejectsBadFilesNamingTheField) {
+  EXPECT_EQ(LoadError(kGood), "");
+
+  EXPECT_NE(LoadError("not yaml at all {{{").find("arview_camera_bad.yaml"), std::string::npos);
+  std::string no_width = kGood;
+  no_width.replace(no_width.find("image_width: 640"), 16, "image_wide: 640");
+  EXPECT_NE(LoadError(no_width).find("image_width is missing"), std::string::npos);
+  std::string neg_f = kGood;
+  neg_f.replace(neg_f.find("500., 0., 320."), 4, "-500");
+  EXPECT_NE(LoadError(neg_f).find("fx must be a positive"), std::string::npos);
+  std::string outside = kGood;
+  outside.replace(outside.find("320."), 4, "900.");
+  EXPECT_NE(LoadError(outside).find("principal point cx"), std::string::npos);
+  std::string zero_h = kGood;
+  zero_h.replace(zero_h.find("image_height: 480"), 17, "image_height: 0  ");
+  EXPECT_NE(LoadError(zero_h).find("image_height must be positive"), std::string::npos);
+  EXPECT_THROW(LoadCamera("/nonexistent/camera.yaml"), CameraError);
+}
+
+}  // namespace
+}  // namespace arview::calib

@@ -1,0 +1,57 @@
+#pragma once
+// The Map the tracker loads: COLMAP's sparse model and feature descriptors, in memory, in the
+// map's world frame. This header is the contract between mapping/ (which builds, saves and
+// loads it) and tracker/ (which only reads it).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "calib/camera.h"
+#include "calib/pose.h"
+
+namespace arview::mapping {
+
+struct MapError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct MapPoint {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::array<std::uint8_t, 3> rgb{0, 0, 0};
+  double reprojection_error = 0;     // COLMAP's mean error of the track, pixels
+  std::uint32_t first_descriptor = 0;  // rows [first, first + count) of Map::descriptors
+  std::uint32_t descriptor_count = 0;
+};
+
+// One 2D-3D correspondence of a keyframe, in OpenCV pixel convention (COLMAP's +0.5 removed).
+struct KeyframeObservation {
+  std::uint32_t point = 0;  // index into Map::points
+  Eigen::Vector2f pixel = Eigen::Vector2f::Zero();
+  std::uint32_t descriptor = 0;  // row of Map::descriptors holding this observation's SIFT
+};
+
+struct Keyframe {
+  std::uint32_t colmap_image_id = 0;
+  std::string name;          // frame path relative to the recording
+  int frame_index = -1;      // index into the recording's frames.txt
+  double timestamp = 0;
+  calib::Pose pose;          // world → camera
+  std::vector<KeyframeObservation> observations;
+};
+
+struct Map {
+  calib::Camera camera;  // OpenCV convention
+  std::vector<Keyframe> keyframes;
+  std::vector<MapPoint> points;
+  // One row per track element: uint8 SIFT in COLMAP's convention (L1-root, ×512, clamp 255).
+  cv::Mat descriptors;                      // N x 128, CV_8U
+  std::vector<std::uint32_t> descriptor_point;  // row → index into points
+};
+
+}  // namespace arview::mapping

@@ -1,0 +1,161 @@
+#include "recordings/recording.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace arview::recordings {
+
+namespace fs = std::filesystem;
+
+bool Recording::IsVideo() const {
+  if (frames.size() < 2) {
+    if (frames.empty()) return false;
+    const std::string ext = fs::path(frames[0].path).extension().string();
+    return ext == ".mp4" || ext == ".avi" || ext == ".mkv" || ext == ".mov" || ext == ".webm";
+  }
+  return frames[0].path == frames[1].path;
+}
+
+cv::Mat Recording::ReadImage(size_t index) const {
+  const fs::path p = FramePath(index);
+  cv::Mat image = cv::imread(p.string(), cv::IMREAD_COLOR);
+  if (image.empty()) throw RecordingError(p.string() + ": cannot be read as an image");
+  return image;
+}
+
+namespace {
+
+std::vector<FrameEntry> ReadFramesTxt(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw RecordingError(file.string() + ": missing (every recording needs frames.txt)");
+  std::vector<FrameEntry> frames;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream ss(line);
+    FrameEntry e;
+    if (!(ss >> e.timestamp) || !std::isfinite(e.timestamp)) {
+      throw RecordingError(file.string() + ":" + std::to_string(line_no) + ": expected 'timestamp path'");
+    }
+    std::getline(ss >> std::ws, e.path);
+    if (e.path.empty()) {
+      throw RecordingError(file.string() + ":" + std::to_string(line_no) + ": frame path missing");
+    }
+    if (!frames.empty() && e.timestamp <= frames.back().timestamp) {
+      throw RecordingError(file.string() + ":" + std::to_string(line_no) +
+                           ": timestamps must increase strictly");
+    }
+    frames.push_back(std::move(e));
+  }
+  if (frames.empty()) throw RecordingError(file.string() + ": lists no frames");
+  return frames;
+}
+
+}  // namespace
+
+Recording LoadRecording(const fs::path& root) {
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) throw RecordingError(root.string() + ": recording folder does not exist");
+  Recording r;
+  r.root = root;
+  const fs::path camera_file = root / "camera.yaml";
+  if (!fs::exists(camera_file, ec)) throw RecordingError(camera_file.string() + ": missing (every recording needs camera.yaml)");
+  try {
+    r.camera = calib::LoadCamera(camera_file);
+  } catch (const calib::CameraError& e) {
+    throw RecordingError(e.what());
+  }
+  r.frames = ReadFramesTxt(root / "frames.txt");
+  std::set<std::string> checked;
+  for (const FrameEntry& f : r.frames) {
+    if (!checked.insert(f.path).second) continue;
+    if (!fs::is_regular_file(root / f.path, ec)) {
+      throw RecordingError((root / f.path).string() + ": listed in frames.txt but missing");
+    }
+  }
+  if (checked.size() != 1 && checked.size() != r.frames.size()) {
+    throw RecordingError((root / "frames.txt").string() +
+                         ": lists some files more than once (expected one file per frame, or one video)");
+  }
+  const fs::path gt = root / "groundtruth.txt";
+  if (fs::exists(gt, ec)) r.groundtruth = ReadTum(gt);
+  return r;
+}
+
+void WriteFramesTxt(const fs::path& root, const std::vector<FrameEntry>& frames) {
+  const fs::path file = root / "frames.txt";
+  const fs::path tmp = root / "frames.txt.tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw RecordingError(file.string() + ": cannot write");
+    out << "# timestamp path\n";
+    char buf[64];
+    for (const FrameEntry& f : frames) {
+      std::snprintf(buf, sizeof(buf), "%.9f", f.timestamp);
+      out << buf << ' ' << f.path << '\n';
+    }
+    out.flush();
+    if (!out) throw RecordingError(file.string() + ": write failed");
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw RecordingError(file.string() + ": cannot write (" + ec.message() + ")");
+}
+
+namespace {
+
+int ParseIndex(const std::string& text, const std::string& spec) {
+  if (text.empty() || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    throw RecordingError("frame spec '" + spec + "': '" + text + "' is not a frame index");
+  }
+  if (text.size() > 9) throw RecordingError("frame spec '" + spec + "': index '" + text + "' is too large");
+  return std::stoi(text);
+}
+
+}  // namespace
+
+std::vector<int> ParseFrameSpec(const std::string& spec, int frame_count) {
+  std::set<int> out;
+  std::stringstream ss(spec);
+  std::string item;
+  bool any = false;
+  while (std::getline(ss, item, ',')) {
+    item.erase(std::remove_if(item.begin(), item.end(), ::isspace), item.end());
+    if (item.empty()) throw RecordingError("frame spec '" + spec + "': empty item");
+    any = true;
+    int step = 1;
+    std::string range = item;
+    if (const auto colon = item.find(':'); colon != std::string::npos) {
+      step = ParseIndex(item.substr(colon + 1), spec);
+      if (step <= 0) throw RecordingError("frame spec '" + spec + "': step must be positive");
+      range = item.substr(0, colon);
+    }
+    int a = 0, b = 0;
+    if (const auto dash = range.find('-'); dash != std::string::npos) {
+      a = ParseIndex(range.substr(0, dash), spec);
+      b = ParseIndex(range.substr(dash + 1), spec);
+      if (b < a) throw RecordingError("frame spec '" + spec + "': range " + range + " runs backwards");
+    } else {
+      if (step != 1) throw RecordingError("frame spec '" + spec + "': a step needs a range (a-b:step)");
+      a = b = ParseIndex(range, spec);
+    }
+    if (b >= frame_count) {
+      throw RecordingError("frame spec '" + spec + "': frame " + std::to_string(b) +
+                           " is beyond the recording's " + std::to_string(frame_count) + " frames (0-based)");
+    }
+    for (int i = a; i <= b; i += step) out.insert(i);
+  }
+  if (!any) throw RecordingError("frame spec is empty");
+  return {out.begin(), out.end()};
+}
+
+}  // namespace arview::recordings

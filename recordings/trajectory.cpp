@@ -1,0 +1,61 @@
+#include "recordings/trajectory.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace arview::recordings {
+
+Trajectory ReadTum(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw RecordingError(path.string() + ": cannot open trajectory file");
+  Trajectory out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream ss(line);
+    double v[8];
+    for (double& x : v) {
+      if (!(ss >> x) || !std::isfinite(x)) {
+        throw RecordingError(path.string() + ":" + std::to_string(line_no) +
+                             ": expected 'timestamp tx ty tz qx qy qz qw'");
+      }
+    }
+    const Eigen::Quaterniond q_wc(v[7], v[4], v[5], v[6]);
+    if (std::abs(q_wc.norm() - 1.0) > 1e-3) {
+      throw RecordingError(path.string() + ":" + std::to_string(line_no) +
+                           ": quaternion is not of unit length");
+    }
+    out.push_back({v[0], calib::Pose::FromCameraToWorld(q_wc, {v[1], v[2], v[3]})});
+  }
+  return out;
+}
+
+void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
+              const std::string& header_comment) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw RecordingError(path.string() + ": cannot write trajectory file here");
+    if (!header_comment.empty()) out << "# " << header_comment << "\n";
+    out << "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
+    out << std::setprecision(17);
+    for (const StampedPose& p : trajectory) {
+      const Eigen::Vector3d c = p.pose.Center();
+      const Eigen::Quaterniond q = p.pose.CameraToWorldRotation();
+      out << std::setprecision(9) << std::fixed << p.timestamp << std::defaultfloat << std::setprecision(17)
+          << ' ' << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z()
+          << ' ' << q.w() << '\n';
+    }
+    if (!out) throw RecordingError(path.string() + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw RecordingError(path.string() + ": cannot write trajectory file (" + ec.message() + ")");
+}
+
+}  // namespace arview::recordings

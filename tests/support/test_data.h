@@ -1,0 +1,48 @@
+#pragma once
+// Where tests find real data: ../shared/data beside the project (never copied into it),
+// and files from Debian packages (assimp-testmodels, opencv-doc).
+//
+// On a user's fresh machine a missing folder makes the test skip with a message naming it;
+// under ARVIEW_REQUIRE_DATA=1 (set by .ci/run) a missing folder is a failure.
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace arview::testing {
+
+inline std::filesystem::path SourceDir() {
+  if (const char* env = std::getenv("ARVIEW_SOURCE_DIR"); env && *env) return env;
+#ifdef ARVIEW_SOURCE_DIR_DEFAULT
+  return ARVIEW_SOURCE_DIR_DEFAULT;
+#else
+  return std::filesystem::current_path();
+#endif
+}
+
+// ../shared/data/<relative> seen from the project root.
+inline std::filesystem::path SharedData(const std::string& relative) {
+  return (SourceDir() / ".." / "shared" / "data" / relative).lexically_normal();
+}
+
+inline bool DataRequired() {
+  const char* env = std::getenv("ARVIEW_REQUIRE_DATA");
+  return env && std::string(env) == "1";
+}
+
+}  // namespace arview::testing
+
+// Skips (or, under ARVIEW_REQUIRE_DATA=1, fails) the current test when `path` is missing.
+// `what` says where the data comes from, e.g. "../shared/data" or "Debian package opencv-doc".
+#define ARVIEW_REQUIRE_DATA_PATH(path, what)                                              \
+  do {                                                                                    \
+    const std::filesystem::path arview_required_path_ = (path);                           \
+    if (!std::filesystem::exists(arview_required_path_)) {                                \
+      if (::arview::testing::DataRequired()) {                                            \
+        FAIL() << "missing test data " << arview_required_path_ << " (from " << (what)    \
+               << "); ARVIEW_REQUIRE_DATA=1 makes this a failure";                        \
+      } else {                                                                            \
+        GTEST_SKIP() << "needs " << arview_required_path_ << " (from " << (what) << ")";  \
+      }                                                                                   \
+    }                                                                                     \
+  } while (0)
