@@ -1,0 +1,75 @@
+#pragma once
+// Nearest-neighbour search over the map's SIFT descriptors (Map::descriptors, N x 128 CV_8U in
+// COLMAP's uint8 convention). The tracker queries it with its own frame's descriptors converted
+// the same way (L1-normalise, square root, x512, round, clamp to 255).
+//
+// The index type was chosen by measurement (docs/mapping.md, "Descriptor index"): recall of the
+// true nearest neighbour against query time on the templeRing map.
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+namespace arview::mapping {
+
+struct DescriptorIndexError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class IndexKind {
+  kLinear,  // exact brute force (the reference for recall measurements)
+  kKdTree,  // FLANN randomized kd-trees
+  kKMeans,  // FLANN hierarchical k-means tree
+};
+
+struct IndexParams {
+  IndexKind kind = IndexKind::kKdTree;
+  int trees = 4;        // kd-trees: number of randomized trees
+  int branching = 32;   // k-means: branching factor
+  int iterations = 11;  // k-means: iterations per level
+  int checks = 64;      // leaves visited per query (accuracy vs time); ignored by kLinear
+  int threads = 1;      // threads for a batch of queries (FLANN's own, needs OpenMP)
+  unsigned seed = 0;    // FLANN picks split dimensions at random; seeded for repeatable results
+};
+
+// One neighbour of a query: the row of Map::descriptors and the Euclidean (not squared)
+// distance between the two uint8 descriptors, in descriptor units (0 .. 255*sqrt(128)).
+struct Neighbor {
+  std::uint32_t row = 0;
+  float distance = 0;
+};
+
+class DescriptorIndex {
+ public:
+  DescriptorIndex();
+  ~DescriptorIndex();
+  DescriptorIndex(DescriptorIndex&&) noexcept;
+  DescriptorIndex& operator=(DescriptorIndex&&) noexcept;
+
+  // Builds the index over `descriptors` (N x 128, CV_8U, N > 0). The index keeps a reference-
+  // counted header of the matrix (no copy): do not modify the rows while the index lives.
+  // Throws DescriptorIndexError on a wrong type, shape or empty matrix.
+  explicit DescriptorIndex(const cv::Mat& descriptors, const IndexParams& params = {});
+
+  // For each row of `queries` (M x 128, CV_8U), its k nearest rows of the indexed matrix, best
+  // first. result[q] has min(k, size()) entries (fewer only if an approximate index finds fewer).
+  // Safe to call from several threads at once.
+  std::vector<std::vector<Neighbor>> Knn(const cv::Mat& queries, int k) const;
+
+  // The same for one descriptor (a 1 x 128 CV_8U row or 128 contiguous bytes).
+  std::vector<Neighbor> Knn(const std::uint8_t* descriptor, int k) const;
+
+  std::size_t size() const;
+  bool empty() const { return size() == 0; }
+  const IndexParams& params() const { return params_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  IndexParams params_;
+};
+
+}  // namespace arview::mapping
