@@ -49,6 +49,18 @@ int main(int argc, char** argv) {
   AddRunCommand(app);
   AddDemoCommand(app);
 
+  // CLI11 would report an unknown command as a missing subcommand; name it instead.
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+      known = known || sub->get_name() == argv[1];
+    }
+    if (!known) {
+      std::cerr << "arview: unknown command '" << argv[1] << "' (see 'arview --help' for the list)\n";
+      return 2;
+    }
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

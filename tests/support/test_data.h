@@ -34,9 +34,9 @@ inline bool DataRequired() {
 
 // Skips (or, under ARVIEW_REQUIRE_DATA=1, fails) the current test when `path` is missing.
 // `what` says where the data comes from, e.g. "../shared/data" or "Debian package opencv-doc".
-#define ARVIEW_REQUIRE_DATA_PATH(path, what)                                              \
+#define ARVIEW_REQUIRE_DATA_PATH(required_path, what)                                              \
   do {                                                                                    \
-    const std::filesystem::path arview_required_path_ = (path);                           \
+    const std::filesystem::path arview_required_path_ = (required_path);                           \
     if (!std::filesystem::exists(arview_required_path_)) {                                \
       if (::arview::testing::DataRequired()) {                                            \
         FAIL() << "missing test data " << arview_required_path_ << " (from " << (what)    \
