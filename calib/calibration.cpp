@@ -1,0 +1,269 @@
+#include "calib/calibration.h"
+
+#include <glob.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace arview::calib {
+
+std::vector<std::string> ExpandImageGlob(const std::string& pattern) {
+  glob_t g{};
+  const int rc = ::glob(pattern.c_str(), GLOB_ERR, nullptr, &g);
+  std::vector<std::string> files;
+  if (rc == 0) {
+    for (size_t i = 0; i < g.gl_pathc; ++i) files.emplace_back(g.gl_pathv[i]);
+  }
+  globfree(&g);
+  if (files.empty()) throw CalibrationError("--images '" + pattern + "' matches no file");
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+namespace {
+
+struct Detection {
+  std::vector<cv::Point2f> image_points;
+  std::vector<cv::Point3f> object_points;
+};
+
+cv::Ptr<cv::aruco::Dictionary> CharucoDictionary(const std::string& name) {
+  static const std::map<std::string, int> kNames = {
+      {"DICT_4X4_50", cv::aruco::DICT_4X4_50},     {"DICT_4X4_100", cv::aruco::DICT_4X4_100},
+      {"DICT_5X5_50", cv::aruco::DICT_5X5_50},     {"DICT_5X5_100", cv::aruco::DICT_5X5_100},
+      {"DICT_5X5_250", cv::aruco::DICT_5X5_250},   {"DICT_6X6_50", cv::aruco::DICT_6X6_50},
+      {"DICT_6X6_250", cv::aruco::DICT_6X6_250},   {"DICT_7X7_100", cv::aruco::DICT_7X7_100},
+      {"DICT_ARUCO_ORIGINAL", cv::aruco::DICT_ARUCO_ORIGINAL},
+  };
+  const auto it = kNames.find(name);
+  if (it == kNames.end()) throw CalibrationError("unknown ChArUco dictionary '" + name + "'");
+  return cv::aruco::getPredefinedDictionary(static_cast<cv::aruco::PREDEFINED_DICTIONARY_NAME>(it->second));
+}
+
+cv::Ptr<cv::aruco::CharucoBoard> MakeCharucoBoard(const CalibrationOptions& o) {
+  const double marker = o.marker_size > 0 ? o.marker_size : 0.7 * o.square_size;
+  return cv::aruco::CharucoBoard::create(o.board.width, o.board.height, static_cast<float>(o.square_size),
+                                         static_cast<float>(marker), CharucoDictionary(o.charuco_dictionary));
+}
+
+bool DetectChessboard(const cv::Mat& gray, const CalibrationOptions& o, Detection* d) {
+  std::vector<cv::Point2f> corners;
+  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+  if (!cv::findChessboardCorners(gray, o.board, corners, flags)) return false;
+  cv::cornerSubPix(gray, corners, cv::Size(11, 11), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+  d->image_points = corners;
+  for (int y = 0; y < o.board.height; ++y) {
+    for (int x = 0; x < o.board.width; ++x) {
+      d->object_points.emplace_back(static_cast<float>(x * o.square_size), static_cast<float>(y * o.square_size), 0.f);
+    }
+  }
+  return true;
+}
+
+bool DetectCharuco(const cv::Mat& gray, const cv::Ptr<cv::aruco::CharucoBoard>& board, Detection* d) {
+  std::vector<std::vector<cv::Point2f>> marker_corners;
+  std::vector<int> marker_ids;
+  cv::aruco::detectMarkers(gray, board->dictionary, marker_corners, marker_ids);
+  if (marker_ids.size() < 4) return false;
+  std::vector<cv::Point2f> corners;
+  std::vector<int> ids;
+  const int n = cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, gray, board, corners, ids);
+  // Fewer than 6 corners cannot constrain a homography robustly.
+  if (n < 6) return false;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    d->image_points.push_back(corners[i]);
+    d->object_points.push_back(board->chessboardCorners[ids[i]]);
+  }
+  return true;
+}
+
+double ViewRms(const Detection& d, const cv::Mat& K, const cv::Mat& dist, const cv::Mat& rvec, const cv::Mat& tvec) {
+  std::vector<cv::Point2f> projected;
+  cv::projectPoints(d.object_points, rvec, tvec, K, dist, projected);
+  double sum = 0;
+  for (size_t i = 0; i < projected.size(); ++i) {
+    const cv::Point2f e = projected[i] - d.image_points[i];
+    sum += e.dot(e);
+  }
+  return std::sqrt(sum / projected.size());
+}
+
+struct PassResult {
+  double rms = 0;
+  cv::Mat K, dist;
+  std::vector<double> view_rms;
+};
+
+PassResult CalibratePass(const std::vector<const Detection*>& views, cv::Size image_size) {
+  std::vector<std::vector<cv::Point3f>> object;
+  std::vector<std::vector<cv::Point2f>> image;
+  for (const Detection* d : views) {
+    object.push_back(d->object_points);
+    image.push_back(d->image_points);
+  }
+  PassResult r;
+  std::vector<cv::Mat> rvecs, tvecs;
+  r.rms = cv::calibrateCamera(object, image, image_size, r.K, r.dist, rvecs, tvecs);
+  for (size_t i = 0; i < views.size(); ++i) r.view_rms.push_back(ViewRms(*views[i], r.K, r.dist, rvecs[i], tvecs[i]));
+  return r;
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const CalibrationOptions& o,
+                            const std::function<void(int, int)>& progress) {
+  if (o.board.width < 2 || o.board.height < 2) throw CalibrationError("board must have at least 2x2 corners");
+  if (!(o.square_size > 0)) throw CalibrationError("square size must be positive");
+  cv::Ptr<cv::aruco::CharucoBoard> charuco;
+  if (o.kind == BoardKind::kCharuco) charuco = MakeCharucoBoard(o);
+
+  CalibrationResult result;
+  std::vector<Detection> detections(image_paths.size());
+  cv::Size image_size;
+  std::string size_source;
+  for (size_t i = 0; i < image_paths.size(); ++i) {
+    if (progress) progress(static_cast<int>(i) + 1, static_cast<int>(image_paths.size()));
+    ViewReport view;
+    view.path = image_paths[i];
+    const cv::Mat gray = cv::imread(image_paths[i], cv::IMREAD_GRAYSCALE);
+    if (gray.empty()) throw CalibrationError(image_paths[i] + ": cannot be read as an image");
+    if (image_size.empty()) {
+      image_size = gray.size();
+      size_source = image_paths[i];
+    } else if (gray.size() != image_size) {
+      throw CalibrationError(image_paths[i] + ": image is " + std::to_string(gray.cols) + "x" +
+                             std::to_string(gray.rows) + " but " + size_source + " is " +
+                             std::to_string(image_size.width) + "x" + std::to_string(image_size.height) +
+                             "; all calibration images must come from one camera at one size");
+    }
+    view.board_found = charuco ? DetectCharuco(gray, charuco, &detections[i]) : DetectChessboard(gray, o, &detections[i]);
+    view.corners = static_cast<int>(detections[i].image_points.size());
+    if (!view.board_found) ++result.views_without_board;
+    result.views.push_back(view);
+  }
+
+  std::vector<size_t> used;
+  for (size_t i = 0; i < detections.size(); ++i) {
+    if (result.views[i].board_found) used.push_back(i);
+  }
+  auto too_few = [&](const std::string& why) {
+    return CalibrationError("only " + std::to_string(used.size()) + " usable view(s) of " +
+                            std::to_string(image_paths.size()) + " image(s) " + why + "; at least " +
+                            std::to_string(o.min_views) + " are needed");
+  };
+  if (static_cast<int>(used.size()) < o.min_views) {
+    throw too_few(used.empty() ? "(no board found: check --board, which counts inner corners)" : "");
+  }
+
+  auto run = [&](const std::vector<size_t>& indices) {
+    std::vector<const Detection*> views;
+    for (size_t i : indices) views.push_back(&detections[i]);
+    return CalibratePass(views, image_size);
+  };
+  PassResult pass = run(used);
+  const double threshold = std::max(o.reject_factor * Median(pass.view_rms), o.reject_floor_px);
+  std::vector<size_t> kept;
+  for (size_t k = 0; k < used.size(); ++k) {
+    result.views[used[k]].rms = pass.view_rms[k];
+    if (pass.view_rms[k] > threshold) {
+      result.views[used[k]].rejected = true;
+      ++result.views_rejected;
+    } else {
+      kept.push_back(used[k]);
+    }
+  }
+  if (kept.size() != used.size()) {
+    used = kept;
+    if (static_cast<int>(used.size()) < o.min_views) throw too_few("after rejecting outlier views");
+    pass = run(used);
+    for (size_t k = 0; k < used.size(); ++k) result.views[used[k]].rms = pass.view_rms[k];
+  }
+
+  Camera& c = result.camera;
+  c.width = image_size.width;
+  c.height = image_size.height;
+  c.fx = pass.K.at<double>(0, 0);
+  c.fy = pass.K.at<double>(1, 1);
+  c.cx = pass.K.at<double>(0, 2);
+  c.cy = pass.K.at<double>(1, 2);
+  for (int i = 0; i < 5; ++i) c.dist[i] = pass.dist.at<double>(i);
+  c.Validate("calibration result");
+  result.rms = pass.rms;
+  result.views_used = static_cast<int>(used.size());
+
+  const int gx = o.coverage_grid, gy = std::max(1, o.coverage_grid * 3 / 4);
+  std::vector<char> cells(gx * gy, 0);
+  for (size_t i : used) {
+    result.used_corners.push_back(detections[i].image_points);
+    for (const cv::Point2f& p : detections[i].image_points) {
+      const int cxi = std::clamp(static_cast<int>(p.x / image_size.width * gx), 0, gx - 1);
+      const int cyi = std::clamp(static_cast<int>(p.y / image_size.height * gy), 0, gy - 1);
+      cells[cyi * gx + cxi] = 1;
+    }
+  }
+  result.coverage = static_cast<double>(std::count(cells.begin(), cells.end(), 1)) / cells.size();
+  return result;
+}
+
+cv::Mat DrawCalibrationReport(const CalibrationResult& r) {
+  const int w = r.camera.width, h = r.camera.height;
+  cv::Mat left(h, w, CV_8UC3, cv::Scalar(30, 30, 30));
+  for (size_t v = 0; v < r.used_corners.size(); ++v) {
+    cv::Mat hsv(1, 1, CV_8UC3, cv::Scalar(static_cast<int>(180.0 * v / std::max<size_t>(1, r.used_corners.size())), 220, 255));
+    cv::Mat bgr;
+    cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+    const cv::Vec3b c = bgr.at<cv::Vec3b>(0, 0);
+    for (const cv::Point2f& p : r.used_corners[v]) cv::circle(left, p, 3, cv::Scalar(c[0], c[1], c[2]), cv::FILLED, cv::LINE_AA);
+  }
+  cv::putText(left, cv::format("corner coverage %.0f%%", 100 * r.coverage), {10, 25}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
+              {255, 255, 255}, 1, cv::LINE_AA);
+
+  cv::Mat right(h, w, CV_8UC3, cv::Scalar(255, 255, 255));
+  double max_rms = 0.5;
+  for (const ViewReport& v : r.views) max_rms = std::max(max_rms, v.rms);
+  const int n = static_cast<int>(r.views.size());
+  const int margin = 40, plot_h = h - 2 * margin;
+  const double bar_w = static_cast<double>(w - 2 * margin) / std::max(1, n);
+  for (int i = 0; i < n; ++i) {
+    const ViewReport& v = r.views[i];
+    const int x0 = margin + static_cast<int>(i * bar_w) + 1, x1 = margin + static_cast<int>((i + 1) * bar_w) - 1;
+    if (!v.board_found) {
+      cv::putText(right, "x", {x0, h - margin - 4}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {128, 128, 128});
+      continue;
+    }
+    const int top = h - margin - static_cast<int>(plot_h * v.rms / max_rms);
+    cv::rectangle(right, {x0, top}, {x1, h - margin}, v.rejected ? cv::Scalar(40, 40, 220) : cv::Scalar(180, 120, 40),
+                  cv::FILLED);
+  }
+  const int mean_y = h - margin - static_cast<int>(plot_h * r.rms / max_rms);
+  cv::line(right, {margin, mean_y}, {w - margin, mean_y}, {0, 160, 0}, 1, cv::LINE_AA);
+  cv::putText(right, cv::format("per-view RMS (px), overall %.3f; red = rejected, x = no board", r.rms), {10, 25},
+              cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0}, 1, cv::LINE_AA);
+  cv::putText(right, cv::format("%.2f", max_rms), {2, margin + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.4, {0, 0, 0});
+  cv::Mat out;
+  cv::hconcat(left, right, out);
+  return out;
+}
+
+cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square) {
+  const auto board = MakeCharucoBoard(options);
+  cv::Mat image;
+  board->draw(cv::Size(options.board.width * pixels_per_square, options.board.height * pixels_per_square), image,
+              pixels_per_square / 2);
+  return image;
+}
+
+}  // namespace arview::calib
