@@ -1,0 +1,77 @@
+#pragma once
+// The pose solver on 2D-3D correspondences: bearings from the calibrated camera, OpenGV RANSAC
+// (P3P KNEIP / GAO or EPnP), Ceres refinement on the inliers, then verification. A pose is
+// returned only when it was verified; otherwise the failure says why.
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "calib/camera.h"
+#include "calib/pose.h"
+#include "tracker/ransac_p3p.h"
+#include "tracker/refine_pose.h"
+
+namespace arview::tracker {
+
+struct AbsolutePoseOptions {
+  MinimalSolver solver = MinimalSolver::kKneip;
+  double ransac_threshold_px = 4.0;  // converted to OpenGV's 1 − cos(angle) with the mean focal
+  int ransac_max_iterations = 1000;
+  double ransac_success_probability = 0.999;
+  std::uint32_t seed = 0;
+  bool refine = true;
+  RefineOptions refinement;
+  // After refinement, a correspondence is an inlier when its reprojection error is below this.
+  double inlier_threshold_px = 4.0;
+  // Acceptance: a pose is reported only with at least this many inliers and an inlier RMS
+  // below max_rms_px.
+  int min_inliers = 12;
+  double max_rms_px = 2.5;
+  // Inlier world points whose second principal extent is below this fraction of the first lie
+  // on a line: rotation about that line is unobservable.
+  double min_collinearity_ratio = 0.02;
+};
+
+enum class PoseFailure {
+  kNone,
+  kTooFewCorrespondences,
+  kRansacFailed,
+  kTooFewInliers,
+  kDegenerate,
+  kRefinementFailed,
+  kRmsTooHigh,
+};
+const char* PoseFailureName(PoseFailure failure);
+
+struct AbsolutePoseStats {
+  int correspondences = 0;
+  int ransac_iterations = 0;
+  int ransac_inliers = 0;
+  int refine_iterations = 0;
+  int inliers = 0;          // final, after refinement
+  double rms_px = 0;        // over the final inliers
+  double ransac_ms = 0;
+  double refine_ms = 0;
+};
+
+struct AbsolutePoseResult {
+  bool ok = false;
+  PoseFailure failure = PoseFailure::kNone;
+  std::string reason;          // human-readable when !ok
+  calib::Pose pose;            // world → camera; meaningful only when ok
+  std::vector<int> inliers;    // indices into the input correspondences
+  AbsolutePoseStats stats;
+};
+
+// pixels: distorted pixels (OpenCV convention); points: world points, same order.
+AbsolutePoseResult EstimateAbsolutePose(const calib::Camera& camera,
+                                        const std::vector<Eigen::Vector2d>& pixels,
+                                        const std::vector<Eigen::Vector3d>& points,
+                                        const AbsolutePoseOptions& options);
+
+// Second / first principal standard deviation of a point set (0 for fewer than two points).
+double CollinearityRatio(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& subset);
+
+}  // namespace arview::tracker
