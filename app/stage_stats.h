@@ -1,0 +1,48 @@
+#pragma once
+// Per-stage timings of the real-time pipeline: each stage records how long it took for each
+// frame; the summary gives the median and 95th percentile that stats.json and the console show.
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace arview::app {
+
+struct TimingSummary {
+  size_t count = 0;
+  double median_ms = 0;
+  double p95_ms = 0;
+  double mean_ms = 0;
+  double max_ms = 0;
+};
+
+TimingSummary Summarize(std::vector<double> samples_ms);
+
+// Thread-safe: stages running on different threads record into one object.
+class StageStats {
+ public:
+  void Record(const std::string& stage, double ms);
+  std::map<std::string, TimingSummary> Summaries() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<double>> samples_;
+};
+
+class ScopedStageTimer {
+ public:
+  ScopedStageTimer(StageStats& stats, std::string stage)
+      : stats_(stats), stage_(std::move(stage)), start_(std::chrono::steady_clock::now()) {}
+  ~ScopedStageTimer() {
+    stats_.Record(stage_, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count());
+  }
+
+ private:
+  StageStats& stats_;
+  std::string stage_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace arview::app

@@ -1,0 +1,84 @@
+// The command line as a user meets it: help, unknown commands, bad values, calibration.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+
+#include "tests/support/run_command.h"
+#include "tests/support/test_data.h"
+
+namespace arview {
+namespace {
+
+using testing::LineCount;
+using testing::RunArview;
+
+const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "map", "track", "eval",
+                              "anim", "place", "render", "replay", "run", "demo"};
+
+TEST(Cli, HelpListsEverySubcommand) {
+  const auto r = RunArview({"--help"});
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* sub : kSubcommands) EXPECT_NE(r.out.find(std::string("  ") + sub + " "), std::string::npos) << sub;
+}
+
+TEST(Cli, EverySubcommandHasHelp) {
+  for (const char* sub : kSubcommands) {
+    const auto r = RunArview({sub, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << sub;
+    EXPECT_NE(r.out.find("--help"), std::string::npos) << sub;
+  }
+}
+
+TEST(Cli, UnknownCommandIsOneClearLine) {
+  const auto r = RunArview({"frobnicate"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("unknown command 'frobnicate'"), std::string::npos) << r.err;
+}
+
+TEST(Cli, CalibrateHelpDocumentsDefaults) {
+  const auto r = RunArview({"calibrate", "--help"});
+  EXPECT_NE(r.out.find("--board"), std::string::npos);
+  EXPECT_NE(r.out.find("9x6"), std::string::npos);
+  EXPECT_NE(r.out.find("0.025"), std::string::npos);
+}
+
+TEST(Cli, CalibrateBadInputsAreOneClearLine) {
+  const std::string out = (std::filesystem::temp_directory_path() / "arview_cli_cam.yaml").string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  } cases[] = {
+      {{"calibrate", "--images", "/nonexistent/*.jpg", "--out", out}, "matches no file"},
+      {{"calibrate", "--images", "/tmp/*.jpg", "--board", "nine", "--out", out}, "must look like 9x6"},
+      {{"calibrate", "--images", "/tmp/*.jpg", "--square", "-1", "--out", out}, "--square"},
+      {{"calibrate", "--images", "/tmp/*.jpg", "--out", "/nonexistent/dir/cam.yaml"}, "does not exist"},
+      {{"calibrate", "--out", out}, "--images is required"},
+  };
+  for (const Case& c : cases) {
+    const auto r = RunArview(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.message;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
+}
+
+TEST(Cli, CalibrateOnOpenCvPhotos) {
+  ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+  const auto dir = std::filesystem::temp_directory_path() / ("arview_cli_calib_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto r = RunArview({"calibrate", "--images", "/usr/share/doc/opencv-doc/examples/data/left[0-9]*.jpg",
+                            "--out", (dir / "camera.yaml").string(), "--report", (dir / "report.png").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(RMS reprojection error\s+([0-9.]+) px)"))) << r.out;
+  EXPECT_LE(std::stod(m[1]), 0.45);
+  EXPECT_TRUE(std::filesystem::exists(dir / "camera.yaml"));
+  EXPECT_GT(std::filesystem::file_size(dir / "report.png"), 1000u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
