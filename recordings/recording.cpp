@@ -28,11 +28,9 @@ cv::Mat Recording::ReadImage(size_t index) const {
   return image;
 }
 
-namespace {
-
-std::vector<FrameEntry> ReadFramesTxt(const fs::path& file) {
+std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) throw RecordingError(file.string() + ": missing (every recording needs frames.txt)");
+  if (!in) throw RecordingError(file.string() + ": cannot open");
   std::vector<FrameEntry> frames;
   std::string line;
   int line_no = 0;
@@ -60,8 +58,6 @@ std::vector<FrameEntry> ReadFramesTxt(const fs::path& file) {
   return frames;
 }
 
-}  // namespace
-
 Recording LoadRecording(const fs::path& root) {
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw RecordingError(root.string() + ": recording folder does not exist");
@@ -74,7 +70,10 @@ Recording LoadRecording(const fs::path& root) {
   } catch (const calib::CameraError& e) {
     throw RecordingError(e.what());
   }
-  r.frames = ReadFramesTxt(root / "frames.txt");
+  if (!fs::exists(root / "frames.txt", ec)) {
+    throw RecordingError((root / "frames.txt").string() + ": missing (every recording needs frames.txt)");
+  }
+  r.frames = ReadFrameList(root / "frames.txt");
   std::set<std::string> checked;
   for (const FrameEntry& f : r.frames) {
     if (!checked.insert(f.path).second) continue;

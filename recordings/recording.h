@@ -38,6 +38,10 @@ struct Recording {
 // increasing, every file present), groundtruth.txt when present.
 Recording LoadRecording(const std::filesystem::path& root);
 
+// Reads a "timestamp path" list (frames.txt, TUM's rgb.txt): '#' comments and blank lines
+// skipped, timestamps strictly increasing; throws RecordingError naming file and line.
+std::vector<FrameEntry> ReadFrameList(const std::filesystem::path& file);
+
 // Writes frames.txt atomically (a temporary file renamed into place).
 void WriteFramesTxt(const std::filesystem::path& root, const std::vector<FrameEntry>& frames);
 
