@@ -1,0 +1,129 @@
+#pragma once
+// A skinned, animated character loaded from a file through Assimp (glTF 2.0 .glb/.gltf, FBX,
+// Collada .dae, DirectX .X, BVH), in the asset's own units and axes ("model space").
+//
+//   Character c = LoadCharacter("Fox.glb");          // throws anim::Error naming the file
+//   c.skeleton.parents[j]      parent joint (−1 for a root); parents come before children
+//   c.skeleton.inverse_bind[j] model space → joint j's space at bind time
+//   c.meshes[i].positions / normals / uvs / indices (triangles) / joints / weights (≤ 4, sum 1)
+//   c.materials[c.meshes[i].material].base_color and .texture (index into c.textures, or −1)
+//   c.textures[k]: .path (a file), or .encoded bytes (png/jpg, decode them), or raw .rgba
+//   c.clips[n].name, .duration (seconds)
+//
+// Skinning (see pose.h for the jobs that compute it every frame):
+//   skin_j = model_j · inverse_bind_j, where model_j is joint j's model-space transform;
+//   v_model = Σ_i weights[i] · skin_{joints[i]} · v_mesh.
+// In the rest pose every mesh's skinned vertices equal its rest vertices in model space (the
+// importer bakes each mesh's node transform into its vertices so that this holds).
+// Meshes without bones are bound rigidly (weight 1) to their nearest joint ancestor.
+// BVH files carry no skin: their Character has a skeleton and clips and no meshes.
+
+#include "anim/dual_quat.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace arview::anim {
+
+// Every failure in anim/ (bad file, bad scene, bad argument) throws this, with a message that
+// names the file and the problem.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Local transform of a joint relative to its parent: M = T · R · S (glTF order).
+struct Transform {
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+
+  Eigen::Matrix4d ToMatrix() const;
+  DualQuatd Rigid() const { return DualQuatd::FromRotationTranslation(rotation, translation); }
+  // Decomposes an affine matrix (positive scale assumed; a reflection goes into scale.z).
+  static Transform FromMatrix(const Eigen::Matrix4d& m);
+};
+
+struct Skeleton {
+  std::vector<std::string> names;
+  std::vector<int> parents;                    // parents[j] < j; −1 for roots
+  std::vector<Transform> rest;                 // local rest pose
+  std::vector<Eigen::Matrix4d> inverse_bind;   // model space → joint space, at bind
+  // Fixed transform of the node above the skeleton's roots, in model space (often identity);
+  // model_root = root_parent · local_root.
+  Eigen::Matrix4d root_parent = Eigen::Matrix4d::Identity();
+
+  int size() const { return static_cast<int>(names.size()); }
+  // −1 when absent. Exact name match.
+  int Find(const std::string& name) const;
+};
+
+template <class V>
+struct Key {
+  double time = 0;  // seconds
+  V value;
+};
+
+// One joint's animation. An empty list means "the rest value" for that component.
+struct JointTrack {
+  std::vector<Key<Eigen::Vector3d>> translation;
+  std::vector<Key<Eigen::Quaterniond>> rotation;
+  std::vector<Key<Eigen::Vector3d>> scale;
+};
+
+struct Clip {
+  std::string name;
+  double duration = 0;           // seconds
+  double ticks_per_second = 0;   // from the file (e.g. 120 for CMU BVH); 0 if it gave none
+  std::vector<JointTrack> tracks;  // one per skeleton joint
+};
+
+struct Texture {
+  std::string path;                 // an image file (absolute), or empty
+  std::vector<std::uint8_t> encoded;  // or the bytes of a compressed image (png, jpg, ...)
+  std::string format_hint;          // "png", "jpg", ... for `encoded`
+  int width = 0, height = 0;        // or raw pixels:
+  std::vector<std::uint8_t> rgba;   // width·height·4 bytes, row-major, top row first
+};
+
+struct Material {
+  std::string name;
+  Eigen::Vector4f base_color = Eigen::Vector4f::Ones();  // linear RGBA factor
+  int texture = -1;  // base-colour texture: index into Character::textures, −1 if none
+};
+
+struct Mesh {
+  std::string name;
+  std::vector<Eigen::Vector3f> positions;  // model space, rest pose
+  std::vector<Eigen::Vector3f> normals;    // unit, same count
+  std::vector<Eigen::Vector2f> uvs;        // empty when the mesh has none
+  std::vector<std::uint32_t> indices;      // triangles, counter-clockwise front faces
+  std::vector<std::array<std::uint16_t, 4>> joints;  // skeleton joint indices per vertex
+  std::vector<Eigen::Vector4f> weights;    // matching weights, sum 1 (unused slots 0)
+  int material = -1;                       // index into Character::materials
+  int vertex_count() const { return static_cast<int>(positions.size()); }
+};
+
+struct Character {
+  std::string source;  // the file it came from
+  Skeleton skeleton;
+  std::vector<Clip> clips;
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+
+  // nullptr when absent.
+  const Clip* FindClip(const std::string& name) const;
+};
+
+// Loads a character. Throws Error (naming the file) when the file is missing or unreadable,
+// Assimp cannot parse it, or it has no skeleton (no bones and no animated nodes).
+Character LoadCharacter(const std::filesystem::path& path);
+
+}  // namespace arview::anim

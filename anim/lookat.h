@@ -1,0 +1,46 @@
+#pragma once
+// Authoring of key animations that look toward a viewpoint (the animator's work in the paper,
+// automated): from a base clip, a chain of joints (spine → neck → head) turns so that the head's
+// forward axis points along the key viewpoint, the rotation spread along the chain, each joint
+// limited to its own angle.
+//
+//   LookAtChain chain = MakeLookAtChain(character.skeleton, {}, {}, forward);   // defaults by name
+//   Clip key = GenerateLookAtClip(character.skeleton, base_clip, chain, viewpoint);
+//   Eigen::Vector3d f = HeadForward(chain, model_pose);   // for checks
+
+#include "anim/character.h"
+
+#include <span>
+#include <string>
+#include <vector>
+
+namespace arview::anim {
+
+struct LookAtChain {
+  std::vector<int> joints;              // root-most first; the last is the head
+  std::vector<double> limits_rad;       // per joint, > 0
+  Eigen::Vector3d head_forward_local = Eigen::Vector3d::UnitZ();  // in the head joint's frame
+};
+
+// Names of a spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH, Fox,
+// BCN_Epileptic, CesiumMan, Unreal/Unity humanoids). Empty when no head-like joint exists.
+std::vector<std::string> DefaultLookAtChain(const Skeleton& skeleton);
+
+// Builds the chain. Empty `names` uses DefaultLookAtChain(); empty `limits_deg` uses 45° per
+// spine joint, 50° for the neck (the joint before the head) and 70° for the head. The head's
+// forward axis is the model-space `forward` at rest, expressed in the head's frame.
+// Throws Error when a name is missing, the joints do not form one parent chain, or the
+// counts differ.
+LookAtChain MakeLookAtChain(const Skeleton& skeleton, const std::vector<std::string>& names,
+                            const std::vector<double>& limits_deg, const Eigen::Vector3d& forward);
+
+// The base clip with the chain turned toward `viewpoint` (character frame) at every key time of
+// the base clip (resampled at `sample_rate` Hz where the chain's parents move between keys).
+// `base` may be nullptr: the result is a static look from the rest pose.
+Clip GenerateLookAtClip(const Skeleton& skeleton, const Clip* base, const LookAtChain& chain,
+                        const Eigen::Vector3d& viewpoint, double sample_rate = 30.0);
+
+// The head's forward axis in model space for a pose given as model-space joint matrices.
+Eigen::Vector3d HeadForward(const LookAtChain& chain, std::span<const Eigen::Matrix4d> model);
+
+}  // namespace arview::anim

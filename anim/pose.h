@@ -1,0 +1,112 @@
+#pragma once
+// Per-frame animation jobs in ozz-animation's style: a plain struct of inputs and outputs,
+// Validate() says whether they fit together, Run() validates then computes and returns false on
+// invalid input. Jobs never allocate: outputs are sized by the caller (LocalPose::Resize once).
+//
+//   LocalPose pose(skeleton.size());
+//   SamplingJob{&skeleton, &clip, time, /*loop=*/true, &pose}.Run();
+//   std::vector<Eigen::Matrix4d> model(skeleton.size());
+//   LocalToModelJob{&skeleton, &pose, model}.Run();
+//   std::vector<Eigen::Matrix4f> skin(skeleton.size());
+//   std::vector<DualQuatf> skin_dq(skeleton.size());
+//   SkinningMatricesJob{&skeleton, model, skin, skin_dq}.Run();   // upload to the GPU
+//
+// A pose is, per joint, the local rigid transform as a unit dual quaternion plus a scale
+// (applied first, M = T·R·S); blending (BlendingJob) works on the dual quaternions and blends
+// scales linearly.
+
+#include "anim/blend.h"
+#include "anim/character.h"
+
+#include <span>
+#include <vector>
+
+namespace arview::anim {
+
+struct LocalPose {
+  std::vector<DualQuatd> rigid;
+  std::vector<Eigen::Vector3d> scale;
+
+  LocalPose() = default;
+  explicit LocalPose(int joints) { Resize(joints); }
+  void Resize(int joints);
+  int size() const { return static_cast<int>(rigid.size()); }
+  // The skeleton's rest pose.
+  static LocalPose Rest(const Skeleton& skeleton);
+};
+
+// Samples `clip` at `time` seconds: linear translation and scale, slerp rotation between keys.
+// `loop` wraps time into [0, duration); otherwise it is clamped.
+struct SamplingJob {
+  const Skeleton* skeleton = nullptr;
+  const Clip* clip = nullptr;
+  double time = 0;
+  bool loop = true;
+  LocalPose* output = nullptr;
+
+  bool Validate() const;
+  bool Run() const;
+};
+
+enum class BlendMethod { kDlb, kDib };
+
+// Blends K poses joint by joint with the given convex weights (Eq. 3). At most kMaxInputs.
+struct BlendingJob {
+  static constexpr int kMaxInputs = 64;
+  std::span<const LocalPose* const> inputs;
+  std::span<const double> weights;
+  BlendMethod method = BlendMethod::kDlb;
+  DibOptions<double> dib;
+  LocalPose* output = nullptr;
+  // Filled when not null: for DIB, whether every joint converged and the most iterations any
+  // joint took.
+  bool* converged = nullptr;
+  int* max_iterations = nullptr;
+
+  bool Validate() const;
+  bool Run() const;
+};
+
+// Local poses → model-space matrices (root_parent · … · parent · local).
+struct LocalToModelJob {
+  const Skeleton* skeleton = nullptr;
+  const LocalPose* input = nullptr;
+  std::span<Eigen::Matrix4d> output;
+
+  bool Validate() const;
+  bool Run() const;
+};
+
+// Model-space joint matrices → skinning matrices (model · inverse_bind), as float matrices and,
+// when `dual_quats` is not empty, as dual quaternions of their rigid part (for DQ skinning; a
+// non-rigid skinning matrix loses its scale there: see RigidSkinning()).
+struct SkinningMatricesJob {
+  const Skeleton* skeleton = nullptr;
+  std::span<const Eigen::Matrix4d> model;
+  std::span<Eigen::Matrix4f> matrices;
+  std::span<DualQuatf> dual_quats;
+
+  bool Validate() const;
+  bool Run() const;
+};
+
+// Whether every skinning matrix is rigid (rotation + translation) to `tolerance`; DQ skinning
+// is exact only then.
+bool RigidSkinning(std::span<const Eigen::Matrix4f> matrices, float tolerance = 1e-3f);
+
+// CPU skinning of one mesh (Kavan et al. 2007 for DQS). Outputs have mesh.vertex_count()
+// entries; `normals_out` may be empty.
+enum class SkinningMethod { kLinear, kDualQuaternion };
+struct SkinningJob {
+  const Mesh* mesh = nullptr;
+  SkinningMethod method = SkinningMethod::kLinear;
+  std::span<const Eigen::Matrix4f> matrices;  // for kLinear
+  std::span<const DualQuatf> dual_quats;      // for kDualQuaternion
+  std::span<Eigen::Vector3f> positions_out;
+  std::span<Eigen::Vector3f> normals_out;
+
+  bool Validate() const;
+  bool Run() const;
+};
+
+}  // namespace arview::anim

@@ -1,0 +1,165 @@
+#pragma once
+// Scene files (YAML) describing view-adaptive characters, and the runtime that animates one.
+//
+// For render/ and app/:
+//
+//   Scene scene = LoadScene("scene.yaml");               // throws anim::Error (file:line: why)
+//   const CharacterSpec& spec = scene.characters[0];
+//   AnimatedCharacter fox(spec);                          // loads the asset, builds key clips
+//   const Character& c = fox.character();                 // meshes, materials, skeleton
+//   Eigen::Matrix4d model_to_map = spec.ModelToMap();     // place it in the map
+//   // every frame, with C the camera centre in map coordinates (C = −Rᵀt):
+//   Eigen::Vector3d v = spec.ViewpointFromCamera(C);      // direction in the character's frame
+//   const FrameOutput& out = fox.Update(v, time_seconds); // no allocation
+//   out.skinning_matrices[j] (Matrix4f, model space) or out.skinning_dual_quats[j] → shader;
+//   v_map = model_to_map · Σ w_i · skinning_matrices[joint_i] · v_mesh
+//
+// The scene format (paths are relative to the scene file; angles in degrees):
+//
+//   characters:
+//     - name: fox
+//       asset: ../shared/data/characters/Fox/glTF-Binary/Fox.glb
+//       scale: 0.01                 # asset units → metres
+//       anchor:                     # character frame → map frame
+//         position: [0, 0, 0]
+//         rotation: [0, 0, 0, 1]    # quaternion x y z w (or rotation_deg: [rx, ry, rz], XYZ)
+//         scale: 1
+//       forward: [0, 0, 1]          # the character's front in model space (default +Z)
+//       up: [0, 1, 0]               # default +Y
+//       weights: {mode: inverse-distance | local, distance: geodesic | chordal, alpha: 3}
+//       blend: {method: dlb | dib, precision: 0.001, max_iterations: 32}
+//       phase: shared | independent  # key clips on one normalised phase (default) or own loops
+//       lookat:                      # for keys with `generate: lookat`
+//         base_clip: Survey
+//         chain: [b_Spine01_02, b_Spine02_03, b_Neck_04, b_Head_05]  # default: found by name
+//         limits: [45, 45, 50, 70]   # per joint, degrees (default 45 per spine joint, 50 neck, 70 head)
+//       keys:
+//         - viewpoint: [0, 0, 1]     # or azimuth: 0 with elevation: 0
+//           clip: Survey             # a clip of the asset ...
+//         - azimuth: 90
+//           generate: lookat         # ... or generated (see lookat.h) ...
+//         - azimuth: 180
+//           pose: rest               # ... or a static pose: rest, or "<clip>@<seconds>"
+//
+// Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
+
+#include "anim/character.h"
+#include "anim/lookat.h"
+#include "anim/pose.h"
+#include "anim/view_sphere.h"
+
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace arview::anim {
+
+enum class PhaseMode { kShared, kIndependent };
+
+struct Anchor {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  double scale = 1.0;
+};
+
+struct KeySpec {
+  enum class Source { kClip, kLookAt, kRestPose, kStaticPose };
+  Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // unit, character frame
+  Source source = Source::kClip;
+  std::string clip;        // kClip, kStaticPose
+  double pose_time = 0;    // kStaticPose
+  int line = 0;            // where it was written, for messages
+};
+
+struct LookAtSpec {
+  std::string base_clip;             // empty: the first clip, or the rest pose if none
+  std::vector<std::string> chain;    // empty: DefaultLookAtChain()
+  std::vector<double> limits_deg;    // empty: defaults
+};
+
+struct CharacterSpec {
+  std::string name;
+  std::filesystem::path asset;  // absolute (resolved against the scene file)
+  double scale = 1.0;
+  Anchor anchor;
+  Eigen::Vector3d forward = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  ViewSphereOptions weights;
+  BlendMethod blend = BlendMethod::kDlb;
+  DibOptions<double> dib;
+  PhaseMode phase = PhaseMode::kShared;
+  bool has_lookat = false;
+  LookAtSpec lookat;
+  std::vector<KeySpec> keys;
+
+  // model space → map: translate(position) · rotation · uniform scale (anchor.scale · scale).
+  Eigen::Matrix4d ModelToMap() const;
+  // Unit direction from the character to a camera centre given in map coordinates, in the
+  // character's frame; zero vector if the camera sits on the anchor.
+  Eigen::Vector3d ViewpointFromCamera(const Eigen::Vector3d& camera_center_map) const;
+};
+
+struct Scene {
+  std::filesystem::path file;
+  std::vector<CharacterSpec> characters;
+};
+
+// Parses and checks a scene file (not the assets: AnimatedCharacter loads those).
+Scene LoadScene(const std::filesystem::path& path);
+Scene ParseScene(const std::string& text, const std::filesystem::path& file_for_messages);
+
+struct FrameOutput {
+  std::span<const double> weights;                  // one per key
+  std::span<const Eigen::Matrix4d> model;           // joint model-space transforms
+  std::span<const Eigen::Matrix4f> skinning_matrices;
+  std::span<const DualQuatf> skinning_dual_quats;   // rigid part of skinning_matrices
+  bool converged = true;                            // DIB converged on every joint
+  int max_iterations = 0;                           // DIB, worst joint
+};
+
+class AnimatedCharacter {
+ public:
+  // Loads spec.asset and prepares one clip per key (from the asset, generated, or static).
+  // Throws Error naming the scene/asset and the problem (e.g. a clip that does not exist).
+  explicit AnimatedCharacter(const CharacterSpec& spec);
+  AnimatedCharacter(std::shared_ptr<const Character> character, const CharacterSpec& spec);
+
+  const Character& character() const { return *character_; }
+  std::shared_ptr<const Character> shared_character() const { return character_; }
+  const CharacterSpec& spec() const { return spec_; }
+  const ViewSphere& view_sphere() const { return sphere_; }
+  // One clip per key (shared between keys that name the same clip).
+  const Clip& key_clip(int key) const { return *key_clips_[key]; }
+  // The look-at chain used for generated keys (empty joints if none).
+  const LookAtChain& lookat_chain() const { return chain_; }
+
+  // Weights for `viewpoint` (character frame), then every key clip sampled at `time_seconds`,
+  // blended, and converted to skinning transforms. Valid until the next call.
+  const FrameOutput& Update(const Eigen::Vector3d& viewpoint, double time_seconds);
+
+ private:
+  void Build();
+  double KeyTime(int key, double time_seconds) const;
+
+  std::shared_ptr<const Character> character_;
+  CharacterSpec spec_;
+  ViewSphere sphere_;
+  LookAtChain chain_;
+  std::vector<std::shared_ptr<const Clip>> key_clips_;
+  double shared_period_ = 0;
+  // Per-frame buffers.
+  std::vector<double> weights_;
+  std::vector<LocalPose> key_poses_;
+  std::vector<const LocalPose*> key_pose_ptrs_;
+  std::vector<const LocalPose*> active_ptrs_;
+  std::vector<double> active_weights_;
+  LocalPose blended_;
+  std::vector<Eigen::Matrix4d> model_;
+  std::vector<Eigen::Matrix4f> skin_;
+  std::vector<DualQuatf> skin_dq_;
+  FrameOutput out_;
+};
+
+}  // namespace arview::anim
