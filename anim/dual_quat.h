@@ -138,13 +138,13 @@ class DualQuat {
     const T c = rc.w(), dw = dc.w();
     const T s = rv.norm();
     const T a = std::atan2(s, c);
-    T k, g;  // k = a/s, g = (s − a c)/s², both with series near a = 0
+    T k, g;  // k = a/s, g = (s − a c)/s³, both with series near a = 0
     if (s < SmallAngle()) {
       k = T(1) + a * a / T(6);
-      g = a / T(3);
+      g = T(1) / T(3) + a * a * T(2) / T(15);
     } else {
       k = a / s;
-      g = (s - a * c) / (s * s);
+      g = (s - a * c) / (s * s * s);
     }
     DualLog<T> l;
     l.real = k * rv;
