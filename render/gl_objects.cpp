@@ -1,0 +1,207 @@
+#include "render/gl_objects.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <vector>
+
+#include "render/offscreen.h"
+
+namespace arview::render {
+namespace {
+
+// GL_TEXTURE_MAX_ANISOTROPY: core since 4.6, same value as the EXT token llvmpipe exposes.
+constexpr GLenum kMaxAnisotropy = 0x84FE;
+constexpr GLenum kMaxAnisotropyLimit = 0x84FF;
+
+GlName CompileShader(const GlApi& gl, GLenum type, const std::string& source, const std::string& label) {
+  GlName shader(&gl, gl.CreateShader(type), [](const GlApi& g, GLuint n) { g.DeleteShader(n); });
+  const char* text = source.c_str();
+  gl.ShaderSource(shader.get(), 1, &text, nullptr);
+  gl.CompileShader(shader.get());
+  GLint ok = 0;
+  gl.GetShaderiv(shader.get(), GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    gl.GetShaderInfoLog(shader.get(), sizeof log, nullptr, log);
+    throw RenderError(label + (type == GL_VERTEX_SHADER ? " vertex" : " fragment") +
+                      " shader does not compile: " + log);
+  }
+  return shader;
+}
+
+}  // namespace
+
+GlName MakeProgram(const GlApi& gl, const std::string& label, const std::string& vertex_source,
+                   const std::string& fragment_source) {
+  GlName vs = CompileShader(gl, GL_VERTEX_SHADER, vertex_source, label);
+  GlName fs = CompileShader(gl, GL_FRAGMENT_SHADER, fragment_source, label);
+  GlName program(&gl, gl.CreateProgram(), [](const GlApi& g, GLuint n) { g.DeleteProgram(n); });
+  gl.AttachShader(program.get(), vs.get());
+  gl.AttachShader(program.get(), fs.get());
+  gl.LinkProgram(program.get());
+  GLint ok = 0;
+  gl.GetProgramiv(program.get(), GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096] = {0};
+    gl.GetProgramInfoLog(program.get(), sizeof log, nullptr, log);
+    throw RenderError(label + " program does not link: " + log);
+  }
+  return program;
+}
+
+GLint Uniform(const GlApi& gl, GLuint program, const char* name) { return gl.GetUniformLocation(program, name); }
+
+namespace {
+
+cv::Mat ToRgba(const cv::Mat& image) {
+  if (image.empty() || image.depth() != CV_8U) throw RenderError("texture image must be a non-empty 8-bit image");
+  cv::Mat rgba;
+  switch (image.channels()) {
+    case 1: cv::cvtColor(image, rgba, cv::COLOR_GRAY2RGBA); break;
+    case 3: cv::cvtColor(image, rgba, cv::COLOR_BGR2RGBA); break;
+    case 4: cv::cvtColor(image, rgba, cv::COLOR_BGRA2RGBA); break;
+    default: throw RenderError("texture image must have 1, 3 or 4 channels");
+  }
+  return rgba;
+}
+
+}  // namespace
+
+GlName MakeTexture(const GlApi& gl, const cv::Mat& image, const TextureOptions& options) {
+  const cv::Mat rgba = ToRgba(image);
+  GLuint name = 0;
+  gl.GenTextures(1, &name);
+  GlName texture(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteTextures(1, &n); });
+  gl.BindTexture(GL_TEXTURE_2D, name);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(rgba.step / 4));
+  gl.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, rgba.cols, rgba.rows, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  const GLint wrap = options.repeat ? GL_REPEAT : GL_CLAMP_TO_EDGE;
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+  gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  if (options.mipmaps) {
+    gl.GenerateMipmap(GL_TEXTURE_2D);
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    if (options.anisotropy > 1.f) {
+      GLfloat limit = 1.f;
+      gl.GetFloatv(kMaxAnisotropyLimit, &limit);
+      gl.TexParameterf(GL_TEXTURE_2D, kMaxAnisotropy, std::min(options.anisotropy, limit));
+    }
+  } else {
+    gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  }
+  CheckGl(gl, "texture upload");
+  return texture;
+}
+
+void UpdateTexture(const GlApi& gl, GLuint texture, const cv::Mat& image) {
+  const cv::Mat rgba = ToRgba(image);
+  gl.BindTexture(GL_TEXTURE_2D, texture);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(rgba.step / 4));
+  gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, rgba.cols, rgba.rows, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  CheckGl(gl, "texture update");
+}
+
+GlName MakeBuffer(const GlApi& gl, GLenum target, const void* data, size_t bytes, GLenum usage) {
+  GLuint name = 0;
+  gl.GenBuffers(1, &name);
+  GlName buffer(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteBuffers(1, &n); });
+  gl.BindBuffer(target, name);
+  gl.BufferData(target, static_cast<GLsizeiptr>(bytes), data, usage);
+  return buffer;
+}
+
+GlName MakeVertexArray(const GlApi& gl) {
+  GLuint name = 0;
+  gl.GenVertexArrays(1, &name);
+  return GlName(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteVertexArrays(1, &n); });
+}
+
+namespace {
+
+GlName MakeRenderbuffer(const GlApi& gl, GLenum format, int width, int height, int samples) {
+  GLuint name = 0;
+  gl.GenRenderbuffers(1, &name);
+  GlName rb(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteRenderbuffers(1, &n); });
+  gl.BindRenderbuffer(GL_RENDERBUFFER, name);
+  gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, format, width, height);
+  return rb;
+}
+
+GlName MakeFramebuffer(const GlApi& gl) {
+  GLuint name = 0;
+  gl.GenFramebuffers(1, &name);
+  return GlName(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteFramebuffers(1, &n); });
+}
+
+void RequireComplete(const GlApi& gl, const std::string& what) {
+  const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw RenderError(what + " framebuffer is incomplete (status " + std::to_string(status) + ")");
+  }
+}
+
+}  // namespace
+
+RenderTarget::RenderTarget(const GlApi& gl, int width, int height, int samples)
+    : gl_(&gl), width_(width), height_(height), samples_(samples) {
+  if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
+    throw RenderError("render target size " + std::to_string(width) + "x" + std::to_string(height) +
+                      " is not usable");
+  }
+  GLint max_samples = 0;
+  gl.GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  if (samples < 0 || samples > max_samples) {
+    throw RenderError(std::to_string(samples) + " samples requested; this OpenGL offers at most " +
+                      std::to_string(max_samples));
+  }
+  draw_fbo_ = MakeFramebuffer(gl);
+  color_rb_ = MakeRenderbuffer(gl, GL_RGBA8, width, height, samples);
+  depth_rb_ = MakeRenderbuffer(gl, GL_DEPTH_COMPONENT24, width, height, samples);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, draw_fbo_.get());
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_rb_.get());
+  gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb_.get());
+  RequireComplete(gl, "drawing");
+  if (samples > 1) {
+    resolve_fbo_ = MakeFramebuffer(gl);
+    resolve_rb_ = MakeRenderbuffer(gl, GL_RGBA8, width, height, 0);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, resolve_fbo_.get());
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_rb_.get());
+    RequireComplete(gl, "resolve");
+  }
+  CheckGl(gl, "render target creation");
+}
+
+void RenderTarget::Bind() const {
+  gl_->BindFramebuffer(GL_FRAMEBUFFER, draw_fbo_.get());
+  gl_->Viewport(0, 0, width_, height_);
+}
+
+cv::Mat RenderTarget::Read(GLenum format, int channels) const {
+  const GlApi& gl = *gl_;
+  GLuint source = draw_fbo_.get();
+  if (samples_ > 1) {
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, draw_fbo_.get());
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_.get());
+    gl.BlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    source = resolve_fbo_.get();
+  }
+  gl.BindFramebuffer(GL_READ_FRAMEBUFFER, source);
+  gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  cv::Mat bottom_up(height_, width_, CV_8UC(channels));
+  gl.ReadPixels(0, 0, width_, height_, format, GL_UNSIGNED_BYTE, bottom_up.data);
+  CheckGl(gl, "read-back");
+  cv::Mat image;
+  cv::flip(bottom_up, image, 0);
+  return image;
+}
+
+cv::Mat RenderTarget::ReadBgr() const { return Read(GL_BGR, 3); }
+cv::Mat RenderTarget::ReadBgra() const { return Read(GL_BGRA, 4); }
+
+}  // namespace arview::render

@@ -1,0 +1,88 @@
+#pragma once
+// Owning wrappers for the few kinds of OpenGL objects render/ uses, and the render target
+// that every drawing goes into (multisampled colour + depth, resolved and read back as an
+// OpenCV image with row 0 at the top).
+
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <utility>
+
+#include "render/gl_api.h"
+
+namespace arview::render {
+
+// A move-only GL name with its deleter.
+class GlName {
+ public:
+  using Deleter = void (*)(const GlApi&, GLuint);
+  GlName() = default;
+  GlName(const GlApi* gl, GLuint name, Deleter deleter) : gl_(gl), name_(name), deleter_(deleter) {}
+  GlName(GlName&& other) noexcept { *this = std::move(other); }
+  GlName& operator=(GlName&& other) noexcept {
+    if (this != &other) {
+      Reset();
+      std::swap(gl_, other.gl_);
+      std::swap(name_, other.name_);
+      std::swap(deleter_, other.deleter_);
+    }
+    return *this;
+  }
+  GlName(const GlName&) = delete;
+  GlName& operator=(const GlName&) = delete;
+  ~GlName() { Reset(); }
+  GLuint get() const { return name_; }
+  void Reset() {
+    if (gl_ != nullptr && name_ != 0) deleter_(*gl_, name_);
+    gl_ = nullptr;
+    name_ = 0;
+  }
+
+ private:
+  const GlApi* gl_ = nullptr;
+  GLuint name_ = 0;
+  Deleter deleter_ = nullptr;
+};
+
+// Compiles and links; throws RenderError with the driver's log naming `label`.
+GlName MakeProgram(const GlApi& gl, const std::string& label, const std::string& vertex_source,
+                   const std::string& fragment_source);
+GLint Uniform(const GlApi& gl, GLuint program, const char* name);  // -1 when optimised out
+
+struct TextureOptions {
+  bool mipmaps = true;
+  float anisotropy = 8.f;  // GL_TEXTURE_MAX_ANISOTROPY (core in 4.6, EXT on 4.5; llvmpipe has 16)
+  bool repeat = false;
+};
+// An 8-bit BGR, BGRA or grey cv::Mat as an sRGB-agnostic RGBA texture. Row 0 of the image is
+// uploaded first, so texture coordinate v = 0 is the image's top row.
+GlName MakeTexture(const GlApi& gl, const cv::Mat& image, const TextureOptions& options = {});
+// Replaces the contents of a texture made by MakeTexture with an image of the same size.
+void UpdateTexture(const GlApi& gl, GLuint texture, const cv::Mat& image);
+
+GlName MakeBuffer(const GlApi& gl, GLenum target, const void* data, size_t bytes, GLenum usage = GL_STATIC_DRAW);
+GlName MakeVertexArray(const GlApi& gl);
+
+// A framebuffer to draw into: colour RGBA8 + depth 24, multisampled when samples > 1 and
+// resolved on read-back.
+class RenderTarget {
+ public:
+  RenderTarget(const GlApi& gl, int width, int height, int samples);
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int samples() const { return samples_; }
+  // Binds the drawing framebuffer and sets the viewport.
+  void Bind() const;
+  // Resolves and reads back. Row 0 of the result is the top row of the image (OpenGL's
+  // bottom-up rows are flipped here, the one place that does so).
+  cv::Mat ReadBgr() const;   // CV_8UC3
+  cv::Mat ReadBgra() const;  // CV_8UC4, alpha = coverage
+ private:
+  cv::Mat Read(GLenum format, int channels) const;
+  const GlApi* gl_;
+  int width_, height_, samples_;
+  GlName draw_fbo_, color_rb_, depth_rb_;
+  GlName resolve_fbo_, resolve_rb_;
+};
+
+}  // namespace arview::render
