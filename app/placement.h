@@ -1,0 +1,54 @@
+#pragma once
+// Where a character stands in a map: the dominant plane of the map's points near the middle of
+// the scene (RANSAC), the character's up along the plane normal towards the cameras, facing the
+// first keyframe, scaled to the scene.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+namespace arview::app {
+
+struct PlacementError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Plane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit
+  double offset = 0;                                   // normal·x + offset = 0
+  int inliers = 0;
+  double Distance(const Eigen::Vector3d& x) const { return normal.dot(x) + offset; }
+};
+
+struct PlaneFitOptions {
+  double inlier_distance = 0;   // 0: 1% of the scene's robust extent
+  double middle_fraction = 0.5; // use the points within this fraction of the extent around the median
+  int iterations = 500;
+  std::uint64_t seed = 1;
+};
+
+// Throws PlacementError when there are fewer than 3 points or no plane holds enough of them.
+Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& options);
+
+struct Anchor {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // character frame → map frame
+  double scale = 1;
+};
+
+struct PlacementOptions {
+  PlaneFitOptions plane;
+  // The character's height as a fraction of the median distance from the cameras to the anchor.
+  double height_fraction = 0.3;
+};
+
+// Character frame convention (glTF): +Y up, +Z forward (the direction the character faces).
+// `character_height` is the height of the character's bind pose in its own units.
+Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<Eigen::Vector3d>& camera_centres, double character_height,
+                            const PlacementOptions& options);
+
+}  // namespace arview::app
