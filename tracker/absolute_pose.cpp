@@ -7,13 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tracker/timing.h"
+
 namespace arview::tracker {
 namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 AbsolutePoseResult Fail(AbsolutePoseResult result, PoseFailure failure, const std::string& reason) {
   result.ok = false;

@@ -1,0 +1,45 @@
+#pragma once
+// SIFT features of a frame with descriptors in COLMAP's uint8 convention, so that they can be
+// matched against the map's descriptors (mapping/map.h).
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+
+#include <vector>
+
+namespace arview::tracker {
+
+struct FeatureOptions {
+  int max_features = 2000;  // strongest responses kept (0 = all)
+  int octave_layers = 3;
+  double contrast_threshold = 0.04;
+  double edge_threshold = 10;
+  double sigma = 1.6;
+};
+
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;  // OpenCV pixel convention
+  cv::Mat descriptors;                  // keypoints.size() x 128, CV_8U, COLMAP convention
+};
+
+// Float SIFT descriptors (N x 128, CV_32F) to COLMAP's: L1-normalise each row, square root,
+// x512, round, clamp to 255, uint8.
+cv::Mat ToColmapDescriptors(const cv::Mat& sift);
+
+// Reuses one cv::SIFT detector across frames.
+class SiftExtractor {
+ public:
+  explicit SiftExtractor(const FeatureOptions& options = {});
+  // image: 8-bit grey or BGR. An empty or tiny image gives no features (never throws).
+  Features Extract(const cv::Mat& image) const;
+  const FeatureOptions& options() const { return options_; }
+
+ private:
+  FeatureOptions options_;
+  cv::Ptr<cv::SIFT> sift_;
+};
+
+// 8-bit single-channel view of a frame (converted when it is BGR, BGRA or 16-bit).
+cv::Mat ToGray8(const cv::Mat& image);
+
+}  // namespace arview::tracker

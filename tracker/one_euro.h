@@ -1,0 +1,32 @@
+#pragma once
+// One Euro filter (Casiez, Roussel, Vogel, CHI 2012) on a 3-vector, used to smooth the camera
+// centre that drives the character's animation. Jitter is removed at low speed (min_cutoff),
+// lag is reduced at high speed (beta). The raw pose still places the character in the image.
+
+#include <Eigen/Core>
+
+namespace arview::tracker {
+
+struct OneEuroOptions {
+  double min_cutoff_hz = 1.0;  // cutoff at rest: lower = smoother, more lag
+  double beta = 0.5;           // cutoff growth per unit of speed (units/s): higher = less lag
+  double derivative_cutoff_hz = 1.0;
+};
+
+class OneEuroFilter {
+ public:
+  explicit OneEuroFilter(const OneEuroOptions& options = {}) : options_(options) {}
+  // Time must increase; a non-increasing time restarts the filter at `x`.
+  Eigen::Vector3d Filter(const Eigen::Vector3d& x, double time_s);
+  void Reset() { initialised_ = false; }
+  const OneEuroOptions& options() const { return options_; }
+
+ private:
+  OneEuroOptions options_;
+  bool initialised_ = false;
+  double last_time_ = 0;
+  Eigen::Vector3d x_hat_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d dx_hat_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace arview::tracker

@@ -1,0 +1,89 @@
+#include "tracker/relocalizer.h"
+
+#include "tracker/timing.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace arview::tracker {
+
+std::vector<MapMatch> MatchToMap(const Features& features, const mapping::Map& map,
+                                 const mapping::DescriptorIndex& index, const MatchOptions& options) {
+  std::vector<MapMatch> matches;
+  if (features.descriptors.empty() || index.empty()) return matches;
+  const auto neighbours = index.Knn(features.descriptors, options.knn);
+  std::unordered_map<std::uint32_t, size_t> best_for_point;  // point → position in matches
+  for (size_t q = 0; q < neighbours.size(); ++q) {
+    const auto& nn = neighbours[q];
+    if (nn.empty()) continue;
+    const std::uint32_t best_point = map.descriptor_point[nn[0].row];
+    float second = std::numeric_limits<float>::infinity();
+    for (size_t j = 1; j < nn.size(); ++j) {
+      if (map.descriptor_point[nn[j].row] != best_point) {
+        second = nn[j].distance;
+        break;
+      }
+    }
+    // With fewer than k distinct points in reach, the last neighbour bounds the second best.
+    if (!std::isfinite(second) && nn.size() == static_cast<size_t>(options.knn))
+      second = nn.back().distance;
+    if (std::isfinite(second) && nn[0].distance > options.ratio * second) continue;
+    const MapMatch match{static_cast<int>(q), best_point, nn[0].distance};
+    auto [it, inserted] = best_for_point.try_emplace(best_point, matches.size());
+    if (inserted) matches.push_back(match);
+    else if (match.distance < matches[it->second].distance) matches[it->second] = match;
+  }
+  return matches;
+}
+
+void GatherCorrespondences(const Features& features, const mapping::Map& map,
+                           const std::vector<MapMatch>& matches,
+                           std::vector<Eigen::Vector2d>* pixels,
+                           std::vector<Eigen::Vector3d>* points) {
+  pixels->clear();
+  points->clear();
+  pixels->reserve(matches.size());
+  points->reserve(matches.size());
+  for (const auto& m : matches) {
+    const cv::Point2f& p = features.keypoints[m.keypoint].pt;
+    pixels->emplace_back(p.x, p.y);
+    points->push_back(map.points[m.point].xyz);
+  }
+}
+
+Relocalizer::Relocalizer(const mapping::Map& map, const mapping::DescriptorIndex& index,
+                         const RelocalizerOptions& options)
+    : map_(map), index_(index), options_(options), extractor_(options.features) {}
+
+RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
+  const auto start = std::chrono::steady_clock::now();
+  const Features features = extractor_.Extract(gray);
+  const double extract_ms = MillisecondsSince(start);
+  RelocalizationResult result = Relocalize(features);
+  result.extract_ms = extract_ms;
+  return result;
+}
+
+RelocalizationResult Relocalizer::Relocalize(const Features& features) const {
+  RelocalizationResult result;
+  result.keypoints = static_cast<int>(features.keypoints.size());
+  const auto match_start = std::chrono::steady_clock::now();
+  const std::vector<MapMatch> matches = MatchToMap(features, map_, index_, options_.matching);
+  result.match_ms = MillisecondsSince(match_start);
+  result.matches = static_cast<int>(matches.size());
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  GatherCorrespondences(features, map_, matches, &pixels, &points);
+  result.pose = EstimateAbsolutePose(map_.camera, pixels, points, options_.pose);
+  if (result.pose.ok) {
+    for (int i : result.pose.inliers) {
+      result.inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
+      result.inliers.points.push_back(matches[i].point);
+    }
+  }
+  return result;
+}
+
+}  // namespace arview::tracker

@@ -1,0 +1,81 @@
+#pragma once
+// Relocalization without a prior: SIFT on the frame, k-nearest-neighbour search over the map's
+// descriptors with a ratio test between distinct map points, then the pose solver.
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+#include "mapping/descriptor_index.h"
+#include "mapping/map.h"
+#include "tracker/absolute_pose.h"
+#include "tracker/features.h"
+
+namespace arview::tracker {
+
+struct MatchOptions {
+  // Lowe's ratio: best distance / best distance to a different map point. A map point owns one
+  // descriptor per observation, so the second neighbour is often the same point; k neighbours
+  // are fetched to find the nearest other point.
+  double ratio = 0.8;
+  int knn = 4;
+};
+
+// A frame keypoint matched to a map point.
+struct MapMatch {
+  int keypoint = 0;
+  std::uint32_t point = 0;
+  float distance = 0;
+};
+
+// Global matching; each map point keeps only its closest keypoint.
+std::vector<MapMatch> MatchToMap(const Features& features, const mapping::Map& map,
+                                 const mapping::DescriptorIndex& index, const MatchOptions& options);
+
+// The correspondences of a localisation, kept for the next frame's optical flow.
+struct Track2D3D {
+  std::vector<cv::Point2f> pixels;
+  std::vector<std::uint32_t> points;
+};
+
+struct RelocalizerOptions {
+  FeatureOptions features;
+  MatchOptions matching;
+  AbsolutePoseOptions pose;
+};
+
+struct RelocalizationResult {
+  AbsolutePoseResult pose;  // ok / failure / reason / stats of the solver
+  int keypoints = 0;
+  int matches = 0;
+  double extract_ms = 0;
+  double match_ms = 0;
+  Track2D3D inliers;  // the verified correspondences (empty unless pose.ok)
+};
+
+class Relocalizer {
+ public:
+  // `map` and `index` must outlive the relocalizer.
+  Relocalizer(const mapping::Map& map, const mapping::DescriptorIndex& index,
+              const RelocalizerOptions& options);
+  RelocalizationResult Relocalize(const cv::Mat& gray) const;
+  // Features already extracted (e.g. by guided matching of the same frame).
+  RelocalizationResult Relocalize(const Features& features) const;
+  const RelocalizerOptions& options() const { return options_; }
+  const SiftExtractor& extractor() const { return extractor_; }
+
+ private:
+  const mapping::Map& map_;
+  const mapping::DescriptorIndex& index_;
+  RelocalizerOptions options_;
+  SiftExtractor extractor_;
+};
+
+// Pixels and world points of `matches`, in order, for the pose solver.
+void GatherCorrespondences(const Features& features, const mapping::Map& map,
+                           const std::vector<MapMatch>& matches,
+                           std::vector<Eigen::Vector2d>* pixels,
+                           std::vector<Eigen::Vector3d>* points);
+
+}  // namespace arview::tracker

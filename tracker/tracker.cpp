@@ -1,0 +1,351 @@
+#include "tracker/tracker.h"
+
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+#include "tracker/timing.h"
+
+namespace arview::tracker {
+namespace {
+
+calib::Pose Compose(const calib::Pose& a, const calib::Pose& b) {  // x ↦ a(b(x))
+  return {(a.q_cw * b.q_cw).normalized(), a.q_cw * b.t_cw + a.t_cw};
+}
+
+calib::Pose Inverse(const calib::Pose& p) {
+  const Eigen::Quaterniond qi = p.q_cw.conjugate();
+  return {qi, -(qi * p.t_cw)};
+}
+
+int SquaredDistance(const std::uint8_t* a, const std::uint8_t* b) {
+  int sum = 0;
+  for (int i = 0; i < 128; ++i) {
+    const int d = int(a[i]) - int(b[i]);
+    sum += d * d;
+  }
+  return sum;
+}
+
+void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
+  result->inliers = pose.stats.inliers;
+  result->rms_px = pose.stats.rms_px;
+  result->times.ransac_ms += pose.stats.ransac_ms;
+  result->times.refine_ms += pose.stats.refine_ms;
+}
+
+}  // namespace
+
+const char* TrackStatusName(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::kTracking: return "tracking";
+    case TrackStatus::kRelocalized: return "relocalized";
+    case TrackStatus::kLost: return "lost";
+  }
+  return "?";
+}
+
+calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity) {
+  return Compose(velocity, last);
+}
+
+calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last) {
+  return Compose(last, Inverse(previous));
+}
+
+void ValidateMap(const mapping::Map& map, int min_points) {
+  std::ostringstream msg;
+  if (static_cast<int>(map.points.size()) < min_points) {
+    msg << "map has " << map.points.size() << " points, at least " << min_points
+        << " are needed to track against it";
+    throw TrackerError(msg.str());
+  }
+  if (map.descriptors.empty() || map.descriptors.type() != CV_8U || map.descriptors.cols != 128)
+    throw TrackerError("map descriptors must be a non-empty N x 128 uint8 matrix");
+  if (map.descriptor_point.size() != static_cast<size_t>(map.descriptors.rows)) {
+    msg << "map has " << map.descriptors.rows << " descriptor rows but "
+        << map.descriptor_point.size() << " descriptor → point entries";
+    throw TrackerError(msg.str());
+  }
+  for (std::uint32_t p : map.descriptor_point)
+    if (p >= map.points.size()) throw TrackerError("map descriptor refers to a missing point");
+  for (const auto& point : map.points)
+    if (static_cast<std::uint64_t>(point.first_descriptor) + point.descriptor_count >
+        static_cast<std::uint64_t>(map.descriptors.rows))
+      throw TrackerError("map point refers to descriptor rows past the end");
+  try {
+    map.camera.Validate("map camera");
+  } catch (const calib::CameraError& e) {
+    throw TrackerError(e.what());
+  }
+}
+
+Tracker::Tracker(const mapping::Map& map, const TrackerOptions& options)
+    : map_(map), options_(options), smoother_(options.smoothing) {
+  ValidateMap(map, options.min_map_points);
+  index_ = mapping::DescriptorIndex(map.descriptors, options.index);
+  relocalizer_ = std::make_unique<Relocalizer>(map_, index_, options.relocalization);
+  point_stamp_.assign(map.points.size(), 0);
+}
+
+Tracker::~Tracker() = default;
+
+void Tracker::Reset() {
+  has_pose_ = false;
+  has_velocity_ = false;
+  last_pyramid_.clear();
+  last_inliers_ = {};
+  smoother_.Reset();
+}
+
+std::vector<int> Tracker::NearestKeyframes(const calib::Pose& pose) const {
+  const Eigen::Vector3d centre = pose.Center();
+  const Eigen::Vector3d axis = pose.q_cw.conjugate() * Eigen::Vector3d::UnitZ();
+  std::vector<std::pair<double, int>> ranked;
+  for (size_t k = 0; k < map_.keyframes.size(); ++k) {
+    const calib::Pose& kp = map_.keyframes[k].pose;
+    // Keyframes looking more than ~70° away see other surfaces or other sides of them.
+    if ((kp.q_cw.conjugate() * Eigen::Vector3d::UnitZ()).dot(axis) < 0.34) continue;
+    ranked.emplace_back((kp.Center() - centre).squaredNorm(), static_cast<int>(k));
+  }
+  const size_t n = std::min<size_t>(ranked.size(), options_.tracking.guided_keyframes);
+  std::partial_sort(ranked.begin(), ranked.begin() + n, ranked.end());
+  std::vector<int> nearest;
+  for (size_t i = 0; i < n; ++i) nearest.push_back(ranked[i].second);
+  return nearest;
+}
+
+// Guided matching: SIFT keypoints of the frame against map points projected with the predicted
+// pose, only within a small radius, with a ratio test between distinct points.
+struct Tracker::Guided {
+  struct Candidate {
+    Eigen::Vector2d pixel;
+    std::uint32_t point;
+  };
+
+  static std::vector<MapMatch> Match(const Features& features, const std::vector<Candidate>& cands,
+                                     const mapping::Map& map, double radius, double ratio,
+                                     const cv::Size& size) {
+    const int cell = std::max(4, static_cast<int>(std::ceil(radius)));
+    const int gw = size.width / cell + 1, gh = size.height / cell + 1;
+    std::vector<std::vector<int>> grid(static_cast<size_t>(gw) * gh);
+    for (size_t i = 0; i < cands.size(); ++i) {
+      const int gx = std::clamp(static_cast<int>(cands[i].pixel.x() / cell), 0, gw - 1);
+      const int gy = std::clamp(static_cast<int>(cands[i].pixel.y() / cell), 0, gh - 1);
+      grid[gy * gw + gx].push_back(static_cast<int>(i));
+    }
+    std::vector<MapMatch> matches;
+    std::unordered_map<std::uint32_t, size_t> best_for_point;
+    const double r2 = radius * radius;
+    for (size_t k = 0; k < features.keypoints.size(); ++k) {
+      const cv::Point2f& kp = features.keypoints[k].pt;
+      const std::uint8_t* desc = features.descriptors.ptr<std::uint8_t>(static_cast<int>(k));
+      const int cx = static_cast<int>(kp.x / cell), cy = static_cast<int>(kp.y / cell);
+      int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
+      std::uint32_t best_point = 0;
+      for (int gy = std::max(0, cy - 1); gy <= std::min(gh - 1, cy + 1); ++gy) {
+        for (int gx = std::max(0, cx - 1); gx <= std::min(gw - 1, cx + 1); ++gx) {
+          for (int i : grid[gy * gw + gx]) {
+            const Candidate& c = cands[i];
+            if ((c.pixel - Eigen::Vector2d(kp.x, kp.y)).squaredNorm() > r2) continue;
+            const mapping::MapPoint& mp = map.points[c.point];
+            int d = std::numeric_limits<int>::max();
+            for (std::uint32_t r = 0; r < mp.descriptor_count; ++r)
+              d = std::min(d, SquaredDistance(desc, map.descriptors.ptr<std::uint8_t>(
+                                                        static_cast<int>(mp.first_descriptor + r))));
+            if (d < best) {
+              if (c.point != best_point) second = best;
+              best = d;
+              best_point = c.point;
+            } else if (d < second && c.point != best_point) {
+              second = d;
+            }
+          }
+        }
+      }
+      if (best == std::numeric_limits<int>::max()) continue;
+      // Distances are squared: compare with the squared ratio.
+      if (second != std::numeric_limits<int>::max() &&
+          static_cast<double>(best) > ratio * ratio * static_cast<double>(second))
+        continue;
+      const MapMatch match{static_cast<int>(k), best_point, std::sqrt(static_cast<float>(best))};
+      auto [it, inserted] = best_for_point.try_emplace(best_point, matches.size());
+      if (inserted) matches.push_back(match);
+      else if (match.distance < matches[it->second].distance) matches[it->second] = match;
+    }
+    return matches;
+  }
+};
+
+bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result) {
+  const TrackingOptions& opt = options_.tracking;
+  const calib::Camera& camera = map_.camera;
+  const calib::Pose predicted =
+      has_velocity_ ? PredictConstantVelocity(last_pose_, velocity_) : last_pose_;
+
+  // 1. Pyramidal LK from last frame's inliers, started where the prediction puts them.
+  const auto flow_start = std::chrono::steady_clock::now();
+  std::vector<cv::Mat> pyramid;
+  const cv::Size window(opt.lk_window_px, opt.lk_window_px);
+  cv::buildOpticalFlowPyramid(gray, pyramid, window, opt.lk_pyramid_levels);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::uint32_t> point_ids;
+  ++frame_counter_;
+  if (!last_inliers_.pixels.empty() && !last_pyramid_.empty()) {
+    std::vector<cv::Point2f> guess;
+    guess.reserve(last_inliers_.pixels.size());
+    for (size_t i = 0; i < last_inliers_.pixels.size(); ++i) {
+      const Eigen::Vector3d pc = predicted.ToCamera(map_.points[last_inliers_.points[i]].xyz);
+      const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
+      guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
+    }
+    std::vector<unsigned char> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(
+        last_pyramid_, pyramid, last_inliers_.pixels, guess, status, error, window,
+        opt.lk_pyramid_levels,
+        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
+        cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (size_t i = 0; i < guess.size(); ++i) {
+      const Eigen::Vector2d px(guess[i].x, guess[i].y);
+      if (!status[i] || !camera.InImage(px, 1.0)) continue;
+      const std::uint32_t id = last_inliers_.points[i];
+      pixels.push_back(px);
+      points.push_back(map_.points[id].xyz);
+      point_ids.push_back(id);
+      point_stamp_[id] = frame_counter_;
+    }
+  }
+  result->flow_tracks = static_cast<int>(pixels.size());
+  result->times.flow_ms = MillisecondsSince(flow_start);
+
+  // 2. Guided matching when the flow tracks have thinned out.
+  if (result->flow_tracks < opt.replenish_below) {
+    const auto extract_start = std::chrono::steady_clock::now();
+    const Features features = relocalizer_->extractor().Extract(gray);
+    result->keypoints = static_cast<int>(features.keypoints.size());
+    result->times.extract_ms = MillisecondsSince(extract_start);
+    const auto match_start = std::chrono::steady_clock::now();
+    std::vector<Guided::Candidate> candidates;
+    for (int k : NearestKeyframes(predicted)) {
+      for (const auto& obs : map_.keyframes[k].observations) {
+        if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
+        point_stamp_[obs.point] = frame_counter_;
+        const Eigen::Vector3d pc = predicted.ToCamera(map_.points[obs.point].xyz);
+        if (pc.z() <= 0) continue;
+        const Eigen::Vector2d px = camera.Project(pc);
+        if (camera.InImage(px)) candidates.push_back({px, obs.point});
+      }
+    }
+    const auto guided = Guided::Match(features, candidates, map_, opt.guided_radius_px,
+                                      opt.guided_ratio, gray.size());
+    for (const auto& m : guided) {
+      const cv::Point2f& p = features.keypoints[m.keypoint].pt;
+      pixels.emplace_back(p.x, p.y);
+      points.push_back(map_.points[m.point].xyz);
+      point_ids.push_back(m.point);
+    }
+    result->guided_matches = static_cast<int>(guided.size());
+    result->times.match_ms = MillisecondsSince(match_start);
+  }
+
+  // 3. Short RANSAC + refinement.
+  AbsolutePoseOptions pose_options = options_.relocalization.pose;
+  pose_options.ransac_max_iterations = opt.ransac_max_iterations;
+  pose_options.min_inliers = opt.min_inliers;
+  pose_options.seed += frame_counter_;
+  const AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+  CopyStats(pose, result);
+  last_pyramid_ = std::move(pyramid);
+  if (!pose.ok) {
+    result->reason = "tracking failed: " + pose.reason;
+    return false;
+  }
+  result->pose = pose.pose;
+  Track2D3D inliers;
+  for (int i : pose.inliers) {
+    inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
+    inliers.points.push_back(point_ids[i]);
+  }
+  last_inliers_ = std::move(inliers);
+  return true;
+}
+
+void Tracker::Remember(const FrameResult& result, const Track2D3D& inliers) {
+  if (has_pose_ && result.status == TrackStatus::kTracking) {
+    velocity_ = RelativeMotion(last_pose_, result.pose);
+    has_velocity_ = true;
+  } else {
+    has_velocity_ = false;
+  }
+  last_pose_ = result.pose;
+  has_pose_ = true;
+  if (result.status == TrackStatus::kRelocalized) last_inliers_ = inliers;
+}
+
+FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameResult result;
+  const cv::Mat gray = image.empty() ? cv::Mat() : ToGray8(image);
+  if (gray.empty() || gray.size() != map_.camera.Size()) {
+    std::ostringstream msg;
+    msg << "frame is " << gray.cols << "x" << gray.rows << ", the map camera is "
+        << map_.camera.width << "x" << map_.camera.height;
+    result.reason = msg.str();
+    Reset();
+    result.times.total_ms = MillisecondsSince(start);
+    return result;
+  }
+
+  bool tracked = false;
+  std::string tracking_reason;
+  if (has_pose_) {
+    tracked = TrackWithPrior(gray, &result);
+    tracking_reason = result.reason;
+  }
+  Track2D3D reloc_inliers;
+  if (tracked) {
+    result.status = TrackStatus::kTracking;
+    result.reason.clear();
+  } else {
+    const RelocalizationResult reloc = relocalizer_->Relocalize(gray);
+    result.keypoints = reloc.keypoints;
+    result.matches = reloc.matches;
+    result.times.extract_ms += reloc.extract_ms;
+    result.times.match_ms += reloc.match_ms;
+    CopyStats(reloc.pose, &result);
+    if (reloc.pose.ok) {
+      result.status = TrackStatus::kRelocalized;
+      result.pose = reloc.pose.pose;
+      result.reason = tracking_reason;
+      reloc_inliers = reloc.inliers;
+      if (last_pyramid_.empty() || !has_pose_)
+        cv::buildOpticalFlowPyramid(gray, last_pyramid_,
+                                    cv::Size(options_.tracking.lk_window_px, options_.tracking.lk_window_px),
+                                    options_.tracking.lk_pyramid_levels);
+    } else {
+      result.status = TrackStatus::kLost;
+      result.reason = (tracking_reason.empty() ? "" : tracking_reason + "; ") +
+                      "relocalization failed: " + reloc.pose.reason;
+      result.inliers = 0;
+    }
+  }
+
+  if (result.status == TrackStatus::kLost) {
+    Reset();
+  } else {
+    Remember(result, reloc_inliers);
+    result.center = result.pose.Center();
+    result.smoothed_center = smoother_.Filter(result.center, timestamp);
+  }
+  result.times.total_ms = MillisecondsSince(start);
+  return result;
+}
+
+}  // namespace arview::tracker

@@ -1,0 +1,119 @@
+#pragma once
+// Per-frame camera pose against a map. With a prior (the previous frames were localised) the
+// pose is predicted with a constant-velocity model, last frame's inliers are followed with
+// pyramidal Lucas-Kanade, guided matches are added when the flow tracks thin out, and a short
+// RANSAC + refinement verifies the pose. Without a prior, or when tracking fails, the frame is
+// relocalised globally (tracker/relocalizer.h). A pose is reported only when verified.
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mapping/descriptor_index.h"
+#include "mapping/map.h"
+#include "tracker/one_euro.h"
+#include "tracker/relocalizer.h"
+
+namespace arview::tracker {
+
+struct TrackerError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+enum class TrackStatus { kTracking, kRelocalized, kLost };
+const char* TrackStatusName(TrackStatus status);
+
+struct TrackingOptions {
+  int lk_window_px = 21;
+  int lk_pyramid_levels = 3;
+  int lk_max_iterations = 20;
+  // Guided matching (SIFT on the frame, matched only against map points projected within
+  // guided_radius_px) runs when fewer flow tracks than this survive.
+  int replenish_below = 150;
+  int guided_keyframes = 3;  // nearest keyframes whose observations are projected
+  double guided_radius_px = 10;
+  double guided_ratio = 0.85;
+  int ransac_max_iterations = 50;  // the inlier ratio is high when tracking
+  int min_inliers = 30;            // below this, fall back to relocalization
+};
+
+struct TrackerOptions {
+  RelocalizerOptions relocalization;
+  TrackingOptions tracking;
+  OneEuroOptions smoothing;
+  mapping::IndexParams index;
+  int min_map_points = 30;  // a map with fewer points is refused at construction
+};
+
+struct StageTimes {
+  double flow_ms = 0;
+  double extract_ms = 0;
+  double match_ms = 0;  // global (FLANN) or guided
+  double ransac_ms = 0;
+  double refine_ms = 0;
+  double total_ms = 0;
+};
+
+struct FrameResult {
+  TrackStatus status = TrackStatus::kLost;
+  calib::Pose pose;  // raw refined pose (world → camera); meaningful unless lost
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();           // C = −Rᵀt
+  Eigen::Vector3d smoothed_center = Eigen::Vector3d::Zero();  // One Euro filtered C
+  int inliers = 0;
+  double rms_px = 0;
+  int flow_tracks = 0;     // LK tracks that survived into this frame
+  int guided_matches = 0;  // added by guided matching
+  int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
+  int matches = 0;         // global matches (relocalization)
+  std::string reason;      // why the frame is lost, or why tracking fell back
+  StageTimes times;
+};
+
+class Tracker {
+ public:
+  // Validates the map and builds its descriptor index. `map` must outlive the tracker.
+  // Throws TrackerError when the map has too few points or inconsistent descriptors.
+  Tracker(const mapping::Map& map, const TrackerOptions& options = {});
+  ~Tracker();
+
+  // image: 8-bit grey or BGR at the map camera's resolution; timestamp in seconds.
+  FrameResult Track(const cv::Mat& image, double timestamp);
+  // Forgets the prior: the next frame is relocalised.
+  void Reset();
+  const TrackerOptions& options() const { return options_; }
+
+ private:
+  struct Guided;
+  bool TrackWithPrior(const cv::Mat& gray, FrameResult* result);
+  void Remember(const FrameResult& result, const Track2D3D& inliers);
+  std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
+
+  const mapping::Map& map_;
+  TrackerOptions options_;
+  mapping::DescriptorIndex index_;
+  std::unique_ptr<Relocalizer> relocalizer_;
+  OneEuroFilter smoother_;
+
+  // The prior.
+  bool has_pose_ = false;
+  bool has_velocity_ = false;
+  calib::Pose last_pose_;
+  calib::Pose velocity_;  // last_pose ∘ previous⁻¹
+  std::vector<cv::Mat> last_pyramid_;
+  Track2D3D last_inliers_;
+  std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
+  std::uint32_t frame_counter_ = 0;
+};
+
+// Throws TrackerError naming the problem when `map` cannot be tracked against.
+void ValidateMap(const mapping::Map& map, int min_points);
+
+// Constant-velocity prediction: apply the last inter-frame motion once more.
+calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity);
+// velocity such that PredictConstantVelocity(previous, velocity) == last.
+calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last);
+
+}  // namespace arview::tracker

@@ -1,0 +1,209 @@
+#include "tracker/tracker.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <memory>
+#include <random>
+
+#include "tests/support/test_data.h"
+#include "tracker/test_planar_scene.h"
+#include "tracker/test_scene.h"
+
+namespace arview::tracker {
+namespace {
+
+using testing::LookAt;
+using testing::PlanarWorld;
+using testing::RotationErrorDeg;
+using testing::TestCamera;
+
+const char* kOpenCvData = "/usr/share/doc/opencv-doc/examples/data/";
+
+// A graffiti texture on a 1.2 m x 0.96 m plane, mapped from four keyframes ~0.9 m away.
+class PlanarTrackerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const cv::Mat texture = cv::imread(std::string(kOpenCvData) + "graf1.png");
+    if (texture.empty()) return;
+    world_ = std::make_unique<PlanarWorld>(texture, TestCamera(), 0.0015);
+    const SiftExtractor sift;
+    map_ = std::make_unique<mapping::Map>(world_->MakeMap(
+        {LookAt({0, 0, -0.9}, {0, 0, 0}), LookAt({0.3, 0, -0.85}, {0.05, 0, 0}),
+         LookAt({-0.3, 0.1, -0.85}, {-0.05, 0, 0}), LookAt({0, -0.25, -0.85}, {0, -0.05, 0})},
+        sift));
+  }
+  static void TearDownTestSuite() {
+    map_.reset();
+    world_.reset();
+  }
+  void SetUp() override {
+    ARVIEW_REQUIRE_DATA_PATH(std::string(kOpenCvData) + "graf1.png", "Debian package opencv-doc");
+    ASSERT_TRUE(map_);
+  }
+
+  static calib::Pose PathPose(int i) {  // a slow sideways arc, ~4 mm per frame
+    const double a = 0.004 * i;
+    return LookAt({-0.15 + a, 0.05 * std::sin(3 * a), -0.8 - 0.1 * a}, {0.02, 0, 0});
+  }
+
+  static void ExpectNear(const FrameResult& r, const calib::Pose& truth, double metres, double deg) {
+    EXPECT_LT((r.pose.Center() - truth.Center()).norm(), metres);
+    EXPECT_LT(RotationErrorDeg(r.pose, truth), deg);
+  }
+
+  static std::unique_ptr<PlanarWorld> world_;
+  static std::unique_ptr<mapping::Map> map_;
+};
+std::unique_ptr<PlanarWorld> PlanarTrackerTest::world_;
+std::unique_ptr<mapping::Map> PlanarTrackerTest::map_;
+
+TEST_F(PlanarTrackerTest, RelocalizesANovelView) {
+  Tracker tracker(*map_);
+  const calib::Pose truth = LookAt({0.12, 0.06, -0.75}, {0.03, 0.01, 0});
+  const FrameResult r = tracker.Track(world_->Render(truth), 0.0);
+  ASSERT_EQ(r.status, TrackStatus::kRelocalized) << r.reason;
+  ExpectNear(r, truth, 0.003, 0.2);
+  EXPECT_GE(r.inliers, 50);
+  EXPECT_LT(r.rms_px, 1.0);
+  EXPECT_GT(r.keypoints, 0);
+  EXPECT_GT(r.matches, r.inliers / 2);
+}
+
+TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
+  Tracker tracker(*map_);
+  int tracked = 0;
+  for (int i = 0; i < 30; ++i) {
+    const calib::Pose truth = PathPose(i);
+    const FrameResult r = tracker.Track(world_->Render(truth), i / 30.0);
+    ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
+    ExpectNear(r, truth, 0.003, 0.2);
+    if (i == 0) {
+      EXPECT_EQ(r.status, TrackStatus::kRelocalized);
+    }
+    if (r.status == TrackStatus::kTracking) {
+      ++tracked;
+      EXPECT_EQ(r.matches, 0) << "tracking must not run global matching";
+    }
+  }
+  EXPECT_GE(tracked, 28);
+  // A jump to the other side, the camera rolled by 90°: the constant-velocity prior is wrong
+  // and optical flow cannot follow, relocalization recovers.
+  const calib::Pose far = LookAt({0.25, -0.15, -0.7}, {-0.05, 0.05, 0}, Eigen::Vector3d::UnitX());
+  const FrameResult r = tracker.Track(world_->Render(far), 1.0);
+  ASSERT_EQ(r.status, TrackStatus::kRelocalized)
+      << r.reason << " flow " << r.flow_tracks << " guided " << r.guided_matches << " inliers "
+      << r.inliers << " err " << (r.pose.Center() - far.Center()).norm();
+  ExpectNear(r, far, 0.003, 0.2);
+}
+
+TEST_F(PlanarTrackerTest, FrameOfAnotherSceneIsLostNotAPose) {
+  Tracker tracker(*map_);
+  for (const char* name : {"left01.jpg", "box_in_scene.png", "fruits.jpg"}) {
+    cv::Mat other = cv::imread(std::string(kOpenCvData) + name);
+    ASSERT_FALSE(other.empty()) << name;
+    cv::resize(other, other, map_->camera.Size());
+    const FrameResult r = tracker.Track(other, 0.0);
+    EXPECT_EQ(r.status, TrackStatus::kLost) << name << ": " << r.inliers << " inliers";
+    EXPECT_FALSE(r.reason.empty());
+  }
+}
+
+TEST_F(PlanarTrackerTest, BlackAndTinyFramesAreLost) {
+  Tracker tracker(*map_);
+  const FrameResult black = tracker.Track(cv::Mat::zeros(map_->camera.Size(), CV_8UC3), 0.0);
+  EXPECT_EQ(black.status, TrackStatus::kLost);
+  EXPECT_NE(black.reason.find("relocalization failed"), std::string::npos) << black.reason;
+  const FrameResult tiny = tracker.Track(cv::Mat::zeros(4, 4, CV_8U), 0.1);
+  EXPECT_EQ(tiny.status, TrackStatus::kLost);
+  EXPECT_NE(tiny.reason.find("4x4"), std::string::npos) << tiny.reason;
+  EXPECT_EQ(tracker.Track(cv::Mat(), 0.2).status, TrackStatus::kLost);
+  // Lost frames drop the prior: a good frame afterwards is a relocalization.
+  const FrameResult good = tracker.Track(world_->Render(PathPose(0)), 0.3);
+  EXPECT_EQ(good.status, TrackStatus::kRelocalized) << good.reason;
+}
+
+TEST_F(PlanarTrackerTest, MapWithTooFewPointsIsAClearErrorAtLoad) {
+  mapping::Map small = *map_;
+  small.points.resize(10);
+  small.keyframes.clear();
+  small.descriptors = small.descriptors.rowRange(0, 10).clone();
+  small.descriptor_point.resize(10);
+  try {
+    Tracker tracker(small);
+    FAIL() << "a 10-point map was accepted";
+  } catch (const TrackerError& e) {
+    EXPECT_NE(std::string(e.what()).find("map has 10 points"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ValidateMap, InconsistentDescriptorsAreRefused) {
+  mapping::Map map;
+  map.camera = TestCamera();
+  map.points.resize(40);
+  map.descriptors = cv::Mat::zeros(40, 128, CV_8U);
+  map.descriptor_point.assign(39, 0);
+  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
+  map.descriptor_point.assign(40, 40);
+  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
+  map.descriptor_point.assign(40, 0);
+  ValidateMap(map, 30);
+  map.descriptors = cv::Mat::zeros(40, 64, CV_8U);
+  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
+}
+
+TEST(ConstantVelocity, PredictionRepeatsTheLastMotion) {
+  const calib::Pose a = LookAt({0, 0, -1}, {0, 0, 0});
+  const calib::Pose b = LookAt({0.1, 0, -1}, {0.05, 0, 0});
+  const calib::Pose c = PredictConstantVelocity(b, RelativeMotion(a, b));
+  EXPECT_NEAR((c.Center() - Eigen::Vector3d(0.2, 0, -1)).norm(), 0, 0.02);
+  const calib::Pose same = PredictConstantVelocity(b, RelativeMotion(b, b));
+  EXPECT_LT((same.t_cw - b.t_cw).norm(), 1e-12);
+}
+
+TEST(ColmapDescriptors, RootL1TimesFiveHundredTwelveClamped) {
+  cv::Mat sift = cv::Mat::zeros(2, 128, CV_32F);
+  sift.at<float>(0, 0) = 3;
+  sift.at<float>(0, 1) = 1;  // L1 = 4: sqrt(0.75)*512 = 443.4 → 255, sqrt(0.25)*512 = 256 → 255
+  for (int c = 0; c < 128; ++c) sift.at<float>(1, c) = 2;  // sqrt(1/128)*512 = 45.25 → 45
+  const cv::Mat out = ToColmapDescriptors(sift);
+  ASSERT_EQ(out.type(), CV_8U);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 0), 255);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 1), 255);
+  EXPECT_EQ(out.at<std::uint8_t>(0, 2), 0);
+  EXPECT_EQ(out.at<std::uint8_t>(1, 77), 45);
+  EXPECT_EQ(ToColmapDescriptors(cv::Mat()).rows, 0);
+}
+
+TEST(SiftExtractor, TinyAndEmptyImagesGiveNoFeatures) {
+  const SiftExtractor sift;
+  EXPECT_TRUE(sift.Extract(cv::Mat()).keypoints.empty());
+  EXPECT_TRUE(sift.Extract(cv::Mat::zeros(8, 8, CV_8U)).keypoints.empty());
+  EXPECT_EQ(sift.Extract(cv::Mat::zeros(8, 8, CV_8U)).descriptors.cols, 128);
+}
+
+TEST(OneEuroFilter, SmoothsJitterAtRestAndFollowsMotion) {
+  OneEuroFilter filter({1.0, 0.5, 1.0});
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0, 0.002);
+  double raw_var = 0, filtered_var = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d x(noise(rng), noise(rng), noise(rng));
+    const Eigen::Vector3d y = filter.Filter(x, i / 30.0);
+    if (i > 30) {
+      raw_var += x.squaredNorm();
+      filtered_var += y.squaredNorm();
+    }
+  }
+  EXPECT_LT(filtered_var, 0.25 * raw_var);
+  // A step: the filter converges to the new position.
+  Eigen::Vector3d y;
+  for (int i = 300; i < 400; ++i) y = filter.Filter(Eigen::Vector3d(1, 0, 0), i / 30.0);
+  EXPECT_NEAR(y.x(), 1.0, 1e-3);
+  // Time going backwards restarts at the input.
+  EXPECT_EQ(filter.Filter(Eigen::Vector3d(5, 5, 5), 0.0), Eigen::Vector3d(5, 5, 5));
+}
+
+}  // namespace
+}  // namespace arview::tracker
