@@ -1,0 +1,297 @@
+#include "recordings/accuracy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <set>
+#include <sstream>
+
+#include <Eigen/SVD>
+
+namespace arview::recordings {
+
+calib::Pose Sim3::Apply(const calib::Pose& pose) const {
+  const Eigen::Quaterniond q_wc(R * pose.CameraToWorldRotation().toRotationMatrix());
+  return calib::Pose::FromCameraToWorld(q_wc, (*this)(pose.Center()));
+}
+
+Sim3 Sim3::Inverse() const {
+  Sim3 inv;
+  inv.scale = 1.0 / scale;
+  inv.R = R.transpose();
+  inv.t = -(inv.scale * (inv.R * t));
+  return inv;
+}
+
+Eigen::Matrix4d Sim3::Matrix() const {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = scale * R;
+  m.topRightCorner<3, 1>() = t;
+  return m;
+}
+
+AlignMode ParseAlignMode(const std::string& text) {
+  if (text == "none") return AlignMode::kNone;
+  if (text == "se3") return AlignMode::kSE3;
+  if (text == "sim3") return AlignMode::kSim3;
+  throw RecordingError("alignment '" + text + "' is not one of none, se3, sim3");
+}
+
+std::string ToString(AlignMode mode) {
+  switch (mode) {
+    case AlignMode::kNone: return "none";
+    case AlignMode::kSE3: return "se3";
+    case AlignMode::kSim3: return "sim3";
+  }
+  return "?";
+}
+
+Sim3 Umeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, bool with_scale) {
+  if (src.size() != dst.size()) throw RecordingError("alignment: point lists differ in length");
+  const size_t n = src.size();
+  if (n < 3) throw RecordingError("alignment: needs at least 3 corresponding positions, has " + std::to_string(n));
+  Eigen::Vector3d mu_s = Eigen::Vector3d::Zero(), mu_d = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    mu_s += src[i];
+    mu_d += dst[i];
+  }
+  mu_s /= static_cast<double>(n);
+  mu_d /= static_cast<double>(n);
+  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+  double var_s = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d s = src[i] - mu_s;
+    sigma += (dst[i] - mu_d) * s.transpose();
+    var_s += s.squaredNorm();
+  }
+  sigma /= static_cast<double>(n);
+  var_s /= static_cast<double>(n);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d d = svd.singularValues();
+  // A rotation is determined only when the points span at least a plane in both sets.
+  if (!(var_s > 0) || !(d(1) > 1e-12 * std::max(d(0), 1e-300))) {
+    throw RecordingError("alignment: the positions are degenerate (all on one line or one point); cannot fit a rotation");
+  }
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) S(2, 2) = -1;
+  Sim3 out;
+  out.R = svd.matrixU() * S * svd.matrixV().transpose();
+  out.scale = with_scale ? (d.asDiagonal() * S).trace() / var_s : 1.0;
+  out.t = mu_d - out.scale * (out.R * mu_s);
+  return out;
+}
+
+std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(const Trajectory& a, const Trajectory& b, double max_dt) {
+  if (!(max_dt >= 0) || !std::isfinite(max_dt)) {
+    throw RecordingError("association tolerance must be a non-negative number of seconds");
+  }
+  std::vector<size_t> b_sorted(b.size());
+  std::iota(b_sorted.begin(), b_sorted.end(), size_t{0});
+  std::sort(b_sorted.begin(), b_sorted.end(), [&](size_t x, size_t y) { return b[x].timestamp < b[y].timestamp; });
+  struct Candidate {
+    double dt;
+    size_t i, j;
+  };
+  std::vector<Candidate> candidates;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double t = a[i].timestamp;
+    auto it = std::lower_bound(b_sorted.begin(), b_sorted.end(), t - max_dt,
+                               [&](size_t j, double value) { return b[j].timestamp < value; });
+    for (; it != b_sorted.end() && b[*it].timestamp <= t + max_dt; ++it) {
+      candidates.push_back({std::abs(b[*it].timestamp - t), i, *it});
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return x.dt < y.dt;
+  });
+  std::vector<bool> used_a(a.size(), false), used_b(b.size(), false);
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (const Candidate& c : candidates) {
+    if (used_a[c.i] || used_b[c.j]) continue;
+    used_a[c.i] = used_b[c.j] = true;
+    pairs.emplace_back(c.i, c.j);
+  }
+  std::sort(pairs.begin(), pairs.end(), [&](const auto& x, const auto& y) {
+    return a[x.first].timestamp < a[y.first].timestamp;
+  });
+  return pairs;
+}
+
+Sim3 FitAlignment(const Trajectory& from, const Trajectory& to, AlignMode mode, double max_dt) {
+  if (mode == AlignMode::kNone) return {};
+  const auto pairs = AssociateByTimestamp(from, to, max_dt);
+  if (pairs.size() < 3) {
+    throw RecordingError("alignment: only " + std::to_string(pairs.size()) +
+                         " poses share a timestamp with the ground truth (tolerance " + std::to_string(max_dt) +
+                         " s); at least 3 are needed");
+  }
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const auto& [i, j] : pairs) {
+    src.push_back(from[i].pose.Center());
+    dst.push_back(to[j].pose.Center());
+  }
+  return Umeyama(src, dst, mode == AlignMode::kSim3);
+}
+
+Trajectory TransformTrajectory(const Trajectory& trajectory, const Sim3& transform) {
+  Trajectory out;
+  out.reserve(trajectory.size());
+  for (const StampedPose& p : trajectory) out.push_back({p.timestamp, transform.Apply(p.pose)});
+  return out;
+}
+
+ErrorStats ComputeStats(const std::vector<double>& values) {
+  ErrorStats s;
+  s.count = static_cast<int>(values.size());
+  if (values.empty()) return s;
+  double sum = 0, sum2 = 0;
+  for (double v : values) {
+    sum += v;
+    sum2 += v * v;
+    s.max = std::max(s.max, v);
+  }
+  const double n = static_cast<double>(values.size());
+  s.mean = sum / n;
+  s.rmse = std::sqrt(sum2 / n);
+  std::vector<double> sorted = values;
+  std::sort(sorted.begin(), sorted.end());
+  const size_t mid = sorted.size() / 2;
+  s.median = sorted.size() % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
+  return s;
+}
+
+double RotationErrorDeg(const calib::Pose& a, const calib::Pose& b) {
+  return a.q_cw.angularDistance(b.q_cw) * 180.0 / M_PI;
+}
+
+namespace {
+
+// Relative motion from pose i to pose j, camera-to-world frames: (R_i^T R_j, R_i^T (C_j - C_i)).
+struct Motion {
+  Eigen::Quaterniond q;
+  Eigen::Vector3d t;
+};
+
+Motion Relative(const calib::Pose& i, const calib::Pose& j) {
+  const Eigen::Quaterniond qi = i.CameraToWorldRotation(), qj = j.CameraToWorldRotation();
+  return {qi.conjugate() * qj, qi.conjugate() * (j.Center() - i.Center())};
+}
+
+}  // namespace
+
+AccuracyReport EvaluateTrajectory(const Trajectory& estimate, const Trajectory& groundtruth,
+                                  const AccuracyOptions& options) {
+  if (estimate.empty()) throw RecordingError("evaluation: the estimated trajectory is empty");
+  if (groundtruth.empty()) throw RecordingError("evaluation: the ground-truth trajectory is empty");
+  if (options.rpe_delta < 1) throw RecordingError("evaluation: the RPE interval must be at least 1 frame");
+  AccuracyReport r;
+  r.align = options.align;
+  r.aligned_with_other = options.align_with != nullptr;
+  r.estimate_poses = static_cast<int>(estimate.size());
+  r.groundtruth_poses = static_cast<int>(groundtruth.size());
+  r.rpe_delta = options.rpe_delta;
+  const Trajectory& fit_on = options.align_with ? *options.align_with : estimate;
+  r.alignment = FitAlignment(fit_on, groundtruth, options.align, options.max_dt);
+  if (options.align != AlignMode::kNone) {
+    r.alignment_pairs = static_cast<int>(AssociateByTimestamp(fit_on, groundtruth, options.max_dt).size());
+  }
+  r.aligned_estimate = TransformTrajectory(estimate, r.alignment);
+  r.pairs = AssociateByTimestamp(estimate, groundtruth, options.max_dt);
+  if (r.pairs.empty()) {
+    throw RecordingError("evaluation: no estimated pose has a ground-truth pose within " +
+                         std::to_string(options.max_dt) + " s of its timestamp");
+  }
+  r.associated = static_cast<int>(r.pairs.size());
+  r.coverage = static_cast<double>(r.associated) / static_cast<double>(r.groundtruth_poses);
+  for (const auto& [i, j] : r.pairs) {
+    const calib::Pose& e = r.aligned_estimate[i].pose;
+    const calib::Pose& g = groundtruth[j].pose;
+    r.position_errors.push_back((e.Center() - g.Center()).norm());
+    r.rotation_errors_deg.push_back(RotationErrorDeg(e, g));
+  }
+  r.ate = ComputeStats(r.position_errors);
+  r.rotation_deg = ComputeStats(r.rotation_errors_deg);
+  std::vector<double> rpe_t, rpe_r;
+  const size_t delta = static_cast<size_t>(options.rpe_delta);
+  for (size_t k = 0; k + delta < r.pairs.size(); ++k) {
+    const auto [ei, gi] = r.pairs[k];
+    const auto [ej, gj] = r.pairs[k + delta];
+    const Motion m_gt = Relative(groundtruth[gi].pose, groundtruth[gj].pose);
+    const Motion m_est = Relative(r.aligned_estimate[ei].pose, r.aligned_estimate[ej].pose);
+    // Error motion m_gt^-1 · m_est.
+    rpe_t.push_back((m_gt.q.conjugate() * (m_est.t - m_gt.t)).norm());
+    rpe_r.push_back(m_gt.q.angularDistance(m_est.q) * 180.0 / M_PI);
+  }
+  r.rpe_translation = ComputeStats(rpe_t);
+  r.rpe_rotation_deg = ComputeStats(rpe_r);
+  return r;
+}
+
+namespace {
+
+std::string Num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.9g", v);
+  return buf;
+}
+
+std::string StatsJson(const ErrorStats& s) {
+  return "{\"rmse\": " + Num(s.rmse) + ", \"mean\": " + Num(s.mean) + ", \"median\": " + Num(s.median) +
+         ", \"max\": " + Num(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
+}
+
+}  // namespace
+
+std::string ReportToJson(const AccuracyReport& r) {
+  std::ostringstream o;
+  o << "{\n";
+  o << "  \"align\": \"" << ToString(r.align) << "\",\n";
+  o << "  \"aligned_with_other_trajectory\": " << (r.aligned_with_other ? "true" : "false") << ",\n";
+  o << "  \"alignment_pairs\": " << r.alignment_pairs << ",\n";
+  o << "  \"alignment\": {\"scale\": " << Num(r.alignment.scale) << ", \"R\": [";
+  for (int i = 0; i < 9; ++i) o << (i ? ", " : "") << Num(r.alignment.R(i / 3, i % 3));
+  o << "], \"t\": [" << Num(r.alignment.t.x()) << ", " << Num(r.alignment.t.y()) << ", " << Num(r.alignment.t.z())
+    << "]},\n";
+  o << "  \"estimate_poses\": " << r.estimate_poses << ",\n";
+  o << "  \"groundtruth_poses\": " << r.groundtruth_poses << ",\n";
+  o << "  \"associated\": " << r.associated << ",\n";
+  o << "  \"coverage\": " << Num(r.coverage) << ",\n";
+  o << "  \"ate\": " << StatsJson(r.ate) << ",\n";
+  o << "  \"rotation_deg\": " << StatsJson(r.rotation_deg) << ",\n";
+  o << "  \"rpe_delta\": " << r.rpe_delta << ",\n";
+  o << "  \"rpe_translation\": " << StatsJson(r.rpe_translation) << ",\n";
+  o << "  \"rpe_rotation_deg\": " << StatsJson(r.rpe_rotation_deg) << "\n";
+  o << "}\n";
+  return o.str();
+}
+
+std::string ReportToText(const AccuracyReport& r) {
+  char buf[512];
+  std::ostringstream o;
+  std::snprintf(buf, sizeof(buf), "alignment   %s%s, scale %.6g (fitted on %d pairs)\n", ToString(r.align).c_str(),
+                r.aligned_with_other ? " fitted on --align-with" : "", r.alignment.scale, r.alignment_pairs);
+  o << buf;
+  std::snprintf(buf, sizeof(buf), "coverage    %d of %d ground-truth poses have an estimate (%.1f%%); %d estimated poses\n",
+                r.associated, r.groundtruth_poses, 100.0 * r.coverage, r.estimate_poses);
+  o << buf;
+  std::snprintf(buf, sizeof(buf), "ATE         rmse %.6g  mean %.6g  median %.6g  max %.6g\n", r.ate.rmse, r.ate.mean,
+                r.ate.median, r.ate.max);
+  o << buf;
+  std::snprintf(buf, sizeof(buf), "rotation    median %.4g deg  max %.4g deg\n", r.rotation_deg.median,
+                r.rotation_deg.max);
+  o << buf;
+  if (r.rpe_translation.count > 0) {
+    std::snprintf(buf, sizeof(buf), "RPE (%d)     translation rmse %.6g  median %.6g; rotation rmse %.4g deg  median %.4g deg\n",
+                  r.rpe_delta, r.rpe_translation.rmse, r.rpe_translation.median, r.rpe_rotation_deg.rmse,
+                  r.rpe_rotation_deg.median);
+  } else {
+    std::snprintf(buf, sizeof(buf), "RPE (%d)     not computed: fewer than %d associated poses\n", r.rpe_delta,
+                  r.rpe_delta + 1);
+  }
+  o << buf;
+  return o.str();
+}
+
+}  // namespace arview::recordings
