@@ -1,0 +1,377 @@
+// Character import through Assimp. The skeleton is the part of the node tree that the skin
+// references (bone nodes and the nodes between them and their lowest common ancestor); a file
+// without a skin (BVH) uses its animated nodes instead.
+
+#include "anim/character.h"
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <unordered_map>
+
+namespace arview::anim {
+namespace {
+
+namespace fs = std::filesystem;
+
+Eigen::Matrix4d ToEigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d e;
+  e << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  return e;
+}
+
+Eigen::Matrix4d GlobalTransform(const aiNode* node) {
+  Eigen::Matrix4d g = Eigen::Matrix4d::Identity();
+  for (const aiNode* n = node; n; n = n->mParent) g = ToEigen(n->mTransformation) * g;
+  return g;
+}
+
+std::vector<const aiNode*> PathFromRoot(const aiNode* node) {
+  std::vector<const aiNode*> path;
+  for (const aiNode* n = node; n; n = n->mParent) path.push_back(n);
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+struct NodeSelection {
+  const aiNode* top = nullptr;               // lowest common ancestor of the selected nodes
+  std::set<const aiNode*> members;
+};
+
+NodeSelection SelectSkeletonNodes(const aiScene* scene, const std::set<std::string>& names, const std::string& file) {
+  NodeSelection sel;
+  std::vector<std::vector<const aiNode*>> paths;
+  for (const std::string& name : names) {
+    const aiNode* n = scene->mRootNode->FindNode(name.c_str());
+    if (!n) throw Error(file + ": the skin names a bone '" + name + "' that is not a node of the file");
+    paths.push_back(PathFromRoot(n));
+  }
+  std::size_t common = paths.front().size();
+  for (const auto& p : paths) {
+    std::size_t i = 0;
+    while (i < common && i < p.size() && p[i] == paths.front()[i]) ++i;
+    common = i;
+  }
+  sel.top = paths.front()[common - 1];
+  for (const auto& p : paths)
+    for (std::size_t i = common - 1; i < p.size(); ++i) sel.members.insert(p[i]);
+  return sel;
+}
+
+void AddJoints(const aiNode* node, int parent, const NodeSelection& sel, Skeleton& sk,
+               std::unordered_map<const aiNode*, int>& index) {
+  if (!sel.members.count(node)) return;
+  const int j = sk.size();
+  index[node] = j;
+  sk.names.emplace_back(node->mName.C_Str());
+  sk.parents.push_back(parent);
+  sk.rest.push_back(Transform::FromMatrix(ToEigen(node->mTransformation)));
+  sk.inverse_bind.push_back(Eigen::Matrix4d::Identity());
+  for (unsigned c = 0; c < node->mNumChildren; ++c) AddJoints(node->mChildren[c], j, sel, sk, index);
+}
+
+std::vector<Eigen::Matrix4d> RestModel(const Skeleton& sk) {
+  std::vector<Eigen::Matrix4d> g(sk.size());
+  for (int j = 0; j < sk.size(); ++j)
+    g[j] = (sk.parents[j] < 0 ? sk.root_parent : g[sk.parents[j]]) * sk.rest[j].ToMatrix();
+  return g;
+}
+
+struct Influence {
+  int joint;
+  float weight;
+};
+
+// Applies `m` to a mesh's positions and its inverse transpose to its normals.
+void BakeTransform(Mesh& mesh, const Eigen::Matrix4d& m) {
+  if (m.isIdentity(1e-12)) return;
+  const Eigen::Matrix3f a = m.block<3, 3>(0, 0).cast<float>();
+  const Eigen::Vector3f t = m.block<3, 1>(0, 3).cast<float>();
+  const Eigen::Matrix3f n = a.inverse().transpose();
+  for (auto& p : mesh.positions) p = a * p + t;
+  for (auto& v : mesh.normals) v = (n * v).normalized();
+}
+
+void FinishInfluences(Mesh& mesh, std::vector<std::vector<Influence>>& inf, int fallback_joint) {
+  mesh.joints.resize(mesh.positions.size());
+  mesh.weights.resize(mesh.positions.size());
+  for (std::size_t v = 0; v < inf.size(); ++v) {
+    auto& list = inf[v];
+    std::sort(list.begin(), list.end(), [](const Influence& a, const Influence& b) { return a.weight > b.weight; });
+    if (list.size() > 4) list.resize(4);
+    float sum = 0;
+    for (const auto& i : list) sum += i.weight;
+    std::array<std::uint16_t, 4> joints{};
+    Eigen::Vector4f weights = Eigen::Vector4f::Zero();
+    if (sum <= 0) {  // an unweighted vertex follows the fallback joint rigidly
+      joints[0] = static_cast<std::uint16_t>(fallback_joint);
+      weights[0] = 1;
+    } else {
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        joints[i] = static_cast<std::uint16_t>(list[i].joint);
+        weights[i] = list[i].weight / sum;
+      }
+    }
+    mesh.joints[v] = joints;
+    mesh.weights[v] = weights;
+  }
+}
+
+Mesh CopyGeometry(const aiMesh* m) {
+  Mesh mesh;
+  mesh.name = m->mName.C_Str();
+  mesh.material = static_cast<int>(m->mMaterialIndex);
+  mesh.positions.reserve(m->mNumVertices);
+  for (unsigned v = 0; v < m->mNumVertices; ++v)
+    mesh.positions.emplace_back(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z);
+  mesh.normals.resize(m->mNumVertices, Eigen::Vector3f::UnitY());
+  if (m->HasNormals())
+    for (unsigned v = 0; v < m->mNumVertices; ++v) {
+      Eigen::Vector3f n(m->mNormals[v].x, m->mNormals[v].y, m->mNormals[v].z);
+      if (n.norm() > 0) mesh.normals[v] = n.normalized();
+    }
+  if (m->HasTextureCoords(0)) {
+    mesh.uvs.reserve(m->mNumVertices);
+    for (unsigned v = 0; v < m->mNumVertices; ++v)
+      mesh.uvs.emplace_back(m->mTextureCoords[0][v].x, m->mTextureCoords[0][v].y);
+  }
+  for (unsigned f = 0; f < m->mNumFaces; ++f) {
+    const aiFace& face = m->mFaces[f];
+    if (face.mNumIndices != 3) continue;  // points and lines left over by triangulation
+    for (int i = 0; i < 3; ++i) mesh.indices.push_back(face.mIndices[i]);
+  }
+  return mesh;
+}
+
+class Importer {
+ public:
+  Importer(const aiScene* scene, const fs::path& path) : scene_(scene), path_(path), file_(path.string()) {}
+
+  Character Run() {
+    Character c;
+    c.source = file_;
+    BuildSkeleton(c.skeleton);
+    rest_model_ = RestModel(c.skeleton);
+    ImportMeshes(c);
+    ImportMaterials(c);
+    ImportClips(c);
+    return c;
+  }
+
+ private:
+  void BuildSkeleton(Skeleton& sk) {
+    std::set<std::string> names;
+    for (unsigned i = 0; i < scene_->mNumMeshes; ++i)
+      for (unsigned b = 0; b < scene_->mMeshes[i]->mNumBones; ++b)
+        names.insert(scene_->mMeshes[i]->mBones[b]->mName.C_Str());
+    if (names.empty())
+      for (unsigned a = 0; a < scene_->mNumAnimations; ++a)
+        for (unsigned ch = 0; ch < scene_->mAnimations[a]->mNumChannels; ++ch)
+          names.insert(scene_->mAnimations[a]->mChannels[ch]->mNodeName.C_Str());
+    if (names.empty()) throw Error(file_ + ": no skeleton (no skinned mesh and no animated node)");
+    const NodeSelection sel = SelectSkeletonNodes(scene_, names, file_);
+    if (sel.top->mParent) sk.root_parent = GlobalTransform(sel.top->mParent);
+    AddJoints(sel.top, -1, sel, sk, index_);
+    if (sk.size() > 65535) throw Error(file_ + ": more than 65535 joints");
+  }
+
+  void ImportMeshes(Character& c) {
+    Skeleton& sk = c.skeleton;
+    std::vector<bool> has_bind(sk.size(), false);
+    // Skinned meshes first: they define the inverse bind matrices.
+    std::vector<std::pair<const aiNode*, unsigned>> instances;
+    CollectInstances(scene_->mRootNode, instances);
+    for (const auto& [node, mi] : instances) {
+      const aiMesh* m = scene_->mMeshes[mi];
+      if (m->mNumBones == 0 || m->mNumVertices == 0) continue;
+      Mesh mesh = CopyGeometry(m);
+      std::vector<std::vector<Influence>> inf(m->mNumVertices);
+      std::optional<Eigen::Matrix4d> bake;
+      for (unsigned b = 0; b < m->mNumBones; ++b) {
+        const aiBone* bone = m->mBones[b];
+        const int j = JointOf(bone->mName.C_Str());
+        const Eigen::Matrix4d offset = ToEigen(bone->mOffsetMatrix);
+        if (!has_bind[j]) {
+          sk.inverse_bind[j] = offset;
+          has_bind[j] = true;
+        } else {
+          // Another mesh bound this joint differently: v' = IB⁻¹ · offset · v keeps the skinning
+          // formula, if one correction serves every bone of this mesh.
+          const Eigen::Matrix4d d = sk.inverse_bind[j].inverse() * offset;
+          if (!bake) bake = d;
+          else if (!bake->isApprox(d, 1e-6))
+            throw Error(file_ + ": mesh '" + mesh.name + "' is bound with inconsistent bind matrices for bone '" +
+                        sk.names[j] + "'");
+        }
+        for (unsigned w = 0; w < bone->mNumWeights; ++w) {
+          const aiVertexWeight& vw = bone->mWeights[w];
+          if (vw.mVertexId < m->mNumVertices && vw.mWeight > 0) inf[vw.mVertexId].push_back({j, vw.mWeight});
+        }
+      }
+      if (bake) BakeTransform(mesh, *bake);
+      FinishInfluences(mesh, inf, JointOf(m->mBones[0]->mName.C_Str()));
+      c.meshes.push_back(std::move(mesh));
+    }
+    // Joints that no skin references: bind them where they rest.
+    for (int j = 0; j < sk.size(); ++j)
+      if (!has_bind[j]) sk.inverse_bind[j] = rest_model_[j].inverse();
+    for (const auto& [node, mi] : instances) {
+      const aiMesh* m = scene_->mMeshes[mi];
+      if (m->mNumBones != 0 || m->mNumVertices == 0) continue;
+      const int j = NearestJoint(node);
+      Mesh mesh = CopyGeometry(m);
+      // At rest: model_j · IB_j · v' = G_node · v.
+      BakeTransform(mesh, sk.inverse_bind[j].inverse() * rest_model_[j].inverse() * GlobalTransform(node));
+      std::vector<std::vector<Influence>> inf(m->mNumVertices, {{j, 1.0f}});
+      FinishInfluences(mesh, inf, j);
+      c.meshes.push_back(std::move(mesh));
+    }
+  }
+
+  void CollectInstances(const aiNode* node, std::vector<std::pair<const aiNode*, unsigned>>& out) {
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) out.emplace_back(node, node->mMeshes[i]);
+    for (unsigned c = 0; c < node->mNumChildren; ++c) CollectInstances(node->mChildren[c], out);
+  }
+
+  int NearestJoint(const aiNode* node) const {
+    for (const aiNode* n = node; n; n = n->mParent)
+      if (auto it = index_.find(n); it != index_.end()) return it->second;
+    return 0;
+  }
+
+  int JointOf(const std::string& name) const {
+    const aiNode* n = scene_->mRootNode->FindNode(name.c_str());
+    auto it = index_.find(n);
+    if (it == index_.end()) throw Error(file_ + ": bone '" + name + "' is not in the skeleton");
+    return it->second;
+  }
+
+  void ImportMaterials(Character& c) {
+    std::map<std::string, int> texture_index;
+    for (unsigned i = 0; i < scene_->mNumMaterials; ++i) {
+      const aiMaterial* mat = scene_->mMaterials[i];
+      Material m;
+      aiString name;
+      if (mat->Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = name.C_Str();
+      aiColor4D col;
+      if (mat->Get(AI_MATKEY_BASE_COLOR, col) == AI_SUCCESS || mat->Get(AI_MATKEY_COLOR_DIFFUSE, col) == AI_SUCCESS)
+        m.base_color = Eigen::Vector4f(col.r, col.g, col.b, col.a);
+      aiString tex;
+      if (mat->GetTexture(aiTextureType_BASE_COLOR, 0, &tex) == AI_SUCCESS ||
+          mat->GetTexture(aiTextureType_DIFFUSE, 0, &tex) == AI_SUCCESS) {
+        const std::string key = tex.C_Str();
+        auto it = texture_index.find(key);
+        if (it == texture_index.end()) {
+          c.textures.push_back(LoadTexture(key));
+          it = texture_index.emplace(key, static_cast<int>(c.textures.size()) - 1).first;
+        }
+        m.texture = it->second;
+      }
+      c.materials.push_back(std::move(m));
+    }
+  }
+
+  Texture LoadTexture(const std::string& key) const {
+    Texture t;
+    if (const aiTexture* e = scene_->GetEmbeddedTexture(key.c_str())) {
+      if (e->mHeight == 0) {
+        const auto* bytes = reinterpret_cast<const std::uint8_t*>(e->pcData);
+        t.encoded.assign(bytes, bytes + e->mWidth);
+        t.format_hint = e->achFormatHint;
+      } else {
+        t.width = static_cast<int>(e->mWidth);
+        t.height = static_cast<int>(e->mHeight);
+        t.rgba.reserve(static_cast<std::size_t>(t.width) * t.height * 4);
+        for (unsigned p = 0; p < e->mWidth * e->mHeight; ++p) {
+          const aiTexel& x = e->pcData[p];
+          t.rgba.insert(t.rgba.end(), {x.r, x.g, x.b, x.a});
+        }
+      }
+      return t;
+    }
+    fs::path p = key;
+    if (p.is_relative()) p = path_.parent_path() / p;
+    t.path = fs::absolute(p).lexically_normal().string();
+    return t;
+  }
+
+  void ImportClips(Character& c) {
+    std::set<std::string> used;
+    for (unsigned a = 0; a < scene_->mNumAnimations; ++a) {
+      const aiAnimation* anim = scene_->mAnimations[a];
+      Clip clip;
+      clip.name = anim->mName.length ? anim->mName.C_Str() : "clip" + std::to_string(a);
+      for (int n = 2; used.count(clip.name); ++n) clip.name = std::string(anim->mName.C_Str()) + "#" + std::to_string(n);
+      used.insert(clip.name);
+      clip.ticks_per_second = anim->mTicksPerSecond;
+      const double tps = anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0;  // Assimp's default
+      clip.duration = anim->mDuration / tps;
+      clip.tracks.resize(c.skeleton.size());
+      for (unsigned ch = 0; ch < anim->mNumChannels; ++ch) {
+        const aiNodeAnim* na = anim->mChannels[ch];
+        const aiNode* node = scene_->mRootNode->FindNode(na->mNodeName);
+        auto it = index_.find(node);
+        if (it == index_.end()) continue;  // animates a node outside the skeleton (e.g. a mesh node)
+        JointTrack& tr = clip.tracks[it->second];
+        for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
+          const auto& v = na->mPositionKeys[k];
+          tr.translation.push_back({v.mTime / tps, Eigen::Vector3d(v.mValue.x, v.mValue.y, v.mValue.z)});
+        }
+        for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
+          const auto& v = na->mRotationKeys[k];
+          tr.rotation.push_back({v.mTime / tps, Eigen::Quaterniond(v.mValue.w, v.mValue.x, v.mValue.y, v.mValue.z).normalized()});
+        }
+        for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
+          const auto& v = na->mScalingKeys[k];
+          tr.scale.push_back({v.mTime / tps, Eigen::Vector3d(v.mValue.x, v.mValue.y, v.mValue.z)});
+        }
+        for (const auto* keys : {&tr.translation, &tr.scale})
+          for (const auto& k : *keys)
+            if (!k.value.allFinite()) throw Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
+        for (const auto& k : tr.rotation)
+          if (!k.value.coeffs().allFinite()) throw Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
+      }
+      if (!(clip.duration >= 0) || !std::isfinite(clip.duration))
+        throw Error(file_ + ": clip '" + clip.name + "' has an invalid duration");
+      c.clips.push_back(std::move(clip));
+    }
+  }
+
+  const aiScene* scene_;
+  fs::path path_;
+  std::string file_;
+  std::unordered_map<const aiNode*, int> index_;
+  std::vector<Eigen::Matrix4d> rest_model_;
+};
+
+}  // namespace
+
+Character LoadCharacter(const fs::path& path) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(file + ": no such file");
+  if (!fs::is_regular_file(path, ec)) throw Error(file + ": not a regular file");
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw Error(file + ": cannot open for reading");
+  }
+  Assimp::Importer importer;
+  // No stand-in "skeleton mesh" for files that have bones but no skin (BVH).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  const aiScene* scene = importer.ReadFile(
+      file, aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices |
+                aiProcess_LimitBoneWeights | aiProcess_SortByPType);
+  if (!scene || !scene->mRootNode) {
+    const std::string why = importer.GetErrorString();
+    throw Error(file + ": cannot read as a 3D asset" + (why.empty() ? std::string() : ": " + why));
+  }
+  return Importer(scene, path).Run();
+}
+
+}  // namespace arview::anim

@@ -1,0 +1,220 @@
+#include "anim/character.h"
+#include "anim/pose.h"
+#include "tests/support/test_data.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+namespace arview::anim {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kBcn = "/usr/share/assimp/models/X/BCN_Epileptic.X";
+const fs::path kBvh = "/usr/share/assimp/models/BVH/01_01.bvh";
+fs::path Fox() { return testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
+fs::path CesiumMan() { return testing::SharedData("characters/CesiumMan.glb"); }
+
+// Skins every mesh at the given pose; returns the largest distance to the rest mesh placed in
+// model space, relative to the model's size.
+double RestSkinningError(const Character& c, SkinningMethod method) {
+  const Skeleton& sk = c.skeleton;
+  const LocalPose rest = LocalPose::Rest(sk);
+  std::vector<Eigen::Matrix4d> model(sk.size());
+  EXPECT_TRUE((LocalToModelJob{&sk, &rest, model}.Run()));
+  std::vector<Eigen::Matrix4f> skin(sk.size());
+  std::vector<DualQuatf> dq(sk.size());
+  EXPECT_TRUE((SkinningMatricesJob{&sk, model, skin, dq}.Run()));
+  double worst = 0, extent = 0;
+  for (const Mesh& m : c.meshes) {
+    std::vector<Eigen::Vector3f> pos(m.vertex_count()), nrm(m.vertex_count());
+    EXPECT_TRUE((SkinningJob{&m, method, skin, dq, pos, nrm}.Run()));
+    for (int v = 0; v < m.vertex_count(); ++v) {
+      worst = std::max(worst, double((pos[v] - m.positions[v]).norm()));
+      extent = std::max(extent, double(m.positions[v].norm()));
+    }
+  }
+  return worst / std::max(extent, 1e-9);
+}
+
+void ExpectValidSkin(const Character& c) {
+  for (const Mesh& m : c.meshes) {
+    ASSERT_EQ(m.joints.size(), m.positions.size());
+    ASSERT_EQ(m.normals.size(), m.positions.size());
+    ASSERT_EQ(m.indices.size() % 3, 0u);
+    for (auto i : m.indices) ASSERT_LT(i, m.positions.size());
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      EXPECT_NEAR(m.weights[v].sum(), 1.0f, 1e-5f);
+      EXPECT_GE(m.weights[v].minCoeff(), 0.0f);
+      for (auto j : m.joints[v]) ASSERT_LT(int(j), c.skeleton.size());
+    }
+  }
+  for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT(c.skeleton.parents[j], j);
+}
+
+TEST(Import, Fox) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Character c = LoadCharacter(Fox());
+  EXPECT_EQ(c.skeleton.size(), 24);
+  ASSERT_EQ(c.clips.size(), 3u);
+  EXPECT_NE(c.FindClip("Survey"), nullptr);
+  EXPECT_NE(c.FindClip("Walk"), nullptr);
+  EXPECT_NE(c.FindClip("Run"), nullptr);
+  EXPECT_NEAR(c.FindClip("Walk")->duration, 0.708, 0.01);
+  ASSERT_EQ(c.meshes.size(), 1u);
+  EXPECT_FALSE(c.meshes[0].uvs.empty());
+  ASSERT_GE(c.meshes[0].material, 0);
+  const Material& mat = c.materials[c.meshes[0].material];
+  ASSERT_GE(mat.texture, 0);
+  EXPECT_EQ(c.textures[mat.texture].format_hint, "png");
+  EXPECT_GT(c.textures[mat.texture].encoded.size(), 1000u);
+  ExpectValidSkin(c);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-5);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-5);
+}
+
+TEST(Import, CesiumMan) {
+  ARVIEW_REQUIRE_DATA_PATH(CesiumMan(), "../shared/data");
+  const Character c = LoadCharacter(CesiumMan());
+  EXPECT_EQ(c.skeleton.size(), 19);
+  EXPECT_EQ(c.clips.size(), 1u);
+  ASSERT_EQ(c.meshes.size(), 1u);
+  ExpectValidSkin(c);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
+}
+
+TEST(Import, BcnEpilepticX) {
+  ARVIEW_REQUIRE_DATA_PATH(kBcn, "Debian package assimp-testmodels");
+  const Character c = LoadCharacter(kBcn);
+  EXPECT_EQ(c.skeleton.size(), 54);
+  EXPECT_EQ(c.clips.size(), 1u);
+  EXPECT_EQ(c.meshes.size(), 3u);
+  EXPECT_GE(c.skeleton.Find("B_Neck"), 0);
+  ExpectValidSkin(c);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
+}
+
+TEST(Import, CmuBvh) {
+  ARVIEW_REQUIRE_DATA_PATH(kBvh, "Debian package assimp-testmodels");
+  const Character c = LoadCharacter(kBvh);
+  EXPECT_EQ(c.skeleton.size(), 31);
+  EXPECT_TRUE(c.meshes.empty());
+  ASSERT_EQ(c.clips.size(), 1u);
+  const Clip& clip = c.clips[0];
+  EXPECT_NEAR(clip.ticks_per_second, 120.0, 1e-3);
+  const int hips = c.skeleton.Find("Hips");
+  ASSERT_EQ(hips, 0);
+  const auto& keys = clip.tracks[hips].rotation;
+  ASSERT_GT(keys.size(), 100u);
+  EXPECT_NEAR(keys[1].time - keys[0].time, 1.0 / 120, 1e-6);
+  EXPECT_NEAR(clip.duration, (keys.size() - 1) / 120.0, 1e-3);
+}
+
+TEST(Import, SamplingInterpolatesAndLoops) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Character c = LoadCharacter(Fox());
+  const Clip& walk = *c.FindClip("Walk");
+  const Skeleton& sk = c.skeleton;
+  LocalPose a(sk.size()), b(sk.size());
+  ASSERT_TRUE((SamplingJob{&sk, &walk, 0.1, true, &a}.Run()));
+  ASSERT_TRUE((SamplingJob{&sk, &walk, 0.1 + walk.duration, true, &b}.Run()));
+  for (int j = 0; j < sk.size(); ++j) EXPECT_LT((a.rigid[j].ToMatrix() - b.rigid[j].ToMatrix()).norm(), 1e-9);
+  // Clamp: beyond the end holds the last key.
+  ASSERT_TRUE((SamplingJob{&sk, &walk, 100.0, false, &a}.Run()));
+  ASSERT_TRUE((SamplingJob{&sk, &walk, walk.duration, false, &b}.Run()));
+  for (int j = 0; j < sk.size(); ++j) EXPECT_LT((a.rigid[j].ToMatrix() - b.rigid[j].ToMatrix()).norm(), 1e-9);
+  // Between two keys the rotation lies between the keys' rotations.
+  const int hip = sk.Find("b_Hip_01");
+  const auto& keys = walk.tracks[hip].rotation;
+  ASSERT_GT(keys.size(), 2u);
+  const double mid = 0.5 * (keys[0].time + keys[1].time);
+  ASSERT_TRUE((SamplingJob{&sk, &walk, mid, false, &a}.Run()));
+  const Eigen::Quaterniond r = a.rigid[hip].Rotation();
+  EXPECT_NEAR(r.angularDistance(keys[0].value), 0.5 * keys[0].value.angularDistance(keys[1].value), 1e-9);
+}
+
+TEST(Import, JobsRejectMismatchedSizes) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Character c = LoadCharacter(Fox());
+  LocalPose wrong(3);
+  EXPECT_FALSE((SamplingJob{&c.skeleton, &c.clips[0], 0.0, true, &wrong}.Run()));
+  std::vector<Eigen::Matrix4d> model(2);
+  LocalPose rest = LocalPose::Rest(c.skeleton);
+  EXPECT_FALSE((LocalToModelJob{&c.skeleton, &rest, model}.Run()));
+}
+
+TEST(Import, AnimatedPoseLbsAndDqsAgreeRoughly) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Character c = LoadCharacter(Fox());
+  const Skeleton& sk = c.skeleton;
+  LocalPose p(sk.size());
+  ASSERT_TRUE((SamplingJob{&sk, c.FindClip("Run"), 0.3, true, &p}.Run()));
+  std::vector<Eigen::Matrix4d> model(sk.size());
+  ASSERT_TRUE((LocalToModelJob{&sk, &p, model}.Run()));
+  std::vector<Eigen::Matrix4f> skin(sk.size());
+  std::vector<DualQuatf> dq(sk.size());
+  ASSERT_TRUE((SkinningMatricesJob{&sk, model, skin, dq}.Run()));
+  EXPECT_TRUE(RigidSkinning(skin));
+  const Mesh& m = c.meshes[0];
+  std::vector<Eigen::Vector3f> lbs(m.vertex_count()), dqs(m.vertex_count());
+  ASSERT_TRUE((SkinningJob{&m, SkinningMethod::kLinear, skin, dq, lbs, {}}.Run()));
+  ASSERT_TRUE((SkinningJob{&m, SkinningMethod::kDualQuaternion, skin, dq, dqs, {}}.Run()));
+  double worst = 0, moved = 0;
+  for (int v = 0; v < m.vertex_count(); ++v) {
+    worst = std::max(worst, double((lbs[v] - dqs[v]).norm()));
+    moved = std::max(moved, double((lbs[v] - m.positions[v]).norm()));
+  }
+  EXPECT_GT(moved, 1.0);       // the run pose really moves the mesh (model units: cm)
+  EXPECT_LT(worst, 0.2 * moved);  // the two skinning methods differ only near blended joints
+  // Rigidly bound vertices (one influence) agree exactly.
+  for (int v = 0; v < m.vertex_count(); ++v) {
+    if (m.weights[v][0] == 1.0f) {
+      EXPECT_LT((lbs[v] - dqs[v]).norm(), 1e-3f);
+    }
+  }
+}
+
+fs::path TempFile(const std::string& name) { return fs::temp_directory_path() / ("arview_anim_" + name); }
+
+TEST(ImportErrors, MissingFile) {
+  try {
+    LoadCharacter("/nonexistent/dir/fox.glb");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/fox.glb: no such file"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImportErrors, TruncatedGltf) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  std::ifstream in(Fox(), std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const fs::path cut = TempFile("truncated.glb");
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), bytes.size() / 3);
+  try {
+    LoadCharacter(cut);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(cut.string() + ": cannot read"), std::string::npos) << e.what();
+  }
+  fs::remove(cut);
+}
+
+TEST(ImportErrors, NoSkeleton) {
+  const fs::path obj = TempFile("cube.obj");
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  try {
+    LoadCharacter(obj);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(obj.string() + ": no skeleton"), std::string::npos) << e.what();
+  }
+  fs::remove(obj);
+}
+
+}  // namespace
+}  // namespace arview::anim
