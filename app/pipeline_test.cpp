@@ -57,3 +57,18 @@ TEST(StageStats, RecordsFromSeveralThreads) {
 
 }  // namespace
 }  // namespace arview::app
+
+#include "app/json_writer.h"
+
+namespace arview::app {
+namespace {
+
+TEST(JsonWriter, NestedObjectsArraysAndEscapes) {
+  JsonWriter w;
+  w.BeginObject().Value("frames", 3).Value("name", "a\"b\n").BeginArray("ms").Element(1.5).Element(NAN).EndArray();
+  w.BeginObject("empty").EndObject().EndObject();
+  EXPECT_EQ(w.str(), "{\n  \"frames\": 3,\n  \"name\": \"a\\\"b\\n\",\n  \"ms\": [\n    1.5,\n    null\n  ],\n  \"empty\": {}\n}");
+}
+
+}  // namespace
+}  // namespace arview::app
