@@ -270,9 +270,14 @@ std::string ReportToJson(const AccuracyReport& r) {
 std::string ReportToText(const AccuracyReport& r) {
   char buf[512];
   std::ostringstream o;
-  std::snprintf(buf, sizeof(buf), "alignment   %s%s, scale %.6g (fitted on %d pairs)\n", ToString(r.align).c_str(),
-                r.aligned_with_other ? " fitted on --align-with" : "", r.alignment.scale, r.alignment_pairs);
-  o << buf;
+  if (r.align == AlignMode::kNone) {
+    o << "alignment   none\n";
+  } else {
+    std::snprintf(buf, sizeof(buf), "alignment   %s, scale %.6g, fitted on %d pose pairs of %s\n",
+                  ToString(r.align).c_str(), r.alignment.scale, r.alignment_pairs,
+                  r.aligned_with_other ? "the --align-with trajectory" : "the estimate");
+    o << buf;
+  }
   std::snprintf(buf, sizeof(buf), "coverage    %d of %d ground-truth poses have an estimate (%.1f%%); %d estimated poses\n",
                 r.associated, r.groundtruth_poses, 100.0 * r.coverage, r.estimate_poses);
   o << buf;

@@ -10,6 +10,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "recordings/recording.h"
+#include "recordings/test_helpers.h"
 #include "tests/support/test_data.h"
 
 namespace arview::recordings {
@@ -17,23 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh, empty folder under the system temp directory, removed at the end of the test.
-class TempDir {
- public:
-  explicit TempDir(const std::string& name)
-      : path_(fs::temp_directory_path() / ("arview_recordings_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using test::TempDir;
+using test::WriteFile;
+using test::WriteImage;
 
 struct ParLine {
   std::string name;
@@ -110,19 +97,6 @@ TEST(ImportMiddlebury, TempleRingMatchesTheOriginalProjections) {
   EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0);
 }
 
-void WriteFile(const fs::path& p, const std::string& text) {
-  fs::create_directories(p.parent_path());
-  std::ofstream(p) << text;
-}
-
-void WriteImage(const fs::path& p, int w, int h, int seed) {
-  fs::create_directories(p.parent_path());
-  cv::Mat image(h, w, CV_8UC3);
-  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
-  cv::putText(image, std::to_string(seed), {5, h / 2}, cv::FONT_HERSHEY_SIMPLEX, 1.0, {255, 255, 255}, 2);
-  ASSERT_TRUE(cv::imwrite(p.string(), image));
-}
-
 const char* kPar2 =
     "2\n"
     "a.png 100 0 16 0 100 12 0 0 1  1 0 0 0 1 0 0 0 1  0 0 1\n"
@@ -173,6 +147,183 @@ TEST(ImportMiddlebury, RefusesToOverwriteWithoutPermission) {
   WriteFile(dir.path() / "precious/notes.txt", "keep me");
   EXPECT_THROW(ImportMiddlebury(dir.path() / "src", dir.path() / "precious", force), RecordingError);
   EXPECT_TRUE(fs::exists(dir.path() / "precious/notes.txt"));
+}
+
+// ---------------------------------------------------------------- Strecha
+
+// K[Rᵀ | −RᵀC] as the EPFL benchmark defines it.
+Eigen::Matrix<double, 3, 4> StrechaP(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& C) {
+  Eigen::Matrix<double, 3, 4> Rt;
+  Rt << R_wc.transpose(), -R_wc.transpose() * C;
+  return K * Rt;
+}
+
+std::string StrechaFile(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& C,
+                        const std::string& distortion = "0 0 0") {
+  std::ostringstream o;
+  o.precision(17);
+  for (int r = 0; r < 3; ++r) o << K(r, 0) << " " << K(r, 1) << " " << K(r, 2) << "\n";
+  o << distortion << "\n";
+  for (int r = 0; r < 3; ++r) o << R_wc(r, 0) << " " << R_wc(r, 1) << " " << R_wc(r, 2) << "\n";
+  o << C.x() << " " << C.y() << " " << C.z() << "\n";
+  o << "64 48\n";
+  return o.str();
+}
+
+TEST(ImportStrecha, GroundTruthReprojectsLikeTheBenchmarkCameras) {
+  TempDir dir("strecha");
+  Eigen::Matrix3d K;
+  K << 70, 0, 31.5, 0, 71, 23.5, 0, 0, 1;
+  std::vector<Eigen::Matrix3d> rotations;
+  std::vector<Eigen::Vector3d> centres;
+  for (int i = 0; i < 3; ++i) {
+    rotations.push_back(Eigen::AngleAxisd(0.3 * i + 0.1, Eigen::Vector3d(0.2, 1, 0.1).normalized()).toRotationMatrix());
+    centres.emplace_back(i * 0.5, -0.2 * i, 1.0 + i);
+    const std::string name = "000" + std::to_string(i) + (i == 1 ? ".jpg" : ".png");
+    WriteImage(dir.path() / "src/images" / name, 64, 48, i);
+    WriteFile(dir.path() / "src/gt_dense_cameras" / (name + ".camera"), StrechaFile(K, rotations[i], centres[i]));
+  }
+  const ImportResult result = ImportStrecha(dir.path() / "src", dir.path() / "out");
+  EXPECT_EQ(result.frame_count, 3);
+  const Recording rec = LoadRecording(dir.path() / "out");
+  ASSERT_TRUE(rec.groundtruth);
+  ASSERT_EQ(rec.groundtruth->size(), 3u);
+  EXPECT_DOUBLE_EQ(rec.camera.fx, 70);
+  EXPECT_DOUBLE_EQ(rec.camera.cy, 23.5);
+  for (int i = 0; i < 3; ++i) {
+    const calib::Pose& pose = (*rec.groundtruth)[i].pose;
+    EXPECT_LT((pose.Center() - centres[i]).norm(), 1e-12);
+    const Eigen::Vector3d X(0.3, -0.1, 5.0);
+    const Eigen::Vector3d x = StrechaP(K, rotations[i], centres[i]) * X.homogeneous();
+    EXPECT_LT((rec.camera.Project(pose.ToCamera(X)) - x.head<2>() / x.z()).norm(), 1e-9);
+    EXPECT_EQ(rec.ReadImage(i).size(), cv::Size(64, 48));
+  }
+  EXPECT_EQ(rec.frames[1].path, "frames/000001.png");  // the JPEG became a PNG
+}
+
+TEST(ImportStrecha, ReportsBadCameraFilesWithFileAndLine) {
+  TempDir dir("strecha_bad");
+  Eigen::Matrix3d K;
+  K << 70, 0, 31.5, 0, 71, 23.5, 0, 0, 1;
+  WriteImage(dir.path() / "src/images/0000.png", 64, 48, 0);
+  std::string text = StrechaFile(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  text.replace(text.find("0 0 0\n"), 6, "0 0\n");
+  WriteFile(dir.path() / "src/gt_dense_cameras/0000.png.camera", text);
+  try {
+    ImportStrecha(dir.path() / "src", dir.path() / "out");
+    FAIL() << "expected a RecordingError";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("0000.png.camera:4"), std::string::npos) << e.what();
+  }
+  WriteFile(dir.path() / "src/gt_dense_cameras/0000.png.camera",
+            StrechaFile(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), "0.1 0 0"));
+  EXPECT_THROW(ImportStrecha(dir.path() / "src", dir.path() / "out"), RecordingError);
+  fs::remove(dir.path() / "src/gt_dense_cameras/0000.png.camera");
+  try {
+    ImportStrecha(dir.path() / "src", dir.path() / "out");
+    FAIL() << "expected a RecordingError";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("0000.png.camera"), std::string::npos) << e.what();
+  }
+}
+
+// ---------------------------------------------------------------- TUM, images, video
+
+calib::Camera SmallCamera() { return calib::Camera::Pinhole(64, 48, 60, 60, 31.5, 23.5); }
+
+TEST(ImportTum, KeepsTimestampsAndCopiesGroundTruth) {
+  TempDir dir("tum");
+  const fs::path src = dir.path() / "rgbd_dataset_test";
+  WriteFile(src / "rgb.txt",
+            "# color images\n# file: 'test.bag'\n# timestamp filename\n"
+            "1305031102.175304 rgb/1305031102.175304.png\n"
+            "1305031102.211214 rgb/1305031102.211214.png\n"
+            "1305031102.243211 rgb/1305031102.243211.png\n");
+  for (const char* t : {"1305031102.175304", "1305031102.211214", "1305031102.243211"}) {
+    WriteImage(src / "rgb" / (std::string(t) + ".png"), 64, 48, 1);
+  }
+  WriteFile(src / "groundtruth.txt",
+            "# ground truth trajectory\n# timestamp tx ty tz qx qy qz qw\n"
+            "1305031102.1758 1.3405 0.6266 1.6575 0.6574 0.6126 -0.2949 -0.3248\n"
+            "1305031102.1858 1.3303 0.6256 1.6464 0.6579 0.6161 -0.2932 -0.3189\n"
+            "1305031102.2158 1.3160 0.6254 1.6302 0.6609 0.6199 -0.2893 -0.3086\n"
+            "1305031102.2458 1.3054 0.6251 1.6161 0.6641 0.6236 -0.2850 -0.2969\n");
+  EXPECT_THROW(ImportTum(src, dir.path() / "out"), RecordingError);  // no intrinsics anywhere
+  ImportOptions options;
+  options.camera = SmallCamera();
+  const ImportResult result = ImportTum(src, dir.path() / "out", options);
+  EXPECT_EQ(result.frame_count, 3);
+  EXPECT_TRUE(result.has_groundtruth);
+  const Recording rec = LoadRecording(dir.path() / "out");
+  ASSERT_EQ(rec.frames.size(), 3u);
+  EXPECT_NEAR(rec.frames[1].timestamp, 1305031102.211214, 1e-6);
+  ASSERT_TRUE(rec.groundtruth);
+  ASSERT_EQ(rec.groundtruth->size(), 4u);
+  EXPECT_NEAR((*rec.groundtruth)[2].pose.Center().x(), 1.3160, 1e-12);
+  // A missing image is named.
+  fs::remove(src / "rgb/1305031102.211214.png");
+  options.overwrite = true;
+  try {
+    ImportTum(src, dir.path() / "out", options);
+    FAIL() << "expected a RecordingError";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("1305031102.211214.png"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ImportImages, TakesImagesInNameOrderWithTheGivenCamera) {
+  TempDir dir("images");
+  WriteImage(dir.path() / "src/b.jpg", 64, 48, 2);
+  WriteImage(dir.path() / "src/a.png", 64, 48, 1);
+  WriteImage(dir.path() / "src/c.bmp", 64, 48, 3);
+  WriteFile(dir.path() / "src/notes.txt", "not an image");
+  EXPECT_THROW(ImportImages(dir.path() / "src", dir.path() / "out"), RecordingError);  // no --camera
+  ImportOptions options;
+  options.camera = SmallCamera();
+  EXPECT_EQ(ImportImages(dir.path() / "src", dir.path() / "out", options).frame_count, 3);
+  const Recording rec = LoadRecording(dir.path() / "out");
+  ASSERT_EQ(rec.frames.size(), 3u);
+  EXPECT_DOUBLE_EQ(rec.frames[2].timestamp, 2.0);
+  EXPECT_FALSE(rec.groundtruth);
+  EXPECT_EQ(cv::norm(rec.ReadImage(0), cv::imread((dir.path() / "src/a.png").string()), cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(rec.ReadImage(2), cv::imread((dir.path() / "src/c.bmp").string()), cv::NORM_INF), 0);
+  // An image of another size than the camera is an error naming it.
+  WriteImage(dir.path() / "src/d.png", 32, 48, 4);
+  options.overwrite = true;
+  try {
+    ImportImages(dir.path() / "src", dir.path() / "out", options);
+    FAIL() << "expected a RecordingError";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("d.png"), std::string::npos) << e.what();
+  }
+}
+
+using test::WriteTestVideo;
+
+TEST(ImportVideo, CountsFramesAndKeepsTheirTimestamps) {
+  TempDir dir("video");
+  ASSERT_TRUE(WriteTestVideo(dir.path() / "clip.avi", 12, 10.0));
+  EXPECT_THROW(ImportVideo(dir.path() / "clip.avi", dir.path() / "out"), RecordingError);  // no --camera
+  ImportOptions options;
+  options.camera = SmallCamera();
+  EXPECT_EQ(ImportVideo(dir.path() / "clip.avi", dir.path() / "out", options).frame_count, 12);
+  const Recording rec = LoadRecording(dir.path() / "out");
+  ASSERT_EQ(rec.frames.size(), 12u);
+  EXPECT_TRUE(rec.IsVideo());
+  EXPECT_EQ(rec.frames[0].path, "frames/clip.avi");
+  for (size_t i = 0; i < rec.frames.size(); ++i) EXPECT_NEAR(rec.frames[i].timestamp, 0.1 * i, 1e-6);
+  // Wrong camera size; not a video.
+  options.camera = calib::Camera::Pinhole(640, 480, 500, 500, 320, 240);
+  options.overwrite = true;
+  EXPECT_THROW(ImportVideo(dir.path() / "clip.avi", dir.path() / "out", options), RecordingError);
+  WriteFile(dir.path() / "fake.mp4", "this is not a video");
+  EXPECT_THROW(ImportVideo(dir.path() / "fake.mp4", dir.path() / "out2", options), RecordingError);
+  EXPECT_THROW(ImportVideo(dir.path() / "missing.mp4", dir.path() / "out2", options), RecordingError);
+}
+
+TEST(Import, DispatchesByKindAndRejectsUnknownKinds) {
+  EXPECT_THROW(Import("colmap", "/tmp", "/tmp/none"), RecordingError);
+  EXPECT_EQ(ImporterKinds().size(), 5u);
 }
 
 }  // namespace

@@ -92,6 +92,18 @@ void PlotTrajectories(const AccuracyReport& report, const Trajectory& groundtrut
     scale = std::min({scale, su, sv});
   }
 
+  // Consecutive ground-truth poses are joined only when they are near neighbours: still-image
+  // data sets (templeRing) list views out of path order, and long chords would mislead.
+  std::vector<double> steps;
+  for (size_t k = 1; k < gt_points.size(); ++k) steps.push_back((gt_points[k] - gt_points[k - 1]).norm());
+  std::vector<bool> joined(gt_points.size(), false);
+  if (!steps.empty()) {
+    std::vector<double> sorted = steps;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double limit = 3 * sorted[sorted.size() / 2];
+    for (size_t k = 1; k < gt_points.size(); ++k) joined[k] = steps[k - 1] <= limit;
+  }
+
   cv::Mat image(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const double max_error = std::max(report.ate.max, 1e-12);
   for (const Panel& p : panels) {
@@ -107,6 +119,7 @@ void PlotTrajectories(const AccuracyReport& report, const Trajectory& groundtrut
     cv::putText(image, p.title, {p.area.x + 8, p.area.y + 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {60, 60, 60}, 1,
                 cv::LINE_AA);
     for (size_t k = 1; k < groundtruth.size(); ++k) {
+      if (!joined[k]) continue;
       cv::line(image, fixed(pixel(groundtruth[k - 1].pose.Center())), fixed(pixel(groundtruth[k].pose.Center())),
                {150, 150, 150}, 1, cv::LINE_AA, shift);
     }

@@ -1,0 +1,77 @@
+#pragma once
+// Where frames come from: a recording being replayed or a live V4L2 camera. The tracker and
+// the real-time pipeline read every source through this one interface.
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "recordings/recording.h"
+
+namespace arview::recordings {
+
+struct Frame {
+  cv::Mat image;          // BGR, 8 bits per channel
+  double timestamp = 0;   // seconds (recording: frames.txt time; live: kernel capture time)
+  int64_t index = 0;      // recording: the frame's 0-based line in frames.txt; live: sequence number
+};
+
+// A source that fails while running (file unreadable, device gone); the message names it.
+struct SourceError : RecordingError {
+  using RecordingError::RecordingError;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // The next frame; false at the end of the stream (or after Stop()). Throws SourceError.
+  virtual bool Next(Frame& frame) = 0;
+  // The recording folder or device path, for messages.
+  virtual std::string Name() const = 0;
+};
+
+struct ReplayOptions {
+  // Deliver frames at the recorded rate (sleeping between them) instead of as fast as possible.
+  bool paced = false;
+  double speed = 1.0;  // with paced: 2 = twice the recorded rate
+  // Start again after the last frame, forever. Timestamps keep increasing across passes (each
+  // pass is shifted by the recording's duration plus one median frame interval).
+  bool loop = false;
+  // 0-based indices into frames.txt to deliver, in this order (ParseFrameSpec); empty = all.
+  std::vector<int> frames;
+};
+
+// Replays a recording folder: one image per frame, or one video file decoded with OpenCV's
+// FFmpeg backend (whose frame count must match frames.txt).
+class RecordingSource : public FrameSource {
+ public:
+  explicit RecordingSource(Recording recording, ReplayOptions options = {});
+  bool Next(Frame& frame) override;
+  std::string Name() const override { return recording_.root.string(); }
+  const Recording& recording() const { return recording_; }
+
+ private:
+  cv::Mat ReadFrame(int index);
+  cv::Mat ReadVideoFrame(int index);
+  void WaitUntilDue(double timestamp);
+
+  Recording recording_;
+  ReplayOptions options_;
+  std::vector<int> order_;
+  size_t cursor_ = 0;
+  double loop_offset_ = 0;
+  double pass_length_ = 0;
+  cv::VideoCapture video_;
+  int video_next_ = 0;  // index of the frame the next video read returns
+  bool started_ = false;
+  std::chrono::steady_clock::time_point wall_start_;
+  double first_timestamp_ = 0;
+};
+
+}  // namespace arview::recordings

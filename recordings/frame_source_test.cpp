@@ -1,0 +1,141 @@
+#include "recordings/frame_source.h"
+
+#include <chrono>
+
+#include <gtest/gtest.h>
+
+#include "recordings/importers.h"
+#include "recordings/test_helpers.h"
+
+namespace arview::recordings {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+// A recording of `n` distinct 64x48 still frames, 0.02 s apart.
+Recording MakeStillRecording(const fs::path& root, int n) {
+  fs::create_directories(root / "frames");
+  std::vector<FrameEntry> frames;
+  for (int i = 0; i < n; ++i) {
+    const std::string rel = "frames/" + std::to_string(100 + i) + ".png";
+    test::WriteImage(root / rel, 64, 48, i);
+    frames.push_back({10.0 + 0.02 * i, rel});
+  }
+  calib::SaveCamera(calib::Camera::Pinhole(64, 48, 60, 60, 31.5, 23.5), root / "camera.yaml");
+  WriteFramesTxt(root, frames);
+  return LoadRecording(root);
+}
+
+TEST(RecordingSource, ReplaysStillFramesInOrder) {
+  TempDir dir("replay");
+  RecordingSource source(MakeStillRecording(dir.path() / "rec", 5));
+  Frame f;
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(source.Next(f));
+    EXPECT_EQ(f.index, i);
+    EXPECT_NEAR(f.timestamp, 10.0 + 0.02 * i, 1e-9);
+    EXPECT_EQ(f.image.type(), CV_8UC3);
+    EXPECT_EQ(cv::norm(f.image, test::MakeImage(64, 48, i), cv::NORM_INF), 0);
+  }
+  EXPECT_FALSE(source.Next(f));
+  EXPECT_FALSE(source.Next(f));
+}
+
+TEST(RecordingSource, LoopsWithIncreasingTimestampsAndSelectsFrames) {
+  TempDir dir("replay_loop");
+  ReplayOptions options;
+  options.loop = true;
+  options.frames = {1, 3};
+  RecordingSource source(MakeStillRecording(dir.path() / "rec", 5), options);
+  Frame f;
+  std::vector<int64_t> indices;
+  std::vector<double> stamps;
+  for (int k = 0; k < 6; ++k) {
+    ASSERT_TRUE(source.Next(f));
+    indices.push_back(f.index);
+    stamps.push_back(f.timestamp);
+  }
+  EXPECT_EQ(indices, (std::vector<int64_t>{1, 3, 1, 3, 1, 3}));
+  // A pass lasts last - first + one interval: 0.04 + 0.04.
+  EXPECT_NEAR(stamps[2] - stamps[0], 0.08, 1e-9);
+  EXPECT_NEAR(stamps[5] - stamps[3], 0.08, 1e-9);
+  for (size_t k = 1; k < stamps.size(); ++k) EXPECT_GT(stamps[k], stamps[k - 1]);
+}
+
+TEST(RecordingSource, PacedReplayWaitsForTheRecordedTimes) {
+  TempDir dir("replay_paced");
+  ReplayOptions options;
+  options.paced = true;
+  RecordingSource source(MakeStillRecording(dir.path() / "rec", 6), options);
+  Frame f;
+  const auto start = std::chrono::steady_clock::now();
+  int n = 0;
+  while (source.Next(f)) ++n;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(n, 6);
+  EXPECT_GE(elapsed, 0.1 - 1e-3);  // frame 5 is due 5 × 0.02 s after frame 0: a lower bound only
+}
+
+TEST(RecordingSource, ReplaysAVideoRecording) {
+  TempDir dir("replay_video");
+  ASSERT_TRUE(test::WriteTestVideo(dir.path() / "clip.avi", 8, 25.0));
+  ImportOptions io;
+  io.camera = calib::Camera::Pinhole(64, 48, 60, 60, 31.5, 23.5);
+  ImportVideo(dir.path() / "clip.avi", dir.path() / "rec", io);
+  ReplayOptions options;
+  options.loop = true;
+  RecordingSource source(LoadRecording(dir.path() / "rec"), options);
+  Frame f;
+  for (int k = 0; k < 11; ++k) {  // one pass and then some: the video is reopened
+    ASSERT_TRUE(source.Next(f));
+    EXPECT_EQ(f.index, k % 8);
+    ASSERT_EQ(f.image.size(), cv::Size(64, 48));
+    // MJPEG is lossy; the frame must still be far closer to its own source than to another.
+    const double own = cv::norm(f.image, test::MakeImage(64, 48, k % 8), cv::NORM_L1);
+    const double other = cv::norm(f.image, test::MakeImage(64, 48, (k + 1) % 8), cv::NORM_L1);
+    EXPECT_LT(own, 0.5 * other) << "frame " << k;
+  }
+  // Jumping backwards within a pass works too.
+  options.loop = false;
+  options.frames = {5, 2};
+  RecordingSource jump(LoadRecording(dir.path() / "rec"), options);
+  ASSERT_TRUE(jump.Next(f));
+  EXPECT_EQ(f.index, 5);
+  ASSERT_TRUE(jump.Next(f));
+  EXPECT_EQ(f.index, 2);
+  EXPECT_LT(cv::norm(f.image, test::MakeImage(64, 48, 2), cv::NORM_L1),
+            0.5 * cv::norm(f.image, test::MakeImage(64, 48, 3), cv::NORM_L1));
+}
+
+TEST(RecordingSource, NamesTheFileWhenAFrameIsUnreadableOrTheVideoIsShort) {
+  TempDir dir("replay_bad");
+  Recording rec = MakeStillRecording(dir.path() / "rec", 3);
+  test::WriteFile(dir.path() / "rec/frames/101.png", "garbage");
+  RecordingSource source(rec);
+  Frame f;
+  ASSERT_TRUE(source.Next(f));
+  try {
+    source.Next(f);
+    FAIL() << "expected a SourceError";
+  } catch (const SourceError& e) {
+    EXPECT_NE(std::string(e.what()).find("101.png"), std::string::npos) << e.what();
+  }
+  // A video with fewer frames than frames.txt lists.
+  ASSERT_TRUE(test::WriteTestVideo(dir.path() / "clip.avi", 4, 25.0));
+  ImportOptions io;
+  io.camera = calib::Camera::Pinhole(64, 48, 60, 60, 31.5, 23.5);
+  ImportVideo(dir.path() / "clip.avi", dir.path() / "vid", io);
+  std::vector<FrameEntry> frames = LoadRecording(dir.path() / "vid").frames;
+  frames.push_back({frames.back().timestamp + 1, frames.back().path});
+  WriteFramesTxt(dir.path() / "vid", frames);
+  RecordingSource video(LoadRecording(dir.path() / "vid"));
+  for (int k = 0; k < 4; ++k) ASSERT_TRUE(video.Next(f));
+  EXPECT_THROW(video.Next(f), SourceError);
+  ReplayOptions bad;
+  bad.frames = {7};
+  EXPECT_THROW(RecordingSource(LoadRecording(dir.path() / "vid"), bad), SourceError);
+}
+
+}  // namespace
+}  // namespace arview::recordings
