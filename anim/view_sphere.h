@@ -19,6 +19,7 @@
 // Both modes are continuous in the viewpoint.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <array>
 #include <span>
@@ -48,17 +49,25 @@ class ViewSphere {
   // `viewpoint` need not be unit; a zero vector gives equal weights. `out` has size() entries.
   void Weights(const Eigen::Vector3d& viewpoint, std::span<double> out) const;
 
-  // What kLocalSupport found in the key layout (for tests and `anim weights`).
+  // What kLocalSupport found in the key layout (for tests and `anim weights`). Triangles and
+  // ring indices refer to distinct directions (directions()), not to keys.
   enum class Layout { kSpanning, kRing, kOther };
   Layout layout() const { return layout_; }
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
+  const std::vector<Eigen::Vector3d>& directions() const { return dirs_; }
 
  private:
+  static constexpr int kMaxStackDirs = 64;  // more distinct keys than this allocate per call
+  void BuildHull();
+  void DetectRing();
+  // These work on distinct directions (dirs_), not on keys.
   void InverseDistance(const Eigen::Vector3d& v, std::span<double> out) const;
-  bool Triangulated(const Eigen::Vector3d& v, std::span<double> out) const;
+  void Triangulated(const Eigen::Vector3d& v, std::span<double> out) const;
   void Ring(const Eigen::Vector3d& v, std::span<double> out) const;
 
   std::vector<Eigen::Vector3d> keys_;
+  std::vector<Eigen::Vector3d> dirs_;           // distinct key directions
+  std::vector<std::vector<int>> members_;       // keys at each direction
   ViewSphereOptions options_;
   Layout layout_ = Layout::kOther;
   std::vector<std::array<int, 3>> triangles_;
