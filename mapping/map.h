@@ -52,6 +52,10 @@ struct Map {
   // One row per track element: uint8 SIFT in COLMAP's convention (L1-root, ×512, clamp 255).
   cv::Mat descriptors;                      // N x 128, CV_8U
   std::vector<std::uint32_t> descriptor_point;  // row → index into points
+  // Added by mapping/: row → index into keyframes (the keyframe whose keypoint gave the row).
+  std::vector<std::uint32_t> descriptor_keyframe;
 };
+
+// Reading and writing maps, and what `arview map info` prints: mapping/map_file.h.
 
 }  // namespace arview::mapping

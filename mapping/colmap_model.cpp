@@ -1,0 +1,459 @@
+#include "mapping/colmap_model.h"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <unordered_map>
+
+namespace arview::mapping {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::uint64_t kInvalidPoint3D = std::numeric_limits<std::uint64_t>::max();
+constexpr int kDescriptorSize = 128;
+
+// A whole file in memory with bounds-checked little-endian reads.
+class BinaryReader {
+ public:
+  explicit BinaryReader(const fs::path& path) : path_(path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw MapError(path.string() + ": missing or unreadable");
+    data_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) throw MapError(path.string() + ": read error");
+  }
+
+  template <typename T>
+  T Read(const char* what) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    Need(sizeof(T), what);
+    T value;
+    std::memcpy(&value, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+
+  std::string ReadCString(const char* what) {
+    const auto begin = data_.begin() + static_cast<std::ptrdiff_t>(pos_);
+    const auto end = std::find(begin, data_.end(), '\0');
+    if (end == data_.end()) Fail(std::string("truncated inside ") + what);
+    std::string s(begin, end);
+    pos_ += s.size() + 1;
+    return s;
+  }
+
+  // A count read from the file, checked against the bytes left so that a corrupted count
+  // fails here instead of in a huge allocation.
+  std::uint64_t ReadCount(const char* what, std::size_t min_record_bytes) {
+    const auto n = Read<std::uint64_t>(what);
+    if (min_record_bytes > 0 && n > Remaining() / min_record_bytes) {
+      Fail(std::string(what) + " = " + std::to_string(n) + " does not fit in the " +
+           std::to_string(Remaining()) + " bytes left (truncated or corrupted)");
+    }
+    return n;
+  }
+
+  std::size_t Remaining() const { return data_.size() - pos_; }
+  void ExpectEnd() const {
+    if (Remaining() != 0) Fail(std::to_string(Remaining()) + " unexpected bytes after the last record");
+  }
+  [[noreturn]] void Fail(const std::string& problem) const {
+    throw MapError(path_.string() + ": " + problem + " (at byte " + std::to_string(pos_) + ")");
+  }
+
+ private:
+  void Need(std::size_t n, const char* what) const {
+    if (Remaining() < n) Fail(std::string("truncated while reading ") + what);
+  }
+
+  fs::path path_;
+  std::vector<char> data_;
+  std::size_t pos_ = 0;
+};
+
+int NumParams(int model_id) {
+  switch (model_id) {
+    case 0: return 3;   // SIMPLE_PINHOLE f, cx, cy
+    case 1: return 4;   // PINHOLE fx, fy, cx, cy
+    case 2: return 4;   // SIMPLE_RADIAL f, cx, cy, k
+    case 3: return 5;   // RADIAL f, cx, cy, k1, k2
+    case 4: return 8;   // OPENCV fx, fy, cx, cy, k1, k2, p1, p2
+    case 5: return 8;   // OPENCV_FISHEYE
+    case 6: return 12;  // FULL_OPENCV
+    case 7: return 5;   // FOV
+    case 8: return 4;   // SIMPLE_RADIAL_FISHEYE
+    case 9: return 5;   // RADIAL_FISHEYE
+    case 10: return 12; // THIN_PRISM_FISHEYE
+    default: return -1;
+  }
+}
+
+// COLMAP's camera to the shared OpenCV-convention camera (principal point − 0.5).
+calib::Camera ToCamera(int model_id, std::uint64_t width, std::uint64_t height, const std::vector<double>& p,
+                       const fs::path& file) {
+  calib::Camera c;
+  c.width = static_cast<int>(width);
+  c.height = static_cast<int>(height);
+  switch (model_id) {
+    case 0: c.fx = c.fy = p[0]; c.cx = p[1]; c.cy = p[2]; break;
+    case 1: c.fx = p[0]; c.fy = p[1]; c.cx = p[2]; c.cy = p[3]; break;
+    case 2: c.fx = c.fy = p[0]; c.cx = p[1]; c.cy = p[2]; c.dist[0] = p[3]; break;
+    case 3: c.fx = c.fy = p[0]; c.cx = p[1]; c.cy = p[2]; c.dist[0] = p[3]; c.dist[1] = p[4]; break;
+    case 4:
+      c.fx = p[0]; c.fy = p[1]; c.cx = p[2]; c.cy = p[3];
+      c.dist = {p[4], p[5], p[6], p[7], 0.0};
+      break;
+    case 6:  // FULL_OPENCV: OpenCV's rational model; arview uses it only for k3 (k4..k6 = 0)
+      if (p[9] != 0 || p[10] != 0 || p[11] != 0) {
+        throw MapError(file.string() + ": FULL_OPENCV camera with rational terms k4..k6 is not supported");
+      }
+      c.fx = p[0]; c.fy = p[1]; c.cx = p[2]; c.cy = p[3];
+      c.dist = {p[4], p[5], p[6], p[7], p[8]};
+      break;
+    default:
+      throw MapError(file.string() + ": camera model " + std::to_string(model_id) +
+                     " has no OpenCV radial-tangential equivalent (arview maps use OPENCV)");
+  }
+  c.cx -= 0.5;
+  c.cy -= 0.5;
+  try {
+    c.Validate(file.string());
+  } catch (const calib::CameraError& e) {
+    throw MapError(e.what());
+  }
+  return c;
+}
+
+std::unordered_map<std::uint32_t, calib::Camera> ReadCameras(const fs::path& file) {
+  BinaryReader r(file);
+  const auto n = r.ReadCount("camera count", 4 + 4 + 8 + 8);
+  std::unordered_map<std::uint32_t, calib::Camera> cameras;
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const auto id = r.Read<std::uint32_t>("camera id");
+    const auto model = r.Read<std::int32_t>("camera model");
+    const auto width = r.Read<std::uint64_t>("camera width");
+    const auto height = r.Read<std::uint64_t>("camera height");
+    const int np = NumParams(model);
+    if (np < 0) r.Fail("unknown camera model id " + std::to_string(model));
+    if (width == 0 || height == 0 || width > 100000 || height > 100000) {
+      r.Fail("camera " + std::to_string(id) + " has an impossible size " + std::to_string(width) + "x" +
+             std::to_string(height));
+    }
+    std::vector<double> params(static_cast<size_t>(np));
+    for (double& v : params) v = r.Read<double>("camera parameters");
+    if (!cameras.emplace(id, ToCamera(model, width, height, params, file)).second) {
+      r.Fail("camera id " + std::to_string(id) + " appears twice");
+    }
+  }
+  r.ExpectEnd();
+  return cameras;
+}
+
+struct ColmapImage {
+  std::uint32_t id = 0;
+  std::uint32_t camera_id = 0;
+  std::string name;
+  calib::Pose pose;
+  std::vector<Eigen::Vector2d> xy;          // COLMAP convention
+  std::vector<std::uint64_t> point3d_ids;   // kInvalidPoint3D when none
+};
+
+std::vector<ColmapImage> ReadImages(const fs::path& file) {
+  BinaryReader r(file);
+  const auto n = r.ReadCount("registered image count", 4 + 7 * 8 + 4 + 1 + 8);
+  std::vector<ColmapImage> images;
+  images.reserve(n);
+  for (std::uint64_t i = 0; i < n; ++i) {
+    ColmapImage im;
+    im.id = r.Read<std::uint32_t>("image id");
+    double q[4], t[3];
+    for (double& v : q) v = r.Read<double>("image rotation");
+    for (double& v : t) v = r.Read<double>("image translation");
+    im.camera_id = r.Read<std::uint32_t>("image camera id");
+    im.name = r.ReadCString("image name");
+    const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
+    if (!std::isfinite(quat.norm()) || std::abs(quat.norm() - 1.0) > 1e-3 ||
+        !Eigen::Vector3d(t[0], t[1], t[2]).allFinite()) {
+      r.Fail("image " + std::to_string(im.id) + " ('" + im.name + "') has an invalid pose");
+    }
+    im.pose.q_cw = quat.normalized();
+    im.pose.t_cw = Eigen::Vector3d(t[0], t[1], t[2]);
+    const auto np = r.ReadCount("2D point count", 8 + 8 + 8);
+    im.xy.resize(np);
+    im.point3d_ids.resize(np);
+    for (std::uint64_t k = 0; k < np; ++k) {
+      const double x = r.Read<double>("2D point x");
+      const double y = r.Read<double>("2D point y");
+      im.xy[k] = {x, y};
+      im.point3d_ids[k] = r.Read<std::uint64_t>("2D point's 3D point id");
+    }
+    images.push_back(std::move(im));
+  }
+  r.ExpectEnd();
+  return images;
+}
+
+struct TrackElement {
+  std::uint32_t image_id;
+  std::uint32_t point2d_idx;
+};
+
+struct ColmapPoint {
+  std::uint64_t id = 0;
+  MapPoint point;
+  std::vector<TrackElement> track;
+};
+
+std::vector<ColmapPoint> ReadPoints(const fs::path& file) {
+  BinaryReader r(file);
+  const auto n = r.ReadCount("3D point count", 8 + 24 + 3 + 8 + 8);
+  std::vector<ColmapPoint> points;
+  points.reserve(n);
+  for (std::uint64_t i = 0; i < n; ++i) {
+    ColmapPoint p;
+    p.id = r.Read<std::uint64_t>("3D point id");
+    for (int k = 0; k < 3; ++k) p.point.xyz[k] = r.Read<double>("3D point position");
+    for (int k = 0; k < 3; ++k) p.point.rgb[static_cast<size_t>(k)] = r.Read<std::uint8_t>("3D point colour");
+    p.point.reprojection_error = r.Read<double>("3D point error");
+    if (!p.point.xyz.allFinite() || !std::isfinite(p.point.reprojection_error)) {
+      r.Fail("3D point " + std::to_string(p.id) + " is not finite");
+    }
+    const auto len = r.ReadCount("track length", 8);
+    if (len == 0) r.Fail("3D point " + std::to_string(p.id) + " has an empty track");
+    p.track.resize(len);
+    for (auto& e : p.track) {
+      e.image_id = r.Read<std::uint32_t>("track image id");
+      e.point2d_idx = r.Read<std::uint32_t>("track 2D point index");
+    }
+    points.push_back(std::move(p));
+  }
+  r.ExpectEnd();
+  return points;
+}
+
+// The database, read-only.
+class Database {
+ public:
+  explicit Database(const fs::path& path) : path_(path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) throw MapError(path.string() + ": COLMAP database missing");
+    sqlite3* db = nullptr;
+    const int rc = sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+    db_.reset(db);
+    if (rc != SQLITE_OK) Fail("cannot open");
+  }
+
+  // The descriptors of one image (rows x 128, CV_8U).
+  cv::Mat Descriptors(std::uint32_t image_id) {
+    Statement st(*this, "SELECT rows, cols, data FROM descriptors WHERE image_id = ?");
+    sqlite3_bind_int64(st.get(), 1, image_id);
+    const int rc = sqlite3_step(st.get());
+    if (rc == SQLITE_DONE) Fail("no descriptors for image id " + std::to_string(image_id));
+    if (rc != SQLITE_ROW) Fail("reading descriptors of image id " + std::to_string(image_id));
+    const sqlite3_int64 rows = sqlite3_column_int64(st.get(), 0);
+    const sqlite3_int64 cols = sqlite3_column_int64(st.get(), 1);
+    const void* blob = sqlite3_column_blob(st.get(), 2);
+    const sqlite3_int64 bytes = sqlite3_column_bytes(st.get(), 2);
+    if (cols != kDescriptorSize || rows < 0 || rows > (1 << 24) || bytes != rows * cols || (rows > 0 && !blob)) {
+      Fail("descriptors of image id " + std::to_string(image_id) + " have a wrong shape (" + std::to_string(rows) +
+           " x " + std::to_string(cols) + ", " + std::to_string(bytes) + " bytes; expected uint8 x 128)");
+    }
+    cv::Mat m(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
+    if (rows > 0) std::memcpy(m.data, blob, static_cast<size_t>(bytes));
+    return m;
+  }
+
+  std::string ImageName(std::uint32_t image_id) {
+    Statement st(*this, "SELECT name FROM images WHERE image_id = ?");
+    sqlite3_bind_int64(st.get(), 1, image_id);
+    const int rc = sqlite3_step(st.get());
+    if (rc == SQLITE_DONE) Fail("no image with id " + std::to_string(image_id) + " (not the model's database?)");
+    if (rc != SQLITE_ROW) Fail("reading image id " + std::to_string(image_id));
+    const unsigned char* text = sqlite3_column_text(st.get(), 0);
+    return text ? reinterpret_cast<const char*>(text) : "";
+  }
+
+ private:
+  struct Closer {
+    void operator()(sqlite3* db) const { sqlite3_close(db); }
+  };
+  class Statement {
+   public:
+    Statement(Database& db, const char* sql) {
+      if (sqlite3_prepare_v2(db.db_.get(), sql, -1, &st_, nullptr) != SQLITE_OK) db.Fail("query failed");
+    }
+    ~Statement() { sqlite3_finalize(st_); }
+    Statement(const Statement&) = delete;
+    Statement& operator=(const Statement&) = delete;
+    sqlite3_stmt* get() { return st_; }
+
+   private:
+    sqlite3_stmt* st_ = nullptr;
+  };
+
+  [[noreturn]] void Fail(const std::string& problem) {
+    std::string detail = db_ ? sqlite3_errmsg(db_.get()) : "out of memory";
+    throw MapError(path_.string() + ": " + problem + " (SQLite: " + detail + ")");
+  }
+
+  fs::path path_;
+  std::unique_ptr<sqlite3, Closer> db_;
+};
+
+std::uint64_t Key(std::uint32_t image_id, std::uint32_t point2d_idx) {
+  return (static_cast<std::uint64_t>(image_id) << 32) | point2d_idx;
+}
+
+}  // namespace
+
+std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
+  BinaryReader r(sparse_dir / "images.bin");
+  return r.Read<std::uint64_t>("registered image count");
+}
+
+Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames) {
+  const fs::path cameras_file = sparse_dir / "cameras.bin";
+  const fs::path images_file = sparse_dir / "images.bin";
+  const fs::path points_file = sparse_dir / "points3D.bin";
+  const auto cameras = ReadCameras(cameras_file);
+  auto images = ReadImages(images_file);
+  const auto points = ReadPoints(points_file);
+  if (images.empty()) throw MapError(images_file.string() + ": the model has no registered images");
+  if (points.empty()) throw MapError(points_file.string() + ": the model has no 3D points");
+
+  // One camera for all keyframes (arview runs COLMAP with --ImageReader.single_camera 1).
+  const std::uint32_t camera_id = images.front().camera_id;
+  Map map;
+  for (const auto& im : images) {
+    if (im.camera_id != camera_id) {
+      throw MapError(images_file.string() + ": images use several cameras (" + std::to_string(camera_id) + ", " +
+                     std::to_string(im.camera_id) + "); arview maps have one");
+    }
+  }
+  const auto cam = cameras.find(camera_id);
+  if (cam == cameras.end()) {
+    throw MapError(images_file.string() + ": camera id " + std::to_string(camera_id) + " is not in " +
+                   cameras_file.string());
+  }
+  map.camera = cam->second;
+
+  auto frame_of = [&](const ColmapImage& im) {
+    if (frames.empty()) return FrameInfo{};
+    const auto it = frames.find(im.name);
+    if (it == frames.end()) {
+      throw MapError(images_file.string() + ": image '" + im.name + "' is not a frame of the recording");
+    }
+    return it->second;
+  };
+  std::sort(images.begin(), images.end(), [&](const ColmapImage& a, const ColmapImage& b) {
+    const int fa = frame_of(a).frame_index, fb = frame_of(b).frame_index;
+    return fa != fb ? fa < fb : a.name < b.name;
+  });
+
+  std::unordered_map<std::uint32_t, std::uint32_t> keyframe_of_image;
+  for (const auto& im : images) {
+    if (!keyframe_of_image.emplace(im.id, static_cast<std::uint32_t>(map.keyframes.size())).second) {
+      throw MapError(images_file.string() + ": image id " + std::to_string(im.id) + " appears twice");
+    }
+    const FrameInfo info = frame_of(im);
+    Keyframe kf;
+    kf.colmap_image_id = im.id;
+    kf.name = im.name;
+    kf.frame_index = info.frame_index;
+    kf.timestamp = info.timestamp;
+    kf.pose = im.pose;
+    map.keyframes.push_back(std::move(kf));
+  }
+
+  std::unordered_map<std::uint64_t, std::uint32_t> point_index;  // COLMAP id → index
+  std::size_t rows = 0;
+  for (const auto& p : points) {
+    if (!point_index.emplace(p.id, static_cast<std::uint32_t>(point_index.size())).second) {
+      throw MapError(points_file.string() + ": 3D point id " + std::to_string(p.id) + " appears twice");
+    }
+    rows += p.track.size();
+  }
+  if (rows > std::numeric_limits<std::uint32_t>::max()) throw MapError(points_file.string() + ": tracks too long");
+
+  // Track elements must name registered images and 2D points that point back at them.
+  for (const auto& p : points) {
+    for (const auto& e : p.track) {
+      const auto kf = keyframe_of_image.find(e.image_id);
+      if (kf == keyframe_of_image.end()) {
+        throw MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + " is seen by image id " +
+                       std::to_string(e.image_id) + ", which is not in " + images_file.string());
+      }
+      const auto& im = images[kf->second];
+      if (e.point2d_idx >= im.point3d_ids.size() || im.point3d_ids[e.point2d_idx] != p.id) {
+        throw MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
+                       std::to_string(e.point2d_idx) + " of image '" + im.name + "', which does not refer back to it");
+      }
+    }
+  }
+
+  Database db(database);
+  map.descriptors.create(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
+  map.descriptor_point.resize(rows);
+  map.descriptor_keyframe.resize(rows);
+  map.points.resize(points.size());
+  std::unordered_map<std::uint64_t, std::uint32_t> row_of;  // (image, 2D index) → row
+  row_of.reserve(rows);
+  // Rows are filled image by image so that each image's descriptors are read once.
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> wanted(images.size());  // (2D idx, row)
+  std::uint32_t row = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    MapPoint& mp = map.points[i];
+    mp = points[i].point;
+    mp.first_descriptor = row;
+    mp.descriptor_count = static_cast<std::uint32_t>(points[i].track.size());
+    for (const auto& e : points[i].track) {
+      const std::uint32_t kf = keyframe_of_image.at(e.image_id);
+      if (!row_of.emplace(Key(e.image_id, e.point2d_idx), row).second) {
+        throw MapError(points_file.string() + ": 2D point " + std::to_string(e.point2d_idx) + " of image id " +
+                       std::to_string(e.image_id) + " is in two tracks");
+      }
+      map.descriptor_point[row] = static_cast<std::uint32_t>(i);
+      map.descriptor_keyframe[row] = kf;
+      wanted[kf].push_back({e.point2d_idx, row});
+      ++row;
+    }
+  }
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    const auto& im = images[k];
+    const std::string db_name = db.ImageName(im.id);
+    if (db_name != im.name) {
+      throw MapError(database.string() + ": image id " + std::to_string(im.id) + " is '" + db_name + "' but " +
+                     images_file.string() + " calls it '" + im.name + "' (a different database?)");
+    }
+    const cv::Mat desc = db.Descriptors(im.id);
+    if (static_cast<std::size_t>(desc.rows) != im.xy.size()) {
+      throw MapError(database.string() + ": image '" + im.name + "' has " + std::to_string(desc.rows) +
+                     " descriptors but " + std::to_string(im.xy.size()) + " 2D points in " + images_file.string());
+    }
+    for (const auto& [idx, r] : wanted[k]) desc.row(static_cast<int>(idx)).copyTo(map.descriptors.row(static_cast<int>(r)));
+
+    Keyframe& kf = map.keyframes[k];
+    for (std::uint32_t idx = 0; idx < im.point3d_ids.size(); ++idx) {
+      const std::uint64_t pid = im.point3d_ids[idx];
+      if (pid == kInvalidPoint3D) continue;
+      const auto pi = point_index.find(pid);
+      const auto ri = row_of.find(Key(im.id, idx));
+      if (pi == point_index.end() || ri == row_of.end()) {
+        throw MapError(images_file.string() + ": 2D point " + std::to_string(idx) + " of '" + im.name +
+                       "' refers to 3D point " + std::to_string(pid) + ", whose track does not list it");
+      }
+      const Eigen::Vector2d px = im.xy[idx] - Eigen::Vector2d(0.5, 0.5);  // COLMAP → OpenCV pixels
+      kf.observations.push_back({pi->second, px.cast<float>(), ri->second});
+    }
+  }
+  return map;
+}
+
+}  // namespace arview::mapping

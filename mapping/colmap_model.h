@@ -1,0 +1,32 @@
+#pragma once
+// Reading COLMAP's output directly: the binary sparse model (cameras.bin, images.bin,
+// points3D.bin) and the SQLite feature database (descriptors). Every size and id is validated:
+// a truncated or corrupted file throws MapError naming the file and what is wrong.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "mapping/map.h"
+
+namespace arview::mapping {
+
+// What the recording says about one image COLMAP saw, keyed by COLMAP's image name.
+struct FrameInfo {
+  int frame_index = -1;
+  double timestamp = 0;
+};
+using FrameLookup = std::map<std::string, FrameInfo>;
+
+// The number of registered images in a sparse model folder (reads only images.bin's header);
+// used to pick the largest of several models. Throws MapError when images.bin is unreadable.
+std::uint64_t CountRegisteredImages(const std::filesystem::path& sparse_dir);
+
+// Builds the Map from a sparse model folder and the database it came from. Every registered
+// image must appear in `frames` (unless `frames` is empty: then frame_index = -1, timestamp 0).
+// Keyframes are ordered by frame index (then name), points by COLMAP's point id.
+Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::filesystem::path& database,
+                  const FrameLookup& frames = {});
+
+}  // namespace arview::mapping

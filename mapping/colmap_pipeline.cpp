@@ -1,0 +1,416 @@
+#include "mapping/colmap_pipeline.h"
+
+#include <sqlite3.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <chrono>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "mapping/colmap_model.h"
+#include "mapping/map_file.h"
+#include "mapping/process.h"
+#include "recordings/trajectory.h"
+
+namespace arview::mapping {
+
+namespace fs = std::filesystem;
+
+MatcherKind ParseMatcherKind(const std::string& text) {
+  if (text == "auto") return MatcherKind::kAuto;
+  if (text == "sequential") return MatcherKind::kSequential;
+  if (text == "exhaustive") return MatcherKind::kExhaustive;
+  throw MapError("--matcher must be auto, sequential or exhaustive (got '" + text + "')");
+}
+
+std::string ToString(MatcherKind kind) {
+  switch (kind) {
+    case MatcherKind::kAuto: return "auto";
+    case MatcherKind::kSequential: return "sequential";
+    case MatcherKind::kExhaustive: return "exhaustive";
+  }
+  return "?";
+}
+
+namespace {
+
+// The images COLMAP reads: a folder and names relative to it, with each name's frame.
+struct ImageSet {
+  fs::path root;
+  std::vector<std::string> names;
+  FrameLookup lookup;
+};
+
+// Stage inputs as text: a stage is skipped when the text saved after its last success matches.
+class StageRecord {
+ public:
+  explicit StageRecord(const fs::path& out_dir) : dir_(out_dir / "stages") {}
+  bool Matches(const std::string& stage, const std::string& inputs) const {
+    std::ifstream in(dir_ / (stage + ".inputs"));
+    if (!in) return false;
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str() == inputs;
+  }
+  void Forget(const std::string& stage) const {
+    std::error_code ec;
+    fs::remove(dir_ / (stage + ".inputs"), ec);
+  }
+  void Save(const std::string& stage, const std::string& inputs) const {
+    fs::create_directories(dir_);
+    std::ofstream out(dir_ / (stage + ".inputs"), std::ios::trunc);
+    out << inputs;
+    if (!out.flush()) throw MapError((dir_ / (stage + ".inputs")).string() + ": cannot write");
+  }
+
+ private:
+  fs::path dir_;
+};
+
+std::string FileIdentity(const fs::path& file) {
+  std::error_code ec;
+  const auto size = fs::file_size(file, ec);
+  if (ec) throw MapError(file.string() + ": missing or unreadable");
+  const auto mtime = fs::last_write_time(file, ec).time_since_epoch().count();
+  return std::to_string(size) + " " + std::to_string(mtime);
+}
+
+std::string Joined(const std::vector<std::string>& args) {
+  std::string s;
+  for (const auto& a : args) s += a + "\n";
+  return s;
+}
+
+std::string FormatParams(const std::vector<double>& v) {
+  std::ostringstream ss;
+  ss.precision(17);
+  for (size_t i = 0; i < v.size(); ++i) ss << (i ? "," : "") << v[i];
+  return ss.str();
+}
+
+// Parses COLMAP's progress lines into (done, total) for the stage being run.
+class ProgressParser {
+ public:
+  ProgressParser(std::string stage, int total, const MapBuildCallbacks& cb)
+      : stage_(std::move(stage)), total_(total), cb_(cb) {}
+  void operator()(const std::string& line) {
+    if (!cb_.progress) return;
+    static const std::regex processed(R"(^Processed file \[(\d+)/(\d+)\])");
+    static const std::regex block(R"(^Matching block \[(\d+)/(\d+), (\d+)/(\d+)\])");
+    static const std::regex image(R"(^Matching image \[(\d+)/(\d+)\])");
+    static const std::regex registering(R"(^Registering image #\d+ \((\d+)\))");
+    static const std::regex initializing(R"(^Initializing with image pair)");
+    std::smatch m;
+    if (std::regex_search(line, m, processed) || std::regex_search(line, m, image)) {
+      cb_.progress(stage_, std::stoi(m[1]), std::stoi(m[2]));
+    } else if (std::regex_search(line, m, block)) {
+      const int a = std::stoi(m[1]), na = std::stoi(m[2]), b = std::stoi(m[3]), nb = std::stoi(m[4]);
+      cb_.progress(stage_, (a - 1) * nb + b, na * nb);
+    } else if (std::regex_search(line, m, registering)) {
+      cb_.progress(stage_, std::stoi(m[1]), total_);
+    } else if (std::regex_search(line, m, initializing)) {
+      cb_.progress(stage_, 0, total_);
+    }
+  }
+
+ private:
+  std::string stage_;
+  int total_;
+  const MapBuildCallbacks& cb_;
+};
+
+class ColmapRunner {
+ public:
+  ColmapRunner(const MapBuildOptions& options, const fs::path& out_dir, const MapBuildCallbacks& cb)
+      : options_(options), log_(out_dir / "colmap.log"), cb_(cb) {
+    if (FindExecutable(options.colmap).empty()) {
+      throw MapError("COLMAP not found: '" + options.colmap +
+                     "' is not on PATH (install it: apt-get install colmap)");
+    }
+  }
+
+  void Run(const std::string& stage, const std::vector<std::string>& args, int total) {
+    std::vector<std::string> argv{options_.colmap};
+    argv.insert(argv.end(), args.begin(), args.end());
+    ProgressParser parser(stage, total, cb_);
+    const ProcessResult r = RunProcess(argv, log_, std::ref(parser));
+    if (!r.ok()) {
+      const std::string how = r.signaled ? "was killed by signal " + std::to_string(r.signal)
+                                         : "exited with code " + std::to_string(r.exit_code);
+      throw ColmapStageError("COLMAP " + args.front() + " (" + stage + " stage) " + how + "; its output is in " +
+                                 log_.string(),
+                             stage, log_, r.tail);
+    }
+  }
+  const fs::path& log() const { return log_; }
+
+ private:
+  const MapBuildOptions& options_;
+  fs::path log_;
+  const MapBuildCallbacks& cb_;
+};
+
+std::vector<int> CandidateFrames(const recordings::Recording& rec, const MapBuildOptions& options) {
+  if (!options.frames_spec.empty()) {
+    return recordings::ParseFrameSpec(options.frames_spec, static_cast<int>(rec.frames.size()));
+  }
+  std::vector<int> all(rec.frames.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  return all;
+}
+
+std::string FrameName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.png", index);
+  return name;
+}
+
+// Video: the selected frames written as PNG files under <out>/images (skipped when done before
+// with the same selection).
+ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& out_dir, const MapBuildOptions& options,
+                            const MapBuildCallbacks& cb, StageRecord& stages, std::vector<int>* selected) {
+  const std::vector<int> candidates = CandidateFrames(rec, options);
+  FrameSelectionOptions sel = options.selection;
+  sel.max_frames = options.max_frames;
+  const fs::path video = rec.FramePath(0);
+  std::ostringstream inputs;
+  inputs << "video " << video.string() << " " << FileIdentity(video) << "\nframes " << options.frames_spec
+         << "\nblur " << sel.blur_ratio << " " << sel.blur_window << "\nduplicate " << sel.duplicate_threshold
+         << "\nmax " << sel.max_frames << "\n";
+  ImageSet set;
+  set.root = out_dir / "images";
+  const fs::path list = out_dir / "selected_frames.txt";
+  if (stages.Matches("select", inputs.str()) && fs::exists(list)) {
+    std::ifstream in(list);
+    int f;
+    while (in >> f) selected->push_back(f);
+    if (cb.note) cb.note("frame selection: inputs unchanged, reusing " + std::to_string(selected->size()) + " frames");
+  } else {
+    stages.Forget("select");
+    const FrameSelection s = SelectVideoFrames(rec, candidates, sel, [&](int done, int total) {
+      if (cb.progress) cb.progress("select", done, total);
+    });
+    *selected = s.frames;
+    if (cb.note) {
+      cb.note("frame selection: " + std::to_string(s.frames.size()) + " of " + std::to_string(candidates.size()) +
+              " frames (" + std::to_string(s.blurred) + " blurred, " + std::to_string(s.duplicates) +
+              " near-duplicates, " + std::to_string(s.capped) + " over --max-frames)");
+    }
+    std::error_code ec;
+    fs::remove_all(set.root, ec);
+    fs::create_directories(set.root);
+    cv::VideoCapture cap(video.string());
+    if (!cap.isOpened()) throw recordings::RecordingError(video.string() + ": cannot open the video");
+    cv::Mat frame;
+    size_t next = 0;
+    for (int i = 0; next < selected->size(); ++i) {
+      if (!cap.read(frame) || frame.empty()) throw recordings::RecordingError(video.string() + ": ends early");
+      if (i != (*selected)[next]) continue;
+      const fs::path png = set.root / FrameName(i);
+      if (!cv::imwrite(png.string(), frame)) throw MapError(png.string() + ": cannot write");
+      ++next;
+    }
+    std::ofstream out(list);
+    for (int f : *selected) out << f << "\n";
+    stages.Save("select", inputs.str());
+  }
+  if (selected->empty()) throw MapError(video.string() + ": no usable frames were selected");
+  for (int f : *selected) {
+    set.names.push_back(FrameName(f));
+    set.lookup[set.names.back()] = {f, rec.frames.at(static_cast<size_t>(f)).timestamp};
+  }
+  return set;
+}
+
+ImageSet PrepareStillImages(const recordings::Recording& rec, const MapBuildOptions& options, const MapBuildCallbacks& cb,
+                            std::vector<int>* selected) {
+  const std::vector<int> candidates = CandidateFrames(rec, options);
+  *selected = CapEvenly(candidates, options.max_frames);
+  if (selected->size() < candidates.size() && cb.note) {
+    cb.note("--max-frames " + std::to_string(options.max_frames) + ": using " + std::to_string(selected->size()) +
+            " of " + std::to_string(candidates.size()) + " frames, evenly spread");
+  }
+  ImageSet set;
+  set.root = rec.root;
+  for (int f : *selected) {
+    const auto& entry = rec.frames.at(static_cast<size_t>(f));
+    set.names.push_back(fs::path(entry.path).lexically_normal().generic_string());
+    set.lookup[set.names.back()] = {f, entry.timestamp};
+  }
+  return set;
+}
+
+std::vector<double> ColmapCameraParams(const calib::Camera& c, bool* full_opencv) {
+  // COLMAP's pixel centres are at +0.5 (DESIGN.md, "Pixel coordinates").
+  std::vector<double> p{c.fx, c.fy, c.cx + 0.5, c.cy + 0.5, c.dist[0], c.dist[1], c.dist[2], c.dist[3]};
+  *full_opencv = c.dist[4] != 0.0;
+  if (*full_opencv) p.insert(p.end(), {c.dist[4], 0.0, 0.0, 0.0});
+  return p;
+}
+
+void ClearMatches(const fs::path& database) {
+  sqlite3* db = nullptr;
+  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr);
+  std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
+  char* error = nullptr;
+  if (rc != SQLITE_OK ||
+      sqlite3_exec(db, "DELETE FROM matches; DELETE FROM two_view_geometries;", nullptr, nullptr, &error) != SQLITE_OK) {
+    const std::string why = error ? error : (db ? sqlite3_errmsg(db) : "cannot open");
+    sqlite3_free(error);
+    throw MapError(database.string() + ": cannot clear old matches (" + why + ")");
+  }
+}
+
+void RemoveDatabase(const fs::path& database) {
+  std::error_code ec;
+  for (const char* suffix : {"", "-shm", "-wal", "-journal"}) fs::remove(database.string() + suffix, ec);
+}
+
+// The sparse model with the most registered images among <out>/sparse/<n>/.
+fs::path LargestModel(const fs::path& sparse_root, int* count, const MapBuildCallbacks& cb) {
+  fs::path best;
+  std::uint64_t best_images = 0;
+  std::vector<std::pair<std::string, std::uint64_t>> found;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(sparse_root, ec)) {
+    if (!entry.is_directory() || !fs::exists(entry.path() / "images.bin")) continue;
+    const std::uint64_t n = CountRegisteredImages(entry.path());
+    found.push_back({entry.path().filename().string(), n});
+    if (n > best_images || (n == best_images && entry.path() < best)) {
+      best_images = n;
+      best = entry.path();
+    }
+  }
+  *count = static_cast<int>(found.size());
+  if (found.size() > 1 && cb.note) {
+    std::string list;
+    for (const auto& [name, n] : found) list += (list.empty() ? "" : ", ") + name + ": " + std::to_string(n);
+    cb.note("COLMAP built " + std::to_string(found.size()) + " separate models (registered images " + list +
+            "); keeping the largest, " + best.filename().string());
+  }
+  return best;
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+}  // namespace
+
+MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir, const MapBuildOptions& options,
+                        const MapBuildCallbacks& cb) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec || !fs::is_directory(out_dir)) throw MapError(out_dir.string() + ": cannot create the map directory");
+  MapBuildResult result;
+  StageRecord stages(out_dir);
+  ColmapRunner colmap(options, out_dir, cb);
+
+  auto t0 = std::chrono::steady_clock::now();
+  const ImageSet images = recording.IsVideo()
+                              ? PrepareVideoImages(recording, out_dir, options, cb, stages, &result.selected_frames)
+                              : PrepareStillImages(recording, options, cb, &result.selected_frames);
+  result.timings.push_back({"select", Seconds(t0), false});
+  if (images.names.size() < 2) throw MapError("a map needs at least 2 frames (got " + std::to_string(images.names.size()) + ")");
+  const int n = static_cast<int>(images.names.size());
+  const fs::path list = out_dir / "image_list.txt";
+  {
+    std::ofstream out(list, std::ios::trunc);
+    for (const auto& name : images.names) out << name << "\n";
+    if (!out.flush()) throw MapError(list.string() + ": cannot write");
+  }
+  const fs::path database = out_dir / "database.db";
+  const fs::path sparse = out_dir / "sparse";
+  const std::string threads = std::to_string(options.threads);
+
+  // Each stage's inputs include the previous stage's, so that a change re-runs everything after it.
+  bool full_opencv = false;
+  const std::vector<double> params = ColmapCameraParams(recording.camera, &full_opencv);
+  const std::vector<std::string> extract_args{
+      "feature_extractor", "--database_path", database.string(), "--image_path", images.root.string(),
+      "--image_list_path", list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
+      "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
+      "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
+      "--SiftExtraction.max_num_features", std::to_string(options.max_num_features)};
+  std::string inputs = Joined(extract_args);
+  for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
+
+  auto stage = [&](const std::string& name, const std::string& stage_inputs, const std::function<void()>& prepare,
+                   const std::vector<std::string>& args, bool outputs_exist) {
+    t0 = std::chrono::steady_clock::now();
+    if (outputs_exist && stages.Matches(name, stage_inputs)) {
+      if (cb.note) cb.note(name + ": inputs unchanged since the last run, skipped");
+      result.timings.push_back({name, 0, true});
+      return;
+    }
+    stages.Forget(name);
+    prepare();
+    colmap.Run(name, args, n);
+    stages.Save(name, stage_inputs);
+    result.timings.push_back({name, Seconds(t0), false});
+  };
+
+  stage("extract", inputs, [&] { RemoveDatabase(database); }, extract_args, fs::exists(database));
+
+  const bool exhaustive = options.matcher == MatcherKind::kExhaustive ||
+                          (options.matcher == MatcherKind::kAuto && n <= options.auto_exhaustive_limit);
+  std::vector<std::string> match_args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
+                                      "--database_path", database.string(),
+                                      "--SiftMatching.use_gpu", "0",
+                                      "--SiftMatching.num_threads", threads,
+                                      "--SiftMatching.max_num_trials", std::to_string(options.max_ransac_trials)};
+  if (!exhaustive) {
+    match_args.insert(match_args.end(), {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
+                                         "--SequentialMatching.quadratic_overlap",
+                                         options.quadratic_overlap ? "1" : "0"});
+  }
+  inputs += "--\n" + Joined(match_args);
+  stage("match", inputs, [&] { ClearMatches(database); }, match_args, true);
+
+  const std::string refine = options.refine_intrinsics ? "1" : "0";
+  std::vector<std::string> mapper_args{"mapper", "--database_path", database.string(), "--image_path",
+                                       images.root.string(), "--output_path", sparse.string(),
+                                       "--Mapper.num_threads", threads,
+                                       "--Mapper.ba_refine_focal_length", refine,
+                                       "--Mapper.ba_refine_principal_point", refine,
+                                       "--Mapper.ba_refine_extra_params", refine};
+  mapper_args.insert(mapper_args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
+  inputs += "--\n" + Joined(mapper_args);
+  stage(
+      "map", inputs,
+      [&] {
+        fs::remove_all(sparse, ec);
+        fs::create_directories(sparse);
+      },
+      mapper_args, fs::is_directory(sparse));
+
+  t0 = std::chrono::steady_clock::now();
+  result.model_dir = LargestModel(sparse, &result.models, cb);
+  if (result.model_dir.empty()) {
+    stages.Forget("map");
+    throw ColmapStageError("COLMAP mapper registered no images (no model in " + sparse.string() +
+                               "): too few matches between the frames? Its output is in " + colmap.log().string(),
+                           "map", colmap.log(), {});
+  }
+  result.map = ReadColmapMap(result.model_dir, database, images.lookup);
+  WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
+  SaveMap(result.map, out_dir / kMapFileName);
+  WriteTopView(result.map, out_dir / "map.png");
+  result.timings.push_back({"write", Seconds(t0), false});
+  return result;
+}
+
+void WriteKeyframesTum(const Map& map, const fs::path& file) {
+  recordings::Trajectory trajectory;
+  for (const Keyframe& k : map.keyframes) trajectory.push_back({k.timestamp, k.pose});
+  try {
+    recordings::WriteTum(trajectory, file, "arview map: the frames COLMAP registered (the keyframes of the map)");
+  } catch (const std::exception& e) {
+    throw MapError(file.string() + ": cannot write keyframes (" + e.what() + ")");
+  }
+}
+
+}  // namespace arview::mapping

@@ -1,0 +1,87 @@
+#pragma once
+// `arview map`: from a recording to a map directory, with COLMAP's command-line tool run as
+// child processes (feature_extractor, a matcher, mapper).
+//
+// The map directory holds COLMAP's own database.db and sparse/<n>/ model (so that the map opens
+// in COLMAP's GUI), colmap.log (everything COLMAP printed), keyframes.txt (TUM, camera-to-world,
+// the recording's timestamps), map.arvmap (the compact map the tracker loads) and map.png (a top
+// view). stages/ remembers the inputs of each finished stage, so that a re-run skips the stages
+// whose inputs did not change.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mapping/frame_selection.h"
+#include "mapping/map.h"
+#include "recordings/recording.h"
+
+namespace arview::mapping {
+
+enum class MatcherKind { kAuto, kSequential, kExhaustive };
+MatcherKind ParseMatcherKind(const std::string& text);  // throws MapError
+std::string ToString(MatcherKind kind);
+
+struct MapBuildOptions {
+  std::string frames_spec;  // recordings::ParseFrameSpec syntax; empty: every frame
+  MatcherKind matcher = MatcherKind::kAuto;
+  int auto_exhaustive_limit = 100;  // kAuto: exhaustive up to this many frames, sequential above
+  int max_frames = 300;             // cap on the frames given to COLMAP (0: none)
+  FrameSelectionOptions selection;  // video recordings only (its max_frames is ignored)
+  bool refine_intrinsics = false;   // let COLMAP's bundle adjustment refine the camera
+  int threads = 2;                  // COLMAP's threads per stage (-1: all cores)
+  // Speed settings, chosen on templeRing (docs/mapping.md, "Mapping time").
+  int max_num_features = 8192;      // SiftExtraction.max_num_features
+  int max_ransac_trials = 10000;    // SiftMatching.max_num_trials
+  int sequential_overlap = 10;      // SequentialMatching.overlap
+  bool quadratic_overlap = true;    // SequentialMatching.quadratic_overlap: loop-like long links
+  std::vector<std::string> extra_mapper_args;  // e.g. {"--Mapper.ba_global_images_ratio", "1.4"}
+  std::string colmap = "colmap";    // the COLMAP executable (found on PATH)
+};
+
+// A COLMAP stage that failed: the message says which and why; `log_tail` holds the last lines
+// COLMAP printed (the full output is in `log`).
+struct ColmapStageError : MapError {
+  ColmapStageError(const std::string& message, std::string stage_name, std::filesystem::path log_file,
+                   std::vector<std::string> tail)
+      : MapError(message), stage(std::move(stage_name)), log(std::move(log_file)), log_tail(std::move(tail)) {}
+  std::string stage;
+  std::filesystem::path log;
+  std::vector<std::string> log_tail;
+};
+
+struct MapBuildCallbacks {
+  // Stage progress: stage is "select", "extract", "match" or "map"; total may be 0 (unknown).
+  std::function<void(const std::string& stage, int done, int total)> progress;
+  // Things the user should know (a skipped stage, several models, dropped frames).
+  std::function<void(const std::string& message)> note;
+};
+
+struct StageTiming {
+  std::string stage;
+  double seconds = 0;
+  bool skipped = false;
+};
+
+struct MapBuildResult {
+  Map map;
+  std::vector<int> selected_frames;  // indices into the recording's frames.txt
+  std::vector<StageTiming> timings;
+  int models = 0;                    // models COLMAP produced
+  std::filesystem::path model_dir;   // the one kept (the largest)
+};
+
+// Runs everything and writes the map directory. Throws MapError (or ColmapStageError,
+// InterruptedError from mapping/process.h, recordings::RecordingError for a bad --frames).
+MapBuildResult BuildMap(const recordings::Recording& recording, const std::filesystem::path& out_dir,
+                        const MapBuildOptions& options, const MapBuildCallbacks& callbacks = {});
+
+// The keyframes as a TUM trajectory (camera-to-world, the recording's timestamps).
+void WriteKeyframesTum(const Map& map, const std::filesystem::path& file);
+
+// A top view of the map: the points (their colours) seen along the axis normal to the plane the
+// cameras move in, with the camera path drawn over them. Throws MapError when it cannot write.
+void WriteTopView(const Map& map, const std::filesystem::path& png, int size = 800);
+
+}  // namespace arview::mapping

@@ -1,0 +1,331 @@
+#include "mapping/map_file.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <type_traits>
+
+namespace arview::mapping {
+
+namespace fs = std::filesystem;
+
+static_assert(std::endian::native == std::endian::little, "the map file is written little-endian");
+
+namespace {
+
+constexpr char kMagic[8] = {'A', 'R', 'V', 'M', 'A', 'P', '\r', '\n'};
+constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8;
+constexpr int kDescriptorSize = 128;
+
+std::uint64_t Checksum(const char* data, std::size_t n) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  constexpr std::uint64_t kPrime = 0x100000001b3ULL;
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, data + i, 8);
+    h = (h ^ word) * kPrime;
+    h ^= h >> 29;
+  }
+  for (; i < n; ++i) h = (h ^ static_cast<unsigned char>(data[i])) * kPrime;
+  return h;
+}
+
+class Writer {
+ public:
+  template <typename T>
+  void Put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&v);
+    buf_.insert(buf_.end(), p, p + sizeof(T));
+  }
+  void PutBytes(const void* p, std::size_t n) {
+    const auto* c = static_cast<const char*>(p);
+    buf_.insert(buf_.end(), c, c + n);
+  }
+  void PutString(const std::string& s) {
+    Put<std::uint32_t>(static_cast<std::uint32_t>(s.size()));
+    PutBytes(s.data(), s.size());
+  }
+  std::vector<char>& buffer() { return buf_; }
+
+ private:
+  std::vector<char> buf_;
+};
+
+class Reader {
+ public:
+  Reader(const char* data, std::size_t size, const fs::path& file) : data_(data), size_(size), file_(file) {}
+  template <typename T>
+  T Get(const char* what) {
+    Need(sizeof(T), what);
+    T v;
+    std::memcpy(&v, data_ + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return v;
+  }
+  void GetBytes(void* out, std::size_t n, const char* what) {
+    Need(n, what);
+    if (n > 0) std::memcpy(out, data_ + pos_, n);
+    pos_ += n;
+  }
+  std::string GetString(const char* what) {
+    const auto n = Get<std::uint32_t>(what);
+    Need(n, what);
+    std::string s(data_ + pos_, n);
+    pos_ += n;
+    return s;
+  }
+  // A count that must fit in the bytes left, `record` bytes per element.
+  std::size_t GetCount(const char* what, std::size_t record) {
+    const auto n = Get<std::uint64_t>(what);
+    if (n > (size_ - pos_) / std::max<std::size_t>(record, 1)) Fail(std::string(what) + " exceeds the file size");
+    return static_cast<std::size_t>(n);
+  }
+  bool AtEnd() const { return pos_ == size_; }
+  [[noreturn]] void Fail(const std::string& problem) const {
+    throw MapError(file_.string() + ": " + problem + " (corrupted map file)");
+  }
+
+ private:
+  void Need(std::size_t n, const char* what) const {
+    if (size_ - pos_ < n) Fail(std::string("truncated while reading ") + what);
+  }
+  const char* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+  fs::path file_;
+};
+
+void WritePayload(const Map& map, Writer& w) {
+  const calib::Camera& c = map.camera;
+  w.Put<std::int32_t>(c.width);
+  w.Put<std::int32_t>(c.height);
+  for (double v : {c.fx, c.fy, c.cx, c.cy}) w.Put(v);
+  for (double v : c.dist) w.Put(v);
+
+  w.Put<std::uint64_t>(map.keyframes.size());
+  for (const Keyframe& k : map.keyframes) {
+    w.Put(k.colmap_image_id);
+    w.Put<std::int32_t>(k.frame_index);
+    w.Put(k.timestamp);
+    for (double v : {k.pose.q_cw.w(), k.pose.q_cw.x(), k.pose.q_cw.y(), k.pose.q_cw.z()}) w.Put(v);
+    for (int i = 0; i < 3; ++i) w.Put(k.pose.t_cw[i]);
+    w.PutString(k.name);
+    w.Put<std::uint64_t>(k.observations.size());
+    for (const KeyframeObservation& o : k.observations) {
+      w.Put(o.point);
+      w.Put(o.pixel.x());
+      w.Put(o.pixel.y());
+      w.Put(o.descriptor);
+    }
+  }
+
+  w.Put<std::uint64_t>(map.points.size());
+  for (const MapPoint& p : map.points) {
+    for (int i = 0; i < 3; ++i) w.Put(p.xyz[i]);
+    w.PutBytes(p.rgb.data(), 3);
+    w.Put(p.reprojection_error);
+    w.Put(p.first_descriptor);
+    w.Put(p.descriptor_count);
+  }
+
+  const auto rows = static_cast<std::uint64_t>(map.descriptors.rows);
+  w.Put(rows);
+  for (int r = 0; r < map.descriptors.rows; ++r) w.PutBytes(map.descriptors.ptr(r), kDescriptorSize);
+  w.PutBytes(map.descriptor_point.data(), map.descriptor_point.size() * sizeof(std::uint32_t));
+  w.PutBytes(map.descriptor_keyframe.data(), map.descriptor_keyframe.size() * sizeof(std::uint32_t));
+}
+
+Map ReadPayload(Reader& r) {
+  Map map;
+  calib::Camera& c = map.camera;
+  c.width = r.Get<std::int32_t>("camera");
+  c.height = r.Get<std::int32_t>("camera");
+  c.fx = r.Get<double>("camera");
+  c.fy = r.Get<double>("camera");
+  c.cx = r.Get<double>("camera");
+  c.cy = r.Get<double>("camera");
+  for (double& d : c.dist) d = r.Get<double>("camera");
+
+  map.keyframes.resize(r.GetCount("keyframe count", 4 + 4 + 8 + 56 + 4 + 8));
+  for (Keyframe& k : map.keyframes) {
+    k.colmap_image_id = r.Get<std::uint32_t>("keyframe");
+    k.frame_index = r.Get<std::int32_t>("keyframe");
+    k.timestamp = r.Get<double>("keyframe");
+    double q[4];
+    for (double& v : q) v = r.Get<double>("keyframe pose");
+    k.pose.q_cw = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+    for (int i = 0; i < 3; ++i) k.pose.t_cw[i] = r.Get<double>("keyframe pose");
+    k.name = r.GetString("keyframe name");
+    k.observations.resize(r.GetCount("observation count", 16));
+    for (KeyframeObservation& o : k.observations) {
+      o.point = r.Get<std::uint32_t>("observation");
+      o.pixel.x() = r.Get<float>("observation");
+      o.pixel.y() = r.Get<float>("observation");
+      o.descriptor = r.Get<std::uint32_t>("observation");
+    }
+  }
+
+  map.points.resize(r.GetCount("point count", 24 + 3 + 8 + 8));
+  for (MapPoint& p : map.points) {
+    for (int i = 0; i < 3; ++i) p.xyz[i] = r.Get<double>("point");
+    r.GetBytes(p.rgb.data(), 3, "point colour");
+    p.reprojection_error = r.Get<double>("point");
+    p.first_descriptor = r.Get<std::uint32_t>("point");
+    p.descriptor_count = r.Get<std::uint32_t>("point");
+  }
+
+  const std::size_t rows = r.GetCount("descriptor count", kDescriptorSize + 8);
+  map.descriptors.create(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
+  r.GetBytes(map.descriptors.data, rows * kDescriptorSize, "descriptors");
+  map.descriptor_point.resize(rows);
+  r.GetBytes(map.descriptor_point.data(), rows * sizeof(std::uint32_t), "descriptor points");
+  map.descriptor_keyframe.resize(rows);
+  r.GetBytes(map.descriptor_keyframe.data(), rows * sizeof(std::uint32_t), "descriptor keyframes");
+  if (!r.AtEnd()) r.Fail("unexpected bytes after the payload");
+  return map;
+}
+
+}  // namespace
+
+void ValidateMap(const Map& map, const std::string& source) {
+  auto fail = [&](const std::string& problem) { throw MapError(source + ": " + problem); };
+  try {
+    map.camera.Validate(source + " (camera)");
+  } catch (const calib::CameraError& e) {
+    throw MapError(e.what());
+  }
+  const auto rows = static_cast<std::size_t>(map.descriptors.rows);
+  if (rows > 0 && (map.descriptors.type() != CV_8UC1 || map.descriptors.cols != kDescriptorSize)) {
+    fail("descriptors must be N x 128 CV_8U");
+  }
+  if (map.descriptor_point.size() != rows || map.descriptor_keyframe.size() != rows) {
+    fail("descriptor_point / descriptor_keyframe sizes differ from the descriptor count");
+  }
+  for (std::size_t i = 0; i < map.keyframes.size(); ++i) {
+    const Keyframe& k = map.keyframes[i];
+    if (!std::isfinite(k.pose.q_cw.norm()) || std::abs(k.pose.q_cw.norm() - 1.0) > 1e-6 || !k.pose.t_cw.allFinite()) {
+      fail("keyframe " + std::to_string(i) + " ('" + k.name + "') has an invalid pose");
+    }
+    for (const KeyframeObservation& o : k.observations) {
+      if (o.point >= map.points.size() || o.descriptor >= rows || !o.pixel.allFinite()) {
+        fail("keyframe " + std::to_string(i) + " has an observation with an index out of range");
+      }
+      if (map.descriptor_point[o.descriptor] != o.point || map.descriptor_keyframe[o.descriptor] != i) {
+        fail("keyframe " + std::to_string(i) + " has an observation whose descriptor row belongs elsewhere");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < map.points.size(); ++i) {
+    const MapPoint& p = map.points[i];
+    if (!p.xyz.allFinite()) fail("point " + std::to_string(i) + " is not finite");
+    if (p.descriptor_count == 0 || p.first_descriptor > rows || p.descriptor_count > rows - p.first_descriptor) {
+      fail("point " + std::to_string(i) + " has a descriptor range outside the descriptor rows");
+    }
+    for (std::uint32_t r = p.first_descriptor; r < p.first_descriptor + p.descriptor_count; ++r) {
+      if (map.descriptor_point[r] != i) fail("descriptor row " + std::to_string(r) + " does not belong to its point");
+    }
+  }
+  for (std::size_t r = 0; r < rows; ++r) {
+    if (map.descriptor_keyframe[r] >= map.keyframes.size()) fail("descriptor row " + std::to_string(r) + " names no keyframe");
+  }
+}
+
+void SaveMap(const Map& map, const fs::path& file) {
+  ValidateMap(map, "map to save as " + file.string());
+  Writer payload;
+  WritePayload(map, payload);
+  const std::vector<char>& body = payload.buffer();
+  Writer header;
+  header.PutBytes(kMagic, sizeof kMagic);
+  header.Put<std::uint32_t>(kMapFileVersion);
+  header.Put<std::uint32_t>(0);
+  header.Put<std::uint64_t>(body.size());
+  header.Put<std::uint64_t>(Checksum(body.data(), body.size()));
+
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw MapError(file.string() + ": cannot write here (directory missing or not writable)");
+    out.write(header.buffer().data(), static_cast<std::streamsize>(header.buffer().size()));
+    out.write(body.data(), static_cast<std::streamsize>(body.size()));
+    if (!out.flush()) throw MapError(file.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw MapError(file.string() + ": cannot move the written map into place: " + ec.message());
+}
+
+Map LoadMap(const fs::path& path) {
+  std::error_code ec;
+  const fs::path file = fs::is_directory(path, ec) ? path / kMapFileName : path;
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
+  if (!in) throw MapError(file.string() + ": map file missing or unreadable (run 'arview map' first)");
+  const auto size = static_cast<std::size_t>(in.tellg());
+  in.seekg(0);
+  std::vector<char> data(size);
+  if (!in.read(data.data(), static_cast<std::streamsize>(size))) throw MapError(file.string() + ": read error");
+
+  Reader header(data.data(), std::min(size, kHeaderSize), file);
+  char magic[8];
+  header.GetBytes(magic, 8, "header");
+  if (std::memcmp(magic, kMagic, 8) != 0) throw MapError(file.string() + ": not an arview map file");
+  const auto version = header.Get<std::uint32_t>("header");
+  if (version != kMapFileVersion) {
+    throw MapError(file.string() + ": map file version " + std::to_string(version) + ", this arview reads version " +
+                   std::to_string(kMapFileVersion) + " (rebuild the map with 'arview map')");
+  }
+  header.Get<std::uint32_t>("header");
+  const auto payload_size = header.Get<std::uint64_t>("header");
+  const auto checksum = header.Get<std::uint64_t>("header");
+  if (payload_size != size - kHeaderSize) {
+    throw MapError(file.string() + ": truncated or padded: the header announces " + std::to_string(payload_size) +
+                   " payload bytes, the file has " + std::to_string(size - kHeaderSize));
+  }
+  if (Checksum(data.data() + kHeaderSize, payload_size) != checksum) {
+    throw MapError(file.string() + ": checksum mismatch (corrupted map file)");
+  }
+  Reader body(data.data() + kHeaderSize, payload_size, file);
+  Map map = ReadPayload(body);
+  ValidateMap(map, file.string());
+  return map;
+}
+
+MapStats ComputeStats(const Map& map) {
+  MapStats s;
+  s.keyframes = map.keyframes.size();
+  s.points = map.points.size();
+  s.descriptors = static_cast<std::size_t>(map.descriptors.rows);
+  std::vector<double> errors;
+  for (const Keyframe& k : map.keyframes) {
+    for (const KeyframeObservation& o : k.observations) {
+      const Eigen::Vector3d pc = k.pose.ToCamera(map.points[o.point].xyz);
+      if (pc.z() <= 0) continue;
+      errors.push_back((map.camera.Project(pc) - o.pixel.cast<double>()).norm());
+    }
+  }
+  s.observations = errors.size();
+  if (!map.points.empty()) {
+    double tracks = 0, colmap_error = 0;
+    for (const MapPoint& p : map.points) {
+      tracks += p.descriptor_count;
+      colmap_error += p.reprojection_error;
+    }
+    s.mean_track_length = tracks / static_cast<double>(map.points.size());
+    s.mean_colmap_point_error = colmap_error / static_cast<double>(map.points.size());
+  }
+  if (!errors.empty()) {
+    double sum = 0;
+    for (double e : errors) sum += e;
+    s.mean_reprojection_error = sum / static_cast<double>(errors.size());
+    auto mid = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
+    std::nth_element(errors.begin(), mid, errors.end());
+    s.median_reprojection_error = *mid;
+  }
+  return s;
+}
+
+}  // namespace arview::mapping
