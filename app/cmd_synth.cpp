@@ -1,11 +1,71 @@
+// arview synth room --out <recording> [--frames N] [--seed S] [--motion-blur N] [--noise sigma] ...
+
+#include <chrono>
+#include <iostream>
+
 #include "app/commands.h"
+#include "render/synth_room.h"
 
 namespace arview::app {
 
+namespace {
+
+struct SynthArgs {
+  render::SynthRoomOptions options;
+  std::string out;
+  std::string data_dir = render::kOpenCvDocData;
+  std::string backend = "auto";
+  bool quiet = false;
+};
+
+void RunSynthRoom(SynthArgs& args) {
+  render::SynthRoomOptions& o = args.options;
+  o.out = args.out;
+  o.data_dir = args.data_dir;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    o.gl.backend = render::ParseGlBackend(args.backend);
+    const render::SynthRoomReport report = render::SynthesizeRoom(o, [&](int done, int total) {
+      if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
+    });
+    if (!args.quiet) std::cerr << "\n";
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "wrote " << report.frames << " frames (640x480, " << o.fps << " fps, seed " << o.seed
+              << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
+  } catch (const std::exception& e) {
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
 void AddSynthCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("synth", "Render synthetic recordings with exact ground truth ('synth room')");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("synth"); });
+  auto* synth = app.add_subcommand("synth", "Render synthetic recordings with exact ground truth ('synth room')");
+  synth->require_subcommand(1);
+  auto* room = synth->add_subcommand(
+      "room", "A room textured with opencv-doc photos, filmed along a hand-held-like path (640x480, 30 fps)");
+  auto args = std::make_shared<SynthArgs>();
+  render::SynthRoomOptions& o = args->options;
+  room->add_option("--out", args->out, "Recording folder to create")->required();
+  room->add_option("--frames", o.frames, "Number of frames (30 per second)")->default_val(o.frames)->check(CLI::Range(1, 1000000));
+  room->add_option("--seed", o.seed, "Seed of the camera path and the noise")->default_val(o.seed);
+  room->add_option("--motion-blur", o.motion_blur_samples, "Renders averaged over the exposure per frame (0 = off)")
+      ->default_val(o.motion_blur_samples)
+      ->check(CLI::Range(0, 64));
+  room->add_option("--exposure", o.exposure_s, "Exposure time spanned by motion blur, seconds")->default_val(o.exposure_s);
+  room->add_option("--noise", o.noise_sigma, "Gaussian sensor noise, standard deviation in grey levels (0 = off)")
+      ->default_val(o.noise_sigma);
+  room->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
+      ->default_val(args->backend)
+      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
+  room->add_option("--gl-threads", o.gl.threads, "llvmpipe rasterizer threads (LP_NUM_THREADS)")
+      ->default_val(2)
+      ->check(CLI::Range(0, 32));
+  o.gl.threads = 2;
+  room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
+  room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
+  room->add_flag("--quiet", args->quiet, "No progress on stderr");
+  room->callback([args] { RunSynthRoom(*args); });
 }
 
 }  // namespace arview::app

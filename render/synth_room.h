@@ -1,0 +1,100 @@
+#pragma once
+// A rendered room with exact ground truth (`arview synth room`): the inside of a 7 x 5 x 2.8 m
+// room whose walls, floor, ceiling and three boxes carry real photos from Debian's opencv-doc
+// package, filmed at 640x480 and 30 fps along a smooth hand-held-like path (a walk round the
+// room looking at the walls, panning, a little shake and one fast turn).
+//
+// World frame: metres, z up, floor at z = 0, room centred on the origin (x in [−3.5, 3.5],
+// y in [−2.5, 2.5], z in [0, 2.8]).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/camera.h"
+#include "calib/pose.h"
+#include "render/offscreen.h"
+#include "render/textured_scene.h"
+
+namespace arview::render {
+
+inline const char* kOpenCvDocData = "/usr/share/doc/opencv-doc/examples/data";
+
+// One textured rectangle of the room, kept for tests and tools: its corners in the world
+// (top-left, top-right, bottom-right, bottom-left of the upright texture) and its image.
+struct RoomPanel {
+  std::string image_name;
+  Eigen::Vector3d corners[4];
+  int texture = 0;
+};
+
+struct RoomScene {
+  std::vector<cv::Mat> textures;       // textures[0] is plain white (wall paint)
+  std::vector<TriangleBatch> batches;  // everything drawn
+  std::vector<RoomPanel> panels;       // the photo rectangles only
+};
+
+// Loads the photos from `data_dir`; throws RenderError naming a missing or unreadable file.
+RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData);
+
+// The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
+calib::Camera RoomCamera();
+
+// The hand-held path: camera pose (world → camera) at time t (seconds) for a sequence of
+// `duration` seconds; deterministic for a seed. The fast turn (90° in 0.6 s) starts at 55% of
+// the duration.
+class RoomPath {
+ public:
+  RoomPath(double duration, uint64_t seed);
+  calib::Pose At(double t) const;
+
+ private:
+  double duration_;
+  double angle0_, direction_, pan_phase_, pitch_phase_, roll_phase_, bob_phase_, turn_sign_;
+  double shake_phase_[6];
+};
+
+struct SynthRoomOptions {
+  std::filesystem::path out;
+  int frames = 300;
+  uint64_t seed = 1;
+  double fps = 30.0;
+  int motion_blur_samples = 0;   // 0 or 1: none; N > 1: average N renders over the exposure
+  double exposure_s = 1.0 / 60;  // shutter time spanned by motion blur
+  double noise_sigma = 0.0;      // additive Gaussian sensor noise, grey levels (8-bit)
+  int samples = 4;               // MSAA samples
+  bool overwrite = false;        // replace an existing recording in `out`
+  std::filesystem::path data_dir = kOpenCvDocData;
+  OffscreenOptions gl;
+};
+
+struct SynthRoomReport {
+  std::string gl_description;
+  int frames = 0;
+};
+
+// Renders and writes the recording: frames/NNNNNN.png, frames.txt, camera.yaml and
+// groundtruth.txt (TUM, camera-to-world, pose at the middle of each exposure).
+// `progress(done, total)` is called after every frame when given.
+SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options,
+                               const std::function<void(int, int)>& progress = nullptr);
+
+// Renders one frame of the room (no noise), for tests and previews.
+class RoomRenderer {
+ public:
+  RoomRenderer(OffscreenContext& context, const RoomScene& scene, const calib::Camera& camera, int samples);
+  cv::Mat Render(const calib::Pose& pose);
+
+ private:
+  OffscreenContext* context_;
+  calib::Camera camera_;
+  TexturedScene scene_;
+  RenderTarget target_;
+};
+
+}  // namespace arview::render
