@@ -1,11 +1,265 @@
+// arview track <recording> --map <map-dir> --out traj.txt [--frames <spec>] [--stats stats.json]
+//
+// Tracks frames of a recording against a map: a TUM trajectory of the localised frames (the
+// recording's timestamps, lost frames omitted), optional per-frame statistics as JSON, and a
+// summary on stdout (frames localised, median and 95th percentile time per status).
+
+#include <opencv2/core.hpp>
+
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <sstream>
+
 #include "app/commands.h"
+#include "app/json_writer.h"
+#include "app/progress.h"
+#include "app/stage_stats.h"
+#include "mapping/map_file.h"
+#include "recordings/frame_source.h"
+#include "recordings/recording.h"
+#include "recordings/trajectory.h"
+#include "tracker/tracker.h"
 
 namespace arview::app {
 
+namespace {
+
+struct TrackArgs {
+  std::string recording;
+  std::string map;
+  std::string out;
+  std::string frames;
+  std::string stats;
+  std::string solver = "kneip";
+  int max_features = 2000;
+  double ratio = 0.8;
+  double ransac_threshold_px = 4.0;
+  int ransac_iterations = 1000;
+  int min_inliers = 12;
+  double max_rms_px = 2.5;
+  int tracking_min_inliers = 30;
+  int replenish_below = 150;
+  double guided_radius_px = 10;
+  unsigned seed = 0;
+  int threads = 1;
+  double smoothing_min_cutoff = 1.0;
+  double smoothing_beta = 0.5;
+};
+
+tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
+  tracker::TrackerOptions o;
+  try {
+    o.relocalization.pose.solver = tracker::ParseMinimalSolver(a.solver);
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(std::string("--solver: ") + e.what());
+  }
+  o.relocalization.features.max_features = a.max_features;
+  o.relocalization.matching.ratio = a.ratio;
+  o.relocalization.pose.ransac_threshold_px = a.ransac_threshold_px;
+  o.relocalization.pose.inlier_threshold_px = a.ransac_threshold_px;
+  o.relocalization.pose.ransac_max_iterations = a.ransac_iterations;
+  o.relocalization.pose.min_inliers = a.min_inliers;
+  o.relocalization.pose.max_rms_px = a.max_rms_px;
+  o.relocalization.pose.seed = a.seed;
+  o.tracking.min_inliers = a.tracking_min_inliers;
+  o.tracking.replenish_below = a.replenish_below;
+  o.tracking.guided_radius_px = a.guided_radius_px;
+  o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
+  o.smoothing.beta = a.smoothing_beta;
+  o.index.seed = a.seed;
+  return o;
+}
+
+struct FrameRecord {
+  int index = 0;
+  double timestamp = 0;
+  tracker::FrameResult result;
+};
+
+void WriteFrameJson(JsonWriter& w, const FrameRecord& f) {
+  const auto& r = f.result;
+  w.BeginObject()
+      .Value("index", f.index)
+      .Value("timestamp", f.timestamp)
+      .Value("status", tracker::TrackStatusName(r.status))
+      .Value("inliers", r.inliers)
+      .Value("rms_px", r.rms_px)
+      .Value("flow_tracks", r.flow_tracks)
+      .Value("guided_matches", r.guided_matches)
+      .Value("keypoints", r.keypoints)
+      .Value("matches", r.matches)
+      .Value("reason", r.reason);
+  w.BeginObject("ms")
+      .Value("flow", r.times.flow_ms)
+      .Value("extract", r.times.extract_ms)
+      .Value("match", r.times.match_ms)
+      .Value("ransac", r.times.ransac_ms)
+      .Value("refine", r.times.refine_ms)
+      .Value("total", r.times.total_ms)
+      .EndObject();
+  if (r.status != tracker::TrackStatus::kLost) {
+    w.BeginArray("center");
+    for (int i = 0; i < 3; ++i) w.Element(r.center[i]);
+    w.EndArray().BeginArray("smoothed_center");
+    for (int i = 0; i < 3; ++i) w.Element(r.smoothed_center[i]);
+    w.EndArray();
+  }
+  w.EndObject();
+}
+
+using StatusSummaries = std::map<std::string, TimingSummary>;
+
+StatusSummaries SummarizeByStatus(const std::vector<FrameRecord>& frames) {
+  std::map<std::string, std::vector<double>> samples;
+  for (const auto& f : frames) {
+    samples[tracker::TrackStatusName(f.result.status)].push_back(f.result.times.total_ms);
+    samples["all"].push_back(f.result.times.total_ms);
+  }
+  StatusSummaries out;
+  for (auto& [status, ms] : samples) out[status] = Summarize(std::move(ms));
+  return out;
+}
+
+void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
+                    const std::vector<FrameRecord>& frames, const StatusSummaries& summaries) {
+  JsonWriter w;
+  w.BeginObject().Value("recording", args.recording).Value("map", args.map).Value("threads", args.threads);
+  w.BeginObject("summary");
+  for (const auto& [status, s] : summaries) {
+    w.BeginObject(status)
+        .Value("frames", s.count)
+        .Value("median_ms", s.median_ms)
+        .Value("p95_ms", s.p95_ms)
+        .Value("mean_ms", s.mean_ms)
+        .Value("max_ms", s.max_ms)
+        .EndObject();
+  }
+  w.EndObject().BeginArray("frames");
+  for (const auto& f : frames) WriteFrameJson(w, f);
+  w.EndArray().EndObject();
+  std::ofstream out(path);
+  out << w.str() << "\n";
+  if (!out) throw CommandError("cannot write " + path.string());
+}
+
+void RunTrack(const TrackArgs& args) {
+  cv::setNumThreads(args.threads);
+  recordings::Recording rec;
+  recordings::ReplayOptions replay;
+  try {
+    rec = recordings::LoadRecording(args.recording);
+    if (!args.frames.empty())
+      replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
+  } catch (const recordings::RecordingError& e) {
+    throw CommandError(e.what());
+  }
+  const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
+  mapping::Map map;
+  try {
+    map = mapping::LoadMap(args.map);
+  } catch (const mapping::MapError& e) {
+    throw CommandError(e.what());
+  }
+  if (map.camera.Size() != rec.camera.Size()) {
+    std::ostringstream msg;
+    msg << args.recording << " has " << rec.camera.width << "x" << rec.camera.height << " frames but the map "
+        << args.map << " was built for " << map.camera.width << "x" << map.camera.height;
+    throw CommandError(msg.str());
+  }
+  const tracker::TrackerOptions options = MakeOptions(args);
+  std::unique_ptr<tracker::Tracker> tracker;
+  try {
+    tracker = std::make_unique<tracker::Tracker>(map, options);
+  } catch (const tracker::TrackerError& e) {
+    throw CommandError(args.map + ": " + e.what());
+  } catch (const mapping::DescriptorIndexError& e) {
+    throw CommandError(args.map + ": " + e.what());
+  }
+
+  recordings::RecordingSource source(std::move(rec), replay);
+  std::vector<FrameRecord> frames;
+  recordings::Trajectory trajectory;
+  Progress progress("track");
+  recordings::Frame frame;
+  try {
+    while (source.Next(frame)) {
+      // A frame after a gap in --frames has no valid motion prior.
+      if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
+      FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp)};
+      if (record.result.status != tracker::TrackStatus::kLost)
+        trajectory.push_back({record.timestamp, record.result.pose});
+      frames.push_back(std::move(record));
+      progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
+                      tracker::TrackStatusName(frames.back().result.status));
+    }
+  } catch (const recordings::RecordingError& e) {
+    throw CommandError(e.what());
+  }
+  progress.Finish();
+
+  try {
+    recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);
+  } catch (const recordings::RecordingError& e) {
+    throw CommandError(e.what());
+  }
+  const StatusSummaries summaries = SummarizeByStatus(frames);
+  if (!args.stats.empty()) WriteStatsJson(args.stats, args, frames, summaries);
+
+  std::cout << "localized " << trajectory.size() << "/" << frames.size() << " frames";
+  for (const char* status : {"tracking", "relocalized", "lost"}) {
+    const auto it = summaries.find(status);
+    std::cout << (status == std::string("tracking") ? " (" : ", ") << status << " "
+              << (it == summaries.end() ? 0 : it->second.count);
+  }
+  std::cout << ")\n" << std::fixed << std::setprecision(2);
+  for (const auto& [status, s] : summaries)
+    std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.median_ms
+              << " ms, p95 " << s.p95_ms << " ms (" << s.count << " frames)\n";
+  for (const auto& f : frames)
+    if (f.result.status == tracker::TrackStatus::kLost)
+      std::cout << "  lost frame " << f.index << ": " << f.result.reason << "\n";
+  std::cout << "trajectory: " << args.out << (args.stats.empty() ? "" : ", statistics: " + args.stats) << "\n";
+}
+
+}  // namespace
+
 void AddTrackCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("track", "Track a recording against a map and write its trajectory");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("track"); });
+  auto a = std::make_shared<TrackArgs>();
+  cmd->add_option("recording", a->recording, "Recording folder")->required();
+  cmd->add_option("--map", a->map, "Map directory (or its map.arvmap)")->required();
+  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required();
+  cmd->add_option("--frames", a->frames, "Frames to track, e.g. 1-46:2 (default: all)");
+  cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON");
+  cmd->add_option("--solver", a->solver, "Minimal solver in RANSAC: kneip | gao | epnp")
+      ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
+  cmd->add_option("--max-features", a->max_features, "SIFT keypoints per frame (strongest kept)")
+      ->capture_default_str()->check(CLI::Range(50, 100000));
+  cmd->add_option("--ratio", a->ratio, "Ratio test of global matching")->capture_default_str()->check(CLI::Range(0.1, 1.0));
+  cmd->add_option("--ransac-threshold", a->ransac_threshold_px, "Inlier threshold, pixels")
+      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
+  cmd->add_option("--ransac-iterations", a->ransac_iterations, "RANSAC iterations when relocalising")
+      ->capture_default_str()->check(CLI::Range(1, 1000000));
+  cmd->add_option("--min-inliers", a->min_inliers, "Inliers needed to accept a relocalization")
+      ->capture_default_str()->check(CLI::Range(6, 100000));
+  cmd->add_option("--max-rms", a->max_rms_px, "Largest inlier RMS reprojection error accepted, pixels")
+      ->capture_default_str()->check(CLI::Range(0.01, 50.0));
+  cmd->add_option("--tracking-min-inliers", a->tracking_min_inliers, "Inliers needed to keep tracking")
+      ->capture_default_str()->check(CLI::Range(6, 100000));
+  cmd->add_option("--replenish-below", a->replenish_below, "Run guided matching when fewer flow tracks survive")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
+      ->capture_default_str()->check(CLI::Range(1.0, 200.0));
+  cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
+  cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")
+      ->capture_default_str()->check(CLI::Range(1, 256));
+  cmd->add_option("--smooth-min-cutoff", a->smoothing_min_cutoff, "One Euro filter: cutoff at rest, Hz")
+      ->capture_default_str()->check(CLI::Range(0.001, 1000.0));
+  cmd->add_option("--smooth-beta", a->smoothing_beta, "One Euro filter: speed coefficient")
+      ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  cmd->callback([a] { RunTrack(*a); });
 }
 
 }  // namespace arview::app

@@ -98,6 +98,7 @@ class PlanarWorld {
         mp.descriptor_count = 1;
         map.points.push_back(mp);
         map.descriptor_point.push_back(id);
+        map.descriptor_keyframe.push_back(static_cast<std::uint32_t>(k));
         rows.push_back(f.descriptors.row(static_cast<int>(i)));
         kf.observations.push_back({id, Eigen::Vector2f(p.x, p.y), row});
       }

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "mapping/map_file.h"
 #include "tracker/timing.h"
 
 namespace arview::tracker {
@@ -59,30 +60,18 @@ calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last)
 }
 
 void ValidateMap(const mapping::Map& map, int min_points) {
-  std::ostringstream msg;
   if (static_cast<int>(map.points.size()) < min_points) {
+    std::ostringstream msg;
     msg << "map has " << map.points.size() << " points, at least " << min_points
         << " are needed to track against it";
     throw TrackerError(msg.str());
   }
-  if (map.descriptors.empty() || map.descriptors.type() != CV_8U || map.descriptors.cols != 128)
-    throw TrackerError("map descriptors must be a non-empty N x 128 uint8 matrix");
-  if (map.descriptor_point.size() != static_cast<size_t>(map.descriptors.rows)) {
-    msg << "map has " << map.descriptors.rows << " descriptor rows but "
-        << map.descriptor_point.size() << " descriptor → point entries";
-    throw TrackerError(msg.str());
-  }
-  for (std::uint32_t p : map.descriptor_point)
-    if (p >= map.points.size()) throw TrackerError("map descriptor refers to a missing point");
-  for (const auto& point : map.points)
-    if (static_cast<std::uint64_t>(point.first_descriptor) + point.descriptor_count >
-        static_cast<std::uint64_t>(map.descriptors.rows))
-      throw TrackerError("map point refers to descriptor rows past the end");
   try {
-    map.camera.Validate("map camera");
-  } catch (const calib::CameraError& e) {
+    mapping::ValidateMap(map, "map");
+  } catch (const mapping::MapError& e) {
     throw TrackerError(e.what());
   }
+  if (map.descriptors.rows == 0) throw TrackerError("map has no descriptors to match against");
 }
 
 Tracker::Tracker(const mapping::Map& map, const TrackerOptions& options)

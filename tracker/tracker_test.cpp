@@ -138,19 +138,16 @@ TEST_F(PlanarTrackerTest, MapWithTooFewPointsIsAClearErrorAtLoad) {
   }
 }
 
-TEST(ValidateMap, InconsistentDescriptorsAreRefused) {
-  mapping::Map map;
-  map.camera = TestCamera();
-  map.points.resize(40);
-  map.descriptors = cv::Mat::zeros(40, 128, CV_8U);
-  map.descriptor_point.assign(39, 0);
-  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
-  map.descriptor_point.assign(40, 40);
-  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
-  map.descriptor_point.assign(40, 0);
-  ValidateMap(map, 30);
-  map.descriptors = cv::Mat::zeros(40, 64, CV_8U);
-  EXPECT_THROW(ValidateMap(map, 30), TrackerError);
+TEST_F(PlanarTrackerTest, InconsistentMapIsRefusedWithTheReason) {
+  mapping::Map broken = *map_;
+  broken.descriptor_point.pop_back();
+  try {
+    Tracker tracker(broken);
+    FAIL() << "an inconsistent map was accepted";
+  } catch (const TrackerError& e) {
+    EXPECT_NE(std::string(e.what()).find("descriptor"), std::string::npos) << e.what();
+  }
+  ValidateMap(*map_, 30);
 }
 
 TEST(ConstantVelocity, PredictionRepeatsTheLastMotion) {
