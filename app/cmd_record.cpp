@@ -1,11 +1,139 @@
+// arview record --device /dev/video0 --out <recording> [--size 640x480] [--seconds N]
+//               [--format auto|yuyv|mjpeg] [--camera camera.yaml] [--force]
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <regex>
+
 #include "app/commands.h"
+#include "recordings/recorder.h"
+#include "recordings/v4l2_source.h"
 
 namespace arview::app {
 
+namespace {
+
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the Ctrl-C flag is set from a signal handler");
+
+extern "C" void OnStopSignal(int) { g_stop.store(true); }
+
+// Restores the previous SIGINT/SIGTERM handlers when recording ends, however it ends.
+class StopOnSignals {
+ public:
+  StopOnSignals() {
+    g_stop.store(false);
+    old_int_ = std::signal(SIGINT, OnStopSignal);
+    old_term_ = std::signal(SIGTERM, OnStopSignal);
+  }
+  ~StopOnSignals() {
+    std::signal(SIGINT, old_int_);
+    std::signal(SIGTERM, old_term_);
+  }
+
+ private:
+  void (*old_int_)(int) = SIG_DFL;
+  void (*old_term_)(int) = SIG_DFL;
+};
+
+struct RecordArgs {
+  std::string device = "/dev/video0";
+  std::string out;
+  std::string size = "640x480";
+  double seconds = 0;
+  std::string format = "auto";
+  std::string camera;
+  bool force = false;
+};
+
+cv::Size ParseSize(const std::string& text) {
+  static const std::regex pattern("([0-9]{1,5})x([0-9]{1,5})");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0) {
+    throw CommandError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 640x480)", 2);
+  }
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
+
+void RunRecord(const RecordArgs& args) {
+  const cv::Size size = ParseSize(args.size);
+  std::optional<calib::Camera> camera;
+  if (!args.camera.empty()) {
+    try {
+      camera = calib::LoadCamera(args.camera);
+    } catch (const calib::CameraError& e) {
+      throw CommandError(e.what());
+    }
+  }
+  StopOnSignals signals;
+  recordings::V4l2Options options;
+  options.width = size.width;
+  options.height = size.height;
+  options.format = args.format;
+  options.stop = &g_stop;
+  try {
+    recordings::V4l2Source source(args.device, options);
+    if (source.size() != size) {
+      std::cerr << "note: " << args.device << " gives " << source.size().width << "x" << source.size().height
+                << " instead of " << args.size << "\n";
+    }
+    if (camera && camera->Size() != source.size()) {
+      throw CommandError(args.camera + ": camera is " + std::to_string(camera->width) + "x" +
+                         std::to_string(camera->height) + " but " + args.device + " delivers " +
+                         std::to_string(source.size().width) + "x" + std::to_string(source.size().height));
+    }
+    recordings::RecordingWriter writer(args.out, camera, args.force);
+    std::cerr << "recording " << args.device << " (" << source.CardName() << ", " << source.FormatName() << " "
+              << source.size().width << "x" << source.size().height << ") into " << args.out
+              << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
+    auto progress = [](const recordings::RecordStats& s) {
+      std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps", s.seconds, s.frames, s.fps);
+      std::fflush(stderr);
+    };
+    recordings::RecordStats stats;
+    try {
+      stats = recordings::RecordFrames(source, writer, args.seconds, &g_stop, progress);
+    } catch (const recordings::SourceError& e) {
+      std::fprintf(stderr, "\n");
+      throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
+                         " frames recorded before stay a valid recording in " + args.out);
+    }
+    std::fprintf(stderr, "\n");
+    std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out;
+    if (source.skipped_frames() + stats.skipped > 0) {
+      std::cout << " (" << source.skipped_frames() + stats.skipped << " corrupt or out-of-order frames skipped)";
+    }
+    std::cout << "\n";
+    if (!camera) {
+      std::cout << "note: no --camera given: put a camera.yaml (arview calibrate) into " << args.out
+                << " before mapping or tracking\n";
+    }
+  } catch (const recordings::RecordingError& e) {  // SourceError included
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
 void AddRecordCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("record", "Record a V4L2 camera into a recording folder");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("record"); });
+  auto args = std::make_shared<RecordArgs>();
+  cmd->add_option("--device", args->device, "V4L2 capture device")->capture_default_str();
+  cmd->add_option("--out", args->out, "Recording folder to create")->required();
+  cmd->add_option("--size", args->size, "Requested frame size WIDTHxHEIGHT (the driver may choose the nearest)")
+      ->capture_default_str();
+  cmd->add_option("--seconds", args->seconds, "Stop after this many seconds (0: until Ctrl-C)")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
+  cmd->add_option("--format", args->format, "Pixel format to ask the camera for")
+      ->check(CLI::IsMember({"auto", "yuyv", "mjpeg"}))
+      ->capture_default_str();
+  cmd->add_option("--camera", args->camera, "camera.yaml to store with the recording (its size must match)");
+  cmd->add_flag("--force", args->force, "Replace a recording already in --out");
+  cmd->callback([args] { RunRecord(*args); });
 }
 
 }  // namespace arview::app

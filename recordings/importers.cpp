@@ -37,29 +37,6 @@ void RequireDirectory(const fs::path& dir, const std::string& what) {
   if (!fs::is_directory(dir, ec)) throw RecordingError(dir.string() + ": " + what + " is not a folder");
 }
 
-// Creates an empty output folder. A folder that already holds a recording is replaced only
-// with overwrite; any other non-empty folder is refused, so that a typo never deletes data.
-void PrepareOutput(const fs::path& out_dir, bool overwrite) {
-  std::error_code ec;
-  if (fs::exists(out_dir, ec)) {
-    if (!fs::is_directory(out_dir, ec)) throw RecordingError(out_dir.string() + ": exists and is not a folder");
-    if (!fs::is_empty(out_dir, ec)) {
-      if (!fs::exists(out_dir / "frames.txt", ec)) {
-        throw RecordingError(out_dir.string() + ": exists, is not empty and is not a recording; choose another --out");
-      }
-      if (!overwrite) {
-        throw RecordingError(out_dir.string() + ": already holds a recording (use --force to replace it)");
-      }
-      fs::remove(out_dir / "frames.txt", ec);  // first, so a failure below leaves no valid recording
-      for (const char* name : {"camera.yaml", "groundtruth.txt"}) fs::remove(out_dir / name, ec);
-      fs::remove_all(out_dir / "frames", ec);
-      if (ec) throw RecordingError(out_dir.string() + ": cannot clear the old recording (" + ec.message() + ")");
-    }
-  }
-  fs::create_directories(out_dir / "frames", ec);
-  if (ec) throw RecordingError(out_dir.string() + ": cannot create the recording folder (" + ec.message() + ")");
-}
-
 std::string FrameName(size_t index) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%06zu.png", index);
@@ -335,7 +312,7 @@ ImportResult ImportMiddlebury(const fs::path& source_dir, const fs::path& out_di
   if (options.camera) {
     notes.push_back("--camera ignored: the Middlebury file gives the intrinsics");
   }
-  PrepareOutput(out_dir, options.overwrite);
+  PrepareRecordingFolder(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, "the first image " + images[0].string());
   Trajectory gt;
   for (size_t i = 0; i < views.size(); ++i) {
@@ -378,7 +355,7 @@ ImportResult ImportStrecha(const fs::path& source_dir, const fs::path& out_dir, 
   }
   std::vector<std::string> notes;
   if (options.camera) notes.push_back("--camera ignored: the .camera files give the intrinsics");
-  PrepareOutput(out_dir, options.overwrite);
+  PrepareRecordingFolder(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, first_cam.string());
   Trajectory gt;
   for (size_t i = 0; i < cams.size(); ++i) {
@@ -422,7 +399,7 @@ ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, cons
   const fs::path gt_file = source_dir / "groundtruth.txt";
   std::optional<Trajectory> gt;
   if (fs::exists(gt_file, ec)) gt = ReadTum(gt_file);
-  PrepareOutput(out_dir, options.overwrite);
+  PrepareRecordingFolder(out_dir, options.overwrite);
   std::vector<FrameEntry> frames;
   for (size_t i = 0; i < list.size(); ++i) {
     const fs::path image_file = source_dir / list[i].path;
@@ -442,7 +419,7 @@ ImportResult ImportImages(const fs::path& source_dir, const fs::path& out_dir, c
   RequireDirectory(source_dir, "image folder");
   const calib::Camera camera = RequireCamera(options, "images");
   const std::vector<fs::path> images = ImagesInFolder(source_dir);
-  PrepareOutput(out_dir, options.overwrite);
+  PrepareRecordingFolder(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, "--camera");
   return Finish(out_dir, camera, frames, nullptr, {});
 }
@@ -473,7 +450,7 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
     for (size_t i = 0; i < stamps.size(); ++i) stamps[i] = static_cast<double>(i) / rate;
     notes.push_back("frame timestamps computed as index / frame rate");
   }
-  PrepareOutput(out_dir, options.overwrite);
+  PrepareRecordingFolder(out_dir, options.overwrite);
   const std::string rel = "frames/" + video_file.filename().string();
   fs::copy_file(video_file, out_dir / rel, fs::copy_options::overwrite_existing, ec);
   if (ec) throw RecordingError((out_dir / rel).string() + ": cannot copy the video (" + ec.message() + ")");

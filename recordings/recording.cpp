@@ -90,6 +90,27 @@ Recording LoadRecording(const fs::path& root) {
   return r;
 }
 
+void PrepareRecordingFolder(const fs::path& out_dir, bool overwrite) {
+  std::error_code ec;
+  if (fs::exists(out_dir, ec)) {
+    if (!fs::is_directory(out_dir, ec)) throw RecordingError(out_dir.string() + ": exists and is not a folder");
+    if (!fs::is_empty(out_dir, ec)) {
+      if (!fs::exists(out_dir / "frames.txt", ec)) {
+        throw RecordingError(out_dir.string() + ": exists, is not empty and is not a recording; choose another --out");
+      }
+      if (!overwrite) {
+        throw RecordingError(out_dir.string() + ": already holds a recording (use --force to replace it)");
+      }
+      fs::remove(out_dir / "frames.txt", ec);
+      for (const char* name : {"camera.yaml", "groundtruth.txt"}) fs::remove(out_dir / name, ec);
+      fs::remove_all(out_dir / "frames", ec);
+      if (ec) throw RecordingError(out_dir.string() + ": cannot clear the old recording (" + ec.message() + ")");
+    }
+  }
+  fs::create_directories(out_dir / "frames", ec);
+  if (ec) throw RecordingError(out_dir.string() + ": cannot create the recording folder (" + ec.message() + ")");
+}
+
 void WriteFramesTxt(const fs::path& root, const std::vector<FrameEntry>& frames) {
   const fs::path file = root / "frames.txt";
   const fs::path tmp = root / "frames.txt.tmp";

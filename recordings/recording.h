@@ -42,6 +42,12 @@ Recording LoadRecording(const std::filesystem::path& root);
 // skipped, timestamps strictly increasing; throws RecordingError naming file and line.
 std::vector<FrameEntry> ReadFrameList(const std::filesystem::path& file);
 
+// Makes `root` an empty recording folder with an empty frames/ inside. A folder that already
+// holds a recording (has frames.txt) is cleared only with overwrite (frames.txt goes first, so
+// that a failure never leaves a valid-looking half); any other non-empty folder is refused, so
+// that a typo never deletes data. Throws RecordingError.
+void PrepareRecordingFolder(const std::filesystem::path& root, bool overwrite);
+
 // Writes frames.txt atomically (a temporary file renamed into place).
 void WriteFramesTxt(const std::filesystem::path& root, const std::vector<FrameEntry>& frames);
 

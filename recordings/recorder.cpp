@@ -1,0 +1,111 @@
+#include "recordings/recorder.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace arview::recordings {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void WriteAll(int fd, const std::string& text, const fs::path& file) {
+  // One write() of a short line with O_APPEND: a line is either wholly in the file or not.
+  const ssize_t n = ::write(fd, text.data(), text.size());
+  if (n != static_cast<ssize_t>(text.size())) {
+    throw RecordingError(file.string() + ": write failed (" + std::string(std::strerror(errno)) + ")");
+  }
+}
+
+}  // namespace
+
+RecordingWriter::RecordingWriter(const fs::path& root, const std::optional<calib::Camera>& camera, bool overwrite)
+    : root_(root), camera_(camera) {
+  PrepareRecordingFolder(root_, overwrite);
+  if (camera_) {
+    try {
+      calib::SaveCamera(*camera_, root_ / "camera.yaml");
+    } catch (const calib::CameraError& e) {
+      throw RecordingError(e.what());
+    }
+    size_ = camera_->Size();
+  }
+  const fs::path file = root_ / "frames.txt";
+  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw RecordingError(file.string() + ": cannot create (" + std::string(std::strerror(errno)) + ")");
+  WriteAll(fd_, "# timestamp path\n", file);
+}
+
+RecordingWriter::~RecordingWriter() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
+  const fs::path list = root_ / "frames.txt";
+  if (image.empty()) throw RecordingError(list.string() + ": cannot record an empty frame");
+  if (!std::isfinite(timestamp) || (count_ > 0 && timestamp <= last_timestamp_)) {
+    throw RecordingError(list.string() + ": frame timestamp " + std::to_string(timestamp) +
+                         " does not follow " + std::to_string(last_timestamp_));
+  }
+  if (size_.area() > 0 && image.size() != size_) {
+    throw RecordingError(list.string() + ": frame is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                         ", the recording is " + std::to_string(size_.width) + "x" + std::to_string(size_.height));
+  }
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06d.png", count_);
+  const std::string rel = std::string("frames/") + name;
+  const fs::path tmp = root_ / "frames" / (std::string(".") + name);  // still a .png for imwrite
+  bool ok = false;
+  try {
+    ok = cv::imwrite(tmp.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1});  // speed over size
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) throw RecordingError((root_ / rel).string() + ": cannot write the frame");
+  std::error_code ec;
+  fs::rename(tmp, root_ / rel, ec);
+  if (ec) throw RecordingError((root_ / rel).string() + ": cannot write the frame (" + ec.message() + ")");
+  char line[96];
+  std::snprintf(line, sizeof(line), "%.9f %s\n", timestamp, rel.c_str());
+  WriteAll(fd_, line, list);
+  if (size_.area() == 0) size_ = image.size();
+  last_timestamp_ = timestamp;
+  ++count_;
+}
+
+RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double max_seconds,
+                         const std::atomic<bool>* stop, const std::function<void(const RecordStats&)>& progress) {
+  RecordStats stats;
+  const auto wall_start = std::chrono::steady_clock::now();
+  Frame frame;
+  double t0 = 0;
+  bool first = true;
+  while (!(stop && stop->load()) && source.Next(frame)) {
+    if (first) {
+      t0 = frame.timestamp;
+      first = false;
+    }
+    const double t = frame.timestamp - t0;
+    if (max_seconds > 0 && t >= max_seconds) break;
+    if (writer.frame_count() > 0 && t <= writer.last_timestamp()) {
+      ++stats.skipped;
+      continue;
+    }
+    writer.Append(frame.image, t);
+    stats.frames = writer.frame_count();
+    stats.seconds = t;
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    stats.fps = wall > 0 ? stats.frames / wall : 0;
+    if (progress) progress(stats);
+  }
+  return stats;
+}
+
+}  // namespace arview::recordings
