@@ -20,6 +20,7 @@ struct LookAtChain {
   std::vector<int> joints;              // root-most first; the last is the head
   std::vector<double> limits_rad;       // per joint, > 0
   Eigen::Vector3d head_forward_local = Eigen::Vector3d::UnitZ();  // in the head joint's frame
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // model space: turns are yaw about it first
 };
 
 // Names of a spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH, Fox,
@@ -32,7 +33,8 @@ std::vector<std::string> DefaultLookAtChain(const Skeleton& skeleton);
 // Throws Error when a name is missing, the joints do not form one parent chain, or the
 // counts differ.
 LookAtChain MakeLookAtChain(const Skeleton& skeleton, const std::vector<std::string>& names,
-                            const std::vector<double>& limits_deg, const Eigen::Vector3d& forward);
+                            const std::vector<double>& limits_deg, const Eigen::Vector3d& forward,
+                            const Eigen::Vector3d& up = Eigen::Vector3d::UnitY());
 
 // The base clip with the chain turned toward `viewpoint` (character frame) at every key time of
 // the base clip (resampled at `sample_rate` Hz where the chain's parents move between keys).

@@ -80,6 +80,7 @@ struct LookAtSpec {
 };
 
 struct CharacterSpec {
+  std::string where;  // "scene.yaml:3", for messages
   std::string name;
   std::filesystem::path asset;  // absolute (resolved against the scene file)
   double scale = 1.0;

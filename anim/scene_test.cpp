@@ -1,0 +1,171 @@
+#include "anim/scene.h"
+#include "tests/support/test_data.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+namespace arview::anim {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path Fox() { return testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
+
+std::string FoxScene(const std::string& keys, const std::string& extra = "") {
+  return "characters:\n  - name: fox\n    asset: " + Fox().string() + "\n    scale: 0.01\n" + extra + "    keys:\n" + keys;
+}
+
+TEST(Scene, ParsesEveryField) {
+  const Scene s = ParseScene(R"(characters:
+  - name: fox
+    asset: chars/fox.glb
+    scale: 0.01
+    anchor:
+      position: [1, 2, 3]
+      rotation_deg: [0, 90, 0]
+      scale: 2
+    forward: [0, 0, 1]
+    up: [0, 1, 0]
+    weights: {mode: local, distance: chordal, alpha: 4}
+    blend: {method: dib, precision: 0.0001, max_iterations: 10}
+    phase: independent
+    lookat:
+      base_clip: Survey
+      chain: [a, b]
+      limits: [30, 60]
+    keys:
+      - viewpoint: [0, 0, 2]
+        clip: Survey
+      - azimuth: 90
+        generate: lookat
+      - azimuth: 180
+        elevation: 30
+        pose: Walk@0.25
+      - azimuth: -90
+        pose: rest
+)", "/scenes/s.yaml");
+  ASSERT_EQ(s.characters.size(), 1u);
+  const CharacterSpec& c = s.characters[0];
+  EXPECT_EQ(c.asset, fs::path("/scenes/chars/fox.glb"));
+  EXPECT_EQ(c.where, "/scenes/s.yaml:2");
+  EXPECT_DOUBLE_EQ(c.scale, 0.01);
+  EXPECT_LT((c.anchor.position - Eigen::Vector3d(1, 2, 3)).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(c.anchor.scale, 2);
+  EXPECT_EQ(c.weights.mode, WeightingMode::kLocalSupport);
+  EXPECT_EQ(c.weights.distance, DistanceKind::kChordal);
+  EXPECT_DOUBLE_EQ(c.weights.alpha, 4);
+  EXPECT_EQ(c.blend, BlendMethod::kDib);
+  EXPECT_DOUBLE_EQ(c.dib.precision, 1e-4);
+  EXPECT_EQ(c.dib.max_iterations, 10);
+  EXPECT_EQ(c.phase, PhaseMode::kIndependent);
+  EXPECT_EQ(c.lookat.chain, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(c.keys.size(), 4u);
+  EXPECT_LT((c.keys[0].viewpoint - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  EXPECT_LT((c.keys[1].viewpoint - Eigen::Vector3d::UnitX()).norm(), 1e-12);
+  EXPECT_EQ(c.keys[1].source, KeySpec::Source::kLookAt);
+  EXPECT_EQ(c.keys[2].source, KeySpec::Source::kStaticPose);
+  EXPECT_EQ(c.keys[2].clip, "Walk");
+  EXPECT_DOUBLE_EQ(c.keys[2].pose_time, 0.25);
+  EXPECT_EQ(c.keys[3].source, KeySpec::Source::kRestPose);
+  // Anchor: model → map, and the camera direction back in the character's frame.
+  const Eigen::Matrix4d m = c.ModelToMap();
+  const Eigen::Vector4d p = m * Eigen::Vector4d(0, 0, 100, 1);  // 1 m in front, scaled by 2
+  EXPECT_LT((p.head<3>() - Eigen::Vector3d(3, 2, 3)).norm(), 1e-9);
+  EXPECT_LT((c.ViewpointFromCamera(Eigen::Vector3d(5, 2, 3)) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+}
+
+void ExpectSceneError(const std::string& text, const std::string& message) {
+  try {
+    ParseScene(text, "bad.yaml");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scene, ParseErrors) {
+  ExpectSceneError("characters:\n  - asset: a.glb\n    keys:\n      - viewpoint: [0, 0, 0]\n        clip: x\n",
+                   "bad.yaml:4: key viewpoint has zero length");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    keys:\n      - azimuth: 0\n", "bad.yaml:4: a key needs exactly one");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    colour: red\n    keys:\n      - azimuth: 0\n        clip: x\n",
+                   "bad.yaml:3: unknown key 'colour'");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    blend: {method: slerp}\n    keys:\n      - azimuth: 0\n        clip: x\n",
+                   "bad.yaml:3: blend.method: 'slerp' is not one of dlb | dib");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    scale: big\n    keys:\n      - azimuth: 0\n        clip: x\n",
+                   "bad.yaml:3: scale: expected a number, got 'big'");
+  ExpectSceneError("characters:\n  - keys:\n      - azimuth: 0\n        clip: x\n", "bad.yaml:2: a character needs 'asset");
+  ExpectSceneError("characters: []\n", "bad.yaml: a scene needs a non-empty 'characters:' list");
+  EXPECT_THROW(LoadScene("/nonexistent/scene.yaml"), Error);
+}
+
+TEST(Scene, MissingClipIsAnError) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Scene s = ParseScene(FoxScene("      - azimuth: 0\n        clip: Survey\n      - azimuth: 90\n        clip: Jump\n"),
+                             "fox.yaml");
+  try {
+    AnimatedCharacter c(s.characters[0]);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("fox.yaml:8: clip 'Jump' does not exist"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Survey, Walk, Run"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scene, MissingAssetIsAnError) {
+  const Scene s = ParseScene("characters:\n  - asset: nowhere.glb\n    keys:\n      - azimuth: 0\n        pose: rest\n",
+                             "/tmp/x/s.yaml");
+  try {
+    AnimatedCharacter c(s.characters[0]);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/tmp/x/nowhere.glb: no such file"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scene, RuntimeOnAKeyPlaysThatClip) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  for (const char* method : {"dlb", "dib"}) {
+    const Scene s = ParseScene(
+        FoxScene("      - azimuth: 0\n        clip: Survey\n      - azimuth: 120\n        clip: Walk\n"
+                 "      - azimuth: 240\n        pose: rest\n",
+                 std::string("    phase: independent\n    blend: {method: ") + method + "}\n"),
+        "fox.yaml");
+    AnimatedCharacter fox(s.characters[0]);
+    const Character& c = fox.character();
+    const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(120, 0), 0.3);
+    EXPECT_DOUBLE_EQ(out.weights[1], 1.0);
+    LocalPose walk(c.skeleton.size());
+    SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run();
+    std::vector<Eigen::Matrix4d> model(c.skeleton.size());
+    LocalToModelJob{&c.skeleton, &walk, model}.Run();
+    for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
+    EXPECT_TRUE(out.converged);
+    // Between keys every joint is a proper blend, and DIB converges.
+    const FrameOutput& mid = fox.Update(DirectionFromAzimuthElevation(60, 20), 1.0);
+    EXPECT_TRUE(mid.converged);
+    for (const auto& m : mid.skinning_matrices) EXPECT_TRUE(m.allFinite());
+    EXPECT_TRUE(RigidSkinning(mid.skinning_matrices));
+  }
+}
+
+TEST(Scene, SharedPhaseStretchesKeyClips) {
+  ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+  const Scene s = ParseScene(FoxScene("      - azimuth: 0\n        clip: Walk\n      - azimuth: 180\n        clip: Run\n"),
+                             "fox.yaml");
+  AnimatedCharacter fox(s.characters[0]);
+  const Character& c = fox.character();
+  const double walk = c.FindClip("Walk")->duration, run = c.FindClip("Run")->duration;
+  const double period = 0.5 * (walk + run);
+  // A quarter of the shared period plays a quarter of the Run clip.
+  const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(180, 0), 0.25 * period);
+  LocalPose expect(c.skeleton.size());
+  SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run();
+  std::vector<Eigen::Matrix4d> model(c.skeleton.size());
+  LocalToModelJob{&c.skeleton, &expect, model}.Run();
+  for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
+}
+
+}  // namespace
+}  // namespace arview::anim
