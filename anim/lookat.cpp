@@ -43,19 +43,6 @@ std::vector<Eigen::Matrix4d> ModelPose(const Skeleton& sk, const LocalPose& pose
   return model;
 }
 
-// The rotation that turns `from` toward `to`: yaw about `up` first, then the remaining tilt, so
-// that turning to look behind stays upright.
-Eigen::Quaterniond TurnToward(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& up) {
-  const Eigen::Vector3d fh = from - from.dot(up) * up, th = to - to.dot(up) * up;
-  Eigen::Quaterniond yaw = Eigen::Quaterniond::Identity();
-  if (fh.norm() > 1e-9 && th.norm() > 1e-9) {
-    const double angle = std::atan2(fh.cross(th).dot(up), fh.dot(th));
-    yaw = Eigen::AngleAxisd(angle, up);
-  }
-  const Eigen::Quaterniond tilt = Eigen::Quaterniond::FromTwoVectors(yaw * from, to);
-  return tilt * yaw;
-}
-
 }  // namespace
 
 std::vector<std::string> DefaultLookAtChain(const Skeleton& sk) {
@@ -73,10 +60,16 @@ std::vector<std::string> DefaultLookAtChain(const Skeleton& sk) {
     }
   if (head < 0) return {};
   std::vector<std::string> chain = {sk.names[head]};
+  int top = head;
   for (int p = sk.parents[head]; p >= 0 && sk.parents[p] >= 0; p = sk.parents[p]) {
     if (!IsSpineLike(Lower(sk.names[p]))) break;
     chain.push_back(sk.names[p]);
+    top = p;
   }
+  // The body: the skeleton's root above the spine turns the whole character.
+  int root = top;
+  while (sk.parents[root] >= 0) root = sk.parents[root];
+  if (root != top) chain.push_back(sk.names[root]);
   std::reverse(chain.begin(), chain.end());
   return chain;
 }
@@ -103,6 +96,7 @@ LookAtChain MakeLookAtChain(const Skeleton& sk, const std::vector<std::string>& 
     chain.joints.push_back(j);
     double limit;
     if (!limits_deg.empty()) limit = limits_deg[i];
+    else if (i == 0 && names.size() > 1) limit = 180;  // the body: takes what the others leave
     else if (i + 1 == names.size()) limit = 70;
     else if (i + 2 == names.size()) limit = 50;
     else limit = 45;
@@ -120,36 +114,71 @@ Eigen::Vector3d HeadForward(const LookAtChain& chain, std::span<const Eigen::Mat
 
 namespace {
 
-// Turns the chain of `pose` toward `target`; `model` is the pose's model-space transforms and
-// is updated along with it.
+// Refreshes the model transforms of joint j and everything below it (children follow parents).
+void RefreshBelow(const Skeleton& sk, int j, const LocalPose& pose, std::vector<Eigen::Matrix4d>& model) {
+  for (int k = j; k < sk.size(); ++k) {
+    if (k != j) {
+      bool below = false;
+      for (int a = sk.parents[k]; a >= j && !below; a = sk.parents[a]) below = a == j;
+      if (!below) continue;
+    }
+    Eigen::Matrix4d local = pose.rigid[k].ToMatrix();
+    local.block<3, 3>(0, 0) *= pose.scale[k].asDiagonal();
+    const int p = sk.parents[k];
+    model[k] = (p < 0 ? sk.root_parent : model[p]) * local;
+  }
+}
+
+// Rotates joint j by `delta` given in model space, about the joint's own origin.
+void RotateInModel(const Skeleton& sk, int j, const Eigen::Quaterniond& delta, LocalPose& pose,
+                   std::vector<Eigen::Matrix4d>& model) {
+  const int p = sk.parents[j];
+  const Eigen::Quaterniond parent(RotationOf(p < 0 ? sk.root_parent : model[p]));
+  const Eigen::Quaterniond local = pose.rigid[j].Rotation();
+  const Eigen::Vector3d t = pose.rigid[j].Translation();
+  pose.rigid[j] = DualQuatd::FromRotationTranslation((parent.conjugate() * delta * parent * local).normalized(), t);
+  RefreshBelow(sk, j, pose, model);
+}
+
+// The yaw an upper joint takes for a total yaw `phi` (radians, in (−π, π]): an even share up to
+// its limit for viewpoints in front, tapering back to zero toward the back. Periodic and
+// continuous in phi, so that keys all around the circle blend without a seam; the first chain
+// joint takes the rest (it alone winds once around as phi goes round).
+double UpperYaw(double phi, double share, double limit) {
+  const double a = std::abs(phi);
+  const double front = std::min(std::min(a, M_PI / 2) * share, limit);
+  const double y = a <= M_PI / 2 ? front : front * (M_PI - a) / (M_PI / 2);
+  return phi < 0 ? -y : y;
+}
+
+// Turns the chain of `pose` toward `target`; `model` holds the pose's model-space transforms and
+// is kept up to date.
 void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
                  std::vector<Eigen::Matrix4d>& model) {
   const std::size_t n = chain.joints.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d f = HeadForward(chain, model);
-    const Eigen::Quaterniond full = TurnToward(f, target, chain.up);
+  const Eigen::Vector3d& up = chain.up;
+  // Yaw about the up axis, measured on the horizontal projections.
+  const Eigen::Vector3d f = HeadForward(chain, model);
+  const Eigen::Vector3d fh = f - f.dot(up) * up, th = target - target.dot(up) * up;
+  if (fh.norm() > 1e-9 && th.norm() > 1e-9) {
+    const double phi = std::atan2(fh.cross(th).dot(up), fh.dot(th));
+    double upper_total = 0;
+    for (std::size_t i = 1; i < n; ++i) {
+      const double y = UpperYaw(phi, 1.0 / double(n), chain.limits_rad[i]);
+      upper_total += y;
+      RotateInModel(sk, chain.joints[i], Eigen::Quaterniond(Eigen::AngleAxisd(y, up)), pose, model);
+    }
+    const double first = phi - upper_total;
+    RotateInModel(sk, chain.joints[0], Eigen::Quaterniond(Eigen::AngleAxisd(first, up)), pose, model);
+  }
+  // The remaining tilt (elevation), spread over the upper joints within their limits.
+  const std::size_t first_tilt = n > 1 ? 1 : 0;
+  for (std::size_t i = first_tilt; i < n; ++i) {
+    const Eigen::Quaterniond full = Eigen::Quaterniond::FromTwoVectors(HeadForward(chain, model), target);
     const double angle = Eigen::AngleAxisd(full).angle();
     if (angle < 1e-12) break;
     const double share = std::min({1.0, 1.0 / double(n - i), chain.limits_rad[i] / angle});
-    const Eigen::Quaterniond delta = Eigen::Quaterniond::Identity().slerp(share, full);
-    const int j = chain.joints[i];
-    const int p = sk.parents[j];
-    const Eigen::Quaterniond parent(RotationOf(p < 0 ? sk.root_parent : model[p]));
-    const Eigen::Quaterniond local = pose.rigid[j].Rotation();
-    const Eigen::Vector3d t = pose.rigid[j].Translation();
-    pose.rigid[j] = DualQuatd::FromRotationTranslation((parent.conjugate() * delta * parent * local).normalized(), t);
-    // Refresh the model transforms below j (children come after their parents).
-    for (int k = j; k < sk.size(); ++k) {
-      if (k != j) {
-        bool below = false;
-        for (int a = sk.parents[k]; a >= j && !below; a = sk.parents[a]) below = a == j;
-        if (!below) continue;
-      }
-      Eigen::Matrix4d local_m = pose.rigid[k].ToMatrix();
-      local_m.block<3, 3>(0, 0) *= pose.scale[k].asDiagonal();
-      const int pk = sk.parents[k];
-      model[k] = (pk < 0 ? sk.root_parent : model[pk]) * local_m;
-    }
+    RotateInModel(sk, chain.joints[i], Eigen::Quaterniond::Identity().slerp(share, full), pose, model);
   }
 }
 

@@ -1,8 +1,16 @@
 #pragma once
 // Authoring of key animations that look toward a viewpoint (the animator's work in the paper,
-// automated): from a base clip, a chain of joints (spine → neck → head) turns so that the head's
-// forward axis points along the key viewpoint, the rotation spread along the chain, each joint
-// limited to its own angle.
+// automated): from a base clip, a chain of joints (body → spine → neck → head) turns so that the
+// head's forward axis points along the key viewpoint, the rotation spread along the chain, each
+// joint limited to its own angle.
+//
+// How the turn is spread: the yaw (about `up`) is shared evenly by the joints after the first,
+// each within its limit, for viewpoints in front; toward the back their share tapers to zero and
+// the first joint (by default the skeleton's root: the whole body) takes the rest. The yaw of
+// every joint is then a continuous function of the viewpoint's azimuth all the way round, which
+// is what lets keys all around the character blend without a seam behind it (a chain that turns
+// left for 180° and right for 225° would blend to facing forward). The remaining tilt
+// (elevation) is spread over the joints after the first, within their limits.
 //
 //   LookAtChain chain = MakeLookAtChain(character.skeleton, {}, {}, forward);   // defaults by name
 //   Clip key = GenerateLookAtClip(character.skeleton, base_clip, chain, viewpoint);
@@ -23,12 +31,15 @@ struct LookAtChain {
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // model space: turns are yaw about it first
 };
 
-// Names of a spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH, Fox,
-// BCN_Epileptic, CesiumMan, Unreal/Unity humanoids). Empty when no head-like joint exists.
+// Names of a body → spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH,
+// Fox, BCN_Epileptic, CesiumMan, Unreal/Unity humanoids): the head (or, without one, the deepest
+// neck joint), its spine/neck/chest/back ancestors, and the skeleton's root first.
+// Empty when no head- or neck-like joint exists.
 std::vector<std::string> DefaultLookAtChain(const Skeleton& skeleton);
 
-// Builds the chain. Empty `names` uses DefaultLookAtChain(); empty `limits_deg` uses 45° per
-// spine joint, 50° for the neck (the joint before the head) and 70° for the head. The head's
+// Builds the chain. Empty `names` uses DefaultLookAtChain(); empty `limits_deg` uses 180° for
+// the first joint (the body), 45° per spine joint, 50° for the joint before the head and 70°
+// for the head. The head's
 // forward axis is the model-space `forward` at rest, expressed in the head's frame.
 // Throws Error when a name is missing, the joints do not form one parent chain, or the
 // counts differ.
