@@ -82,6 +82,7 @@ namespace arview::render {
   X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                              \
   X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                     \
   X(void, Uniform4fv, (GLint, GLsizei, const GLfloat*))                                               \
+  X(void, UniformMatrix3fv, (GLint, GLsizei, GLboolean, const GLfloat*))                              \
   X(void, UniformMatrix4fv, (GLint, GLsizei, GLboolean, const GLfloat*))                              \
   X(void, GenFramebuffers, (GLsizei, GLuint*))                                                        \
   X(void, DeleteFramebuffers, (GLsizei, const GLuint*))                                               \

@@ -1,0 +1,311 @@
+#include "render/character_renderer.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstddef>
+#include <string>
+
+#include "render/offscreen.h"
+
+namespace arview::render {
+namespace {
+
+// Per-vertex data; joints as integers (glVertexAttribIPointer), weights sum to 1.
+struct CharacterVertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+  std::uint16_t joints[4];
+  float weights[4];
+};
+
+std::string VertexShader(int joints) {
+  return "#version 450 core\n#define JOINTS " + std::to_string(joints) + R"(
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec2 uv;
+layout(location = 3) in uvec4 joints;
+layout(location = 4) in vec4 weights;
+uniform mat4 mvp;            // projection · view · model_to_map
+uniform mat4 model;          // model_to_map
+uniform mat3 normal_matrix;  // inverse transpose of model_to_map's 3x3
+uniform int method;          // 0: linear blend, 1: dual quaternion
+uniform mat4 skin[JOINTS];
+uniform vec4 dq_real[JOINTS];  // quaternion (x, y, z, w)
+uniform vec4 dq_dual[JOINTS];
+out vec3 v_normal;
+out vec2 v_uv;
+
+vec3 rotate(vec4 q, vec3 v) { return v + 2.0 * cross(q.xyz, cross(q.xyz, v) + q.w * v); }
+
+void main() {
+  vec3 p;
+  vec3 n;
+  if (method == 1) {
+    // Kavan et al. 2007: blend in the hemisphere of the first joint, normalise, apply.
+    vec4 r0 = dq_real[joints.x];
+    vec4 real = vec4(0.0);
+    vec4 dual = vec4(0.0);
+    for (int i = 0; i < 4; ++i) {
+      float w = weights[i];
+      vec4 r = dq_real[joints[i]];
+      if (dot(r, r0) < 0.0) w = -w;
+      real += w * r;
+      dual += w * dq_dual[joints[i]];
+    }
+    float len = length(real);
+    real /= len;
+    dual /= len;
+    // translation = 2 · dual · conj(real)
+    vec3 t = 2.0 * (real.w * dual.xyz - dual.w * real.xyz + cross(real.xyz, dual.xyz));
+    p = rotate(real, position) + t;
+    n = rotate(real, normal);
+  } else {
+    mat4 m = weights.x * skin[joints.x] + weights.y * skin[joints.y] + weights.z * skin[joints.z] +
+             weights.w * skin[joints.w];
+    p = (m * vec4(position, 1.0)).xyz;
+    n = mat3(m) * normal;
+  }
+  v_normal = normal_matrix * n;
+  // Assimp's texture coordinates have v = 0 at the image's bottom; textures are uploaded top
+  // row first.
+  v_uv = vec2(uv.x, 1.0 - uv.y);
+  gl_Position = mvp * vec4(p, 1.0);
+}
+)";
+}
+
+const char* kFragmentShader = R"(#version 450 core
+in vec3 v_normal;
+in vec2 v_uv;
+uniform sampler2D albedo;
+uniform vec4 base_color;
+uniform vec3 light;  // map frame, towards the light
+uniform float key;
+uniform float ambient;
+out vec4 frag_color;
+void main() {
+  vec3 n = normalize(v_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec4 c = texture(albedo, v_uv) * base_color;
+  float shade = ambient + key * max(dot(n, light), 0.0);
+  frag_color = vec4(c.rgb * shade, 1.0);
+}
+)";
+
+cv::Mat DecodeTexture(const anim::Texture& t, const std::string& source) {
+  cv::Mat image;
+  if (!t.rgba.empty()) {
+    if (t.width <= 0 || t.height <= 0 || t.rgba.size() != static_cast<size_t>(t.width) * t.height * 4) {
+      throw RenderError(source + ": raw texture has inconsistent size");
+    }
+    cv::Mat rgba(t.height, t.width, CV_8UC4, const_cast<std::uint8_t*>(t.rgba.data()));
+    cv::cvtColor(rgba, image, cv::COLOR_RGBA2BGRA);
+  } else if (!t.encoded.empty()) {
+    image = cv::imdecode(t.encoded, cv::IMREAD_COLOR);
+  } else if (!t.path.empty()) {
+    image = cv::imread(t.path, cv::IMREAD_COLOR);
+  }
+  if (image.empty()) {
+    throw RenderError(source + ": cannot decode texture " + (t.path.empty() ? std::string("(embedded)") : t.path));
+  }
+  return image;
+}
+
+int MaxJoints(const GlApi& gl) {
+  // skin (16 floats) + two vec4 per joint, with room for the other uniforms.
+  GLint components = 0;
+  gl.GetIntegerv(GL_MAX_VERTEX_UNIFORM_COMPONENTS, &components);
+  return (components - 64) / 24;
+}
+
+}  // namespace
+
+CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& character) : gl_(&gl) {
+  joints_ = std::max(1, character.skeleton.size());
+  if (joints_ > MaxJoints(gl)) {
+    throw RenderError(character.source + ": " + std::to_string(joints_) + " joints; the vertex shader takes at most " +
+                      std::to_string(MaxJoints(gl)));
+  }
+  program_ = MakeProgram(gl, "character", VertexShader(joints_), kFragmentShader);
+  const GLuint p = program_.get();
+  loc_ = {Uniform(gl, p, "mvp"),     Uniform(gl, p, "model"),   Uniform(gl, p, "normal_matrix"),
+          Uniform(gl, p, "method"),  Uniform(gl, p, "skin"),    Uniform(gl, p, "dq_real"),
+          Uniform(gl, p, "dq_dual"), Uniform(gl, p, "light"),   Uniform(gl, p, "key"),
+          Uniform(gl, p, "ambient"), Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo")};
+  white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
+  for (const anim::Texture& t : character.textures) {
+    textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, 4.f, true}));
+  }
+
+  for (const anim::Mesh& mesh : character.meshes) {
+    const size_t n = mesh.positions.size();
+    if (mesh.normals.size() != n || mesh.joints.size() != n || mesh.weights.size() != n ||
+        (!mesh.uvs.empty() && mesh.uvs.size() != n)) {
+      throw RenderError(character.source + ": mesh '" + mesh.name + "' has inconsistent vertex arrays");
+    }
+    std::vector<CharacterVertex> vertices(n);
+    for (size_t i = 0; i < n; ++i) {
+      CharacterVertex& v = vertices[i];
+      for (int k = 0; k < 3; ++k) {
+        v.position[k] = mesh.positions[i][k];
+        v.normal[k] = mesh.normals[i][k];
+      }
+      v.uv[0] = mesh.uvs.empty() ? 0.f : mesh.uvs[i].x();
+      v.uv[1] = mesh.uvs.empty() ? 0.f : mesh.uvs[i].y();
+      for (int k = 0; k < 4; ++k) {
+        if (mesh.joints[i][k] >= joints_) {
+          throw RenderError(character.source + ": mesh '" + mesh.name + "' refers to joint " +
+                            std::to_string(mesh.joints[i][k]) + " of " + std::to_string(joints_));
+        }
+        v.joints[k] = mesh.joints[i][k];
+        v.weights[k] = mesh.weights[i][k];
+      }
+    }
+    for (std::uint32_t index : mesh.indices) {
+      if (index >= n) throw RenderError(character.source + ": mesh '" + mesh.name + "' has an index out of range");
+    }
+    GpuMesh gpu;
+    gpu.vao = MakeVertexArray(gl);
+    gl.BindVertexArray(gpu.vao.get());
+    gpu.vbo = MakeBuffer(gl, GL_ARRAY_BUFFER, vertices.data(), vertices.size() * sizeof(CharacterVertex));
+    gpu.ibo = MakeBuffer(gl, GL_ELEMENT_ARRAY_BUFFER, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
+    const auto stride = static_cast<GLsizei>(sizeof(CharacterVertex));
+    auto attribute = [&](GLuint location, GLint size, size_t offset) {
+      gl.EnableVertexAttribArray(location);
+      gl.VertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offset));
+    };
+    attribute(0, 3, offsetof(CharacterVertex, position));
+    attribute(1, 3, offsetof(CharacterVertex, normal));
+    attribute(2, 2, offsetof(CharacterVertex, uv));
+    gl.EnableVertexAttribArray(3);
+    gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
+    attribute(4, 4, offsetof(CharacterVertex, weights));
+    gl.BindVertexArray(0);
+    gpu.index_count = static_cast<GLsizei>(mesh.indices.size());
+    triangles_ += gpu.index_count / 3;
+    if (mesh.material >= 0 && mesh.material < static_cast<int>(character.materials.size())) {
+      const anim::Material& material = character.materials[mesh.material];
+      gpu.base_color = material.base_color;
+      if (material.texture >= 0 && material.texture < static_cast<int>(textures_.size())) gpu.texture = material.texture;
+    }
+    meshes_.push_back(std::move(gpu));
+  }
+  dq_upload_.resize(static_cast<size_t>(joints_) * 8);
+  CheckGl(gl, "character upload (" + character.source + ")");
+}
+
+void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const CharacterDraw& d) {
+  const GlApi& gl = *gl_;
+  if (static_cast<int>(d.skinning_matrices.size()) != joints_ ||
+      (d.method == anim::SkinningMethod::kDualQuaternion && static_cast<int>(d.skinning_dual_quats.size()) != joints_)) {
+    throw RenderError("character draw: " + std::to_string(joints_) + " skinning transforms expected");
+  }
+  // DQ skinning drops scale; with scaled joints linear blend is the correct one.
+  const bool dual = d.method == anim::SkinningMethod::kDualQuaternion && anim::RigidSkinning(d.skinning_matrices);
+  used_linear_fallback_ = d.method == anim::SkinningMethod::kDualQuaternion && !dual;
+
+  const Eigen::Matrix4f mvp = (projection * view * d.model_to_map).cast<float>();
+  const Eigen::Matrix4f model = d.model_to_map.cast<float>();
+  const Eigen::Matrix3f normal_matrix = d.model_to_map.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+  const Eigen::Vector3f light = d.light_direction_map.normalized().cast<float>();
+
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  gl.DepthMask(GL_TRUE);
+  gl.Disable(GL_BLEND);
+  gl.Disable(GL_CULL_FACE);
+  gl.UseProgram(program_.get());
+  gl.UniformMatrix4fv(loc_.mvp, 1, GL_FALSE, mvp.data());
+  gl.UniformMatrix4fv(loc_.model, 1, GL_FALSE, model.data());
+  gl.UniformMatrix3fv(loc_.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+  gl.Uniform1i(loc_.method, dual ? 1 : 0);
+  if (dual) {
+    for (int j = 0; j < joints_; ++j) {
+      const anim::DualQuatf& q = d.skinning_dual_quats[j];
+      std::copy_n(q.real().coeffs().data(), 4, &dq_upload_[j * 4]);
+      std::copy_n(q.dual().coeffs().data(), 4, &dq_upload_[(joints_ + j) * 4]);
+    }
+    gl.Uniform4fv(loc_.dq_real, joints_, dq_upload_.data());
+    gl.Uniform4fv(loc_.dq_dual, joints_, dq_upload_.data() + joints_ * 4);
+  } else {
+    gl.UniformMatrix4fv(loc_.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
+  }
+  gl.Uniform3f(loc_.light, light.x(), light.y(), light.z());
+  gl.Uniform1f(loc_.key, d.key);
+  gl.Uniform1f(loc_.ambient, d.ambient);
+  gl.Uniform1i(loc_.albedo, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  for (const GpuMesh& mesh : meshes_) {
+    gl.BindTexture(GL_TEXTURE_2D, mesh.texture >= 0 ? textures_[mesh.texture].get() : white_.get());
+    gl.Uniform4f(loc_.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
+    gl.BindVertexArray(mesh.vao.get());
+    gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+  }
+  gl.BindVertexArray(0);
+}
+
+namespace {
+
+const char* kShadowVertex = R"(#version 450 core
+layout(location = 0) in vec2 corner;  // (±1, ±1)
+uniform mat4 mvp;                     // maps (u, v, 1) to clip space through the plane's frame
+out vec2 v_corner;
+void main() {
+  v_corner = corner;
+  gl_Position = mvp * vec4(corner, 0.0, 1.0);
+}
+)";
+
+const char* kShadowFragment = R"(#version 450 core
+in vec2 v_corner;
+uniform float strength;
+out vec4 frag_color;
+void main() {
+  float r = length(v_corner);
+  // Dark under the character, fading smoothly to nothing at the rim.
+  float a = strength * (1.0 - smoothstep(0.15, 1.0, r));
+  frag_color = vec4(0.0, 0.0, 0.0, a);
+}
+)";
+
+}  // namespace
+
+ContactShadow::ContactShadow(const GlApi& gl) : gl_(&gl) {
+  program_ = MakeProgram(gl, "contact shadow", kShadowVertex, kShadowFragment);
+  mvp_ = Uniform(gl, program_.get(), "mvp");
+  strength_ = Uniform(gl, program_.get(), "strength");
+  const float corners[] = {-1, -1, 1, -1, 1, 1, -1, -1, 1, 1, -1, 1};
+  vao_ = MakeVertexArray(gl);
+  gl.BindVertexArray(vao_.get());
+  vbo_ = MakeBuffer(gl, GL_ARRAY_BUFFER, corners, sizeof corners);
+  gl.EnableVertexAttribArray(0);
+  gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), nullptr);
+  gl.BindVertexArray(0);
+}
+
+void ContactShadow::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const Eigen::Vector3d& center,
+                         const Eigen::Vector3d& axis_u, const Eigen::Vector3d& axis_v, float strength) {
+  const GlApi& gl = *gl_;
+  Eigen::Matrix4d plane = Eigen::Matrix4d::Identity();
+  plane.col(0).head<3>() = axis_u;
+  plane.col(1).head<3>() = axis_v;
+  plane.col(2).head<3>() = axis_u.cross(axis_v).normalized();
+  plane.col(3).head<3>() = center;
+  const Eigen::Matrix4f mvp = (projection * view * plane).cast<float>();
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthMask(GL_FALSE);
+  gl.Enable(GL_BLEND);
+  gl.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  gl.UseProgram(program_.get());
+  gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
+  gl.Uniform1f(strength_, strength);
+  gl.BindVertexArray(vao_.get());
+  gl.DrawArrays(GL_TRIANGLES, 0, 6);
+  gl.BindVertexArray(0);
+  gl.Disable(GL_BLEND);
+  gl.DepthMask(GL_TRUE);
+}
+
+}  // namespace arview::render

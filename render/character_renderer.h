@@ -1,0 +1,76 @@
+#pragma once
+// Draws an anim::Character skinned in the vertex shader, with dual quaternions (Kavan et al.
+// 2007; the default) or linear blend skinning, base-colour textures and factors, normals, and a
+// key + ambient light; and the soft contact shadow that keeps it on its ground plane.
+
+#include <Eigen/Core>
+
+#include <span>
+#include <vector>
+
+#include "anim/character.h"
+#include "anim/pose.h"
+#include "render/gl_objects.h"
+
+namespace arview::render {
+
+struct CharacterDraw {
+  Eigen::Matrix4d model_to_map = Eigen::Matrix4d::Identity();
+  std::span<const Eigen::Matrix4f> skinning_matrices;     // for kLinear (and the DQ fallback)
+  std::span<const anim::DualQuatf> skinning_dual_quats;   // for kDualQuaternion
+  anim::SkinningMethod method = anim::SkinningMethod::kDualQuaternion;
+  Eigen::Vector3d light_direction_map = Eigen::Vector3d::UnitZ();  // unit, towards the light
+  float key = 0.7f;
+  float ambient = 0.45f;
+};
+
+class CharacterRenderer {
+ public:
+  // Uploads meshes and textures; throws RenderError when the character has more joints than
+  // the vertex shader can take, or a texture cannot be decoded.
+  CharacterRenderer(const GlApi& gl, const anim::Character& character);
+  // Draws into the bound framebuffer with depth testing. Dual-quaternion skinning needs rigid
+  // skinning transforms; with scaled joints it falls back to linear blend (see used_linear()).
+  void Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const CharacterDraw& draw);
+  bool used_linear_fallback() const { return used_linear_fallback_; }
+  int joint_count() const { return joints_; }
+  int triangle_count() const { return triangles_; }
+
+ private:
+  struct GpuMesh {
+    GlName vao, vbo, ibo;
+    GLsizei index_count = 0;
+    Eigen::Vector4f base_color = Eigen::Vector4f::Ones();
+    int texture = -1;  // index into textures_, −1: white
+  };
+  const GlApi* gl_;
+  int joints_ = 0;
+  int triangles_ = 0;
+  GlName program_;
+  std::vector<GlName> textures_;
+  GlName white_;
+  std::vector<GpuMesh> meshes_;
+  bool used_linear_fallback_ = false;
+  std::vector<float> dq_upload_;
+  struct Locations {
+    GLint mvp, model, normal_matrix, method, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
+  } loc_{};
+};
+
+// A soft elliptical shadow on a ground plane, darkening what is below it; drawn before the
+// character, after the background.
+class ContactShadow {
+ public:
+  explicit ContactShadow(const GlApi& gl);
+  // `center` on the plane; `axis_u`, `axis_v` in the plane with lengths = the ellipse's radii;
+  // `strength` in [0, 1] is the darkening at the centre.
+  void Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const Eigen::Vector3d& center,
+            const Eigen::Vector3d& axis_u, const Eigen::Vector3d& axis_v, float strength);
+
+ private:
+  const GlApi* gl_;
+  GlName program_, vao_, vbo_;
+  GLint mvp_ = -1, strength_ = -1;
+};
+
+}  // namespace arview::render

@@ -1,0 +1,194 @@
+// The skinned character: GPU skinning (DQ and LBS) against anim/'s CPU skinning, compositing,
+// side-by-side stereo.
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "anim/scene.h"
+#include "render/ar_renderer.h"
+#include "render/test_scene.h"
+#include "tests/support/test_data.h"
+
+namespace arview::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path Fox() { return arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
+
+anim::Scene FoxScene() {
+  return anim::ParseScene("characters:\n  - name: fox\n    asset: " + Fox().string() +
+                              "\n    scale: 0.01\n    anchor:\n      position: [0.2, 0.1, 0]\n"
+                              "      rotation_deg: [90, 0, 30]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
+                              "        clip: Walk\n",
+                          "fox_test.yaml");
+}
+
+// Looking at the anchor from 2 m, 0.8 m up, z up.
+calib::Pose LookingAtFox() {
+  const Eigen::Vector3d eye(0.9, -1.8, 0.8), target(0.2, 0.1, 0.35);
+  const Eigen::Vector3d forward = (target - eye).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Eigen::Matrix3d r_wc;
+  r_wc << right, forward.cross(right), forward;
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
+}
+
+calib::Camera TestCamera() { return calib::Camera::Pinhole(640, 480, 600, 590, 322.5, 236.0); }
+
+const cv::Scalar kMagenta(255, 0, 255);
+
+cv::Mat NotBackground(const cv::Mat& image, const cv::Scalar& background) {
+  cv::Mat diff, grey, mask;
+  cv::absdiff(image, background, diff);
+  cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+  cv::threshold(grey, mask, 40, 255, cv::THRESH_BINARY);
+  return mask;
+}
+
+// The silhouette of anim/'s CPU-skinned meshes, projected with OpenCV and filled per triangle.
+cv::Mat CpuSilhouette(const anim::Character& character, const anim::CharacterSpec& spec,
+                      const anim::FrameOutput& frame, anim::SkinningMethod method, const calib::Camera& camera,
+                      const calib::Pose& pose) {
+  cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8U);
+  const Eigen::Matrix4d model_to_map = spec.ModelToMap();
+  constexpr int kShift = 8;
+  for (const anim::Mesh& mesh : character.meshes) {
+    std::vector<Eigen::Vector3f> skinned(mesh.positions.size());
+    anim::SkinningJob job{&mesh, method, frame.skinning_matrices, frame.skinning_dual_quats, skinned, {}};
+    EXPECT_TRUE(job.Run());
+    std::vector<cv::Point> pixels(skinned.size());
+    for (size_t i = 0; i < skinned.size(); ++i) {
+      const Eigen::Vector3d world = (model_to_map * skinned[i].cast<double>().homogeneous()).head<3>();
+      const Eigen::Vector2d px = camera.Project(pose.ToCamera(world));
+      pixels[i] = cv::Point(cvRound(px.x() * (1 << kShift)), cvRound(px.y() * (1 << kShift)));
+    }
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const cv::Point tri[3] = {pixels[mesh.indices[t]], pixels[mesh.indices[t + 1]], pixels[mesh.indices[t + 2]]};
+      cv::fillConvexPoly(mask, tri, 3, cv::Scalar(255), cv::LINE_8, kShift);
+    }
+  }
+  return mask;
+}
+
+double Iou(const cv::Mat& a, const cv::Mat& b) {
+  const double uni = cv::countNonZero(a | b);
+  return uni > 0 ? cv::countNonZero(a & b) / uni : 0.0;
+}
+
+class FoxTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
+    scene_ = FoxScene();
+    fox_ = std::make_unique<anim::AnimatedCharacter>(scene_.characters[0]);
+  }
+  const anim::FrameOutput& Frame(double time, const calib::Pose& pose) {
+    return fox_->Update(fox_->spec().ViewpointFromCamera(pose.Center()), time);
+  }
+  anim::Scene scene_;
+  std::unique_ptr<anim::AnimatedCharacter> fox_;
+};
+
+TEST_F(FoxTest, GpuSkinningMatchesCpuSkinningForBothMethods) {
+  const calib::Camera camera = TestCamera();
+  const calib::Pose pose = LookingAtFox();
+  for (auto method : {anim::SkinningMethod::kDualQuaternion, anim::SkinningMethod::kLinear}) {
+    ArOptions options;
+    options.skinning = method;
+    options.shadow = false;
+    options.empty_background = kMagenta;
+    ArRenderer renderer(testing::SharedContext(), camera, options);
+    renderer.AddCharacter(fox_->character(), fox_->spec());
+    for (double time : {0.0, 0.37, 0.71}) {
+      const anim::FrameOutput* frame = &Frame(time, pose);
+      const cv::Mat rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
+      const cv::Mat expected = CpuSilhouette(fox_->character(), fox_->spec(), *frame, method, camera, pose);
+      ASSERT_GT(cv::countNonZero(expected), 3000) << "the fox should fill part of the view";
+      EXPECT_FALSE(renderer.used_linear_fallback());
+      const double iou = Iou(rendered, expected);
+      std::printf("%s t=%.2f: silhouette IoU %.4f (%d px)\n",
+                  method == anim::SkinningMethod::kLinear ? "LBS" : "DQS", time, iou, cv::countNonZero(expected));
+      EXPECT_GE(iou, 0.97);
+    }
+  }
+}
+
+TEST_F(FoxTest, CompositesOverTheBackgroundWithAShadowBelow) {
+  const calib::Camera camera = TestCamera();
+  const calib::Pose pose = LookingAtFox();
+  cv::Mat background(camera.height, camera.width, CV_8UC3);
+  cv::randu(background, cv::Scalar::all(0), cv::Scalar::all(255));
+  ArRenderer renderer(testing::SharedContext(), camera, {});
+  renderer.AddCharacter(fox_->character(), fox_->spec());
+  const anim::FrameOutput* frame = &Frame(0.2, pose);
+  const cv::Mat out = renderer.Render(background, pose, {&frame, 1});
+  ASSERT_EQ(out.size(), background.size());
+
+  ArOptions bare;
+  bare.shadow = false;
+  bare.empty_background = kMagenta;
+  ArRenderer silhouette_renderer(testing::SharedContext(), camera, bare);
+  silhouette_renderer.AddCharacter(fox_->character(), fox_->spec());
+  const cv::Mat fox = NotBackground(silhouette_renderer.Render({}, pose, {&frame, 1}), kMagenta);
+
+  // Far from the character and its shadow, the video pixels are untouched.
+  cv::Mat near, diff, changed;
+  cv::dilate(fox, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, {121, 121}));
+  cv::absdiff(out, background, diff);
+  cv::cvtColor(diff, changed, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::countNonZero(changed & ~near), 0);
+  // The character covers the video.
+  EXPECT_GT(cv::mean(changed, fox)[0], 30);
+  // Outside the character, the shadow only darkens, and does so over a visible area.
+  cv::Mat out_grey, bg_grey, darker, brighter;
+  cv::cvtColor(out, out_grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(background, bg_grey, cv::COLOR_BGR2GRAY);
+  cv::subtract(bg_grey, out_grey, darker);
+  cv::subtract(out_grey, bg_grey, brighter);
+  const cv::Mat outside = ~fox;
+  const int shadow_pixels = cv::countNonZero((darker > 10) & outside);
+  std::printf("shadow darkens %d pixels by more than 10 grey levels\n", shadow_pixels);
+  EXPECT_GT(shadow_pixels, 1500);
+  cv::Mat away_from_rim;  // the antialiased rim of the character may be either
+  cv::erode(outside, away_from_rim, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
+  EXPECT_EQ(cv::countNonZero((brighter > 1) & away_from_rim), 0);
+}
+
+TEST_F(FoxTest, SideBySideEyesSeeTheCharacterWithDisparity) {
+  const calib::Camera camera = TestCamera();
+  const calib::Pose pose = LookingAtFox();
+  ArOptions options;
+  options.empty_background = kMagenta;
+  options.shadow = false;
+  ArRenderer renderer(testing::SharedContext(), camera, options);
+  renderer.AddCharacter(fox_->character(), fox_->spec());
+  const anim::FrameOutput* frame = &Frame(0.0, pose);
+  const cv::Mat both = renderer.RenderSideBySide({}, pose, {&frame, 1}, 0.064);
+  ASSERT_EQ(both.size(), cv::Size(2 * camera.width, camera.height));
+  const cv::Moments left = cv::moments(NotBackground(both(cv::Rect(0, 0, camera.width, camera.height)), kMagenta), true);
+  const cv::Moments right =
+      cv::moments(NotBackground(both(cv::Rect(camera.width, 0, camera.width, camera.height)), kMagenta), true);
+  ASSERT_GT(left.m00, 1000);
+  ASSERT_GT(right.m00, 1000);
+  // An object in front: further right in the left eye, by about f·ipd/depth (~17 px at 2.2 m).
+  const double disparity = left.m10 / left.m00 - right.m10 / right.m00;
+  std::printf("disparity %.1f px\n", disparity);
+  EXPECT_GT(disparity, 10);
+  EXPECT_LT(disparity, 30);
+  EXPECT_THROW(renderer.RenderSideBySide({}, pose, {&frame, 1}, -0.1), RenderError);
+}
+
+TEST_F(FoxTest, RejectsMismatchedInputs) {
+  const calib::Camera camera = TestCamera();
+  const calib::Pose pose = LookingAtFox();
+  ArRenderer renderer(testing::SharedContext(), camera, {});
+  renderer.AddCharacter(fox_->character(), fox_->spec());
+  const anim::FrameOutput* frame = &Frame(0.0, pose);
+  EXPECT_THROW(renderer.Render(cv::Mat(100, 100, CV_8UC3), pose, {&frame, 1}), RenderError);
+  EXPECT_THROW(renderer.Render({}, pose, {}), RenderError);
+}
+
+}  // namespace
+}  // namespace arview::render

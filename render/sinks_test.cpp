@@ -1,0 +1,75 @@
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "render/offscreen.h"
+#include "render/sinks.h"
+
+namespace arview::render {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path Scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_sinks_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+cv::Mat Frame(int i) {
+  cv::Mat m(120, 160, CV_8UC3, cv::Scalar(40, 80, 120));
+  cv::circle(m, {20 + 10 * i, 60}, 15, cv::Scalar(255, 255, 255), -1);
+  return m;
+}
+
+TEST(Sinks, Mp4FileReadsBackWithEveryFrame) {
+  const fs::path file = Scratch("out.mp4");
+  {
+    auto sink = OpenSink(file.string(), {160, 120}, 30);
+    for (int i = 0; i < 10; ++i) sink->Write(Frame(i));
+    sink->Close();
+  }
+  cv::VideoCapture in(file.string(), cv::CAP_FFMPEG);
+  ASSERT_TRUE(in.isOpened());
+  int frames = 0;
+  cv::Mat m;
+  while (in.read(m)) {
+    EXPECT_EQ(m.size(), cv::Size(160, 120));
+    ++frames;
+  }
+  EXPECT_EQ(frames, 10);
+  fs::remove_all(file.parent_path());
+}
+
+TEST(Sinks, PngFolderNumbersFrames) {
+  const fs::path folder = Scratch("pngs");
+  auto sink = OpenSink(folder.string() + "/", {160, 120}, 30);
+  sink->Write(Frame(0));
+  sink->Write(Frame(1));
+  EXPECT_TRUE(fs::exists(folder / "000000.png"));
+  EXPECT_TRUE(fs::exists(folder / "000001.png"));
+  EXPECT_THROW(sink->Write(cv::Mat(10, 10, CV_8UC3)), RenderError);
+  fs::remove_all(folder.parent_path());
+}
+
+TEST(Sinks, WindowWithoutDisplaySaysSo) {
+  if (HasDisplay()) GTEST_SKIP() << "a display is present";
+  try {
+    OpenSink("window", {160, 120}, 30);
+    FAIL() << "expected RenderError";
+  } catch (const RenderError& e) {
+    EXPECT_NE(std::string(e.what()).find("DISPLAY"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Sinks, RejectsUnknownTargets) {
+  EXPECT_THROW(OpenSink("out.gif", {160, 120}, 30), RenderError);
+  EXPECT_THROW(OpenSink("/nonexistent-folder/x.mp4", {160, 120}, 30), RenderError);
+  EXPECT_THROW(OpenSink("", {160, 120}, 30), RenderError);
+}
+
+}  // namespace
+}  // namespace arview::render
