@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 
 namespace arview::anim {
 namespace {
@@ -200,7 +201,9 @@ Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain&
     for (int s = 0; s < samples; ++s) times.push_back(base->duration * s / (samples - 1));
     if (base->duration <= 0) times = {0.0};
   }
-  clip.name = (base ? base->name : std::string("rest")) + "@lookat";
+  char where[96];
+  std::snprintf(where, sizeof(where), "@lookat(%.2f,%.2f,%.2f)", target.x(), target.y(), target.z());
+  clip.name = (base ? base->name : std::string("rest")) + where;
   for (int j : chain.joints) clip.tracks[j].rotation.clear();
   LocalPose pose(sk.size());
   for (double t : times) {

@@ -273,6 +273,32 @@ Scene LoadScene(const fs::path& path) {
   return ParseScene(ss.str(), path);
 }
 
+Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what) {
+  std::string t = text;
+  for (char& c : t)
+    if (c == ',') c = ' ';
+  std::istringstream in(t);
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    std::string word;
+    std::size_t used = 0;
+    bool ok = static_cast<bool>(in >> word);
+    if (ok) {
+      try {
+        v[i] = std::stod(word, &used);
+      } catch (const std::exception&) {
+        ok = false;
+      }
+    }
+    if (!ok || used != word.size() || !std::isfinite(v[i]))
+      throw Error(what + ": expected three numbers \"x,y,z\", got \"" + text + "\"");
+  }
+  std::string extra;
+  if (in >> extra) throw Error(what + ": more than three numbers in \"" + text + "\"");
+  if (!(v.norm() > 1e-12)) throw Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
+  return v.normalized();
+}
+
 namespace {
 std::vector<Eigen::Vector3d> KeyDirections(const CharacterSpec& spec) {
   std::vector<Eigen::Vector3d> dirs;

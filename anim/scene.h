@@ -111,6 +111,10 @@ struct Scene {
 Scene LoadScene(const std::filesystem::path& path);
 Scene ParseScene(const std::string& text, const std::filesystem::path& file_for_messages);
 
+// "x,y,z" (commas and/or spaces) → a unit viewpoint direction. Throws Error naming `what` when
+// the text is not three finite numbers or the vector has zero length.
+Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what = "viewpoint");
+
 struct FrameOutput {
   std::span<const double> weights;                  // one per key
   std::span<const Eigen::Matrix4d> model;           // joint model-space transforms

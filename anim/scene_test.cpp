@@ -100,6 +100,21 @@ TEST(Scene, ParseErrors) {
   EXPECT_THROW(LoadScene("/nonexistent/scene.yaml"), Error);
 }
 
+TEST(Scene, ParseViewpoint) {
+  EXPECT_LT((ParseViewpoint("0,0,2") - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  EXPECT_LT((ParseViewpoint(" 1, 0 ,0") - Eigen::Vector3d::UnitX()).norm(), 1e-12);
+  EXPECT_THROW(ParseViewpoint("1,2"), Error);
+  EXPECT_THROW(ParseViewpoint("1,2,3,4"), Error);
+  EXPECT_THROW(ParseViewpoint("1,x,3"), Error);
+  EXPECT_THROW(ParseViewpoint("1,nan,3"), Error);
+  try {
+    ParseViewpoint("0,0,0", "--viewpoint");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--viewpoint: zero-length viewpoint"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scene, MissingClipIsAnError) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
   const Scene s = ParseScene(FoxScene("      - azimuth: 0\n        clip: Survey\n      - azimuth: 90\n        clip: Jump\n"),

@@ -1,11 +1,211 @@
+// arview anim info <asset> [--json]
+// arview anim weights --scene <scene.yaml> --viewpoint x,y,z [--character <name>] [--time s] [--json]
+
+#include <cmath>
+#include <functional>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "anim/lookat.h"
+#include "anim/scene.h"
 #include "app/commands.h"
+#include "app/json_writer.h"
 
 namespace arview::app {
 
+namespace {
+
+struct AnimArgs {
+  std::string asset;
+  std::string scene;
+  std::string viewpoint;
+  std::string character;
+  double time = 0;
+  bool json = false;
+};
+
+std::string Fixed(double v, int digits = 3) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", digits, v);
+  return buf;
+}
+
+int Depth(const anim::Skeleton& sk, int j) {
+  int d = 0;
+  for (; sk.parents[j] >= 0; j = sk.parents[j]) ++d;
+  return d;
+}
+
+// Joints of the skeleton that a mesh's vertices reference.
+int BonesUsed(const anim::Mesh& mesh, int joints) {
+  std::vector<bool> used(joints, false);
+  for (std::size_t v = 0; v < mesh.joints.size(); ++v)
+    for (int i = 0; i < 4; ++i)
+      if (mesh.weights[v][i] > 0) used[mesh.joints[v][i]] = true;
+  int n = 0;
+  for (bool u : used) n += u;
+  return n;
+}
+
+std::string TextureText(const anim::Character& c, int texture) {
+  if (texture < 0) return "none";
+  const anim::Texture& t = c.textures[texture];
+  if (!t.path.empty()) return t.path;
+  if (!t.encoded.empty()) return "embedded " + t.format_hint + " (" + std::to_string(t.encoded.size()) + " bytes)";
+  return "embedded raw " + std::to_string(t.width) + "x" + std::to_string(t.height);
+}
+
+void RunInfo(const AnimArgs& args) {
+  const anim::Character c = anim::LoadCharacter(args.asset);
+  const anim::Skeleton& sk = c.skeleton;
+  const std::vector<std::string> chain = anim::DefaultLookAtChain(sk);
+  if (args.json) {
+    JsonWriter j;
+    j.BeginObject().Value("asset", c.source);
+    j.BeginArray("joints");
+    for (int i = 0; i < sk.size(); ++i)
+      j.BeginObject().Value("index", i).Value("name", sk.names[i]).Value("parent", sk.parents[i]).EndObject();
+    j.EndArray();
+    j.BeginArray("clips");
+    for (const anim::Clip& clip : c.clips)
+      j.BeginObject().Value("name", clip.name).Value("duration_s", clip.duration).Value("ticks_per_second", clip.ticks_per_second).EndObject();
+    j.EndArray();
+    j.BeginArray("meshes");
+    for (const anim::Mesh& m : c.meshes) {
+      j.BeginObject().Value("name", m.name).Value("vertices", m.positions.size()).Value("triangles", m.indices.size() / 3);
+      j.Value("bones", BonesUsed(m, sk.size())).Value("uvs", !m.uvs.empty()).Value("material", m.material);
+      if (m.material >= 0) j.Value("texture", TextureText(c, c.materials[m.material].texture));
+      j.EndObject();
+    }
+    j.EndArray();
+    j.BeginArray("default_lookat_chain");
+    for (const std::string& n : chain) j.BeginObject().Value("joint", n).EndObject();
+    j.EndArray();
+    j.EndObject();
+    std::cout << j.str() << "\n";
+    return;
+  }
+  std::cout << c.source << "\n";
+  std::cout << "skeleton: " << sk.size() << " joints\n";
+  for (int i = 0; i < sk.size(); ++i)
+    std::cout << "  " << std::string(2 * Depth(sk, i), ' ') << "[" << i << "] " << sk.names[i] << "\n";
+  std::cout << "clips: " << c.clips.size() << "\n";
+  for (const anim::Clip& clip : c.clips) {
+    std::cout << "  " << clip.name << "  " << Fixed(clip.duration) << " s";
+    if (clip.ticks_per_second > 0) std::cout << "  (" << Fixed(clip.ticks_per_second, 1) << " ticks/s)";
+    std::cout << "\n";
+  }
+  std::cout << "meshes: " << c.meshes.size() << "\n";
+  for (const anim::Mesh& m : c.meshes) {
+    std::cout << "  " << (m.name.empty() ? "(unnamed)" : m.name) << ": " << m.positions.size() << " vertices, "
+              << m.indices.size() / 3 << " triangles, " << BonesUsed(m, sk.size()) << " bones"
+              << (m.uvs.empty() ? ", no UVs" : "");
+    if (m.material >= 0) {
+      const anim::Material& mat = c.materials[m.material];
+      std::cout << ", base colour (" << Fixed(mat.base_color[0], 2) << ", " << Fixed(mat.base_color[1], 2) << ", "
+                << Fixed(mat.base_color[2], 2) << "), texture " << TextureText(c, mat.texture);
+    }
+    std::cout << "\n";
+  }
+  std::cout << "default look-at chain: ";
+  if (chain.empty()) std::cout << "none found (name the joints in the scene's lookat.chain)";
+  for (std::size_t i = 0; i < chain.size(); ++i) std::cout << (i ? " > " : "") << chain[i];
+  std::cout << "\n";
+}
+
+const char* SourceName(anim::KeySpec::Source s) {
+  switch (s) {
+    case anim::KeySpec::Source::kClip: return "clip";
+    case anim::KeySpec::Source::kLookAt: return "lookat";
+    case anim::KeySpec::Source::kRestPose: return "rest";
+    case anim::KeySpec::Source::kStaticPose: return "pose";
+  }
+  return "?";
+}
+
+void RunWeights(const AnimArgs& args) {
+  const Eigen::Vector3d v = anim::ParseViewpoint(args.viewpoint, "--viewpoint");
+  if (!std::isfinite(args.time)) throw CommandError("--time must be a finite number of seconds");
+  const anim::Scene scene = anim::LoadScene(args.scene);
+  const anim::CharacterSpec* spec = nullptr;
+  for (const anim::CharacterSpec& c : scene.characters)
+    if (args.character.empty() || c.name == args.character) {
+      spec = &c;
+      break;
+    }
+  if (!spec) throw CommandError(args.scene + ": no character named '" + args.character + "'");
+  anim::AnimatedCharacter ch(*spec);
+  const anim::FrameOutput& out = ch.Update(v, args.time);
+  const bool lookat = !ch.lookat_chain().joints.empty();
+  double head_deg = 0;
+  if (lookat) {
+    const Eigen::Vector3d f = anim::HeadForward(ch.lookat_chain(), out.model);
+    head_deg = std::atan2(f.cross(v).norm(), f.dot(v)) * 180 / M_PI;
+  }
+  const bool dib = spec->blend == anim::BlendMethod::kDib;
+  if (args.json) {
+    JsonWriter j;
+    j.BeginObject().Value("scene", args.scene).Value("character", spec->name);
+    j.BeginArray("viewpoint").Element(v.x()).Element(v.y()).Element(v.z()).EndArray();
+    j.Value("time_s", args.time);
+    j.BeginArray("keys");
+    for (std::size_t k = 0; k < spec->keys.size(); ++k) {
+      const anim::KeySpec& key = spec->keys[k];
+      j.BeginObject().Value("index", k).Value("source", SourceName(key.source)).Value("clip", ch.key_clip(int(k)).name);
+      j.BeginArray("viewpoint").Element(key.viewpoint.x()).Element(key.viewpoint.y()).Element(key.viewpoint.z()).EndArray();
+      j.Value("weight", out.weights[k]).EndObject();
+    }
+    j.EndArray();
+    j.Value("blend", dib ? "dib" : "dlb");
+    if (dib) j.Value("dib_converged", out.converged).Value("dib_max_iterations", out.max_iterations);
+    if (lookat) j.Value("head_to_viewpoint_deg", head_deg);
+    j.EndObject();
+    std::cout << j.str() << "\n";
+    return;
+  }
+  std::cout << "character " << spec->name << ", viewpoint (" << Fixed(v.x()) << ", " << Fixed(v.y()) << ", "
+            << Fixed(v.z()) << "), t = " << Fixed(args.time) << " s\n";
+  for (std::size_t k = 0; k < spec->keys.size(); ++k) {
+    const anim::KeySpec& key = spec->keys[k];
+    std::cout << "  key " << k << "  (" << Fixed(key.viewpoint.x()) << ", " << Fixed(key.viewpoint.y()) << ", "
+              << Fixed(key.viewpoint.z()) << ")  " << SourceName(key.source) << " " << ch.key_clip(int(k)).name
+              << "  weight " << Fixed(out.weights[k], 4) << "\n";
+  }
+  if (dib)
+    std::cout << "DIB: " << (out.converged ? "converged" : "NOT converged") << ", at most " << out.max_iterations
+              << " iterations per joint\n";
+  if (lookat) std::cout << "head forward to viewpoint: " << Fixed(head_deg, 2) << " deg\n";
+}
+
+void Guard(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const anim::Error& e) {
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
 void AddAnimCommand(CLI::App& app) {
+  auto args = std::make_shared<AnimArgs>();
   auto* cmd = app.add_subcommand("anim", "Inspect characters and view-adaptive blend weights ('anim info', 'anim weights')");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("anim"); });
+  cmd->require_subcommand(1);
+
+  auto* info = cmd->add_subcommand("info", "Skeleton, clips, meshes and bones per mesh of a character asset");
+  info->add_option("asset", args->asset, "Character file (glTF .glb/.gltf, FBX, Collada .dae, DirectX .X, BVH)")->required();
+  info->add_flag("--json", args->json, "Print JSON instead of text");
+  info->callback([args] { Guard([&] { RunInfo(*args); }); });
+
+  auto* weights = cmd->add_subcommand("weights", "Key weights (and the blended head's direction) for one viewpoint");
+  weights->add_option("--scene", args->scene, "Scene file (YAML, see docs/anim.md)")->required();
+  weights->add_option("--viewpoint", args->viewpoint, "Direction from the character to the viewer, x,y,z in the character's frame")
+      ->required();
+  weights->add_option("--character", args->character, "Character name in the scene (default: the first)");
+  weights->add_option("--time", args->time, "Animation time in seconds (default 0)");
+  weights->add_flag("--json", args->json, "Print JSON instead of text");
+  weights->callback([args] { Guard([&] { RunWeights(*args); }); });
 }
 
 }  // namespace arview::app
