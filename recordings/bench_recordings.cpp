@@ -1,0 +1,73 @@
+// Speed of the per-frame work of live capture and recording, at 640x480: decoding the two
+// V4L2 formats, and writing one frame the way RecordingWriter does (PNG, compression 1).
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "recordings/recorder.h"
+#include "recordings/v4l2_source.h"
+
+namespace {
+
+using namespace arview::recordings;
+
+// A camera-like 640x480 image: smooth shading plus texture, so that codecs work realistically.
+cv::Mat Scene() {
+  cv::Mat image(480, 640, CV_8UC3);
+  cv::RNG rng(1);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      image.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uchar>(x / 3), static_cast<uchar>(y / 2), 120);
+    }
+  }
+  for (int i = 0; i < 300; ++i) {
+    cv::circle(image, {rng.uniform(0, 640), rng.uniform(0, 480)}, rng.uniform(2, 30),
+               cv::Scalar(rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0, 256)), -1);
+  }
+  return image;
+}
+
+void BM_DecodeYuyv640x480(benchmark::State& state) {
+  cv::Mat yuv;
+  cv::cvtColor(Scene(), yuv, cv::COLOR_BGR2YUV);
+  std::vector<uint8_t> packed(640 * 480 * 2);
+  for (int y = 0; y < 480; ++y) {
+    for (int x = 0; x < 640; ++x) {
+      const cv::Vec3b p = yuv.at<cv::Vec3b>(y, x);
+      packed[(y * 640 + x) * 2] = p[0];
+      packed[(y * 640 + x) * 2 + 1] = x % 2 ? p[2] : p[1];
+    }
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(DecodeYuyv(packed.data(), packed.size(), 640, 480, 1280));
+}
+BENCHMARK(BM_DecodeYuyv640x480)->Unit(benchmark::kMillisecond);
+
+void BM_DecodeMjpeg640x480(benchmark::State& state) {
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", Scene(), jpeg, {cv::IMWRITE_JPEG_QUALITY, 85});
+  for (auto _ : state) benchmark::DoNotOptimize(DecodeMjpeg(jpeg.data(), jpeg.size(), 640, 480));
+  state.counters["jpeg_bytes"] = static_cast<double>(jpeg.size());
+}
+BENCHMARK(BM_DecodeMjpeg640x480)->Unit(benchmark::kMillisecond);
+
+void BM_RecordFrame640x480(benchmark::State& state) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_bench_record_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const cv::Mat image = Scene();
+  {
+    RecordingWriter writer(dir, std::nullopt, false);
+    double t = 0;
+    for (auto _ : state) writer.Append(image, t += 1.0 / 30);
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_RecordFrame640x480)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+BENCHMARK_MAIN();
