@@ -1,0 +1,128 @@
+// bench_mapping: map load time and the descriptor index measurement behind the choice of index
+// type (docs/mapping.md, "Descriptor index").
+//
+// Data: templeRing (../shared/data), imported, then two maps built with COLMAP on the first run
+// and kept in $ARVIEW_BENCH_DIR (default /tmp/arview_bench_mapping): the even frames (the map
+// that is indexed) and the odd frames (whose descriptors are the queries: features of frames
+// the map has not seen, as the tracker will query). The first run takes a minute or two.
+//
+// Each index benchmark reports `recall`: the fraction of 2000 queries whose returned nearest row
+// is the true nearest row (found by brute force), and the time per query.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+
+#include "mapping/colmap_pipeline.h"
+#include "mapping/descriptor_index.h"
+#include "mapping/map_file.h"
+#include "recordings/importers.h"
+#include "tests/support/test_data.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace arview;
+
+struct BenchData {
+  fs::path map_dir;
+  mapping::Map map;
+  cv::Mat queries;                      // 2000 rows of the odd-frame map
+  std::vector<std::uint32_t> truth;     // true nearest row of each query
+};
+
+fs::path BenchDir() {
+  const char* env = std::getenv("ARVIEW_BENCH_DIR");
+  return env && *env ? fs::path(env) : fs::temp_directory_path() / "arview_bench_mapping";
+}
+
+const BenchData& Data() {
+  static std::unique_ptr<BenchData> data = [] {
+    auto d = std::make_unique<BenchData>();
+    const fs::path dir = BenchDir();
+    const fs::path source = testing::SharedData("templeRing");
+    if (!fs::exists(dir / "recording" / "frames.txt")) {
+      recordings::ImportOptions io;
+      io.overwrite = true;
+      recordings::ImportMiddlebury(source, dir / "recording", io);
+    }
+    const recordings::Recording rec = recordings::LoadRecording(dir / "recording");
+    mapping::MapBuildOptions options;
+    options.frames_spec = "0-46:2";
+    d->map = mapping::BuildMap(rec, dir / "even", options).map;  // re-uses finished stages
+    d->map_dir = dir / "even";
+    options.frames_spec = "1-45:2";
+    const mapping::Map odd = mapping::BuildMap(rec, dir / "odd", options).map;
+    const int n = std::min(2000, odd.descriptors.rows);
+    const int step = std::max(1, odd.descriptors.rows / n);
+    for (int r = 0; r < n; ++r) d->queries.push_back(odd.descriptors.row(r * step));
+    const mapping::DescriptorIndex exact(d->map.descriptors, {.kind = mapping::IndexKind::kLinear});
+    for (const auto& nn : exact.Knn(d->queries, 1)) d->truth.push_back(nn.at(0).row);
+    std::cerr << "bench data: map " << d->map.descriptors.rows << " descriptors, " << d->queries.rows << " queries\n";
+    return d;
+  }();
+  return *data;
+}
+
+void BM_LoadMap(benchmark::State& state) {
+  const BenchData& d = Data();
+  for (auto _ : state) {
+    mapping::Map m = mapping::LoadMap(d.map_dir);
+    benchmark::DoNotOptimize(m.points.data());
+  }
+  state.counters["descriptors"] = d.map.descriptors.rows;
+  state.counters["file_MiB"] = static_cast<double>(fs::file_size(d.map_dir / mapping::kMapFileName)) / (1 << 20);
+}
+BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond);
+
+mapping::IndexParams Params(const benchmark::State& state) {
+  mapping::IndexParams p;
+  p.kind = static_cast<mapping::IndexKind>(state.range(0));
+  p.trees = static_cast<int>(state.range(1));
+  p.branching = static_cast<int>(state.range(1));
+  p.checks = static_cast<int>(state.range(2));
+  return p;
+}
+
+void BM_BuildIndex(benchmark::State& state) {
+  const BenchData& d = Data();
+  const mapping::IndexParams p = Params(state);
+  for (auto _ : state) {
+    mapping::DescriptorIndex index(d.map.descriptors, p);
+    benchmark::DoNotOptimize(index.size());
+  }
+}
+
+void BM_Knn(benchmark::State& state) {
+  const BenchData& d = Data();
+  const mapping::DescriptorIndex index(d.map.descriptors, Params(state));
+  std::vector<std::vector<mapping::Neighbor>> result;
+  for (auto _ : state) {
+    result = index.Knn(d.queries, 2);
+    benchmark::DoNotOptimize(result.data());
+  }
+  int hits = 0;
+  for (size_t q = 0; q < result.size(); ++q) hits += !result[q].empty() && result[q][0].row == d.truth[q];
+  state.counters["recall"] = static_cast<double>(hits) / static_cast<double>(result.size());
+  state.counters["us_per_query"] = benchmark::Counter(static_cast<double>(d.queries.rows) * 1e-6,
+                                                      benchmark::Counter::kIsIterationInvariantRate |
+                                                          benchmark::Counter::kInvert);
+}
+
+// Args: kind (0 linear, 1 kd-tree, 2 k-means), trees or branching, checks.
+void IndexGrid(benchmark::internal::Benchmark* b) {
+  b->Args({0, 1, 0});
+  for (int trees : {1, 4, 8}) {
+    for (int checks : {16, 32, 64, 128, 256}) b->Args({1, trees, checks});
+  }
+  for (int checks : {16, 32, 64, 128, 256}) b->Args({2, 32, checks});
+}
+
+BENCHMARK(BM_BuildIndex)->Args({1, 4, 64})->Args({1, 8, 64})->Args({2, 32, 64})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Knn)->Apply(IndexGrid)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,103 @@
+#include "mapping/descriptor_index.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <random>
+
+namespace arview::mapping {
+namespace {
+
+// Clustered random descriptors: like SIFT, many rows share structure, and each query is a
+// perturbed copy of one row so that its true nearest neighbour is known to exist.
+cv::Mat RandomDescriptors(int rows, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> value(0, 120);
+  cv::Mat m(rows, 128, CV_8UC1);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < 128; ++c) m.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(value(rng));
+  }
+  return m;
+}
+
+float BruteDistance(const cv::Mat& a, int ra, const cv::Mat& b, int rb) {
+  return static_cast<float>(cv::norm(a.row(ra), b.row(rb), cv::NORM_L2));
+}
+
+TEST(DescriptorIndex, LinearIsExactAndSorted) {
+  const cv::Mat data = RandomDescriptors(500, 1);
+  const cv::Mat queries = RandomDescriptors(20, 2);
+  const DescriptorIndex index(data, {.kind = IndexKind::kLinear});
+  ASSERT_EQ(index.size(), 500u);
+  const auto result = index.Knn(queries, 3);
+  ASSERT_EQ(result.size(), 20u);
+  for (int q = 0; q < queries.rows; ++q) {
+    float best = 1e30f;
+    int best_row = -1;
+    for (int r = 0; r < data.rows; ++r) {
+      const float d = BruteDistance(queries, q, data, r);
+      if (d < best) best = d, best_row = r;
+    }
+    ASSERT_EQ(result[static_cast<size_t>(q)].size(), 3u);
+    EXPECT_EQ(result[static_cast<size_t>(q)][0].row, static_cast<std::uint32_t>(best_row));
+    EXPECT_NEAR(result[static_cast<size_t>(q)][0].distance, best, 1e-3f * best);
+    EXPECT_LE(result[static_cast<size_t>(q)][0].distance, result[static_cast<size_t>(q)][1].distance);
+    EXPECT_LE(result[static_cast<size_t>(q)][1].distance, result[static_cast<size_t>(q)][2].distance);
+  }
+}
+
+TEST(DescriptorIndex, KdTreeFindsPerturbedCopies) {
+  const cv::Mat data = RandomDescriptors(5000, 3);
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<int> pick(0, data.rows - 1), noise(-3, 3);
+  cv::Mat queries(200, 128, CV_8UC1);
+  std::vector<int> truth;
+  for (int q = 0; q < queries.rows; ++q) {
+    truth.push_back(pick(rng));
+    for (int c = 0; c < 128; ++c) {
+      queries.at<std::uint8_t>(q, c) =
+          cv::saturate_cast<std::uint8_t>(data.at<std::uint8_t>(truth.back(), c) + noise(rng));
+    }
+  }
+  for (IndexKind kind : {IndexKind::kKdTree, IndexKind::kKMeans}) {
+    const DescriptorIndex index(data, {.kind = kind, .checks = 128});
+    const auto result = index.Knn(queries, 2);
+    int found = 0;
+    for (size_t q = 0; q < truth.size(); ++q) found += !result[q].empty() && result[q][0].row == static_cast<std::uint32_t>(truth[q]);
+    EXPECT_GE(found, 190) << "kind " << static_cast<int>(kind);
+  }
+}
+
+TEST(DescriptorIndex, SingleQueryMatchesBatch) {
+  const cv::Mat data = RandomDescriptors(300, 5);
+  const DescriptorIndex index(data);
+  const auto batch = index.Knn(data.row(7), 1);
+  const auto single = index.Knn(data.ptr<std::uint8_t>(7), 1);
+  ASSERT_EQ(single.size(), 1u);
+  EXPECT_EQ(single[0].row, batch[0][0].row);
+  EXPECT_EQ(single[0].row, 7u);
+  EXPECT_FLOAT_EQ(single[0].distance, 0.f);
+}
+
+TEST(DescriptorIndex, KLargerThanTheIndexGivesEveryRow) {
+  const cv::Mat data = RandomDescriptors(5, 6);
+  const DescriptorIndex index(data, {.kind = IndexKind::kLinear});
+  EXPECT_EQ(index.Knn(data.row(0), 10)[0].size(), 5u);
+  EXPECT_TRUE(index.Knn(data.row(0), 0)[0].empty());
+}
+
+TEST(DescriptorIndex, RejectsWrongMatrices) {
+  EXPECT_THROW(DescriptorIndex(cv::Mat(10, 64, CV_8UC1, cv::Scalar(0))), DescriptorIndexError);
+  EXPECT_THROW(DescriptorIndex(cv::Mat(10, 128, CV_32FC1, cv::Scalar(0))), DescriptorIndexError);
+  EXPECT_THROW(DescriptorIndex(cv::Mat(0, 128, CV_8UC1)), DescriptorIndexError);
+  const DescriptorIndex index(RandomDescriptors(10, 7));
+  EXPECT_THROW(index.Knn(cv::Mat(1, 128, CV_32FC1, cv::Scalar(0)), 1), DescriptorIndexError);
+  const DescriptorIndex empty;
+  EXPECT_TRUE(empty.empty());
+  EXPECT_TRUE(empty.Knn(RandomDescriptors(2, 8), 1)[0].empty());
+}
+
+}  // namespace
+}  // namespace arview::mapping

@@ -1,0 +1,159 @@
+#include "mapping/map_file.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <random>
+
+namespace arview::mapping {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small consistent map: 3 keyframes on a line looking down +z, points in front of them,
+// each point seen by every keyframe, observations exactly at the projections.
+Map SmallMap() {
+  Map map;
+  map.camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int k = 0; k < 3; ++k) {
+    Keyframe kf;
+    kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
+    kf.name = "frames/" + std::to_string(k) + ".png";
+    kf.frame_index = 2 * k;
+    kf.timestamp = 0.5 * k;
+    kf.pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.3 * k, 0, 0));
+    map.keyframes.push_back(kf);
+  }
+  const int points = 10;
+  map.descriptors.create(points * 3, 128, CV_8UC1);
+  for (int i = 0; i < points; ++i) {
+    MapPoint p;
+    p.xyz = Eigen::Vector3d(u(rng), u(rng), 4 + u(rng));
+    p.rgb = {static_cast<std::uint8_t>(i), 20, 30};
+    p.reprojection_error = 0.1 * i;
+    p.first_descriptor = static_cast<std::uint32_t>(3 * i);
+    p.descriptor_count = 3;
+    map.points.push_back(p);
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t row = static_cast<std::uint32_t>(3 * i) + k;
+      map.descriptors.row(static_cast<int>(row)).setTo(cv::Scalar((row * 7) % 256));
+      map.descriptor_point.push_back(static_cast<std::uint32_t>(i));
+      map.descriptor_keyframe.push_back(k);
+      const Eigen::Vector2d px = map.camera.Project(map.keyframes[k].pose.ToCamera(p.xyz));
+      map.keyframes[k].observations.push_back({static_cast<std::uint32_t>(i), px.cast<float>(), row});
+    }
+  }
+  return map;
+}
+
+class MapFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("arview_map_file_test_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::vector<char> Bytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  void Write(const fs::path& p, const std::vector<char>& bytes) {
+    std::ofstream out(p, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  fs::path dir_;
+};
+
+TEST_F(MapFileTest, RoundTripKeepsEverything) {
+  const Map map = SmallMap();
+  SaveMap(map, dir_ / kMapFileName);
+  const Map back = LoadMap(dir_);  // a directory finds map.arvmap
+  EXPECT_EQ(back.camera.fx, map.camera.fx);
+  EXPECT_EQ(back.camera.cx, map.camera.cx);
+  ASSERT_EQ(back.keyframes.size(), map.keyframes.size());
+  for (size_t k = 0; k < map.keyframes.size(); ++k) {
+    EXPECT_EQ(back.keyframes[k].name, map.keyframes[k].name);
+    EXPECT_EQ(back.keyframes[k].frame_index, map.keyframes[k].frame_index);
+    EXPECT_EQ(back.keyframes[k].timestamp, map.keyframes[k].timestamp);
+    EXPECT_EQ(back.keyframes[k].pose.t_cw, map.keyframes[k].pose.t_cw);
+    ASSERT_EQ(back.keyframes[k].observations.size(), map.keyframes[k].observations.size());
+    EXPECT_EQ(back.keyframes[k].observations[4].pixel, map.keyframes[k].observations[4].pixel);
+  }
+  ASSERT_EQ(back.points.size(), map.points.size());
+  EXPECT_EQ(back.points[3].xyz, map.points[3].xyz);
+  EXPECT_EQ(back.points[3].rgb, map.points[3].rgb);
+  EXPECT_EQ(cv::norm(back.descriptors, map.descriptors, cv::NORM_INF), 0);
+  EXPECT_EQ(back.descriptor_point, map.descriptor_point);
+  EXPECT_EQ(back.descriptor_keyframe, map.descriptor_keyframe);
+  const MapStats s = ComputeStats(back);
+  EXPECT_EQ(s.observations, 30u);
+  EXPECT_NEAR(s.mean_reprojection_error, 0, 1e-3);
+  EXPECT_DOUBLE_EQ(s.mean_track_length, 3);
+}
+
+TEST_F(MapFileTest, EveryTruncationIsAClearError) {
+  const fs::path file = dir_ / kMapFileName;
+  SaveMap(SmallMap(), file);
+  const std::vector<char> bytes = Bytes(file);
+  const fs::path cut = dir_ / "cut.arvmap";
+  for (size_t n = 0; n < bytes.size(); n += std::max<size_t>(1, bytes.size() / 97)) {
+    Write(cut, std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n)));
+    EXPECT_THROW(LoadMap(cut), MapError) << "truncated to " << n << " bytes";
+  }
+}
+
+TEST_F(MapFileTest, FlippedBytesFailTheChecksum) {
+  const fs::path file = dir_ / kMapFileName;
+  SaveMap(SmallMap(), file);
+  std::vector<char> bytes = Bytes(file);
+  bytes[bytes.size() / 2] ^= 0x10;
+  Write(file, bytes);
+  try {
+    LoadMap(file);
+    FAIL() << "expected MapError";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("checksum"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(MapFileTest, WrongMagicAndVersionAreNamed) {
+  const fs::path file = dir_ / kMapFileName;
+  SaveMap(SmallMap(), file);
+  std::vector<char> bytes = Bytes(file);
+  std::vector<char> other = bytes;
+  other[0] = 'X';
+  Write(file, other);
+  EXPECT_THROW(LoadMap(file), MapError);
+  other = bytes;
+  other[8] = 99;  // version
+  Write(file, other);
+  try {
+    LoadMap(file);
+    FAIL() << "expected MapError";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("version 99"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(LoadMap(dir_ / "missing"), MapError);
+}
+
+TEST_F(MapFileTest, InconsistentMapsAreRefused) {
+  Map map = SmallMap();
+  map.keyframes[1].observations[2].point = 1000;
+  EXPECT_THROW(SaveMap(map, dir_ / "bad.arvmap"), MapError);
+  map = SmallMap();
+  map.points[0].descriptor_count = 100;
+  EXPECT_THROW(ValidateMap(map, "test"), MapError);
+  map = SmallMap();
+  map.descriptor_keyframe.pop_back();
+  EXPECT_THROW(ValidateMap(map, "test"), MapError);
+  map = SmallMap();
+  map.keyframes[0].observations[0].descriptor = 1;  // a row of keyframe 1
+  EXPECT_THROW(ValidateMap(map, "test"), MapError);
+  EXPECT_FALSE(fs::exists(dir_ / "bad.arvmap"));
+}
+
+}  // namespace
+}  // namespace arview::mapping

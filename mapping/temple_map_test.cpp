@@ -1,0 +1,231 @@
+// The map of templeRing's 24 even frames, built once with COLMAP (about half a minute on two
+// cores) and shared by every check: registration, reprojection error, accuracy against the
+// Middlebury ground truth, the files written, re-use of finished stages, and how the readers
+// handle truncated or corrupted copies of COLMAP's output.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <memory>
+
+#include "mapping/colmap_model.h"
+#include "mapping/colmap_pipeline.h"
+#include "mapping/descriptor_index.h"
+#include "mapping/map_file.h"
+#include "recordings/accuracy.h"
+#include "recordings/importers.h"
+#include "recordings/trajectory.h"
+#include "tests/support/test_data.h"
+
+namespace arview::mapping {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempleMapTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    const fs::path source = testing::SharedData("templeRing");
+    if (!fs::exists(source)) return;  // each test skips (or fails under ARVIEW_REQUIRE_DATA=1)
+    root_ = fs::temp_directory_path() / ("arview_temple_map_test_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    recordings::ImportMiddlebury(source, root_ / "recording");
+    recording_ = std::make_unique<recordings::Recording>(recordings::LoadRecording(root_ / "recording"));
+    MapBuildOptions options;
+    options.frames_spec = "0-46:2";
+    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options));
+  }
+  static void TearDownTestSuite() {
+    if (!root_.empty()) fs::remove_all(root_);
+    result_.reset();
+    recording_.reset();
+  }
+  void SetUp() override {
+    ARVIEW_REQUIRE_DATA_PATH(testing::SharedData("templeRing"), "../shared/data");
+    ASSERT_TRUE(result_) << "building the map failed in SetUpTestSuite";
+  }
+
+  static const Map& map() { return result_->map; }
+  static fs::path MapDir() { return root_ / "map"; }
+
+  // A copy of the model folder (and database) with one file cut to `bytes` or overwritten.
+  static fs::path BrokenCopy(const std::string& file, const std::function<void(std::vector<char>&)>& damage) {
+    const fs::path dir = root_ / "broken";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
+      fs::copy_file(result_->model_dir / name, dir / name);
+    }
+    fs::copy_file(MapDir() / "database.db", dir / "database.db");
+    std::vector<char> bytes;
+    {
+      std::ifstream in(dir / file, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    damage(bytes);
+    std::ofstream out(dir / file, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return dir;
+  }
+
+  static fs::path root_;
+  static std::unique_ptr<recordings::Recording> recording_;
+  static std::unique_ptr<MapBuildResult> result_;
+};
+
+fs::path TempleMapTest::root_;
+std::unique_ptr<recordings::Recording> TempleMapTest::recording_;
+std::unique_ptr<MapBuildResult> TempleMapTest::result_;
+
+TEST_F(TempleMapTest, RegistersAllTwentyFourEvenFrames) {
+  ASSERT_EQ(result_->selected_frames.size(), 24u);
+  ASSERT_EQ(map().keyframes.size(), 24u);
+  for (size_t i = 0; i < map().keyframes.size(); ++i) {
+    EXPECT_EQ(map().keyframes[i].frame_index, static_cast<int>(2 * i));
+    EXPECT_EQ(map().keyframes[i].timestamp, recording_->frames[2 * i].timestamp);
+    EXPECT_EQ(map().keyframes[i].name, recording_->frames[2 * i].path);
+  }
+  EXPECT_EQ(result_->models, 1);
+}
+
+TEST_F(TempleMapTest, CameraComesBackInOpenCvPixels) {
+  // Fixed intrinsics: exactly the recording's, the +0.5 handed to COLMAP removed again.
+  EXPECT_NEAR(map().camera.cx, recording_->camera.cx, 1e-9);
+  EXPECT_NEAR(map().camera.cy, recording_->camera.cy, 1e-9);
+  EXPECT_NEAR(map().camera.fx, recording_->camera.fx, 1e-9);
+}
+
+TEST_F(TempleMapTest, ReprojectionErrorBelowOnePixel) {
+  const MapStats s = ComputeStats(map());
+  EXPECT_GT(s.points, 1000u);
+  EXPECT_GT(s.mean_track_length, 2.5);
+  EXPECT_LE(s.mean_reprojection_error, 1.0);
+  // Our reprojection (OpenCV convention both sides) agrees with COLMAP's own figure: a
+  // half-pixel slip in either conversion would show here.
+  EXPECT_NEAR(s.mean_reprojection_error, s.mean_colmap_point_error, 0.1);
+}
+
+TEST_F(TempleMapTest, KeyframeCentresMatchGroundTruthAfterSim3) {
+  ASSERT_TRUE(recording_->groundtruth.has_value());
+  const recordings::Trajectory keyframes = recordings::ReadTum(MapDir() / "keyframes.txt");
+  ASSERT_EQ(keyframes.size(), 24u);
+  const recordings::AccuracyReport report = recordings::EvaluateTrajectory(keyframes, *recording_->groundtruth);
+  EXPECT_EQ(report.associated, 24);
+  EXPECT_LE(report.ate.median, 0.002) << recordings::ReportToText(report);
+  EXPECT_LE(report.rotation_deg.median, 0.5);
+}
+
+TEST_F(TempleMapTest, CompactFileLoadsTheSameMap) {
+  const Map loaded = LoadMap(MapDir());
+  ASSERT_EQ(loaded.keyframes.size(), map().keyframes.size());
+  ASSERT_EQ(loaded.points.size(), map().points.size());
+  EXPECT_EQ(loaded.descriptor_point, map().descriptor_point);
+  EXPECT_EQ(cv::norm(loaded.descriptors, map().descriptors, cv::NORM_INF), 0);
+  EXPECT_TRUE(fs::exists(MapDir() / "map.png"));
+  EXPECT_TRUE(fs::exists(result_->model_dir / "points3D.bin"));
+}
+
+TEST_F(TempleMapTest, DescriptorsAreColmapUint8Sift) {
+  // L1-root SIFT scaled by 512: each row's squared values sum to about 512² (clamping and
+  // rounding make it a little less).
+  ASSERT_EQ(map().descriptors.type(), CV_8UC1);
+  for (int r = 0; r < map().descriptors.rows; r += 97) {
+    cv::Mat row;
+    map().descriptors.row(r).convertTo(row, CV_64F);
+    EXPECT_NEAR(std::sqrt(row.dot(row)), 512, 40) << "row " << r;
+  }
+  // The descriptors of one point's track resemble each other far more than random rows.
+  const DescriptorIndex index(map().descriptors);
+  int same_point = 0, tried = 0;
+  for (int r = 0; r < map().descriptors.rows; r += 13, ++tried) {
+    const auto nn = index.Knn(map().descriptors.ptr<std::uint8_t>(r), 2);
+    same_point += nn.size() == 2 && map().descriptor_point[nn[1].row] == map().descriptor_point[static_cast<size_t>(r)];
+  }
+  EXPECT_GT(same_point, tried / 2);
+}
+
+TEST_F(TempleMapTest, ReRunSkipsEveryColmapStage) {
+  MapBuildOptions options;
+  options.frames_spec = "0-46:2";
+  std::vector<std::string> notes;
+  MapBuildCallbacks callbacks;
+  callbacks.note = [&](const std::string& n) { notes.push_back(n); };
+  const MapBuildResult again = BuildMap(*recording_, MapDir(), options, callbacks);
+  int skipped = 0;
+  for (const auto& t : again.timings) skipped += t.skipped;
+  EXPECT_EQ(skipped, 3);
+  EXPECT_EQ(std::count_if(notes.begin(), notes.end(),
+                          [](const std::string& n) { return n.find("skipped") != std::string::npos; }),
+            3);
+  EXPECT_EQ(again.map.points.size(), map().points.size());
+}
+
+TEST_F(TempleMapTest, MissingColmapIsAClearError) {
+  MapBuildOptions options;
+  options.frames_spec = "0-46:2";
+  options.colmap = "arview-no-colmap-here";
+  try {
+    BuildMap(*recording_, root_ / "no_colmap", options);
+    FAIL() << "expected MapError";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("COLMAP not found"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
+  const fs::path fake = root_ / "fake_colmap.sh";
+  {
+    std::ofstream out(fake);
+    out << "#!/bin/sh\necho \"fake colmap running $1\"\necho 'E: something broke' >&2\nexit 2\n";
+  }
+  fs::permissions(fake, fs::perms::owner_all);
+  MapBuildOptions options;
+  options.frames_spec = "0-4";
+  options.colmap = fake.string();
+  try {
+    BuildMap(*recording_, root_ / "failing", options);
+    FAIL() << "expected ColmapStageError";
+  } catch (const ColmapStageError& e) {
+    EXPECT_EQ(e.stage, "extract");
+    EXPECT_NE(std::string(e.what()).find("exited with code 2"), std::string::npos) << e.what();
+    ASSERT_EQ(e.log_tail.size(), 2u);
+    EXPECT_EQ(e.log_tail[1], "E: something broke");
+  }
+}
+
+TEST_F(TempleMapTest, TruncatedModelFilesAreClearErrors) {
+  for (const char* file : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    const auto size = fs::file_size(result_->model_dir / file);
+    for (double fraction : {0.0, 0.001, 0.1, 0.5, 0.9, 0.999}) {
+      const auto keep = static_cast<size_t>(fraction * static_cast<double>(size));
+      const fs::path dir = BrokenCopy(file, [&](std::vector<char>& b) { b.resize(std::min(b.size(), keep)); });
+      try {
+        ReadColmapMap(dir, dir / "database.db");
+        ADD_FAILURE() << file << " cut to " << keep << " bytes was accepted";
+      } catch (const MapError& e) {
+        EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+TEST_F(TempleMapTest, CorruptedCountsAndIdsAreClearErrors) {
+  // A huge image count: refused before any allocation.
+  fs::path dir = BrokenCopy("images.bin", [](std::vector<char>& b) { b[6] = 0x7f; });
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  // A track element pointing to a 2D point that does not point back (first track's image id).
+  dir = BrokenCopy("points3D.bin", [](std::vector<char>& b) { b[8 + 8 + 24 + 3 + 8 + 8] ^= 0x55; });
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  // The database cut short or missing.
+  dir = BrokenCopy("database.db", [](std::vector<char>& b) { b.resize(b.size() / 3); });
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  dir = BrokenCopy("database.db", [](std::vector<char>& b) { std::fill(b.begin(), b.begin() + 100, 'x'); });
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "no_such.db"), MapError);
+  // A model whose images are not the recording's frames.
+  EXPECT_THROW(ReadColmapMap(result_->model_dir, MapDir() / "database.db", FrameLookup{{"other.png", {}}}), MapError);
+}
+
+}  // namespace
+}  // namespace arview::mapping
