@@ -98,10 +98,12 @@ void RunRecord(const RecordArgs& args) {
       stats = recordings::RecordFrames(source, writer, args.seconds, &g_stop, progress);
     } catch (const recordings::SourceError& e) {
       std::fprintf(stderr, "\n");
+      if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
       throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
                          " frames recorded before stay a valid recording in " + args.out);
     }
     std::fprintf(stderr, "\n");
+    if (writer.RemoveIfEmpty()) throw CommandError("stopped before the first frame; nothing was recorded");
     std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out;
     if (source.skipped_frames() + stats.skipped > 0) {
       std::cout << " (" << source.skipped_frames() + stats.skipped << " corrupt or out-of-order frames skipped)";

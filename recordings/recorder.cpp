@@ -47,8 +47,21 @@ RecordingWriter::~RecordingWriter() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+bool RecordingWriter::RemoveIfEmpty() {
+  if (count_ > 0) return false;
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  std::error_code ec;
+  fs::remove(root_ / "frames.txt", ec);
+  fs::remove(root_ / "camera.yaml", ec);
+  fs::remove_all(root_ / "frames", ec);
+  if (fs::is_empty(root_, ec)) fs::remove(root_, ec);
+  return true;
+}
+
 void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
   const fs::path list = root_ / "frames.txt";
+  if (fd_ < 0) throw RecordingError(list.string() + ": the recording was removed");
   if (image.empty()) throw RecordingError(list.string() + ": cannot record an empty frame");
   if (!std::isfinite(timestamp) || (count_ > 0 && timestamp <= last_timestamp_)) {
     throw RecordingError(list.string() + ": frame timestamp " + std::to_string(timestamp) +

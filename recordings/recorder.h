@@ -28,6 +28,10 @@ class RecordingWriter {
   // does not increase, the size differs from the camera's or from the first frame's, or a
   // write fails.
   void Append(const cv::Mat& image, double timestamp);
+  // When no frame was appended: closes frames.txt and deletes what the constructor created
+  // (frames.txt, camera.yaml, frames/, and the folder if it is then empty). Returns whether it
+  // did; a recording with frames is never touched.
+  bool RemoveIfEmpty();
   int frame_count() const { return count_; }
   double last_timestamp() const { return last_timestamp_; }
   const std::filesystem::path& root() const { return root_; }

@@ -82,5 +82,17 @@ TEST(RecordFrames, StopsAfterTheRequestedSpanAndSkipsRepeatedTimestamps) {
   EXPECT_EQ(LoadRecording(dir.path() / "rec").frames.size(), 29u);
 }
 
+TEST(RecordingWriter, RemovesWhatItCreatedWhenNothingWasRecorded) {
+  TempDir dir("writer_empty");
+  RecordingWriter empty(dir.path() / "rec", SmallCamera(), false);
+  EXPECT_TRUE(empty.RemoveIfEmpty());
+  EXPECT_FALSE(fs::exists(dir.path() / "rec"));
+  EXPECT_THROW(empty.Append(test::MakeImage(64, 48, 0), 0.0), RecordingError);
+  RecordingWriter one(dir.path() / "rec2", SmallCamera(), false);
+  one.Append(test::MakeImage(64, 48, 0), 0.0);
+  EXPECT_FALSE(one.RemoveIfEmpty());
+  EXPECT_EQ(LoadRecording(dir.path() / "rec2").frames.size(), 1u);
+}
+
 }  // namespace
 }  // namespace arview::recordings

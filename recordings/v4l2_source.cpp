@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -189,15 +190,19 @@ std::string V4l2Source::FormatName() const { return pixel_format_ == V4L2_PIX_FM
 bool V4l2Source::Next(Frame& frame) {
   if (fd_ < 0) return false;
   using Clock = std::chrono::steady_clock;
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(options_.timeout_seconds));
+  // UVC cameras often need a second or two (auto exposure) before their first frame.
+  const double timeout = delivered_ == 0 ? std::max(options_.timeout_seconds, kFirstFrameTimeout)
+                                         : options_.timeout_seconds;
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   for (;;) {
     if (options_.stop && options_.stop->load()) return false;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
     if (left <= 0) {
       Shutdown();
-      Fail("no frame within " + std::to_string(options_.timeout_seconds) +
-           " s (camera stalled or unplugged); stopped");
+      char seconds[32];
+      std::snprintf(seconds, sizeof(seconds), "%g", timeout);
+      Fail(std::string("no frame within ") + seconds + " s (camera stalled or unplugged); stopped");
     }
     pollfd p{fd_, POLLIN, 0};
     const int r = ::poll(&p, 1, static_cast<int>(std::min<long long>(left, 100)));
@@ -245,7 +250,12 @@ bool V4l2Source::Next(Frame& frame) {
     }
     frame.image = std::move(image);
     frame.timestamp = static_cast<double>(buf.timestamp.tv_sec) + 1e-6 * static_cast<double>(buf.timestamp.tv_usec);
+    if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN || frame.timestamp == 0) {
+      // A driver without capture timestamps: the dequeue time is the best estimate left.
+      frame.timestamp = std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+    }
     frame.index = buf.sequence;
+    ++delivered_;
     return true;
   }
 }

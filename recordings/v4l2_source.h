@@ -14,13 +14,16 @@
 
 namespace arview::recordings {
 
+inline constexpr double kFirstFrameTimeout = 5.0;  // seconds
+
 struct V4l2Options {
   int width = 640;   // requested; the driver may pick the nearest size it supports (see size())
   int height = 480;
   // "auto" (YUYV if offered, else MJPEG), "yuyv" or "mjpeg".
   std::string format = "auto";
   int buffer_count = 4;
-  // No frame within this time is an error (a stalled or unplugged camera).
+  // No frame within this time is an error (a stalled or unplugged camera). The first frame
+  // may take up to kFirstFrameTimeout (cameras settle their exposure first).
   double timeout_seconds = 1.0;
   // When set and true, Next() returns false within ~0.1 s (Ctrl-C handling).
   const std::atomic<bool>* stop = nullptr;
@@ -36,7 +39,8 @@ class V4l2Source : public FrameSource {
   V4l2Source& operator=(const V4l2Source&) = delete;
 
   // Next frame with the kernel's capture timestamp (seconds, the driver's clock, normally
-  // CLOCK_MONOTONIC) and the driver's sequence number as index. Frames the driver flags as
+  // CLOCK_MONOTONIC; the dequeue time on CLOCK_MONOTONIC for drivers that give none) and the
+  // driver's sequence number as index. Frames the driver flags as
   // corrupt are skipped. Throws SourceError when the device disappears or stalls.
   bool Next(Frame& frame) override;
   std::string Name() const override { return device_; }
@@ -67,6 +71,7 @@ class V4l2Source : public FrameSource {
   std::vector<Buffer> buffers_;
   bool streaming_ = false;
   int64_t skipped_ = 0;
+  int64_t delivered_ = 0;
 };
 
 // Packed YUYV 4:2:2 (two bytes per pixel, `stride` bytes per row) to BGR. Throws SourceError
