@@ -4,26 +4,6 @@
 #include <opencv2/imgproc.hpp>
 
 namespace arview::render {
-namespace {
-
-// A full-screen triangle sampling the background so that texel centres fall on pixel centres.
-const char* kBackgroundVertex = R"(#version 450 core
-out vec2 v_uv;
-void main() {
-  vec2 ndc = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
-  v_uv = vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5);  // row 0 of the image at the top
-  gl_Position = vec4(ndc, 1.0, 1.0);
-}
-)";
-
-const char* kBackgroundFragment = R"(#version 450 core
-in vec2 v_uv;
-uniform sampler2D image;
-out vec4 frag_color;
-void main() { frag_color = vec4(texture(image, v_uv).rgb, 1.0); }
-)";
-
-}  // namespace
 
 ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, const ArOptions& options)
     : context_(&context),
@@ -32,16 +12,11 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
       options_(options),
       target_(context.gl(), camera.width, camera.height, options.samples > 1 ? options.samples : 0),
       shadow_(context.gl()) {
-  const GlApi& gl = context.gl();
   ProjectionMatrix(pinhole_, options_.clip);  // validates the camera and the clip range
   if (camera_.HasDistortion()) {
     cv::initUndistortRectifyMap(camera_.K(), camera_.DistCoeffs(), cv::noArray(), camera_.K(), camera_.Size(),
                                 CV_16SC2, undistort_map1_, undistort_map2_);
   }
-  background_program_ = MakeProgram(gl, "background", kBackgroundVertex, kBackgroundFragment);
-  background_vao_ = MakeVertexArray(gl);
-  background_texture_ = MakeTexture(gl, cv::Mat(camera.height, camera.width, CV_8UC3, cv::Scalar::all(0)),
-                                    {false, 1.f, false});
 }
 
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
@@ -49,9 +24,8 @@ int ArRenderer::AddCharacter(const anim::Character& character, const anim::Chara
   return static_cast<int>(characters_.size()) - 1;
 }
 
-void ArRenderer::PrepareBackground(const cv::Mat& background) {
-  has_background_ = !background.empty();
-  if (!has_background_) return;
+cv::Mat ArRenderer::PrepareBackground(const cv::Mat& background) {
+  if (background.empty()) return cv::Mat(camera_.Size(), CV_8UC3, options_.empty_background);
   if (background.size() != camera_.Size() || background.depth() != CV_8U ||
       (background.channels() != 1 && background.channels() != 3)) {
     throw RenderError("background image is " + std::to_string(background.cols) + "x" +
@@ -59,29 +33,16 @@ void ArRenderer::PrepareBackground(const cv::Mat& background) {
                       " channels; the camera is " + std::to_string(camera_.width) + "x" +
                       std::to_string(camera_.height) + " (8-bit BGR or grey expected)");
   }
-  const cv::Mat* image = &background;
-  if (camera_.HasDistortion()) {
-    cv::remap(background, undistorted_, undistort_map1_, undistort_map2_, cv::INTER_LINEAR);
-    image = &undistorted_;
-  }
-  const GlApi& gl = context_->gl();
-  gl.BindTexture(GL_TEXTURE_2D, background_texture_.get());
-  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, static_cast<GLint>(image->step / image->elemSize()));
-  // BGR and grey go up as they are: no conversion on the CPU.
-  gl.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, image->cols, image->rows, image->channels() == 3 ? GL_BGR : GL_RED,
-                   GL_UNSIGNED_BYTE, image->data);
-  gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  if (image->channels() == 1) {
-    const GLint swizzle[] = {GL_RED, GL_RED, GL_RED};
-    for (int i = 0; i < 3; ++i) gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_R + i, swizzle[i]);
-  } else {
-    for (int i = 0; i < 3; ++i) gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_SWIZZLE_R + i, GL_RED + i);
-  }
+  cv::Mat bgr;
+  if (background.channels() == 1) cv::cvtColor(background, bgr, cv::COLOR_GRAY2BGR);
+  else bgr = background;
+  if (!camera_.HasDistortion()) return bgr.clone();
+  cv::Mat undistorted;
+  cv::remap(bgr, undistorted, undistort_map1_, undistort_map2_, cv::INTER_LINEAR);
+  return undistorted;
 }
 
-void ArRenderer::DrawShadow(const Placed& placed, const anim::FrameOutput& frame, const Eigen::Matrix4d& projection,
-                            const Eigen::Matrix4d& view) {
+bool ArRenderer::Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const {
   const anim::CharacterSpec& spec = *placed.spec;
   const Eigen::Matrix4d model_to_map = spec.ModelToMap();
   const Eigen::Matrix3d rotation = spec.anchor.rotation.normalized().toRotationMatrix();
@@ -101,72 +62,127 @@ void ArRenderer::DrawShadow(const Placed& placed, const anim::FrameOutput& frame
     hi = hi.cwiseMax(Eigen::Vector2d(p.dot(u), p.dot(v)));
     height = std::max(height, p.dot(normal));
   }
-  if (frame.model.empty() || !(height > 0)) return;
+  if (frame.model.empty() || !(height > 0)) return false;
   const Eigen::Vector2d mid = (lo + hi) / 2;
   const Eigen::Vector2d radii = ((hi - lo) / 2).cwiseMax(0.15 * height) + Eigen::Vector2d::Constant(0.2 * height);
-  shadow_.Draw(projection, view, origin + mid.x() * u + mid.y() * v, u * radii.x(), v * radii.y(),
-               options_.shadow_strength);
+  *ellipse = {origin + mid.x() * u + mid.y() * v, u * radii.x(), v * radii.y()};
+  return true;
 }
 
-void ArRenderer::Draw(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) {
+cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) const {
+  const cv::Rect full(0, 0, camera_.width, camera_.height);
+  if (options_.full_frame) return full;
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  bool behind = false;
+  auto add = [&](const Eigen::Vector3d& world) {
+    const Eigen::Vector3d c = eye.ToCamera(world);
+    if (c.z() <= options_.clip.near_m) {
+      behind = true;
+      return;
+    }
+    const double u = pinhole_.fx * c.x() / c.z() + pinhole_.cx, v = pinhole_.fy * c.y() / c.z() + pinhole_.cy;
+    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+  };
+  for (size_t i = 0; i < characters_.size(); ++i) {
+    const Placed& placed = characters_[i];
+    const anim::FrameOutput& frame = *frames[i];
+    const Eigen::Matrix4d model_to_map = placed.spec->ModelToMap();
+    const std::vector<float>& radii = placed.renderer->joint_radii();
+    for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
+      if (radii[j] <= 0) continue;
+      // A cube around the joint's sphere of influence, enlarged 10% (DQS need not stay inside
+      // the linear blend's hull) and by the joint's own scale.
+      const Eigen::Matrix4d m = model_to_map * frame.model[j];
+      const double scale = m.topLeftCorner<3, 3>().colwise().norm().maxCoeff();
+      const double r = 1.1 * radii[j] * scale;
+      const Eigen::Vector3d centre = m.col(3).head<3>();
+      for (int k = 0; k < 8; ++k) add(centre + r * Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+    }
+    ShadowEllipse e;
+    if (options_.shadow && Shadow(placed, frame, &e)) {
+      for (int k = 0; k < 4; ++k) add(e.center + (k & 1 ? 1.0 : -1.0) * e.axis_u + (k & 2 ? 1.0 : -1.0) * e.axis_v);
+    }
+    if (behind) return full;
+  }
+  if (u0 > u1) return {};
+  // Pixel centres are integers: a pixel is touched when its square reaches the bound.
+  const cv::Rect box(cv::Point(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2),
+                     cv::Point(static_cast<int>(std::ceil(u1)) + 3, static_cast<int>(std::ceil(v1)) + 3));
+  return box & full;
+}
+
+void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) {
   if (frames.size() != characters_.size()) {
     throw RenderError("AR render: " + std::to_string(characters_.size()) + " characters but " +
                       std::to_string(frames.size()) + " animation frames");
   }
+  used_linear_fallback_ = false;
+  const cv::Rect rect = ScreenBounds(eye, frames);
+  if (rect.empty()) return;  // nothing in view: the video frame as it is
+
   const GlApi& gl = context_->gl();
   target_.Bind();
-  const cv::Scalar& grey = options_.empty_background;
-  gl.ClearColor(float(grey[2] / 255), float(grey[1] / 255), float(grey[0] / 255), 1.f);
+  target_.Scissor(rect);
+  gl.ClearColor(0, 0, 0, 0);
   gl.ClearDepth(1.0);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  if (has_background_) {
-    gl.Disable(GL_DEPTH_TEST);
-    gl.DepthMask(GL_FALSE);
-    gl.UseProgram(background_program_.get());
-    gl.ActiveTexture(GL_TEXTURE0);
-    gl.BindTexture(GL_TEXTURE_2D, background_texture_.get());
-    gl.BindVertexArray(background_vao_.get());
-    gl.DrawArrays(GL_TRIANGLES, 0, 3);
-    gl.DepthMask(GL_TRUE);
-  }
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
   const Eigen::Matrix4d view = ViewMatrix(eye);
-  used_linear_fallback_ = false;
   for (size_t i = 0; i < characters_.size(); ++i) {
     Placed& placed = characters_[i];
-    const anim::FrameOutput& frame = *frames[i];
-    if (options_.shadow) DrawShadow(placed, frame, projection, view);
+    const anim::FrameOutput& out = *frames[i];
+    ShadowEllipse e;
+    if (options_.shadow && Shadow(placed, out, &e)) {
+      shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
+    }
     const Eigen::Matrix3d rotation = placed.spec->anchor.rotation.normalized().toRotationMatrix();
     CharacterDraw draw;
     draw.model_to_map = placed.spec->ModelToMap();
-    draw.skinning_matrices = frame.skinning_matrices;
-    draw.skinning_dual_quats = frame.skinning_dual_quats;
+    draw.skinning_matrices = out.skinning_matrices;
+    draw.skinning_dual_quats = out.skinning_dual_quats;
     draw.method = options_.skinning;
     // Key light from above and in front of the character, so that its face is lit and the
     // contact shadow straight below it is plausible.
-    draw.light_direction_map = (rotation * (placed.spec->up.normalized() + 0.6 * placed.spec->forward.normalized())).normalized();
+    draw.light_direction_map =
+        (rotation * (placed.spec->up.normalized() + 0.6 * placed.spec->forward.normalized())).normalized();
     placed.renderer->Draw(projection, view, draw);
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
+  target_.Scissor({});
   CheckGl(gl, "AR frame");
+
+  // Premultiplied alpha over the video: out = fg + bg·(1 − a).
+  const cv::Mat layer = target_.ReadBgra(rect);
+  for (int y = 0; y < rect.height; ++y) {
+    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
+    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
+    for (int x = 0; x < rect.width; ++x) {
+      const int a = fg[x][3];
+      if (a == 0) continue;
+      const int keep = 255 - a;
+      for (int c = 0; c < 3; ++c) bg[x][c] = cv::saturate_cast<uchar>(fg[x][c] + (bg[x][c] * keep + 127) / 255);
+    }
+  }
 }
 
 cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
                            std::span<const anim::FrameOutput* const> frames) {
-  PrepareBackground(background);
-  Draw(pose, frames);
-  return target_.ReadBgr();
+  cv::Mat frame = PrepareBackground(background);
+  Compose(frame, pose, frames);
+  return frame;
 }
 
 cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
                                      std::span<const anim::FrameOutput* const> frames, double ipd_m) {
   if (!(ipd_m >= 0 && ipd_m < 0.5)) throw RenderError("interpupillary distance must be in [0, 0.5) m");
-  PrepareBackground(background);
+  const cv::Mat video = PrepareBackground(background);
   cv::Mat both(camera_.height, 2 * camera_.width, CV_8UC3);
-  Draw(OffsetEye(pose, -ipd_m / 2), frames);
-  target_.ReadBgr().copyTo(both(cv::Rect(0, 0, camera_.width, camera_.height)));
-  Draw(OffsetEye(pose, ipd_m / 2), frames);
-  target_.ReadBgr().copyTo(both(cv::Rect(camera_.width, 0, camera_.width, camera_.height)));
+  cv::Mat left = both(cv::Rect(0, 0, camera_.width, camera_.height));
+  cv::Mat right = both(cv::Rect(camera_.width, 0, camera_.width, camera_.height));
+  video.copyTo(left);
+  video.copyTo(right);
+  Compose(left, OffsetEye(pose, -ipd_m / 2), frames);
+  Compose(right, OffsetEye(pose, ipd_m / 2), frames);
   return both;
 }
 

@@ -2,6 +2,11 @@
 // The augmented frame: the camera image as background, the placed characters over it with
 // depth, a soft contact shadow under each, antialiased with 4x MSAA (llvmpipe offers 4).
 //
+// Cost: only the screen rectangle that can contain the characters and their shadows (bounded
+// from the posed joints and each joint's skin radius) is cleared, drawn, resolved and read
+// back, as premultiplied RGBA; it is blended over the video frame on the CPU. The video never
+// goes through OpenGL, and multisampling costs in proportion to the character's size on screen.
+//
 // Lens distortion: the background is undistorted with maps precomputed once
 // (cv::initUndistortRectifyMap, same K) and the characters are rendered with the matching
 // pinhole camera, so the output is the undistorted view (docs/render.md has the measured cost).
@@ -28,6 +33,7 @@ struct ArOptions {
   bool shadow = true;
   float shadow_strength = 0.55f;
   cv::Scalar empty_background{128, 128, 128};  // BGR, when no camera image is given
+  bool full_frame = false;  // draw and read the whole frame (for checking the bounds)
 };
 
 class ArRenderer {
@@ -61,18 +67,21 @@ class ArRenderer {
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
   };
-  void PrepareBackground(const cv::Mat& background);
-  void Draw(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
-  void DrawShadow(const Placed& placed, const anim::FrameOutput& frame, const Eigen::Matrix4d& projection,
-                  const Eigen::Matrix4d& view);
+  struct ShadowEllipse {
+    Eigen::Vector3d center, axis_u, axis_v;
+  };
+  cv::Mat PrepareBackground(const cv::Mat& background);
+  // Draws the characters seen from `eye` and blends them over `frame` (in place).
+  void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
+  bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
+  // The screen rectangle that contains everything drawn (empty when nothing is in view).
+  cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) const;
 
   OffscreenContext* context_;
   calib::Camera camera_, pinhole_;
   ArOptions options_;
   RenderTarget target_;
-  cv::Mat undistort_map1_, undistort_map2_, undistorted_;
-  GlName background_program_, background_vao_, background_texture_;
-  bool has_background_ = false;
+  cv::Mat undistort_map1_, undistort_map2_;
   ContactShadow shadow_;
   std::vector<Placed> characters_;
   bool used_linear_fallback_ = false;

@@ -139,6 +139,11 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, 4.f, true}));
   }
 
+  joint_radii_.assign(joints_, 0.f);
+  std::vector<Eigen::Matrix4f> inverse_bind(joints_, Eigen::Matrix4f::Identity());
+  for (int j = 0; j < std::min(joints_, static_cast<int>(character.skeleton.inverse_bind.size())); ++j) {
+    inverse_bind[j] = character.skeleton.inverse_bind[j].cast<float>();
+  }
   for (const anim::Mesh& mesh : character.meshes) {
     const size_t n = mesh.positions.size();
     if (mesh.normals.size() != n || mesh.joints.size() != n || mesh.weights.size() != n ||
@@ -161,6 +166,11 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
         }
         v.joints[k] = mesh.joints[i][k];
         v.weights[k] = mesh.weights[i][k];
+        if (v.weights[k] > 0) {
+          const int j = v.joints[k];
+          const float d = (inverse_bind[j] * mesh.positions[i].homogeneous()).head<3>().norm();
+          joint_radii_[j] = std::max(joint_radii_[j], d);
+        }
       }
     }
     for (std::uint32_t index : mesh.indices) {
@@ -297,7 +307,8 @@ void ContactShadow::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthMask(GL_FALSE);
   gl.Enable(GL_BLEND);
-  gl.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  // Premultiplied: colour stays black, alpha accumulates; the layer is blended over the video.
+  gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   gl.UseProgram(program_.get());
   gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
   gl.Uniform1f(strength_, strength);

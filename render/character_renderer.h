@@ -35,6 +35,10 @@ class CharacterRenderer {
   bool used_linear_fallback() const { return used_linear_fallback_; }
   int joint_count() const { return joints_; }
   int triangle_count() const { return triangles_; }
+  // Per joint, the farthest any vertex it influences lies from it at bind time (model units):
+  // every skinned vertex stays within these spheres around the posed joints (for rigid joints),
+  // which bounds the character on screen.
+  const std::vector<float>& joint_radii() const { return joint_radii_; }
 
  private:
   struct GpuMesh {
@@ -51,14 +55,15 @@ class CharacterRenderer {
   GlName white_;
   std::vector<GpuMesh> meshes_;
   bool used_linear_fallback_ = false;
+  std::vector<float> joint_radii_;
   std::vector<float> dq_upload_;
   struct Locations {
     GLint mvp, model, normal_matrix, method, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
   } loc_{};
 };
 
-// A soft elliptical shadow on a ground plane, darkening what is below it; drawn before the
-// character, after the background.
+// A soft elliptical shadow on a ground plane, drawn before the character into the transparent
+// character layer as premultiplied black with alpha, so it darkens the video it is blended over.
 class ContactShadow {
  public:
   explicit ContactShadow(const GlApi& gl);

@@ -192,3 +192,70 @@ TEST_F(FoxTest, RejectsMismatchedInputs) {
 
 }  // namespace
 }  // namespace arview::render
+
+namespace arview::render {
+namespace {
+
+// Drawing only the bounded screen rectangle must give the same frame as drawing everything,
+// including when the character is partly out of view or close.
+TEST_F(FoxTest, BoundedRenderEqualsFullFrameRender) {
+  const calib::Camera camera = TestCamera();
+  cv::Mat background(camera.height, camera.width, CV_8UC3);
+  cv::randu(background, cv::Scalar::all(0), cv::Scalar::all(255));
+  ArOptions bounded_options, full_options;
+  full_options.full_frame = true;
+  ArRenderer bounded(testing::SharedContext(), camera, bounded_options);
+  ArRenderer full(testing::SharedContext(), camera, full_options);
+  bounded.AddCharacter(fox_->character(), fox_->spec());
+  full.AddCharacter(fox_->character(), fox_->spec());
+  const calib::Pose base = LookingAtFox();
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.6, 0, 1.2), Eigen::Vector3d(-0.3, 0.2, 1.6)}) {
+    calib::Pose pose = base;
+    pose.t_cw -= shift;  // moves the camera along its own axes: closer, off to one side
+    for (double time : {0.1, 0.6}) {
+      const anim::FrameOutput* frame = &Frame(time, pose);
+      const cv::Mat a = bounded.Render(background, pose, {&frame, 1});
+      const cv::Mat b = full.Render(background, pose, {&frame, 1});
+      cv::Mat diff;
+      cv::absdiff(a, b, diff);
+      double worst = 0;
+      cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+      EXPECT_LE(worst, 1) << "camera shift " << shift.transpose() << ", t = " << time;
+    }
+  }
+}
+
+// With lens distortion the video is undistorted to the pinhole view the characters are drawn
+// in: a point's distorted image lands where the pinhole camera projects it.
+TEST(ArRenderer, UndistortsTheBackgroundOntoThePinholeView) {
+  calib::Camera camera = calib::Camera::Pinhole(640, 480, 520, 520, 318.0, 243.0);
+  camera.dist = {-0.28, 0.08, 0.0012, -0.0007, 0};
+  const calib::Camera pinhole = camera.WithoutDistortion();
+  std::vector<Eigen::Vector3d> points;
+  for (double x : {-0.45, 0.0, 0.45})
+    for (double y : {-0.3, 0.0, 0.3}) points.emplace_back(x, y, 1.0);
+  cv::Mat background = cv::Mat::zeros(camera.height, camera.width, CV_8UC3);
+  constexpr int kShift = 8;
+  for (const auto& p : points) {
+    const Eigen::Vector2d d = camera.Project(p);
+    cv::circle(background, cv::Point(cvRound(d.x() * (1 << kShift)), cvRound(d.y() * (1 << kShift))), 4 << kShift,
+               cv::Scalar::all(255), cv::FILLED, cv::LINE_AA, kShift);
+  }
+  ArRenderer renderer(testing::SharedContext(), camera, {});
+  const cv::Mat out = renderer.Render(background, calib::Pose{}, {});
+  cv::Mat grey;
+  cv::cvtColor(out, grey, cv::COLOR_BGR2GRAY);
+  double worst = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector2d expected = pinhole.Project(p);
+    const cv::Rect window(cvRound(expected.x()) - 10, cvRound(expected.y()) - 10, 21, 21);
+    const cv::Moments m = cv::moments(grey(window));
+    ASSERT_GT(m.m00, 0);
+    worst = std::max(worst, std::hypot(window.x + m.m10 / m.m00 - expected.x(), window.y + m.m01 / m.m00 - expected.y()));
+  }
+  std::printf("undistorted background: worst marker error %.3f px\n", worst);
+  EXPECT_LT(worst, 0.3);
+}
+
+}  // namespace
+}  // namespace arview::render

@@ -18,6 +18,7 @@ namespace arview::render {
 // X-macro: (return type, name without the "gl" prefix, parameter list).
 #define ARVIEW_GL_FUNCTIONS(X)                                                                        \
   X(void, Viewport, (GLint, GLint, GLsizei, GLsizei))                                                 \
+  X(void, Scissor, (GLint, GLint, GLsizei, GLsizei))                                                  \
   X(void, Clear, (GLbitfield))                                                                        \
   X(void, ClearColor, (GLfloat, GLfloat, GLfloat, GLfloat))                                           \
   X(void, ClearDepth, (GLdouble))                                                                     \

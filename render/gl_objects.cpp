@@ -181,27 +181,42 @@ void RenderTarget::Bind() const {
   gl_->Viewport(0, 0, width_, height_);
 }
 
-cv::Mat RenderTarget::Read(GLenum format, int channels) const {
+cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect) const {
   const GlApi& gl = *gl_;
+  rect &= cv::Rect(0, 0, width_, height_);
+  if (rect.empty()) return cv::Mat(0, 0, CV_8UC(channels));
+  // OpenGL counts rows from the bottom.
+  const GLint x0 = rect.x, y0 = height_ - rect.y - rect.height, x1 = rect.x + rect.width, y1 = y0 + rect.height;
   GLuint source = draw_fbo_.get();
   if (samples_ > 1) {
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, draw_fbo_.get());
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_.get());
-    gl.BlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     source = resolve_fbo_.get();
   }
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, source);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  cv::Mat bottom_up(height_, width_, CV_8UC(channels));
-  gl.ReadPixels(0, 0, width_, height_, format, GL_UNSIGNED_BYTE, bottom_up.data);
+  cv::Mat bottom_up(rect.height, rect.width, CV_8UC(channels));
+  gl.ReadPixels(x0, y0, rect.width, rect.height, format, GL_UNSIGNED_BYTE, bottom_up.data);
   CheckGl(gl, "read-back");
   cv::Mat image;
   cv::flip(bottom_up, image, 0);
   return image;
 }
 
-cv::Mat RenderTarget::ReadBgr() const { return Read(GL_BGR, 3); }
-cv::Mat RenderTarget::ReadBgra() const { return Read(GL_BGRA, 4); }
+cv::Mat RenderTarget::ReadBgr() const { return Read(GL_BGR, 3, {0, 0, width_, height_}); }
+cv::Mat RenderTarget::ReadBgra() const { return Read(GL_BGRA, 4, {0, 0, width_, height_}); }
+cv::Mat RenderTarget::ReadBgra(const cv::Rect& rect) const { return Read(GL_BGRA, 4, rect); }
+
+void RenderTarget::Scissor(const cv::Rect& rect) const {
+  if (rect.empty()) {
+    gl_->Disable(GL_SCISSOR_TEST);
+    return;
+  }
+  gl_->Enable(GL_SCISSOR_TEST);
+  gl_->Scissor(rect.x, height_ - rect.y - rect.height, rect.width, rect.height);
+}
 
 }  // namespace arview::render

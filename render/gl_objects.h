@@ -77,8 +77,14 @@ class RenderTarget {
   // bottom-up rows are flipped here, the one place that does so).
   cv::Mat ReadBgr() const;   // CV_8UC3
   cv::Mat ReadBgra() const;  // CV_8UC4, alpha = coverage
+  // Only `rect` (image coordinates, row 0 at the top; clipped to the target), resolving only
+  // that part: the cost of multisampling then scales with the area drawn.
+  cv::Mat ReadBgra(const cv::Rect& rect) const;
+  // Limits clears and drawing to `rect` (image coordinates); an empty rect disables the limit.
+  void Scissor(const cv::Rect& rect) const;
+
  private:
-  cv::Mat Read(GLenum format, int channels) const;
+  cv::Mat Read(GLenum format, int channels, cv::Rect rect) const;
   const GlApi* gl_;
   int width_, height_, samples_;
   GlName draw_fbo_, color_rb_, depth_rb_;

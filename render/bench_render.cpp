@@ -1,0 +1,236 @@
+// bench_render: per-frame cost of the augmented frame at 640x480 (Google Benchmark, real time,
+// since llvmpipe rasterizes on its own threads).
+//   BM_ArFrame/<character>       anim update (sample + blend + skinning transforms) + GPU
+//                                skinning (DQS) + draw with 4x MSAA + contact shadow + background
+//                                upload + resolve + read-back: Fox, CesiumMan, and a synthetic
+//                                25 000-triangle skinned tube (10 joints, 2 influences)
+//   BM_ArFrameNoMsaa/<character> the same without multisampling
+//   BM_UndistortBackground       cv::remap of a 640x480 frame with precomputed maps (the cost of
+//                                lens distortion in the AR path)
+//   BM_SynthRoomFrame            one frame of `arview synth room` (render + read-back, no PNG)
+// llvmpipe's thread count is fixed per process: run once per count,
+//   bench_render --gl_threads=1    and    bench_render --gl_threads=2
+// (also --gl=osmesa|egl). Characters come from ../shared/data; missing ones are skipped.
+
+#include <benchmark/benchmark.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstring>
+#include <map>
+
+#include "anim/scene.h"
+#include "render/ar_renderer.h"
+#include "render/synth_room.h"
+#include "tests/support/test_data.h"
+
+namespace arview::render {
+namespace {
+
+OffscreenOptions g_gl{GlBackend::kAuto, 1};
+
+OffscreenContext& Context() {
+  static std::unique_ptr<OffscreenContext> context = OffscreenContext::Create(g_gl);
+  return *context;
+}
+
+calib::Camera BenchCamera() { return calib::Camera::Pinhole(640, 480, 525, 525, 319.5, 239.5); }
+
+// A standing tube of `rings` x `segments` vertices bound to a chain of joints along its axis
+// (model space: y up, 1.6 m tall), with a clip that bends it back and forth.
+std::shared_ptr<const anim::Character> MakeTube(int triangles) {
+  constexpr int kSegments = 50, kJoints = 10;
+  const int rings = triangles / (2 * kSegments) + 1;
+  constexpr double kHeight = 1.6, kRadius = 0.18;
+  anim::Character c;
+  c.source = "synthetic tube";
+  for (int j = 0; j < kJoints; ++j) {
+    c.skeleton.names.push_back("j" + std::to_string(j));
+    c.skeleton.parents.push_back(j - 1);
+    anim::Transform t;
+    t.translation = Eigen::Vector3d(0, j == 0 ? 0 : kHeight / (kJoints - 1), 0);
+    c.skeleton.rest.push_back(t);
+    Eigen::Matrix4d inverse_bind = Eigen::Matrix4d::Identity();
+    inverse_bind(1, 3) = -kHeight * j / (kJoints - 1);
+    c.skeleton.inverse_bind.push_back(inverse_bind);
+  }
+  anim::Clip clip;
+  clip.name = "Bend";
+  clip.duration = 2.0;
+  clip.tracks.resize(kJoints);
+  for (int j = 1; j < kJoints; ++j)
+    for (int k = 0; k <= 20; ++k) {
+      const double t = k * 0.1;
+      clip.tracks[j].rotation.push_back({t, Eigen::Quaterniond(Eigen::AngleAxisd(0.12 * std::sin(M_PI * t + 0.3 * j), Eigen::Vector3d::UnitZ()))});
+    }
+  c.clips.push_back(clip);
+  anim::Mesh mesh;
+  mesh.name = "tube";
+  for (int r = 0; r < rings; ++r) {
+    const double y = kHeight * r / (rings - 1);
+    const double joint_pos = y / kHeight * (kJoints - 1);
+    const int j0 = std::min(static_cast<int>(joint_pos), kJoints - 2);
+    const float w1 = static_cast<float>(joint_pos - j0);
+    for (int s = 0; s < kSegments; ++s) {
+      const double a = 2 * M_PI * s / kSegments;
+      mesh.positions.emplace_back(kRadius * std::cos(a), y, kRadius * std::sin(a));
+      mesh.normals.emplace_back(std::cos(a), 0, std::sin(a));
+      mesh.uvs.emplace_back(static_cast<float>(s) / kSegments, static_cast<float>(y / kHeight));
+      mesh.joints.push_back({static_cast<std::uint16_t>(j0), static_cast<std::uint16_t>(j0 + 1), 0, 0});
+      mesh.weights.emplace_back(1 - w1, w1, 0, 0);
+    }
+  }
+  for (int r = 0; r + 1 < rings; ++r)
+    for (int s = 0; s < kSegments; ++s) {
+      const std::uint32_t a = r * kSegments + s, b = r * kSegments + (s + 1) % kSegments;
+      mesh.indices.insert(mesh.indices.end(), {a, b, a + kSegments, b, b + kSegments, a + kSegments});
+    }
+  mesh.material = 0;
+  c.materials.push_back({"tube", Eigen::Vector4f(0.3f, 0.6f, 0.9f, 1.f), -1});
+  c.meshes.push_back(std::move(mesh));
+  return std::make_shared<const anim::Character>(std::move(c));
+}
+
+struct Subject {
+  std::shared_ptr<const anim::Character> character;
+  anim::CharacterSpec spec;
+  std::unique_ptr<anim::AnimatedCharacter> animated;
+  calib::Pose camera_pose;
+};
+
+// Anchored at the origin of a z-up map, model y up; the camera 2.5 m away, 1.2 m up.
+std::unique_ptr<Subject> MakeSubject(std::shared_ptr<const anim::Character> character, double scale) {
+  auto s = std::make_unique<Subject>();
+  s->character = std::move(character);
+  s->spec.name = s->character->source;
+  s->spec.scale = scale;
+  s->spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());
+  anim::KeySpec key;
+  key.clip = s->character->clips.empty() ? "" : s->character->clips[0].name;
+  key.source = s->character->clips.empty() ? anim::KeySpec::Source::kRestPose : anim::KeySpec::Source::kClip;
+  s->spec.keys.push_back(key);
+  s->animated = std::make_unique<anim::AnimatedCharacter>(s->character, s->spec);
+  const Eigen::Vector3d eye(0.8, -2.4, 1.2), target(0, 0, 0.6);
+  const Eigen::Vector3d forward = (target - eye).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Eigen::Matrix3d r_wc;
+  r_wc << right, forward.cross(right), forward;
+  s->camera_pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
+  return s;
+}
+
+Subject* GetSubject(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<Subject>> cache;
+  if (auto it = cache.find(name); it != cache.end()) return it->second.get();
+  std::unique_ptr<Subject> subject;
+  if (name == "tube25k") {
+    subject = MakeSubject(MakeTube(25000), 1.0);
+  } else {
+    const auto path = name == "Fox" ? arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb")
+                                    : arview::testing::SharedData("characters/CesiumMan.glb");
+    if (!std::filesystem::exists(path)) return nullptr;
+    subject = MakeSubject(std::make_shared<const anim::Character>(anim::LoadCharacter(path)), name == "Fox" ? 0.01 : 1.0);
+  }
+  return (cache[name] = std::move(subject)).get();
+}
+
+cv::Mat Background() {
+  cv::Mat image(480, 640, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::GaussianBlur(image, image, {0, 0}, 3);
+  return image;
+}
+
+void RunArFrame(benchmark::State& state, const std::string& name, int samples) {
+  Subject* subject = GetSubject(name);
+  if (subject == nullptr) {
+    state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
+    return;
+  }
+  ArOptions options;
+  options.samples = samples;
+  ArRenderer renderer(Context(), BenchCamera(), options);
+  renderer.AddCharacter(subject->animated->character(), subject->spec);
+  const cv::Mat background = Background();
+  const Eigen::Vector3d viewpoint = subject->spec.ViewpointFromCamera(subject->camera_pose.Center());
+  double time = 0;
+  cv::Mat frame;
+  for (auto _ : state) {
+    const anim::FrameOutput* out = &subject->animated->Update(viewpoint, time);
+    frame = renderer.Render(background, subject->camera_pose, {&out, 1});
+    benchmark::DoNotOptimize(frame.data);
+    time += 1.0 / 30;
+  }
+  // How much of the frame the character covers, and its size.
+  cv::Mat diff, grey;
+  cv::absdiff(frame, background, diff);
+  cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+  state.counters["coverage_%"] = 100.0 * cv::countNonZero(grey > 8) / grey.total();
+  int triangles = 0;
+  for (const auto& m : subject->character->meshes) triangles += static_cast<int>(m.indices.size() / 3);
+  state.counters["triangles"] = triangles;
+  state.counters["gl_threads"] = Context().threads();
+}
+
+void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, 4); }
+void BM_ArFrameNoMsaa(benchmark::State& state, std::string name) { RunArFrame(state, name, 0); }
+
+void BM_UndistortBackground(benchmark::State& state) {
+  calib::Camera camera = BenchCamera();
+  camera.dist = {-0.28, 0.07, 0.001, -0.0005, 0};
+  cv::Mat map1, map2, out;
+  cv::initUndistortRectifyMap(camera.K(), camera.DistCoeffs(), cv::noArray(), camera.K(), camera.Size(), CV_16SC2, map1, map2);
+  const cv::Mat background = Background();
+  for (auto _ : state) {
+    cv::remap(background, out, map1, map2, cv::INTER_LINEAR);
+    benchmark::DoNotOptimize(out.data);
+  }
+}
+
+void BM_SynthRoomFrame(benchmark::State& state) {
+  if (!std::filesystem::exists(std::filesystem::path(kOpenCvDocData) / "building.jpg")) {
+    state.SkipWithError("needs Debian package opencv-doc");
+    return;
+  }
+  static const RoomScene scene = MakeRoomScene();
+  RoomRenderer renderer(Context(), scene, RoomCamera(), 4);
+  const RoomPath path(10, 1);
+  double t = 0;
+  for (auto _ : state) {
+    cv::Mat frame = renderer.Render(path.At(t));
+    benchmark::DoNotOptimize(frame.data);
+    t = std::fmod(t + 1.0 / 30, 10.0);
+  }
+}
+
+BENCHMARK_CAPTURE(BM_ArFrame, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrame, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrame, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace arview::render
+
+int main(int argc, char** argv) {
+  // Our own flags first (Google Benchmark rejects unknown ones).
+  std::vector<char*> rest;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--gl_threads=", 13) == 0) {
+      arview::render::g_gl.threads = std::atoi(argv[i] + 13);
+    } else if (std::strncmp(argv[i], "--gl=", 5) == 0) {
+      arview::render::g_gl.backend = arview::render::ParseGlBackend(argv[i] + 5);
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  int rest_count = static_cast<int>(rest.size());
+  benchmark::Initialize(&rest_count, rest.data());
+  std::printf("%s\n", arview::render::Context().Description().c_str());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
