@@ -171,7 +171,8 @@ struct Tracker::Guided {
   }
 };
 
-bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result) {
+bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
+                             std::optional<Features>* extracted) {
   const TrackingOptions& opt = options_.tracking;
   const calib::Camera& camera = map_.camera;
   const calib::Pose predicted =
@@ -217,7 +218,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result) {
   // 2. Guided matching when the flow tracks have thinned out.
   if (result->flow_tracks < opt.replenish_below) {
     const auto extract_start = std::chrono::steady_clock::now();
-    const Features features = relocalizer_->extractor().Extract(gray);
+    const Features& features = extracted->emplace(relocalizer_->extractor().Extract(gray));
     result->keypoints = static_cast<int>(features.keypoints.size());
     result->times.extract_ms = MillisecondsSince(extract_start);
     const auto match_start = std::chrono::steady_clock::now();
@@ -294,8 +295,9 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
 
   bool tracked = false;
   std::string tracking_reason;
+  std::optional<Features> features;
   if (has_pose_) {
-    tracked = TrackWithPrior(gray, &result);
+    tracked = TrackWithPrior(gray, &result, &features);
     tracking_reason = result.reason;
   }
   Track2D3D reloc_inliers;
@@ -303,7 +305,8 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     result.status = TrackStatus::kTracking;
     result.reason.clear();
   } else {
-    const RelocalizationResult reloc = relocalizer_->Relocalize(gray);
+    const RelocalizationResult reloc =
+        features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);
     result.keypoints = reloc.keypoints;
     result.matches = reloc.matches;
     result.times.extract_ms += reloc.extract_ms;

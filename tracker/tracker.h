@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -87,7 +88,9 @@ class Tracker {
 
  private:
   struct Guided;
-  bool TrackWithPrior(const cv::Mat& gray, FrameResult* result);
+  // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
+  // to relocalization does not extract it again.
+  bool TrackWithPrior(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features);
   void Remember(const FrameResult& result, const Track2D3D& inliers);
   std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
 
