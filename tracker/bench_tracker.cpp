@@ -231,13 +231,27 @@ void BM_TrackContinuous(benchmark::State& state) {
   // The first frame is a relocalization: done before timing starts.
   tracker.Track(real->frames[0], 0.0);
   size_t k = 1;
-  int tracked = 0;
+  int tracked = 0, replenished = 0;
+  StageTimes sum;
   for (auto _ : state) {
     const FrameResult r = tracker.Track(real->frames[ping_pong(k)], k / 30.0);
     ++k;
     tracked += r.status == TrackStatus::kTracking;
+    replenished += r.keypoints > 0;
+    sum.flow_ms += r.times.flow_ms;
+    sum.extract_ms += r.times.extract_ms;
+    sum.match_ms += r.times.match_ms;
+    sum.ransac_ms += r.times.ransac_ms;
+    sum.refine_ms += r.times.refine_ms;
   }
-  state.counters["tracking_ratio"] = static_cast<double>(tracked) / state.iterations();
+  const double n_iter = static_cast<double>(state.iterations());
+  state.counters["tracking_ratio"] = tracked / n_iter;
+  state.counters["sift_ratio"] = replenished / n_iter;
+  state.counters["flow_ms"] = sum.flow_ms / n_iter;
+  state.counters["extract_ms"] = sum.extract_ms / n_iter;
+  state.counters["match_ms"] = sum.match_ms / n_iter;
+  state.counters["ransac_ms"] = sum.ransac_ms / n_iter;
+  state.counters["refine_ms"] = sum.refine_ms / n_iter;
   state.SetLabel(real->source);
 }
 BENCHMARK(BM_TrackContinuous)->Unit(benchmark::kMillisecond);

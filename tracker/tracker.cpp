@@ -59,6 +59,30 @@ calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last)
   return Compose(last, Inverse(previous));
 }
 
+Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size) {
+  if (static_cast<int>(tracks.pixels.size()) <= max_count) return tracks;
+  const int gw = size.width / cell + 1, gh = size.height / cell + 1;
+  std::vector<std::vector<int>> cells(static_cast<size_t>(gw) * gh);
+  for (size_t i = 0; i < tracks.pixels.size(); ++i) {
+    const int gx = std::clamp(static_cast<int>(tracks.pixels[i].x / cell), 0, gw - 1);
+    const int gy = std::clamp(static_cast<int>(tracks.pixels[i].y / cell), 0, gh - 1);
+    cells[gy * gw + gx].push_back(static_cast<int>(i));
+  }
+  Track2D3D out;
+  for (size_t round = 0; static_cast<int>(out.pixels.size()) < max_count; ++round) {
+    bool any = false;
+    for (const auto& c : cells) {
+      if (round >= c.size()) continue;
+      any = true;
+      out.pixels.push_back(tracks.pixels[c[round]]);
+      out.points.push_back(tracks.points[c[round]]);
+      if (static_cast<int>(out.pixels.size()) == max_count) break;
+    }
+    if (!any) break;
+  }
+  return out;
+}
+
 void ValidateMap(const mapping::Map& map, int min_points) {
   if (static_cast<int>(map.points.size()) < min_points) {
     std::ostringstream msg;
@@ -263,7 +287,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
     inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
     inliers.points.push_back(point_ids[i]);
   }
-  last_inliers_ = std::move(inliers);
+  last_inliers_ = SpreadTracks(inliers, opt.max_flow_tracks, 40, gray.size());
   return true;
 }
 
@@ -276,7 +300,8 @@ void Tracker::Remember(const FrameResult& result, const Track2D3D& inliers) {
   }
   last_pose_ = result.pose;
   has_pose_ = true;
-  if (result.status == TrackStatus::kRelocalized) last_inliers_ = inliers;
+  if (result.status == TrackStatus::kRelocalized)
+    last_inliers_ = SpreadTracks(inliers, options_.tracking.max_flow_tracks, 40, map_.camera.Size());
 }
 
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {

@@ -31,6 +31,9 @@ struct TrackingOptions {
   int lk_window_px = 21;
   int lk_pyramid_levels = 3;
   int lk_max_iterations = 20;
+  // At most this many inliers are followed into the next frame, spread over the image (LK and
+  // refinement time grow with the count; a few hundred well-spread points pin the pose).
+  int max_flow_tracks = 300;
   // Guided matching (SIFT on the frame, matched only against map points projected within
   // guided_radius_px) runs when fewer flow tracks than this survive.
   int replenish_below = 150;
@@ -110,6 +113,10 @@ class Tracker {
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
 };
+
+// At most `max_count` of `tracks`, spread evenly over a grid of `cell` pixel squares (round
+// robin over the cells, in input order within a cell).
+Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size);
 
 // Throws TrackerError naming the problem when `map` cannot be tracked against.
 void ValidateMap(const mapping::Map& map, int min_points);

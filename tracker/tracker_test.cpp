@@ -159,6 +159,25 @@ TEST(ConstantVelocity, PredictionRepeatsTheLastMotion) {
   EXPECT_LT((same.t_cw - b.t_cw).norm(), 1e-12);
 }
 
+TEST(SpreadTracks, KeepsAtMostTheCountSpreadOverTheImage) {
+  Track2D3D tracks;
+  // 100 tracks crowded in the top-left cell, 10 spread along the bottom row.
+  for (int i = 0; i < 100; ++i) {
+    tracks.pixels.emplace_back(1.0f + i * 0.1f, 2.0f);
+    tracks.points.push_back(i);
+  }
+  for (int i = 0; i < 10; ++i) {
+    tracks.pixels.emplace_back(50.0f + 60.0f * i, 470.0f);
+    tracks.points.push_back(1000 + i);
+  }
+  const Track2D3D spread = SpreadTracks(tracks, 20, 40, {640, 480});
+  ASSERT_EQ(spread.pixels.size(), 20u);
+  int bottom = 0;
+  for (std::uint32_t p : spread.points) bottom += p >= 1000;
+  EXPECT_EQ(bottom, 10) << "every sparse cell must keep its track before crowded cells get more";
+  EXPECT_EQ(SpreadTracks(tracks, 500, 40, {640, 480}).pixels.size(), 110u);
+}
+
 TEST(ColmapDescriptors, RootL1TimesFiveHundredTwelveClamped) {
   cv::Mat sift = cv::Mat::zeros(2, 128, CV_32F);
   sift.at<float>(0, 0) = 3;
