@@ -13,9 +13,12 @@
 // Skinning (see pose.h for the jobs that compute it every frame):
 //   skin_j = model_j · inverse_bind_j, where model_j is joint j's model-space transform;
 //   v_model = Σ_i weights[i] · skin_{joints[i]} · v_mesh.
-// In the rest pose every mesh's skinned vertices equal its rest vertices in model space (the
-// importer bakes each mesh's node transform into its vertices so that this holds).
-// Meshes without bones are bound rigidly (weight 1) to their nearest joint ancestor.
+// Mesh positions are in model space: when every bone of a mesh agrees on where the file's rest
+// pose puts it (its rest pose is its bind pose, as in Fox, CesiumMan, BCN_Epileptic and the
+// FBX sample the tests load), the importer bakes that placement into the vertices (and out of
+// the inverse bind matrices), so that skinning the rest pose returns the positions unchanged.
+// Meshes without bones are bound rigidly (weight 1) to their nearest joint ancestor, with their
+// node transform baked in so that the rest pose places them where the file does.
 // BVH files carry no skin: their Character has a skeleton and clips and no meshes.
 
 #include "anim/dual_quat.h"

@@ -192,11 +192,14 @@ class Importer {
       if (m->mNumBones == 0 || m->mNumVertices == 0) continue;
       Mesh mesh = CopyGeometry(m);
       std::vector<std::vector<Influence>> inf(m->mNumVertices);
+      const Eigen::Matrix4d place = RestPlacement(m);
+      BakeTransform(mesh, place);
+      const Eigen::Matrix4d unplace = place.inverse();
       std::optional<Eigen::Matrix4d> bake;
       for (unsigned b = 0; b < m->mNumBones; ++b) {
         const aiBone* bone = m->mBones[b];
         const int j = JointOf(bone->mName.C_Str());
-        const Eigen::Matrix4d offset = ToEigen(bone->mOffsetMatrix);
+        const Eigen::Matrix4d offset = ToEigen(bone->mOffsetMatrix) * unplace;
         if (!has_bind[j]) {
           sk.inverse_bind[j] = offset;
           has_bind[j] = true;
@@ -232,6 +235,29 @@ class Importer {
       FinishInfluences(mesh, inf, j);
       c.meshes.push_back(std::move(mesh));
     }
+  }
+
+  // Where the file's rest pose puts a skinned mesh: model_j · offset_j of the bones, which
+  // agree when the rest pose is the bind pose; when some bones rest elsewhere, the placement
+  // most bones share. Baking it into the vertices gives model-space positions that the rest
+  // pose reproduces (except under the bones that rest away from their bind pose), whatever the
+  // mesh node or the exporter's axis conversion was.
+  Eigen::Matrix4d RestPlacement(const aiMesh* m) const {
+    std::vector<Eigen::Matrix4d> p;
+    for (unsigned b = 0; b < m->mNumBones; ++b)
+      p.push_back(rest_model_[JointOf(m->mBones[b]->mName.C_Str())] * ToEigen(m->mBones[b]->mOffsetMatrix));
+    std::size_t best = 0, best_votes = 0;
+    for (std::size_t a = 0; a < p.size(); ++a) {
+      std::size_t votes = 0;
+      for (const auto& q : p) votes += (q - p[a]).norm() <= 1e-5 * std::max(1.0, p[a].norm());
+      if (votes > best_votes) {
+        best = a;
+        best_votes = votes;
+      }
+    }
+    if (p.empty() || !p[best].allFinite() || std::abs(p[best].block<3, 3>(0, 0).determinant()) < 1e-12)
+      return Eigen::Matrix4d::Identity();
+    return p[best];
   }
 
   void CollectInstances(const aiNode* node, std::vector<std::pair<const aiNode*, unsigned>>& out) {

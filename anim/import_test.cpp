@@ -19,7 +19,9 @@ fs::path CesiumMan() { return testing::SharedData("characters/CesiumMan.glb"); }
 
 // Skins every mesh at the given pose; returns the largest distance to the rest mesh placed in
 // model space, relative to the model's size.
-double RestSkinningError(const Character& c, SkinningMethod method) {
+// Vertices weighted to a joint in `skip` are left out (bones whose rest pose is not their bind
+// pose in the file).
+double RestSkinningError(const Character& c, SkinningMethod method, const std::vector<std::string>& skip = {}) {
   const Skeleton& sk = c.skeleton;
   const LocalPose rest = LocalPose::Rest(sk);
   std::vector<Eigen::Matrix4d> model(sk.size());
@@ -32,6 +34,10 @@ double RestSkinningError(const Character& c, SkinningMethod method) {
     std::vector<Eigen::Vector3f> pos(m.vertex_count()), nrm(m.vertex_count());
     EXPECT_TRUE((SkinningJob{&m, method, skin, dq, pos, nrm}.Run()));
     for (int v = 0; v < m.vertex_count(); ++v) {
+      bool skipped = false;
+      for (int i = 0; i < 4; ++i)
+        for (const auto& name : skip) skipped = skipped || (m.weights[v][i] > 0 && c.skeleton.names[m.joints[v][i]] == name);
+      if (skipped) continue;
       worst = std::max(worst, double((pos[v] - m.positions[v]).norm()));
       extent = std::max(extent, double(m.positions[v].norm()));
     }
@@ -112,6 +118,43 @@ TEST(Import, CmuBvh) {
   ASSERT_GT(keys.size(), 100u);
   EXPECT_NEAR(keys[1].time - keys[0].time, 1.0 / 120, 1e-6);
   EXPECT_NEAR(clip.duration, (keys.size() - 1) / 120.0, 1e-3);
+}
+
+TEST(Import, FbxSkinned) {
+  const fs::path fbx = "/usr/share/assimp/models/FBX/animation_with_skeleton.fbx";
+  ARVIEW_REQUIRE_DATA_PATH(fbx, "Debian package assimp-testmodels");
+  const Character c = LoadCharacter(fbx);
+  EXPECT_EQ(c.skeleton.size(), 15);
+  ASSERT_EQ(c.clips.size(), 1u);
+  EXPECT_NEAR(c.clips[0].duration, 0.833, 0.01);
+  ASSERT_EQ(c.meshes.size(), 1u);
+  ExpectValidSkin(c);
+  // In this file Bone.005 and Bone.006 rest away from their bind pose; the rest is bound as it rests.
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear, {"Bone.005", "Bone.006"}), 1e-5);
+  EXPECT_GT(RestSkinningError(c, SkinningMethod::kLinear), 1e-2);
+}
+
+TEST(Import, ColladaSkinned) {
+  const fs::path dae = "/usr/share/assimp/models/Collada/box_nested_animation.dae";
+  ARVIEW_REQUIRE_DATA_PATH(dae, "Debian package assimp-testmodels");
+  const Character c = LoadCharacter(dae);
+  EXPECT_EQ(c.skeleton.size(), 1);
+  EXPECT_EQ(c.clips.size(), 1u);
+  ASSERT_EQ(c.meshes.size(), 1u);
+  ExpectValidSkin(c);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-5);
+}
+
+TEST(Import, ColladaRigidMeshesFollowTheirNodes) {
+  // 64 animated boxes in a chain, no skin: each mesh is bound rigidly to its node.
+  const fs::path dae = "/usr/share/assimp/models/Collada/anims_with_full_rotations_between_keys.DAE";
+  ARVIEW_REQUIRE_DATA_PATH(dae, "Debian package assimp-testmodels");
+  const Character c = LoadCharacter(dae);
+  EXPECT_EQ(c.skeleton.size(), 64);
+  EXPECT_FALSE(c.meshes.empty());
+  ExpectValidSkin(c);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
 }
 
 TEST(Import, SamplingInterpolatesAndLoops) {
