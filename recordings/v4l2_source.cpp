@@ -22,13 +22,18 @@ namespace arview::recordings {
 
 namespace {
 
-int Ioctl(int fd, unsigned long request, void* arg) {
-  int r;
-  do {
-    r = ::ioctl(fd, request, arg);
-  } while (r == -1 && errno == EINTR);
-  return r;
-}
+class SystemIo : public V4l2Io {
+ public:
+  int Stat(const char* path, struct stat* st) override { return ::stat(path, st); }
+  int Open(const char* path, int flags) override { return ::open(path, flags); }
+  int Close(int fd) override { return ::close(fd); }
+  int Ioctl(int fd, unsigned long request, void* arg) override { return ::ioctl(fd, request, arg); }
+  int Poll(pollfd* fds, nfds_t count, int timeout_ms) override { return ::poll(fds, count, timeout_ms); }
+  void* Mmap(size_t length, int fd, off_t offset) override {
+    return ::mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, offset);
+  }
+  int Munmap(void* address, size_t length) override { return ::munmap(address, length); }
+};
 
 std::string FourccName(uint32_t f) {
   std::string s;
@@ -43,9 +48,23 @@ std::string ErrnoText(int err) { return std::strerror(err); }
 
 }  // namespace
 
+V4l2Io& SystemV4l2Io() {
+  static SystemIo io;
+  return io;
+}
+
+int V4l2Source::Ioctl(unsigned long request, void* arg) {
+  int r;
+  do {
+    r = io_.Ioctl(fd_, request, arg);
+  } while (r == -1 && errno == EINTR);
+  return r;
+}
+
 void V4l2Source::Fail(const std::string& problem) const { throw SourceError(device_ + ": " + problem); }
 
-V4l2Source::V4l2Source(const std::string& device, V4l2Options options) : device_(device), options_(std::move(options)) {
+V4l2Source::V4l2Source(const std::string& device, V4l2Options options, V4l2Io& io)
+    : device_(device), options_(std::move(options)), io_(io) {
   if (options_.width <= 0 || options_.height <= 0) Fail("requested frame size must be positive");
   if (options_.buffer_count < 2 || options_.buffer_count > 32) Fail("buffer count must be between 2 and 32");
   if (!(options_.timeout_seconds > 0)) Fail("frame timeout must be positive");
@@ -53,12 +72,12 @@ V4l2Source::V4l2Source(const std::string& device, V4l2Options options) : device_
     Fail("pixel format '" + options_.format + "' is not auto, yuyv or mjpeg");
   }
   struct stat st {};
-  if (::stat(device_.c_str(), &st) != 0) {
+  if (io_.Stat(device_.c_str(), &st) != 0) {
     if (errno == ENOENT) Fail("no such device (is the camera plugged in? see 'ls /dev/video*')");
     Fail("cannot be inspected (" + ErrnoText(errno) + ")");
   }
   if (!S_ISCHR(st.st_mode)) Fail("not a video device (not a character device)");
-  fd_ = ::open(device_.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  fd_ = io_.Open(device_.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
   if (fd_ < 0) {
     const int err = errno;
     if (err == EACCES) Fail("permission denied (add the user to the 'video' group)");
@@ -80,7 +99,7 @@ V4l2Source::~V4l2Source() { Shutdown(); }
 
 void V4l2Source::QueryCapabilities() {
   v4l2_capability cap{};
-  if (Ioctl(fd_, VIDIOC_QUERYCAP, &cap) != 0) {
+  if (Ioctl(VIDIOC_QUERYCAP, &cap) != 0) {
     if (errno == ENOTTY || errno == EINVAL) Fail("not a V4L2 video device");
     if (errno == ENODEV) Fail("no such device (unplugged?)");
     Fail("capability query failed (" + ErrnoText(errno) + ")");
@@ -99,7 +118,7 @@ void V4l2Source::NegotiateFormat() {
     v4l2_fmtdesc desc{};
     desc.index = i;
     desc.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    if (Ioctl(fd_, VIDIOC_ENUM_FMT, &desc) != 0) break;
+    if (Ioctl(VIDIOC_ENUM_FMT, &desc) != 0) break;
     offered.push_back(desc.pixelformat);
   }
   auto has = [&](uint32_t f) { return std::find(offered.begin(), offered.end(), f) != offered.end(); };
@@ -128,7 +147,7 @@ void V4l2Source::NegotiateFormat() {
   fmt.fmt.pix.height = static_cast<uint32_t>(options_.height);
   fmt.fmt.pix.pixelformat = chosen;
   fmt.fmt.pix.field = V4L2_FIELD_ANY;
-  if (Ioctl(fd_, VIDIOC_S_FMT, &fmt) != 0) {
+  if (Ioctl(VIDIOC_S_FMT, &fmt) != 0) {
     if (errno == EBUSY) Fail("busy (another program is streaming from it)");
     Fail("cannot set format " + FourccName(chosen) + " " + std::to_string(options_.width) + "x" +
          std::to_string(options_.height) + " (" + ErrnoText(errno) + ")");
@@ -148,7 +167,7 @@ void V4l2Source::StartStreaming() {
   req.count = static_cast<uint32_t>(options_.buffer_count);
   req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   req.memory = V4L2_MEMORY_MMAP;
-  if (Ioctl(fd_, VIDIOC_REQBUFS, &req) != 0) {
+  if (Ioctl(VIDIOC_REQBUFS, &req) != 0) {
     if (errno == EBUSY) Fail("busy (another program is streaming from it)");
     Fail("does not support memory-mapped streaming (" + ErrnoText(errno) + ")");
   }
@@ -158,14 +177,14 @@ void V4l2Source::StartStreaming() {
     buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     buf.memory = V4L2_MEMORY_MMAP;
     buf.index = i;
-    if (Ioctl(fd_, VIDIOC_QUERYBUF, &buf) != 0) Fail("cannot query streaming buffer " + std::to_string(i));
-    void* start = ::mmap(nullptr, buf.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, buf.m.offset);
+    if (Ioctl(VIDIOC_QUERYBUF, &buf) != 0) Fail("cannot query streaming buffer " + std::to_string(i));
+    void* start = io_.Mmap(buf.length, fd_, static_cast<off_t>(buf.m.offset));
     if (start == MAP_FAILED) Fail("cannot map streaming buffer " + std::to_string(i) + " (" + ErrnoText(errno) + ")");
     buffers_.push_back({start, buf.length});
-    if (Ioctl(fd_, VIDIOC_QBUF, &buf) != 0) Fail("cannot queue streaming buffer " + std::to_string(i));
+    if (Ioctl(VIDIOC_QBUF, &buf) != 0) Fail("cannot queue streaming buffer " + std::to_string(i));
   }
   v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (Ioctl(fd_, VIDIOC_STREAMON, &type) != 0) {
+  if (Ioctl(VIDIOC_STREAMON, &type) != 0) {
     if (errno == ENOSPC) Fail("not enough USB bandwidth for this size and format (try a smaller --size or MJPEG)");
     Fail("cannot start streaming (" + ErrnoText(errno) + ")");
   }
@@ -176,12 +195,12 @@ void V4l2Source::Shutdown() {
   if (fd_ < 0) return;
   if (streaming_) {
     v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    Ioctl(fd_, VIDIOC_STREAMOFF, &type);  // fails harmlessly when the device is gone
+    Ioctl(VIDIOC_STREAMOFF, &type);  // fails harmlessly when the device is gone
     streaming_ = false;
   }
-  for (const Buffer& b : buffers_) ::munmap(b.start, b.length);
+  for (const Buffer& b : buffers_) io_.Munmap(b.start, b.length);
   buffers_.clear();
-  ::close(fd_);
+  io_.Close(fd_);
   fd_ = -1;
 }
 
@@ -205,7 +224,7 @@ bool V4l2Source::Next(Frame& frame) {
       Fail(std::string("no frame within ") + seconds + " s (camera stalled or unplugged); stopped");
     }
     pollfd p{fd_, POLLIN, 0};
-    const int r = ::poll(&p, 1, static_cast<int>(std::min<long long>(left, 100)));
+    const int r = io_.Poll(&p, 1, static_cast<int>(std::min<long long>(left, 100)));
     if (r < 0) {
       if (errno == EINTR) continue;  // a signal: look at the stop flag again
       const int err = errno;
@@ -220,7 +239,7 @@ bool V4l2Source::Next(Frame& frame) {
     v4l2_buffer buf{};
     buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     buf.memory = V4L2_MEMORY_MMAP;
-    if (Ioctl(fd_, VIDIOC_DQBUF, &buf) != 0) {
+    if (Ioctl(VIDIOC_DQBUF, &buf) != 0) {
       if (errno == EAGAIN) continue;
       const int err = errno;
       Shutdown();
@@ -239,7 +258,7 @@ bool V4l2Source::Next(Frame& frame) {
         image.release();  // a corrupt frame (USB hiccup) is skipped like a flagged one
       }
     }
-    if (Ioctl(fd_, VIDIOC_QBUF, &buf) != 0) {
+    if (Ioctl(VIDIOC_QBUF, &buf) != 0) {
       const int err = errno;
       Shutdown();
       Fail("cannot requeue a buffer (" + ErrnoText(err) + "); stopped");

@@ -3,6 +3,10 @@
 // negotiation (YUYV or MJPEG), memory-mapped streaming buffers, poll with a timeout, decode to
 // BGR, kernel timestamps. Every failure is one SourceError naming the device.
 
+#include <poll.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -13,6 +17,22 @@
 #include "recordings/frame_source.h"
 
 namespace arview::recordings {
+
+// The system calls V4l2Source makes. The default passes them to the kernel; tests stand in a
+// simulated camera (formats, streaming, stalls, unplugging) since no camera is attached here.
+// Each returns what the system call returns and sets errno the same way.
+class V4l2Io {
+ public:
+  virtual ~V4l2Io() = default;
+  virtual int Stat(const char* path, struct stat* st) = 0;
+  virtual int Open(const char* path, int flags) = 0;
+  virtual int Close(int fd) = 0;
+  virtual int Ioctl(int fd, unsigned long request, void* arg) = 0;
+  virtual int Poll(pollfd* fds, nfds_t count, int timeout_ms) = 0;
+  virtual void* Mmap(size_t length, int fd, off_t offset) = 0;  // MAP_FAILED on failure
+  virtual int Munmap(void* address, size_t length) = 0;
+};
+V4l2Io& SystemV4l2Io();
 
 inline constexpr double kFirstFrameTimeout = 5.0;  // seconds
 
@@ -33,7 +53,7 @@ class V4l2Source : public FrameSource {
  public:
   // Opens the device and starts streaming; throws SourceError (no such device, permission,
   // not a capture device, busy, no supported format, ...).
-  V4l2Source(const std::string& device, V4l2Options options = {});
+  V4l2Source(const std::string& device, V4l2Options options = {}, V4l2Io& io = SystemV4l2Io());
   ~V4l2Source() override;
   V4l2Source(const V4l2Source&) = delete;
   V4l2Source& operator=(const V4l2Source&) = delete;
@@ -61,8 +81,11 @@ class V4l2Source : public FrameSource {
   void StartStreaming();
   void Shutdown();
 
+  int Ioctl(unsigned long request, void* arg);  // retried on EINTR
+
   std::string device_;
   V4l2Options options_;
+  V4l2Io& io_;
   int fd_ = -1;
   std::string card_;
   uint32_t pixel_format_ = 0;

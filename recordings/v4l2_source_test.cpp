@@ -44,28 +44,7 @@ TEST(V4l2Source, BadOptionsAreRejectedBeforeOpening) {
   EXPECT_THROW(V4l2Source("/dev/null", options), SourceError);
 }
 
-// Packs a BGR image into YUYV the way a camera does (BT.601 video range, chroma averaged over
-// each horizontal pixel pair), with `pad` spare bytes at the end of each row.
-std::vector<uint8_t> PackYuyv(const cv::Mat& bgr, int pad) {
-  const int stride = 2 * bgr.cols + pad;
-  std::vector<uint8_t> out(static_cast<size_t>(stride) * bgr.rows, 0xEE);
-  for (int y = 0; y < bgr.rows; ++y) {
-    for (int x = 0; x < bgr.cols; x += 2) {
-      double u = 0, v = 0;
-      for (int k = 0; k < 2; ++k) {
-        const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x + k);
-        const double b = p[0], g = p[1], r = p[2];
-        const double Y = 16 + 0.257 * r + 0.504 * g + 0.098 * b;
-        u += 0.5 * (128 - 0.148 * r - 0.291 * g + 0.439 * b);
-        v += 0.5 * (128 + 0.439 * r - 0.368 * g - 0.071 * b);
-        out[static_cast<size_t>(y) * stride + 2 * (x + k)] = cv::saturate_cast<uint8_t>(Y);
-      }
-      out[static_cast<size_t>(y) * stride + 2 * x + 1] = cv::saturate_cast<uint8_t>(u);
-      out[static_cast<size_t>(y) * stride + 2 * x + 3] = cv::saturate_cast<uint8_t>(v);
-    }
-  }
-  return out;
-}
+using test::PackYuyv;
 
 TEST(DecodeYuyv, RecoversTheColoursOfAStoredBuffer) {
   // Flat 2-pixel-wide colour bars: chroma subsampling loses nothing, so only rounding remains.
