@@ -98,6 +98,7 @@ void WriteFrameJson(JsonWriter& w, const FrameRecord& f) {
       .Value("ransac", r.times.ransac_ms)
       .Value("refine", r.times.refine_ms)
       .Value("total", r.times.total_ms)
+      .Value("cpu", r.times.cpu_ms)
       .EndObject();
   if (r.status != tracker::TrackStatus::kLost) {
     w.BeginArray("center");
@@ -109,16 +110,23 @@ void WriteFrameJson(JsonWriter& w, const FrameRecord& f) {
   w.EndObject();
 }
 
-using StatusSummaries = std::map<std::string, TimingSummary>;
+// Per status (and "all"): wall time and thread CPU time of Track().
+struct StatusSummary {
+  TimingSummary wall;
+  TimingSummary cpu;
+};
+using StatusSummaries = std::map<std::string, StatusSummary>;
 
 StatusSummaries SummarizeByStatus(const std::vector<FrameRecord>& frames) {
-  std::map<std::string, std::vector<double>> samples;
+  std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> samples;
   for (const auto& f : frames) {
-    samples[tracker::TrackStatusName(f.result.status)].push_back(f.result.times.total_ms);
-    samples["all"].push_back(f.result.times.total_ms);
+    for (const char* key : {tracker::TrackStatusName(f.result.status), "all"}) {
+      samples[key].first.push_back(f.result.times.total_ms);
+      samples[key].second.push_back(f.result.times.cpu_ms);
+    }
   }
   StatusSummaries out;
-  for (auto& [status, ms] : samples) out[status] = Summarize(std::move(ms));
+  for (auto& [status, ms] : samples) out[status] = {Summarize(std::move(ms.first)), Summarize(std::move(ms.second))};
   return out;
 }
 
@@ -129,11 +137,13 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
   w.BeginObject("summary");
   for (const auto& [status, s] : summaries) {
     w.BeginObject(status)
-        .Value("frames", s.count)
-        .Value("median_ms", s.median_ms)
-        .Value("p95_ms", s.p95_ms)
-        .Value("mean_ms", s.mean_ms)
-        .Value("max_ms", s.max_ms)
+        .Value("frames", s.wall.count)
+        .Value("median_ms", s.wall.median_ms)
+        .Value("p95_ms", s.wall.p95_ms)
+        .Value("mean_ms", s.wall.mean_ms)
+        .Value("max_ms", s.wall.max_ms)
+        .Value("cpu_median_ms", s.cpu.median_ms)
+        .Value("cpu_p95_ms", s.cpu.p95_ms)
         .EndObject();
   }
   w.EndObject().BeginArray("frames");
@@ -211,12 +221,13 @@ void RunTrack(const TrackArgs& args) {
   for (const char* status : {"tracking", "relocalized", "lost"}) {
     const auto it = summaries.find(status);
     std::cout << (status == std::string("tracking") ? " (" : ", ") << status << " "
-              << (it == summaries.end() ? 0 : it->second.count);
+              << (it == summaries.end() ? 0 : it->second.wall.count);
   }
   std::cout << ")\n" << std::fixed << std::setprecision(2);
   for (const auto& [status, s] : summaries)
-    std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.median_ms
-              << " ms, p95 " << s.p95_ms << " ms (" << s.count << " frames)\n";
+    std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.wall.median_ms
+              << " ms, p95 " << s.wall.p95_ms << " ms wall; median " << s.cpu.median_ms << " ms, p95 "
+              << s.cpu.p95_ms << " ms CPU (" << s.wall.count << " frames)\n";
   for (const auto& f : frames)
     if (f.result.status == tracker::TrackStatus::kLost)
       std::cout << "  lost frame " << f.index << ": " << f.result.reason << "\n";

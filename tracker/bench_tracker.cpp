@@ -15,12 +15,15 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <cstring>
+#include <optional>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "mapping/map_file.h"
+#include "recordings/accuracy.h"
 #include "recordings/recording.h"
 #include "tracker/test_planar_scene.h"
 #include "tracker/test_scene.h"
@@ -91,49 +94,59 @@ void BM_PoseSolver_OpenGV_Ceres(benchmark::State& state) {
 }
 BENCHMARK(BM_PoseSolver_OpenGV_Ceres)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
+// OpenCV's pipeline on the same input: solvePnPRansac (same threshold, iterations and
+// confidence) then solvePnPRefineLM on its inliers.
+bool OpenCvPose(const calib::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
+                const std::vector<Eigen::Vector3d>& points, int flags, calib::Pose* pose, int* n_inliers) {
+  const cv::Mat K(camera.K()), dist = camera.DistCoeffs();
+  std::vector<cv::Point2d> image;
+  std::vector<cv::Point3d> object;
+  for (size_t j = 0; j < pixels.size(); ++j) {
+    image.emplace_back(pixels[j].x(), pixels[j].y());
+    object.emplace_back(points[j].x(), points[j].y(), points[j].z());
+  }
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  if (!cv::solvePnPRansac(object, image, K, dist, rvec, tvec, false, 1000, static_cast<float>(kThresholdPx), 0.999,
+                          inliers, flags) ||
+      inliers.size() < 6)
+    return false;
+  std::vector<cv::Point2d> in_image;
+  std::vector<cv::Point3d> in_object;
+  for (int k : inliers) {
+    in_image.push_back(image[k]);
+    in_object.push_back(object[k]);
+  }
+  cv::solvePnPRefineLM(in_object, in_image, K, dist, rvec, tvec);
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d Re;
+  Eigen::Vector3d te;
+  cv::cv2eigen(R, Re);
+  cv::cv2eigen(tvec, te);
+  *pose = calib::Pose::FromRt(Re, te);
+  *n_inliers = static_cast<int>(inliers.size());
+  return true;
+}
+
+const char* OpenCvFlagName(int flags) {
+  return flags == cv::SOLVEPNP_P3P ? "P3P" : flags == cv::SOLVEPNP_AP3P ? "AP3P" : "EPNP";
+}
+
 void BM_PoseSolver_OpenCV_RansacRefineLM(benchmark::State& state) {
   const calib::Camera camera = testing::TestCamera();
-  const cv::Mat K(camera.K()), dist = camera.DistCoeffs();
   const int flags = static_cast<int>(state.range(0));
   ErrorAccumulator errors;
   size_t i = 0;
   for (auto _ : state) {
     const auto& scene = Scenes()[i++ % kScenes];
-    std::vector<cv::Point2d> image;
-    std::vector<cv::Point3d> object;
-    for (size_t j = 0; j < scene.pixels.size(); ++j) {
-      image.emplace_back(scene.pixels[j].x(), scene.pixels[j].y());
-      object.emplace_back(scene.points[j].x(), scene.points[j].y(), scene.points[j].z());
-    }
-    cv::Mat rvec, tvec;
-    std::vector<int> inliers;
-    bool ok = cv::solvePnPRansac(object, image, K, dist, rvec, tvec, false, 1000, static_cast<float>(kThresholdPx),
-                                 0.999, inliers, flags);
-    if (ok && inliers.size() >= 6) {
-      std::vector<cv::Point2d> in_image;
-      std::vector<cv::Point3d> in_object;
-      for (int k : inliers) {
-        in_image.push_back(image[k]);
-        in_object.push_back(object[k]);
-      }
-      cv::solvePnPRefineLM(in_object, in_image, K, dist, rvec, tvec);
-    } else {
-      ok = false;
-    }
     calib::Pose pose;
-    if (ok) {
-      cv::Mat R;
-      cv::Rodrigues(rvec, R);
-      Eigen::Matrix3d Re;
-      Eigen::Vector3d te;
-      cv::cv2eigen(R, Re);
-      cv::cv2eigen(tvec, te);
-      pose = calib::Pose::FromRt(Re, te);
-    }
-    errors.Add(ok, pose, scene.pose, static_cast<int>(inliers.size()));
+    int inliers = 0;
+    const bool ok = OpenCvPose(camera, scene.pixels, scene.points, flags, &pose, &inliers);
+    errors.Add(ok, pose, scene.pose, inliers);
   }
   errors.Report(state);
-  state.SetLabel(flags == cv::SOLVEPNP_P3P ? "P3P" : flags == cv::SOLVEPNP_AP3P ? "AP3P" : "EPNP");
+  state.SetLabel(OpenCvFlagName(flags));
 }
 BENCHMARK(BM_PoseSolver_OpenCV_RansacRefineLM)
     ->Arg(cv::SOLVEPNP_P3P)
@@ -148,6 +161,10 @@ struct RealFrames {
   mapping::Map map;
   std::vector<cv::Mat> frames;  // in sequence order
   std::string source;
+  // Per frame, the true camera centre in the map's world (ground truth mapped by the inverse
+  // of the Sim(3) fitted from the map's keyframes to the ground truth), when known.
+  std::vector<std::optional<Eigen::Vector3d>> true_centre;
+  double map_to_mm = 1000;  // map units → millimetres of the ground truth's world
 };
 
 std::string g_map_dir, g_recording_dir, g_frames_spec;
@@ -160,7 +177,22 @@ std::unique_ptr<RealFrames> LoadRealFrames() {
     const std::vector<int> indices =
         recordings::ParseFrameSpec(g_frames_spec.empty() ? "0-" + std::to_string(rec.frames.size() - 1) : g_frames_spec,
                                    static_cast<int>(rec.frames.size()));
-    for (int i : indices) real->frames.push_back(rec.ReadImage(i));
+    std::optional<recordings::Sim3> to_truth;
+    if (rec.groundtruth) {
+      recordings::Trajectory keyframes;
+      for (const auto& k : real->map.keyframes) keyframes.push_back({k.timestamp, k.pose});
+      to_truth = recordings::FitAlignment(keyframes, *rec.groundtruth, recordings::AlignMode::kSim3, 0.02);
+      real->map_to_mm = 1000 * to_truth->scale;
+    }
+    for (int i : indices) {
+      real->frames.push_back(rec.ReadImage(i));
+      std::optional<Eigen::Vector3d> centre;
+      if (to_truth) {
+        for (const auto& g : *rec.groundtruth)
+          if (std::abs(g.timestamp - rec.frames[i].timestamp) < 1e-6) centre = to_truth->Inverse()(g.pose.Center());
+      }
+      real->true_centre.push_back(centre);
+    }
     real->source = g_recording_dir;
     return real;
   }
@@ -173,7 +205,9 @@ std::unique_ptr<RealFrames> LoadRealFrames() {
                             SiftExtractor());
   for (int i = 0; i < 60; ++i) {
     const double a = 0.004 * i;
-    real->frames.push_back(world.Render(LookAt({-0.15 + a, 0.05 * std::sin(3 * a), -0.8 - 0.1 * a}, {0.02, 0, 0})));
+    const calib::Pose pose = LookAt({-0.15 + a, 0.05 * std::sin(3 * a), -0.8 - 0.1 * a}, {0.02, 0, 0});
+    real->frames.push_back(world.Render(pose));
+    real->true_centre.push_back(pose.Center());
   }
   real->source = "graf1.png on a plane";
   return real;
@@ -255,6 +289,95 @@ void BM_TrackContinuous(benchmark::State& state) {
   state.SetLabel(real->source);
 }
 BENCHMARK(BM_TrackContinuous)->Unit(benchmark::kMillisecond);
+
+// The same side-by-side on real correspondences: each frame's SIFT matched to the map (as
+// relocalization does), solved by both. With --map/--recording and ground truth, the error is
+// the camera-centre distance after the Sim(3) fitted on the map's keyframes.
+struct RealCorrespondences {
+  std::vector<std::vector<Eigen::Vector2d>> pixels;
+  std::vector<std::vector<Eigen::Vector3d>> points;
+  std::vector<std::optional<Eigen::Vector3d>> true_centre;  // in the map's world
+};
+
+const RealCorrespondences* RealMatches() {
+  static const std::unique_ptr<RealCorrespondences> matches = []() -> std::unique_ptr<RealCorrespondences> {
+    const RealFrames* real = Real();
+    if (!real) return nullptr;
+    auto out = std::make_unique<RealCorrespondences>();
+    const mapping::DescriptorIndex index(real->map.descriptors);
+    const SiftExtractor sift;
+    for (size_t f = 0; f < real->frames.size(); ++f) {
+      const Features features = sift.Extract(real->frames[f]);
+      std::vector<Eigen::Vector2d> px;
+      std::vector<Eigen::Vector3d> pts;
+      GatherCorrespondences(features, real->map, MatchToMap(features, real->map, index, {}), &px, &pts);
+      out->pixels.push_back(std::move(px));
+      out->points.push_back(std::move(pts));
+      out->true_centre.push_back(real->true_centre[f]);
+    }
+    return out;
+  }();
+  return matches.get();
+}
+
+struct RealErrors {
+  std::vector<double> centre_mm;
+  int failures = 0;
+  double inliers = 0;
+  void Add(bool ok, const calib::Pose& pose, const std::optional<Eigen::Vector3d>& truth, double scale_to_mm,
+           int n_inliers) {
+    if (!ok) {
+      ++failures;
+      return;
+    }
+    inliers += n_inliers;
+    if (truth) centre_mm.push_back(scale_to_mm * (pose.Center() - *truth).norm());
+  }
+  void Report(benchmark::State& state, size_t solves) const {
+    std::vector<double> sorted = centre_mm;
+    std::sort(sorted.begin(), sorted.end());
+    state.counters["median_centre_err_mm"] = sorted.empty() ? -1 : sorted[sorted.size() / 2];
+    state.counters["failures"] = failures;
+    state.counters["inliers"] = solves > static_cast<size_t>(failures) ? inliers / (solves - failures) : 0;
+  }
+};
+
+void BM_RealCorrespondences_OpenGV_Ceres(benchmark::State& state) {
+  const RealCorrespondences* m = RealMatches();
+  if (!m) return state.SkipWithError("no frames");
+  const calib::Camera& camera = Real()->map.camera;
+  AbsolutePoseOptions options;
+  options.ransac_threshold_px = kThresholdPx;
+  options.inlier_threshold_px = kThresholdPx;
+  RealErrors errors;
+  size_t i = 0;
+  for (auto _ : state) {
+    const size_t f = i++ % m->pixels.size();
+    const AbsolutePoseResult r = EstimateAbsolutePose(camera, m->pixels[f], m->points[f], options);
+    errors.Add(r.ok, r.pose, m->true_centre[f], Real()->map_to_mm, r.stats.inliers);
+  }
+  errors.Report(state, i);
+  state.SetLabel(Real()->source);
+}
+BENCHMARK(BM_RealCorrespondences_OpenGV_Ceres)->Unit(benchmark::kMicrosecond);
+
+void BM_RealCorrespondences_OpenCV_RansacRefineLM(benchmark::State& state) {
+  const RealCorrespondences* m = RealMatches();
+  if (!m) return state.SkipWithError("no frames");
+  const calib::Camera& camera = Real()->map.camera;
+  RealErrors errors;
+  size_t i = 0;
+  for (auto _ : state) {
+    const size_t f = i++ % m->pixels.size();
+    calib::Pose pose;
+    int inliers = 0;
+    const bool ok = OpenCvPose(camera, m->pixels[f], m->points[f], static_cast<int>(state.range(0)), &pose, &inliers);
+    errors.Add(ok, pose, m->true_centre[f], Real()->map_to_mm, inliers);
+  }
+  errors.Report(state, i);
+  state.SetLabel(std::string(OpenCvFlagName(static_cast<int>(state.range(0)))) + ", " + Real()->source);
+}
+BENCHMARK(BM_RealCorrespondences_OpenCV_RansacRefineLM)->Arg(cv::SOLVEPNP_P3P)->Arg(cv::SOLVEPNP_AP3P)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace arview::tracker

@@ -78,7 +78,7 @@ RefineResult RefinePose(const calib::Camera& camera, const std::vector<Eigen::Ve
   problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
 
   ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   solver_options.max_num_iterations = options.max_iterations;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.num_threads = 1;

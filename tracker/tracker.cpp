@@ -306,6 +306,7 @@ void Tracker::Remember(const FrameResult& result, const Track2D3D& inliers) {
 
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = ThreadCpuMilliseconds();
   FrameResult result;
   const cv::Mat gray = image.empty() ? cv::Mat() : ToGray8(image);
   if (gray.empty() || gray.size() != map_.camera.Size()) {
@@ -315,6 +316,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     result.reason = msg.str();
     Reset();
     result.times.total_ms = MillisecondsSince(start);
+    result.times.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
     return result;
   }
 
@@ -362,6 +364,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     result.smoothed_center = smoother_.Filter(result.center, timestamp);
   }
   result.times.total_ms = MillisecondsSince(start);
+  result.times.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
   return result;
 }
 

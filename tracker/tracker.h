@@ -58,7 +58,8 @@ struct StageTimes {
   double match_ms = 0;  // global (FLANN) or guided
   double ransac_ms = 0;
   double refine_ms = 0;
-  double total_ms = 0;
+  double total_ms = 0;  // wall time of Track()
+  double cpu_ms = 0;    // CPU time of the calling thread during Track()
 };
 
 struct FrameResult {
