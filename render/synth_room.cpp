@@ -41,7 +41,7 @@ const std::array<Wall, 4>& Walls() {
       {{0, 1, 0}, kHalfY, 2 * kHalfX, {0.95f, 0.95f, 0.93f}, {"building.jpg", "graf1.png", "home.jpg", "leuvenA.jpg"}},
       {{0, -1, 0}, kHalfY, 2 * kHalfX, {0.85f, 0.85f, 0.84f}, {"aero1.jpg", "fruits.jpg", "baboon.jpg", "messi5.jpg"}},
       {{1, 0, 0}, kHalfX, 2 * kHalfY, {0.9f, 0.9f, 0.88f}, {"box_in_scene.png", "rubberwhale1.png", "starry_night.jpg"}},
-      {{-1, 0, 0}, kHalfX, 2 * kHalfY, {0.8f, 0.8f, 0.8f}, {"ela_original.jpg", "pca_test1.jpg", "left.jpg"}},
+      {{-1, 0, 0}, kHalfX, 2 * kHalfY, {0.8f, 0.8f, 0.8f}, {"squirrel_cls.jpg", "smarties.png", "left.jpg"}},
   }};
   return walls;
 }
@@ -59,9 +59,9 @@ struct BoxSpec {
 const std::array<BoxSpec, 3>& Boxes() {
   static const std::array<BoxSpec, 3> boxes = {{
       {{2.1, 1.3}, 0.35, {0.8, 0.8, 0.9},
-       {"basketball1.png", "squirrel_cls.jpg", "butterfly.jpg", "apple.jpg", "orange.jpg"}},
+       {"basketball1.png", "ela_original.jpg", "butterfly.jpg", "pca_test1.jpg", "orange.jpg"}},
       {{-2.3, -1.1}, -0.25, {1.0, 0.6, 0.6},
-       {"smarties.png", "chicky_512.png", "HappyFish.jpg", "cards.png", "ml.png"}},
+       {"blox.jpg", "chicky_512.png", "HappyFish.jpg", "cards.png", "apple.jpg"}},
       {{0.9, -1.8}, 0.7, {0.6, 0.6, 1.2},
        {"stuff.jpg", "imageTextN.png", "detect_blob.png", "text_motion.jpg", "LinuxLogo.jpg"}},
   }};
@@ -118,7 +118,8 @@ class SceneBuilder {
   int Texture(const char* name) {
     if (auto it = loaded_.find(name); it != loaded_.end()) return it->second;
     const fs::path path = data_dir_ / name;
-    cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
+    std::error_code ec;
+    cv::Mat image = fs::is_regular_file(path, ec) ? cv::imread(path.string(), cv::IMREAD_COLOR) : cv::Mat();
     if (image.empty()) {
       throw RenderError(path.string() + ": missing or unreadable (the room's photos come from Debian package opencv-doc)");
     }
@@ -287,7 +288,7 @@ void PrepareFolder(const SynthRoomOptions& o) {
     throw RenderError(o.out.string() + ": exists and is not a folder");
   }
   if (fs::exists(o.out, ec) && !fs::is_empty(o.out, ec)) {
-    if (!o.overwrite) throw RenderError(o.out.string() + ": folder exists and is not empty (pass --overwrite to replace the recording)");
+    if (!o.overwrite) throw RenderError(o.out.string() + ": folder exists and is not empty (--force replaces the recording)");
     // Only what a recording consists of, never anything else the user keeps there.
     fs::remove_all(o.out / "frames", ec);
     for (const char* file : {"frames.txt", "groundtruth.txt", "camera.yaml"}) fs::remove(o.out / file, ec);
