@@ -258,6 +258,9 @@ TEST(V4l2FakeCamera, EveryOpeningFailureIsOneMessageNamingTheDevice) {
   c.caps = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING;
   EXPECT_TRUE(Contains(OpenError(c), "/dev/video7: not a video capture device"));
   c = {};
+  c.caps = V4L2_CAP_VIDEO_CAPTURE_MPLANE | V4L2_CAP_STREAMING;
+  EXPECT_TRUE(Contains(OpenError(c), "/dev/video7: offers only the multi-planar capture API"));
+  c = {};
   c.caps = V4L2_CAP_VIDEO_CAPTURE;
   EXPECT_TRUE(Contains(OpenError(c), "/dev/video7: does not support streaming"));
   c = {};

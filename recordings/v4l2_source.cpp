@@ -106,6 +106,9 @@ void V4l2Source::QueryCapabilities() {
   }
   card_ = reinterpret_cast<const char*>(cap.card);
   const uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
+  if (!(caps & V4L2_CAP_VIDEO_CAPTURE) && (caps & V4L2_CAP_VIDEO_CAPTURE_MPLANE)) {
+    Fail("offers only the multi-planar capture API, which arview does not read ('" + card_ + "')");
+  }
   if (!(caps & V4L2_CAP_VIDEO_CAPTURE)) {
     Fail("not a video capture device ('" + card_ + "'; a webcam usually has several /dev/video nodes, try another)");
   }
