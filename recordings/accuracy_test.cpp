@@ -1,5 +1,6 @@
 #include "recordings/accuracy.h"
 
+#include <fstream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -244,6 +245,25 @@ TEST(Tum, WriteThenReadRoundTrips) {
     EXPECT_LT((back[i].pose.Center() - gt[i].pose.Center()).norm(), 1e-12);
     EXPECT_LT(RotationErrorDeg(back[i].pose, gt[i].pose), 1e-6);
   }
+}
+
+TEST(Tum, MalformedLinesAreNamedWithFileAndLine) {
+  const fs::path file = fs::temp_directory_path() / ("arview_tum_bad_" + std::to_string(::getpid()) + ".txt");
+  auto error_for = [&](const std::string& text) {
+    std::ofstream(file) << text;
+    try {
+      ReadTum(file);
+    } catch (const RecordingError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_for("# c\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0\n").find(":3: expected"), std::string::npos);
+  EXPECT_NE(error_for("1 0 0 0 0 0 0 1 7\n").find(":1: unexpected '7'"), std::string::npos);
+  EXPECT_NE(error_for("1 0 0 0 0 0 0 2\n").find(":1: quaternion"), std::string::npos);
+  EXPECT_NE(error_for("1 0 nan 0 0 0 0 1\n").find(":1:"), std::string::npos);
+  EXPECT_EQ(error_for("\n# only comments\n1 0 0 0 0 0 0 1\n"), "");
+  fs::remove(file);
 }
 
 }  // namespace

@@ -25,6 +25,11 @@ Trajectory ReadTum(const std::filesystem::path& path) {
                              ": expected 'timestamp tx ty tz qx qy qz qw'");
       }
     }
+    std::string extra;
+    if (ss >> extra) {
+      throw RecordingError(path.string() + ":" + std::to_string(line_no) + ": unexpected '" + extra +
+                           "' after 'timestamp tx ty tz qx qy qz qw'");
+    }
     const Eigen::Quaterniond q_wc(v[7], v[4], v[5], v[6]);
     if (std::abs(q_wc.norm() - 1.0) > 1e-3) {
       throw RecordingError(path.string() + ":" + std::to_string(line_no) +
