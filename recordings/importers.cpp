@@ -448,7 +448,12 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
     const double rate = (std::isfinite(fps) && fps > 0) ? fps : 30.0;
     if (!(std::isfinite(fps) && fps > 0)) notes.push_back("the video declares no frame rate; assumed 30 fps");
     for (size_t i = 0; i < stamps.size(); ++i) stamps[i] = static_cast<double>(i) / rate;
-    notes.push_back("frame timestamps computed as index / frame rate");
+    char text[160];
+    std::snprintf(text, sizeof(text),
+                  "the decoder's frame times do not increase throughout (OpenCV reports none for the last "
+                  "frames of many files); timestamps = frame index / %.6g fps",
+                  rate);
+    notes.push_back(text);
   }
   PrepareRecordingFolder(out_dir, options.overwrite);
   const std::string rel = "frames/" + video_file.filename().string();
