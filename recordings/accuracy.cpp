@@ -94,12 +94,18 @@ std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(const Trajectory& a,
     size_t i, j;
   };
   std::vector<Candidate> candidates;
+  // Per pose of a, the nearest few of b on each side within the tolerance: enough for the
+  // one-to-one matching, and bounded even when the tolerance spans whole trajectories.
+  constexpr std::ptrdiff_t kPerSide = 4;
   for (size_t i = 0; i < a.size(); ++i) {
     const double t = a[i].timestamp;
-    auto it = std::lower_bound(b_sorted.begin(), b_sorted.end(), t - max_dt,
-                               [&](size_t j, double value) { return b[j].timestamp < value; });
-    for (; it != b_sorted.end() && b[*it].timestamp <= t + max_dt; ++it) {
-      candidates.push_back({std::abs(b[*it].timestamp - t), i, *it});
+    const auto mid = std::lower_bound(b_sorted.begin(), b_sorted.end(), t,
+                                      [&](size_t j, double value) { return b[j].timestamp < value; });
+    const auto first = mid - std::min(kPerSide, mid - b_sorted.begin());
+    const auto last = mid + std::min(kPerSide, b_sorted.end() - mid);
+    for (auto it = first; it != last; ++it) {
+      const double dt = std::abs(b[*it].timestamp - t);
+      if (dt <= max_dt) candidates.push_back({dt, i, *it});
     }
   }
   std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {

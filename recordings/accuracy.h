@@ -48,7 +48,8 @@ std::string ToString(AlignMode mode);
 Sim3 Umeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, bool with_scale);
 
 // Pairs (index into a, index into b) whose timestamps differ by at most max_dt seconds; each
-// pose is used at most once, closest pairs first (as TUM's associate.py). Sorted by a's time.
+// pose is used at most once, closest pairs first (as TUM's associate.py, but considering only
+// the 4 nearest poses of b on either side of each pose of a). Sorted by a's time.
 std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(const Trajectory& a, const Trajectory& b,
                                                             double max_dt);
 
