@@ -110,6 +110,21 @@ TEST(Blend, DibTwoKeysEqualsScLerp) {
   }
 }
 
+TEST(Blend, FloatDibMatchesDouble) {
+  std::mt19937 rng(11);
+  for (int i = 0; i < 20; ++i) {
+    std::vector<DualQuatd> q = {RandomDq(rng), RandomDq(rng), RandomDq(rng)};
+    const std::vector<double> w = {0.2, 0.5, 0.3};
+    std::vector<DualQuatf> qf;
+    for (const auto& x : q) qf.push_back(x.cast<float>());
+    const std::vector<float> wf = {0.2f, 0.5f, 0.3f};
+    const DibResult<float> rf = Dib<float>(qf, wf, {1e-5f, 50});
+    const DualQuatd rd = Dib<double>(q, w, {1e-12, 100}).q;
+    EXPECT_LT((rf.q.ToMatrix().cast<double>() - rd.ToMatrix()).norm(), 1e-3) << i;
+    EXPECT_LT((Dlb<float>(qf, wf).ToMatrix().cast<double>() - Dlb<double>(q, w).ToMatrix()).norm(), 1e-4) << i;
+  }
+}
+
 TEST(Blend, DibCoordinateInvariance) {
   std::mt19937 rng(7);
   for (int i = 0; i < 50; ++i) {

@@ -188,6 +188,21 @@ TEST(Import, JobsRejectMismatchedSizes) {
   std::vector<Eigen::Matrix4d> model(2);
   LocalPose rest = LocalPose::Rest(c.skeleton);
   EXPECT_FALSE((LocalToModelJob{&c.skeleton, &rest, model}.Run()));
+  LocalPose out(c.skeleton.size());
+  const LocalPose* inputs[] = {&rest, &rest};
+  const double zero[] = {0.0, 0.0}, nan[] = {NAN, 1.0}, fine[] = {0.5, 0.5};
+  BlendingJob blend;
+  blend.inputs = inputs;
+  blend.output = &out;
+  blend.weights = zero;
+  EXPECT_FALSE(blend.Run());
+  blend.weights = nan;
+  EXPECT_FALSE(blend.Run());
+  blend.weights = fine;
+  EXPECT_TRUE(blend.Run());
+  const LocalPose* mismatched[] = {&rest, &wrong};
+  blend.inputs = mismatched;
+  EXPECT_FALSE(blend.Run());
 }
 
 TEST(Import, AnimatedPoseLbsAndDqsAgreeRoughly) {

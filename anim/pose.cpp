@@ -73,10 +73,12 @@ bool SamplingJob::Run() const {
 
 bool BlendingJob::Validate() const {
   if (!output || inputs.empty() || inputs.size() != weights.size() || inputs.size() > std::size_t(kMaxInputs)) return false;
+  double sum = 0;
   for (std::size_t k = 0; k < inputs.size(); ++k) {
-    if (!inputs[k] || inputs[k]->size() != output->size() || !(weights[k] >= 0)) return false;
+    if (!inputs[k] || inputs[k]->size() != output->size() || !(weights[k] >= 0) || !std::isfinite(weights[k])) return false;
+    sum += weights[k];
   }
-  return true;
+  return sum > 0;
 }
 
 bool BlendingJob::Run() const {

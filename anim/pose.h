@@ -50,7 +50,8 @@ struct SamplingJob {
 
 enum class BlendMethod { kDlb, kDib };
 
-// Blends K poses joint by joint with the given convex weights (Eq. 3). At most kMaxInputs.
+// Blends K poses joint by joint with the given convex weights (Eq. 3). At most kMaxInputs;
+// weights must be finite, non-negative and not all zero.
 struct BlendingJob {
   static constexpr int kMaxInputs = 64;
   std::span<const LocalPose* const> inputs;

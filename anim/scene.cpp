@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -264,13 +263,8 @@ Scene ParseScene(const std::string& text, const fs::path& file) {
 }
 
 Scene LoadScene(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw Error(path.string() + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ParseScene(ss.str(), path);
+  const Node root = yaml::ParseFile(path);  // errors name the file
+  return SceneReader(path.string()).Read(root, path);
 }
 
 Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what) {

@@ -129,6 +129,8 @@ void ViewSphere::DetectRing() {
 }
 
 void ViewSphere::Weights(const Eigen::Vector3d& viewpoint, std::span<double> out) const {
+  if (out.size() != keys_.size())
+    throw Error("view sphere: " + std::to_string(out.size()) + " weight slots for " + std::to_string(keys_.size()) + " keys");
   const int nd = static_cast<int>(dirs_.size());
   // Work on distinct directions in a fixed-size scratch when possible.
   double scratch[kMaxStackDirs];
