@@ -1,6 +1,7 @@
 // bench_anim: the per-frame costs of view-adaptive blending (Google Benchmark, one thread).
 //   BM_Blend/<method>/<K>        blend K poses of 27 joints (DLB or DIB, p = 0.001)
 //   BM_SampleBlend/<method>/<K>  sample K clips of 27 joints at one time, then blend
+//   BM_SampleNlerpBlend/...      the same with nlerp sampling (SamplingJob::nlerp)
 //   BM_Skinning/<method>         CPU skinning of 25 000 vertices, 4 influences, 27 joints
 //   BM_FoxUpdate/<method>        AnimatedCharacter::Update on the Fox with 8 look-at keys
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
@@ -103,14 +104,15 @@ void BM_Blend(benchmark::State& state) {
   state.SetLabel(method == BlendMethod::kDlb ? "DLB" : "DIB");
 }
 
-void BM_SampleBlend(benchmark::State& state) {
+void SampleBlend(benchmark::State& state, bool nlerp) {
   const auto method = static_cast<BlendMethod>(state.range(0));
   Setup s(static_cast<int>(state.range(1)));
   const BlendingJob job = MakeJob(s, method);
   double t = 0;
   for (auto _ : state) {
     t += 1.0 / 60;
-    for (std::size_t k = 0; k < s.clips.size(); ++k) SamplingJob{&s.skeleton, &s.clips[k], t, true, &s.poses[k]}.Run();
+    for (std::size_t k = 0; k < s.clips.size(); ++k)
+      SamplingJob{&s.skeleton, &s.clips[k], t, true, &s.poses[k], nlerp}.Run();
     job.Run();
     benchmark::DoNotOptimize(s.out.rigid.data());
   }
@@ -122,8 +124,11 @@ void BlendArgs(benchmark::internal::Benchmark* b) {
     for (int k : {2, 4, 8, 16}) b->Args({m, k});
   b->ArgNames({"method", "keys"});
 }
+void BM_SampleBlend(benchmark::State& state) { SampleBlend(state, false); }
+void BM_SampleNlerpBlend(benchmark::State& state) { SampleBlend(state, true); }
 BENCHMARK(BM_Blend)->Apply(BlendArgs);
 BENCHMARK(BM_SampleBlend)->Apply(BlendArgs);
+BENCHMARK(BM_SampleNlerpBlend)->Apply(BlendArgs);
 
 void BM_Skinning(benchmark::State& state) {
   const auto method = static_cast<SkinningMethod>(state.range(0));
@@ -170,7 +175,8 @@ void BM_FoxUpdate(benchmark::State& state) {
     return;
   }
   std::string text = "characters:\n  - asset: " + fox.string() + "\n    blend: {method: " +
-                     (state.range(0) ? "dib" : "dlb") + "}\n    keys:\n";
+                     (state.range(0) ? "dib" : "dlb") + "}\n    sampling: " + (state.range(1) ? "nlerp" : "slerp") +
+                     "\n    keys:\n";
   for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
   AnimatedCharacter ch(ParseScene(text, "bench.yaml").characters[0]);
   double t = 0;
@@ -179,9 +185,9 @@ void BM_FoxUpdate(benchmark::State& state) {
     const FrameOutput& out = ch.Update(DirectionFromAzimuthElevation(100 * t, 0), t);
     benchmark::DoNotOptimize(out.skinning_matrices.data());
   }
-  state.SetLabel(state.range(0) ? "DIB" : "DLB");
+  state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + (state.range(1) ? " nlerp" : " slerp"));
 }
-BENCHMARK(BM_FoxUpdate)->Arg(0)->Arg(1)->ArgName("method");
+BENCHMARK(BM_FoxUpdate)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->ArgNames({"method", "nlerp"});
 
 }  // namespace
 }  // namespace arview::anim

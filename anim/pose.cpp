@@ -25,11 +25,16 @@ Eigen::Vector3d SampleVec(const std::vector<Key<Eigen::Vector3d>>& keys, double 
   return (1 - f) * keys[i].value + f * keys[i + 1].value;
 }
 
-Eigen::Quaterniond SampleRot(const std::vector<Key<Eigen::Quaterniond>>& keys, double t, const Eigen::Quaterniond& rest) {
+Eigen::Quaterniond SampleRot(const std::vector<Key<Eigen::Quaterniond>>& keys, double t, const Eigen::Quaterniond& rest,
+                             bool nlerp) {
   if (keys.empty()) return rest;
   const auto [i, f] = Locate(keys, t);
   if (f == 0.0) return keys[i].value;
-  return keys[i].value.slerp(f, keys[i + 1].value);  // Eigen's slerp takes the short way
+  if (!nlerp) return keys[i].value.slerp(f, keys[i + 1].value);  // Eigen's slerp takes the short way
+  const Eigen::Vector4d a = keys[i].value.coeffs();
+  Eigen::Vector4d b = keys[i + 1].value.coeffs();
+  if (a.dot(b) < 0) b = -b;
+  return Eigen::Quaterniond((1 - f) * a + f * b);  // normalised by the caller
 }
 
 }  // namespace
@@ -64,7 +69,7 @@ bool SamplingJob::Run() const {
   for (int j = 0; j < skeleton->size(); ++j) {
     const JointTrack& tr = clip->tracks[j];
     const Transform& rest = skeleton->rest[j];
-    output->rigid[j] = DualQuatd::FromRotationTranslation(SampleRot(tr.rotation, t, rest.rotation),
+    output->rigid[j] = DualQuatd::FromRotationTranslation(SampleRot(tr.rotation, t, rest.rotation, nlerp),
                                                           SampleVec(tr.translation, t, rest.translation));
     output->scale[j] = SampleVec(tr.scale, t, rest.scale);
   }

@@ -37,12 +37,16 @@ struct LocalPose {
 
 // Samples `clip` at `time` seconds: linear translation and scale, slerp rotation between keys.
 // `loop` wraps time into [0, duration); otherwise it is clamped.
+// `nlerp` replaces slerp by normalised linear interpolation of the rotation keys: about 2.5x
+// faster sampling, exact at keys and midpoints; between them, on the test assets' clips, within
+// 0.79° of slerp on the Fox and 0.02° on CesiumMan, BCN_Epileptic and CMU 01_01 (import_test).
 struct SamplingJob {
   const Skeleton* skeleton = nullptr;
   const Clip* clip = nullptr;
   double time = 0;
   bool loop = true;
   LocalPose* output = nullptr;
+  bool nlerp = false;
 
   bool Validate() const;
   bool Run() const;

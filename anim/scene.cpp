@@ -81,7 +81,7 @@ class SceneReader {
   }
 
   CharacterSpec Character(const Node& n, const fs::path& base_dir) const {
-    OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "lookat", "keys"},
+    OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "keys"},
              "a character");
     CharacterSpec c;
     c.where = file_ + ":" + std::to_string(n.line);
@@ -130,6 +130,8 @@ class SceneReader {
     }
     if (const Node* x = n.Find("phase"))
       c.phase = Choice<PhaseMode>(*x, "phase", {{"shared", PhaseMode::kShared}, {"independent", PhaseMode::kIndependent}});
+    if (const Node* x = n.Find("sampling"))
+      c.nlerp_sampling = Choice<bool>(*x, "sampling", {{"slerp", false}, {"nlerp", true}});
     if (const Node* x = n.Find("lookat")) {
       OnlyKeys(*x, {"base_clip", "chain", "limits"}, "lookat");
       c.has_lookat = true;
@@ -410,7 +412,7 @@ const FrameOutput& AnimatedCharacter::Update(const Eigen::Vector3d& viewpoint, d
   for (int k = 0; k < K; ++k) {
     if (weights_[k] <= 0) continue;
     SamplingJob{&sk, key_clips_[k].get(), KeyTime(k, std::isfinite(time_seconds) ? time_seconds : 0.0), true,
-                &key_poses_[k]}
+                &key_poses_[k], spec_.nlerp_sampling}
         .Run();
     active_ptrs_[active] = &key_poses_[k];
     active_weights_[active] = weights_[k];

@@ -29,6 +29,7 @@
 //       weights: {mode: inverse-distance | local, distance: geodesic | chordal, alpha: 3}
 //       blend: {method: dlb | dib, precision: 0.001, max_iterations: 32}
 //       phase: shared | independent  # key clips on one normalised phase (default) or own loops
+//       sampling: slerp | nlerp      # rotation interpolation between clip keys (default slerp)
 //       lookat:                      # for keys with `generate: lookat`
 //         base_clip: Survey
 //         chain: [b_Spine01_02, b_Spine02_03, b_Neck_04, b_Head_05]  # default: found by name
@@ -91,6 +92,7 @@ struct CharacterSpec {
   BlendMethod blend = BlendMethod::kDlb;
   DibOptions<double> dib;
   PhaseMode phase = PhaseMode::kShared;
+  bool nlerp_sampling = false;  // `sampling: nlerp` (default slerp): see SamplingJob::nlerp
   bool has_lookat = false;
   LookAtSpec lookat;
   std::vector<KeySpec> keys;

@@ -31,6 +31,7 @@ TEST(Scene, ParsesEveryField) {
     weights: {mode: local, distance: chordal, alpha: 4}
     blend: {method: dib, precision: 0.0001, max_iterations: 10}
     phase: independent
+    sampling: nlerp
     lookat:
       base_clip: Survey
       chain: [a, b]
@@ -60,6 +61,7 @@ TEST(Scene, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(c.dib.precision, 1e-4);
   EXPECT_EQ(c.dib.max_iterations, 10);
   EXPECT_EQ(c.phase, PhaseMode::kIndependent);
+  EXPECT_TRUE(c.nlerp_sampling);
   EXPECT_EQ(c.lookat.chain, (std::vector<std::string>{"a", "b"}));
   ASSERT_EQ(c.keys.size(), 4u);
   EXPECT_LT((c.keys[0].viewpoint - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
