@@ -22,7 +22,7 @@ struct RenderArgs {
   std::string skinning = "dq";
   bool hmd = false;
   double ipd = 0.064;
-  int samples = 4;
+  std::string antialiasing = "msaa";
   bool no_shadow = false;
   std::string backend = "auto";
   int threads = 1;
@@ -73,7 +73,7 @@ void RunRender(const RenderArgs& args) {
     gl.threads = args.threads;
     auto context = render::OffscreenContext::Create(gl);
     render::ArOptions options;
-    options.samples = args.samples;
+    options.antialiasing = render::ParseAntialiasing(args.antialiasing);
     options.shadow = !args.no_shadow;
     options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
     render::ArRenderer renderer(*context, camera, options);
@@ -114,7 +114,9 @@ void AddRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"dq", "lbs"}));
   cmd->add_flag("--hmd", args->hmd, "Side-by-side stereo for a head-mounted display (2W x H)");
   cmd->add_option("--ipd", args->ipd, "Interpupillary distance for --hmd, metres")->default_val(args->ipd)->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--samples", args->samples, "MSAA samples (0 = off)")->default_val(args->samples)->check(CLI::Range(0, 4));
+  cmd->add_option("--aa", args->antialiasing, "Antialiasing: msaa (4x multisampling) or none")
+      ->default_val(args->antialiasing)
+      ->check(CLI::IsMember({"msaa", "none"}));
   cmd->add_flag("--no-shadow", args->no_shadow, "No contact shadow");
   cmd->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
       ->default_val(args->backend)

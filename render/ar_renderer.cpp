@@ -5,12 +5,18 @@
 
 namespace arview::render {
 
+Antialiasing ParseAntialiasing(const std::string& name) {
+  if (name == "msaa") return Antialiasing::kMsaa;
+  if (name == "none") return Antialiasing::kNone;
+  throw RenderError("unknown antialiasing '" + name + "' (expected msaa or none)");
+}
+
 ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, const ArOptions& options)
     : context_(&context),
       camera_(camera),
       pinhole_(camera.WithoutDistortion()),
       options_(options),
-      target_(context.gl(), camera.width, camera.height, options.samples > 1 ? options.samples : 0),
+      target_(context.gl(), camera.width, camera.height, options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
       shadow_(context.gl()) {
   ProjectionMatrix(pinhole_, options_.clip);  // validates the camera and the clip range
   if (camera_.HasDistortion()) {

@@ -4,7 +4,7 @@
 //                                skinning (DQS) + draw with 4x MSAA + contact shadow + background
 //                                upload + resolve + read-back: Fox, CesiumMan, and a synthetic
 //                                25 000-triangle skinned tube (10 joints, 2 influences)
-//   BM_ArFrameNoMsaa/<character> the same without multisampling
+//   BM_ArFrameNoAa/<character>   the same without antialiasing
 //   BM_UndistortBackground       cv::remap of a 640x480 frame with precomputed maps (the cost of
 //                                lens distortion in the AR path)
 //   BM_SynthRoomFrame            one frame of `arview synth room` (render + read-back, no PNG)
@@ -155,14 +155,14 @@ cv::Mat Background() {
   return image;
 }
 
-void RunArFrame(benchmark::State& state, const std::string& name, int samples) {
+void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing) {
   Subject* subject = GetSubject(name);
   if (subject == nullptr) {
     state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
     return;
   }
   ArOptions options;
-  options.samples = samples;
+  options.antialiasing = antialiasing;
   ArRenderer renderer(Context(), BenchCamera(), options);
   renderer.AddCharacter(subject->animated->character(), subject->spec);
   const cv::Mat background = Background();
@@ -188,8 +188,8 @@ void RunArFrame(benchmark::State& state, const std::string& name, int samples) {
   state.counters["gl_threads"] = Context().threads();
 }
 
-void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, 4); }
-void BM_ArFrameNoMsaa(benchmark::State& state, std::string name) { RunArFrame(state, name, 0); }
+void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa); }
+void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone); }
 
 void BM_UndistortBackground(benchmark::State& state) {
   calib::Camera camera = BenchCamera();
@@ -226,9 +226,9 @@ void BM_SynthRoomFrame(benchmark::State& state) {
 BENCHMARK_CAPTURE(BM_ArFrame, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrame, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrame, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_ArFrameNoMsaa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoAa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoAa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameNoAa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
