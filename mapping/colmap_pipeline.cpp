@@ -7,7 +7,7 @@
 
 #include <chrono>
 #include <fstream>
-#include <regex>
+#include <cstdio>
 #include <sstream>
 
 #include "mapping/colmap_model.h"
@@ -98,20 +98,17 @@ class ProgressParser {
       : stage_(std::move(stage)), total_(total), cb_(cb) {}
   void operator()(const std::string& line) {
     if (!cb_.progress) return;
-    static const std::regex processed(R"(^Processed file \[(\d+)/(\d+)\])");
-    static const std::regex block(R"(^Matching block \[(\d+)/(\d+), (\d+)/(\d+)\])");
-    static const std::regex image(R"(^Matching image \[(\d+)/(\d+)\])");
-    static const std::regex registering(R"(^Registering image #\d+ \((\d+)\))");
-    static const std::regex initializing(R"(^Initializing with image pair)");
-    std::smatch m;
-    if (std::regex_search(line, m, processed) || std::regex_search(line, m, image)) {
-      cb_.progress(stage_, std::stoi(m[1]), std::stoi(m[2]));
-    } else if (std::regex_search(line, m, block)) {
-      const int a = std::stoi(m[1]), na = std::stoi(m[2]), b = std::stoi(m[3]), nb = std::stoi(m[4]);
+    // COLMAP 3.8's progress lines (sscanf rather than std::regex: no allocation per line).
+    const char* text = line.c_str();
+    int a = 0, na = 0, b = 0, nb = 0;
+    if (std::sscanf(text, "Processed file [%d/%d]", &a, &na) == 2 ||
+        std::sscanf(text, "Matching image [%d/%d]", &a, &na) == 2) {
+      cb_.progress(stage_, a, na);
+    } else if (std::sscanf(text, "Matching block [%d/%d, %d/%d]", &a, &na, &b, &nb) == 4) {
       cb_.progress(stage_, (a - 1) * nb + b, na * nb);
-    } else if (std::regex_search(line, m, registering)) {
-      cb_.progress(stage_, std::stoi(m[1]), total_);
-    } else if (std::regex_search(line, m, initializing)) {
+    } else if (std::sscanf(text, "Registering image #%d (%d)", &b, &a) == 2) {
+      cb_.progress(stage_, a, total_);
+    } else if (line.rfind("Initializing with image pair", 0) == 0) {
       cb_.progress(stage_, 0, total_);
     }
   }
@@ -127,8 +124,9 @@ class ColmapRunner {
   ColmapRunner(const MapBuildOptions& options, const fs::path& out_dir, const MapBuildCallbacks& cb)
       : options_(options), log_(out_dir / "colmap.log"), cb_(cb) {
     if (FindExecutable(options.colmap).empty()) {
-      throw MapError("COLMAP not found: '" + options.colmap +
-                     "' is not on PATH (install it: apt-get install colmap)");
+      throw MapError("COLMAP not found: '" + options.colmap + "' is not " +
+                     (options.colmap.find('/') == std::string::npos ? "on PATH" : "an executable file") +
+                     " (install COLMAP: apt-get install colmap)");
     }
   }
 
@@ -302,6 +300,7 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir, const MapBuildOptions& options,
                         const MapBuildCallbacks& cb) {
+  CandidateFrames(recording, options);  // a bad --frames fails before anything is written
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) throw MapError(out_dir.string() + ": cannot create the map directory");

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include "mapping/colmap_model.h"
@@ -34,7 +35,9 @@ class TempleMapTest : public ::testing::Test {
     recording_ = std::make_unique<recordings::Recording>(recordings::LoadRecording(root_ / "recording"));
     MapBuildOptions options;
     options.frames_spec = "0-46:2";
-    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options));
+    MapBuildCallbacks callbacks;
+    callbacks.progress = [](const std::string& stage, int done, int total) { progress_[stage] = {done, total}; };
+    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options, callbacks));
   }
   static void TearDownTestSuite() {
     if (!root_.empty()) fs::remove_all(root_);
@@ -72,11 +75,19 @@ class TempleMapTest : public ::testing::Test {
   static fs::path root_;
   static std::unique_ptr<recordings::Recording> recording_;
   static std::unique_ptr<MapBuildResult> result_;
+  static std::map<std::string, std::pair<int, int>> progress_;  // last (done, total) per stage
 };
 
 fs::path TempleMapTest::root_;
 std::unique_ptr<recordings::Recording> TempleMapTest::recording_;
 std::unique_ptr<MapBuildResult> TempleMapTest::result_;
+std::map<std::string, std::pair<int, int>> TempleMapTest::progress_;
+
+TEST_F(TempleMapTest, ProgressFollowsEveryStageToItsEnd) {
+  EXPECT_EQ(progress_["extract"], std::make_pair(24, 24));
+  EXPECT_EQ(progress_["match"], std::make_pair(1, 1));  // exhaustive: one block of 24 images
+  EXPECT_EQ(progress_["map"], std::make_pair(24, 24));  // every frame registered
+}
 
 TEST_F(TempleMapTest, RegistersAllTwentyFourEvenFrames) {
   ASSERT_EQ(result_->selected_frames.size(), 24u);
