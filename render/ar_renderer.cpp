@@ -147,6 +147,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     draw.skinning_matrices = out.skinning_matrices;
     draw.skinning_dual_quats = out.skinning_dual_quats;
     draw.method = options_.skinning;
+    draw.cull_back_faces = options_.cull_back_faces;
     // Key light from above and in front of the character, so that its face is lit and the
     // contact shadow straight below it is plausible.
     draw.light_direction_map =

@@ -42,6 +42,7 @@ struct ArOptions {
   ClipRange clip{0.02, 200.0};
   anim::SkinningMethod skinning = anim::SkinningMethod::kDualQuaternion;
   bool shadow = true;
+  bool cull_back_faces = true;  // see CharacterDraw
   float shadow_strength = 0.55f;
   cv::Scalar empty_background{128, 128, 128};  // BGR, when no camera image is given
   bool full_frame = false;  // draw and read the whole frame (for checking the bounds)

@@ -113,6 +113,10 @@ cv::Mat DecodeTexture(const anim::Texture& t, const std::string& source) {
   return image;
 }
 
+// Characters are mostly seen face-on: trilinear filtering suffices, and llvmpipe's anisotropic
+// filtering is costly (measured with bench_render).
+constexpr float kCharacterAnisotropy = 1.f;
+
 int MaxJoints(const GlApi& gl) {
   // skin (16 floats) + two vec4 per joint, with room for the other uniforms.
   GLint components = 0;
@@ -136,7 +140,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
           Uniform(gl, p, "ambient"), Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo")};
   white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
   for (const anim::Texture& t : character.textures) {
-    textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, 4.f, true}));
+    textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, kCharacterAnisotropy, true}));
   }
 
   joint_radii_.assign(joints_, 0.f);
@@ -225,7 +229,14 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   gl.DepthFunc(GL_LESS);
   gl.DepthMask(GL_TRUE);
   gl.Disable(GL_BLEND);
-  gl.Disable(GL_CULL_FACE);
+  if (d.cull_back_faces) {
+    // Front faces are counter-clockwise in model space; a mirroring placement reverses that.
+    gl.Enable(GL_CULL_FACE);
+    gl.CullFace(GL_BACK);
+    gl.FrontFace(d.model_to_map.topLeftCorner<3, 3>().determinant() < 0 ? GL_CW : GL_CCW);
+  } else {
+    gl.Disable(GL_CULL_FACE);
+  }
   gl.UseProgram(program_.get());
   gl.UniformMatrix4fv(loc_.mvp, 1, GL_FALSE, mvp.data());
   gl.UniformMatrix4fv(loc_.model, 1, GL_FALSE, model.data());

@@ -22,6 +22,9 @@ struct CharacterDraw {
   Eigen::Vector3d light_direction_map = Eigen::Vector3d::UnitZ();  // unit, towards the light
   float key = 0.7f;
   float ambient = 0.45f;
+  // Skip triangles facing away (counter-clockwise front faces, as anim/ imports them): half the
+  // rasterisation for closed meshes; off for assets with open, single-sided parts.
+  bool cull_back_faces = true;
 };
 
 class CharacterRenderer {
