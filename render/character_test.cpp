@@ -77,6 +77,29 @@ double Iou(const cv::Mat& a, const cv::Mat& b) {
   return uni > 0 ? cv::countNonZero(a & b) / uni : 0.0;
 }
 
+// Options for silhouettes: no shadow, a background colour no character has.
+ArOptions SilhouetteOptions(anim::SkinningMethod method) {
+  ArOptions options;
+  options.skinning = method;
+  options.shadow = false;
+  options.empty_background = kMagenta;
+  return options;
+}
+
+struct Silhouettes {
+  cv::Mat rendered, expected;  // GPU-skinned render, CPU-skinned reference
+  double iou = 0;
+};
+
+Silhouettes Compare(ArRenderer& renderer, const anim::AnimatedCharacter& c, const anim::FrameOutput* frame,
+                    anim::SkinningMethod method, const calib::Camera& camera, const calib::Pose& pose) {
+  Silhouettes s;
+  s.rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
+  s.expected = CpuSilhouette(c.character(), c.spec(), *frame, method, camera, pose);
+  s.iou = Iou(s.rendered, s.expected);
+  return s;
+}
+
 class FoxTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -95,19 +118,14 @@ TEST_F(FoxTest, GpuSkinningMatchesCpuSkinningForBothMethods) {
   const calib::Camera camera = TestCamera();
   const calib::Pose pose = LookingAtFox();
   for (auto method : {anim::SkinningMethod::kDualQuaternion, anim::SkinningMethod::kLinear}) {
-    ArOptions options;
-    options.skinning = method;
-    options.shadow = false;
-    options.empty_background = kMagenta;
-    ArRenderer renderer(testing::SharedContext(), camera, options);
+    ArRenderer renderer(testing::SharedContext(), camera, SilhouetteOptions(method));
     renderer.AddCharacter(fox_->character(), fox_->spec());
     for (double time : {0.0, 0.37, 0.71}) {
-      const anim::FrameOutput* frame = &Frame(time, pose);
-      const cv::Mat rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
-      const cv::Mat expected = CpuSilhouette(fox_->character(), fox_->spec(), *frame, method, camera, pose);
+      const Silhouettes s = Compare(renderer, *fox_, &Frame(time, pose), method, camera, pose);
+      const cv::Mat& expected = s.expected;
+      const double iou = s.iou;
       ASSERT_GT(cv::countNonZero(expected), 3000) << "the fox should fill part of the view";
       EXPECT_FALSE(renderer.used_linear_fallback());
-      const double iou = Iou(rendered, expected);
       std::printf("%s t=%.2f: silhouette IoU %.4f (%d px)\n",
                   method == anim::SkinningMethod::kLinear ? "LBS" : "DQS", time, iou, cv::countNonZero(expected));
       EXPECT_GE(iou, 0.97);
@@ -159,10 +177,7 @@ TEST_F(FoxTest, CompositesOverTheBackgroundWithAShadowBelow) {
 TEST_F(FoxTest, SideBySideEyesSeeTheCharacterWithDisparity) {
   const calib::Camera camera = TestCamera();
   const calib::Pose pose = LookingAtFox();
-  ArOptions options;
-  options.empty_background = kMagenta;
-  options.shadow = false;
-  ArRenderer renderer(testing::SharedContext(), camera, options);
+  ArRenderer renderer(testing::SharedContext(), camera, SilhouetteOptions(anim::SkinningMethod::kDualQuaternion));
   renderer.AddCharacter(fox_->character(), fox_->spec());
   const anim::FrameOutput* frame = &Frame(0.0, pose);
   const cv::Mat both = renderer.RenderSideBySide({}, pose, {&frame, 1}, 0.064);
@@ -281,17 +296,14 @@ TEST(CesiumMan, GpuSilhouetteMatchesCpuSkinningWithBackFacesCulled) {
   const calib::Pose back = calib::Pose::FromCameraToWorld(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()) * level,
                                                           Eigen::Vector3d(0, 2.2, 1.0));
   for (auto method : {anim::SkinningMethod::kDualQuaternion, anim::SkinningMethod::kLinear}) {
-    ArOptions options;
-    options.skinning = method;
-    options.shadow = false;
-    options.empty_background = kMagenta;
+    const ArOptions options = SilhouetteOptions(method);
     ArRenderer renderer(testing::SharedContext(), camera, options);
     renderer.AddCharacter(man.character(), man.spec());
     for (const auto& [pose, time] : {std::pair{front, 0.0}, std::pair{back, 0.9}}) {
       const anim::FrameOutput* frame = &man.Update(man.spec().ViewpointFromCamera(pose.Center()), time);
-      const cv::Mat rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
-      const cv::Mat expected = CpuSilhouette(man.character(), man.spec(), *frame, method, camera, pose);
-      const double iou = Iou(rendered, expected);
+      const Silhouettes s = Compare(renderer, man, frame, method, camera, pose);
+      const cv::Mat& expected = s.expected;
+      const double iou = s.iou;
       ASSERT_GT(cv::countNonZero(expected), 2500);
       std::printf("CesiumMan %s t=%.1f: silhouette IoU %.4f (%d px)\n",
                   method == anim::SkinningMethod::kLinear ? "LBS" : "DQS", time, iou, cv::countNonZero(expected));
