@@ -31,7 +31,9 @@ struct OffscreenOptions {
   // llvmpipe rasterizer threads (LP_NUM_THREADS), set before the context is created because
   // tracking shares the cores. 0 rasterizes on the calling thread. Mesa reads the variable
   // once per process and backend, so the first context fixes it; a later context asking for
-  // a different count is refused rather than silently given the old one.
+  // a different count is refused rather than silently given the old one. The variable is set
+  // with setenv, which is not safe against concurrent getenv: create the first context before
+  // starting other threads.
   int threads = 1;
 };
 
@@ -50,6 +52,8 @@ class OffscreenContext {
   // E.g. "osmesa: llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 (Core Profile) Mesa 22.3.6, 2 llvmpipe threads".
   std::string Description() const;
   int MaxSamples() const;  // GL_MAX_SAMPLES: 4 on llvmpipe
+  // Binds the context to the calling thread (Create binds it to the creating thread); a
+  // context is current on one thread at a time, and every GL call needs it current.
   virtual void MakeCurrent() = 0;
 
  protected:

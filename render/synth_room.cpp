@@ -243,7 +243,7 @@ calib::Pose RoomPath::At(double t) const {
   const double turn_start = 0.55 * duration_;
   const double turn = turn_sign_ * (M_PI / 2) * SmootherStep((t - turn_start) / 0.6);
   const double yaw = angle + 0.45 * std::sin(kTwoPi * t / 6.5 + pan_phase_) + turn + shake(0, 0.002);
-  const double pitch = -0.10 + 0.07 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
+  const double pitch = -0.22 + 0.07 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
   const double roll = 0.03 * std::sin(kTwoPi * t / 4.1 + roll_phase_) + shake(2, 0.0015);
 
   const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
