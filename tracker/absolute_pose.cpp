@@ -103,36 +103,59 @@ AbsolutePoseResult EstimateAbsolutePose(const calib::Camera& camera,
   for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
   if (IsCollinear(points, all, options, &result)) return result;
 
-  const auto ransac_start = std::chrono::steady_clock::now();
-  std::vector<Eigen::Vector3d> bearings;
-  bearings.reserve(pixels.size());
-  for (const auto& p : pixels) bearings.push_back(camera.Unproject(p));
-  RansacOptions ransac_options;
-  ransac_options.solver = options.solver;
-  ransac_options.threshold =
-      PixelThresholdToOpenGV(options.ransac_threshold_px, 0.5 * (camera.fx + camera.fy));
-  ransac_options.max_iterations = options.ransac_max_iterations;
-  ransac_options.success_probability = options.ransac_success_probability;
-  ransac_options.seed = options.seed;
-  const RansacResult ransac = RansacAbsolutePose(bearings, points, ransac_options);
-  result.stats.ransac_ms = MillisecondsSince(ransac_start);
-  result.stats.ransac_iterations = ransac.stats.iterations;
-  result.stats.ransac_inliers = ransac.stats.inliers;
-  if (!ransac.found) return Fail(result, PoseFailure::kRansacFailed, "RANSAC found no pose");
-  if (ransac.stats.inliers < options.min_inliers) {
-    std::ostringstream msg;
-    msg << "RANSAC found " << ransac.stats.inliers << " inliers, at least " << options.min_inliers
-        << " needed";
-    return Fail(result, PoseFailure::kTooFewInliers, msg.str());
+  calib::Pose pose;
+  std::vector<int> hypothesis;  // the correspondences the final refinement runs on
+  if (options.prior) {
+    // A wide robust refinement from the prior over every correspondence settles in the prior's
+    // basin (P3P on a small, nearly planar patch may prefer the mirrored solution); the
+    // correspondences it explains are then refined as RANSAC's inliers would be.
+    const auto refine_start = std::chrono::steady_clock::now();
+    RefineOptions wide = options.refinement;
+    wide.loss_scale_px = options.prior_loss_scale_px;
+    const RefineResult settled = RefinePose(camera, pixels, points, *options.prior, wide);
+    result.stats.refine_ms += MillisecondsSince(refine_start);
+    if (!settled.ok) return Fail(result, PoseFailure::kRefinementFailed, "Ceres refinement failed");
+    double rms_unused = 0;
+    hypothesis = SelectInliers(camera, settled.pose, pixels, points, options.inlier_threshold_px, &rms_unused);
+    pose = settled.pose;
+    if (static_cast<int>(hypothesis.size()) < options.min_inliers) {
+      std::ostringstream msg;
+      msg << hypothesis.size() << " inliers around the prior, at least " << options.min_inliers << " needed";
+      return Fail(result, PoseFailure::kTooFewInliers, msg.str());
+    }
+  } else {
+    const auto ransac_start = std::chrono::steady_clock::now();
+    std::vector<Eigen::Vector3d> bearings;
+    bearings.reserve(pixels.size());
+    for (const auto& p : pixels) bearings.push_back(camera.Unproject(p));
+    RansacOptions ransac_options;
+    ransac_options.solver = options.solver;
+    ransac_options.threshold =
+        PixelThresholdToOpenGV(options.ransac_threshold_px, 0.5 * (camera.fx + camera.fy));
+    ransac_options.max_iterations = options.ransac_max_iterations;
+    ransac_options.success_probability = options.ransac_success_probability;
+    ransac_options.seed = options.seed;
+    const RansacResult ransac = RansacAbsolutePose(bearings, points, ransac_options);
+    result.stats.ransac_ms = MillisecondsSince(ransac_start);
+    result.stats.ransac_iterations = ransac.stats.iterations;
+    result.stats.ransac_inliers = ransac.stats.inliers;
+    if (!ransac.found) return Fail(result, PoseFailure::kRansacFailed, "RANSAC found no pose");
+    if (ransac.stats.inliers < options.min_inliers) {
+      std::ostringstream msg;
+      msg << "RANSAC found " << ransac.stats.inliers << " inliers, at least " << options.min_inliers
+          << " needed";
+      return Fail(result, PoseFailure::kTooFewInliers, msg.str());
+    }
+    pose = ransac.pose;
+    hypothesis = ransac.inliers;
   }
-  if (IsCollinear(points, ransac.inliers, options, &result)) return result;
+  if (IsCollinear(points, hypothesis, options, &result)) return result;
 
-  calib::Pose pose = ransac.pose;
   if (options.refine) {
     const auto refine_start = std::chrono::steady_clock::now();
-    const RefineResult refined = RefinePose(camera, Gather(pixels, ransac.inliers),
-                                            Gather(points, ransac.inliers), pose, options.refinement);
-    result.stats.refine_ms = MillisecondsSince(refine_start);
+    const RefineResult refined = RefinePose(camera, Gather(pixels, hypothesis),
+                                            Gather(points, hypothesis), pose, options.refinement);
+    result.stats.refine_ms += MillisecondsSince(refine_start);
     result.stats.refine_iterations = refined.stats.iterations;
     if (!refined.ok) return Fail(result, PoseFailure::kRefinementFailed, "Ceres refinement failed");
     pose = refined.pose;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ struct AbsolutePoseOptions {
   std::uint32_t seed = 0;
   bool refine = true;
   RefineOptions refinement;
+  // With a prior (tracking), RANSAC is skipped: the pose is refined from the prior over all
+  // correspondences with a wide robust loss (prior_loss_scale_px), then on the inliers found.
+  std::optional<calib::Pose> prior;
+  double prior_loss_scale_px = 8.0;
   // After refinement, a correspondence is an inlier when its reprojection error is below this.
   double inlier_threshold_px = 4.0;
   // Acceptance: a pose is reported only with at least this many inliers and an inlier RMS

@@ -104,6 +104,24 @@ Tracker::Tracker(const mapping::Map& map, const TrackerOptions& options)
   index_ = mapping::DescriptorIndex(map.descriptors, options.index);
   relocalizer_ = std::make_unique<Relocalizer>(map_, index_, options.relocalization);
   point_stamp_.assign(map.points.size(), 0);
+  point_keyframes_.resize(map.points.size());
+  for (size_t k = 0; k < map.keyframes.size(); ++k)
+    for (const auto& obs : map.keyframes[k].observations)
+      point_keyframes_[obs.point].push_back(static_cast<std::uint32_t>(k));
+}
+
+std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& points) const {
+  std::vector<int> votes(map_.keyframes.size(), 0);
+  for (std::uint32_t p : points)
+    for (std::uint32_t k : point_keyframes_[p]) ++votes[k];
+  std::vector<std::pair<int, int>> ranked;  // (−votes, keyframe)
+  for (size_t k = 0; k < votes.size(); ++k)
+    if (votes[k] > 0) ranked.emplace_back(-votes[k], static_cast<int>(k));
+  const size_t n = std::min<size_t>(ranked.size(), options_.tracking.guided_keyframes);
+  std::partial_sort(ranked.begin(), ranked.begin() + n, ranked.end());
+  std::vector<int> best;
+  for (size_t i = 0; i < n; ++i) best.push_back(ranked[i].second);
+  return best;
 }
 
 Tracker::~Tracker() = default;
@@ -247,7 +265,9 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
     result->times.extract_ms = MillisecondsSince(extract_start);
     const auto match_start = std::chrono::steady_clock::now();
     std::vector<Guided::Candidate> candidates;
-    for (int k : NearestKeyframes(predicted)) {
+    const std::vector<int> keyframes =
+        point_ids.empty() ? NearestKeyframes(predicted) : CovisibleKeyframes(point_ids);
+    for (int k : keyframes) {
       for (const auto& obs : map_.keyframes[k].observations) {
         if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
         point_stamp_[obs.point] = frame_counter_;
@@ -269,14 +289,30 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
     result->times.match_ms = MillisecondsSince(match_start);
   }
 
-  // 3. Short RANSAC + refinement.
+  // 3. Refinement from the prediction; when it explains too few correspondences, a short
+  // RANSAC, whose pose must stay near the prediction.
   AbsolutePoseOptions pose_options = options_.relocalization.pose;
   pose_options.ransac_max_iterations = opt.ransac_max_iterations;
   pose_options.min_inliers = opt.min_inliers;
   pose_options.seed += frame_counter_;
-  const AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+  pose_options.prior = predicted;
+  AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
   CopyStats(pose, result);
   last_pyramid_ = std::move(pyramid);
+  if (!pose.ok || pose.stats.inliers < opt.prior_min_inlier_ratio * static_cast<double>(pixels.size())) {
+    pose_options.prior.reset();
+    pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+    CopyStats(pose, result);
+    if (pose.ok) {
+      const double jump_deg = pose.pose.q_cw.angularDistance(predicted.q_cw) * 180.0 / M_PI;
+      if (jump_deg > opt.max_rotation_from_prediction_deg) {
+        std::ostringstream msg;
+        msg << "tracking failed: RANSAC pose turns " << jump_deg << " deg from the prediction";
+        result->reason = msg.str();
+        return false;
+      }
+    }
+  }
   if (!pose.ok) {
     result->reason = "tracking failed: " + pose.reason;
     return false;

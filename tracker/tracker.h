@@ -37,10 +37,18 @@ struct TrackingOptions {
   // Guided matching (SIFT on the frame, matched only against map points projected within
   // guided_radius_px) runs when fewer flow tracks than this survive.
   int replenish_below = 150;
-  int guided_keyframes = 3;  // nearest keyframes whose observations are projected
+  // Keyframes whose observations are projected: those seeing most of the flow tracks
+  // (covisibility), or without tracks the nearest looking the same way.
+  int guided_keyframes = 4;
   double guided_radius_px = 10;
   double guided_ratio = 0.85;
+  // The pose is first refined from the constant-velocity prediction; it is kept when its inliers
+  // are at least this fraction of the correspondences, else a short RANSAC runs.
+  double prior_min_inlier_ratio = 0.5;
   int ransac_max_iterations = 50;  // the inlier ratio is high when tracking
+  // A RANSAC pose turned further than this from the prediction is refused (a P3P solution
+  // mirrored on a nearly planar patch explains the points almost as well as the true one).
+  double max_rotation_from_prediction_deg = 20;
   int min_inliers = 30;            // below this, fall back to relocalization
 };
 
@@ -97,6 +105,7 @@ class Tracker {
   bool TrackWithPrior(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features);
   void Remember(const FrameResult& result, const Track2D3D& inliers);
   std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
+  std::vector<int> CovisibleKeyframes(const std::vector<std::uint32_t>& points) const;
 
   const mapping::Map& map_;
   TrackerOptions options_;
@@ -111,6 +120,7 @@ class Tracker {
   calib::Pose velocity_;  // last_pose ∘ previous⁻¹
   std::vector<cv::Mat> last_pyramid_;
   Track2D3D last_inliers_;
+  std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
 };
