@@ -230,12 +230,13 @@ RoomPath::RoomPath(double duration, uint64_t seed) : duration_(duration) {
 
 calib::Pose RoomPath::At(double t) const {
   constexpr double kTwoPi = 2 * M_PI;
-  // Walk: an ellipse round the room's centre at about 0.3 m/s, clear of the boxes.
+  // Walk: an ellipse round the room's centre at about 0.2 m/s, clear of the boxes, far enough
+  // from the walls that the floor in front of them is in view.
   const double angle = angle0_ + direction_ * kTwoPi * 0.045 * t;
   auto shake = [&](int i, double amplitude) {
     return amplitude * (std::sin(kTwoPi * 6.1 * t + shake_phase_[i]) + 0.6 * std::sin(kTwoPi * 9.7 * t + shake_phase_[5 - i]));
   };
-  Eigen::Vector3d center(1.3 * std::cos(angle), 0.75 * std::sin(angle), 1.5);
+  Eigen::Vector3d center(0.9 * std::cos(angle), 0.55 * std::sin(angle), 1.5);
   center.z() += 0.015 * std::sin(kTwoPi * 1.7 * t + bob_phase_);  // steps
   center += Eigen::Vector3d(shake(3, 0.0015), shake(4, 0.0015), shake(5, 0.0015));
 
@@ -243,7 +244,7 @@ calib::Pose RoomPath::At(double t) const {
   const double turn_start = 0.55 * duration_;
   const double turn = turn_sign_ * (M_PI / 2) * SmootherStep((t - turn_start) / 0.6);
   const double yaw = angle + 0.45 * std::sin(kTwoPi * t / 6.5 + pan_phase_) + turn + shake(0, 0.002);
-  const double pitch = -0.22 + 0.07 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
+  const double pitch = -0.28 + 0.06 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
   const double roll = 0.03 * std::sin(kTwoPi * t / 4.1 + roll_phase_) + shake(2, 0.0015);
 
   const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
