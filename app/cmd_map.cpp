@@ -1,5 +1,5 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive]
-//            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>]
+//            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--colmap-defaults]
 // arview map info <map-dir>
 
 #include <unistd.h>
@@ -28,6 +28,7 @@ struct MapArgs {
   bool refine_intrinsics = false;
   int threads = 2;
   std::string colmap = "colmap";
+  bool colmap_defaults = false;
   std::string info_dir;
 };
 
@@ -84,6 +85,7 @@ void RunMap(const MapArgs& args) {
   options.refine_intrinsics = args.refine_intrinsics;
   options.threads = args.threads;
   options.colmap = args.colmap;
+  if (args.colmap_defaults) options.UseColmapDefaults();
   ProgressBar bar;
   mapping::MapBuildCallbacks callbacks;
   callbacks.progress = [&](const std::string& stage, int done, int total) { bar.Update(stage, done, total); };
@@ -175,6 +177,8 @@ void AddMapCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(-1, 256));
   cmd->add_option("--colmap", args->colmap, "The COLMAP executable")->capture_default_str();
+  cmd->add_flag("--colmap-defaults", args->colmap_defaults,
+                "COLMAP's default feature and bundle-adjustment settings instead of arview's faster ones");
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();

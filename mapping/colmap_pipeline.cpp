@@ -232,7 +232,7 @@ ImageSet PrepareStillImages(const recordings::Recording& rec, const MapBuildOpti
             " of " + std::to_string(candidates.size()) + " frames, evenly spread");
   }
   ImageSet set;
-  set.root = rec.root;
+  set.root = fs::absolute(rec.root).lexically_normal();
   for (int f : *selected) {
     const auto& entry = rec.frames.at(static_cast<size_t>(f));
     set.names.push_back(fs::path(entry.path).lexically_normal().generic_string());
@@ -298,8 +298,11 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 }  // namespace
 
-MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir, const MapBuildOptions& options,
-                        const MapBuildCallbacks& cb) {
+MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir_arg,
+                        const MapBuildOptions& options, const MapBuildCallbacks& cb) {
+  // Absolute paths in COLMAP's command lines: the stage records then do not depend on the
+  // working directory, and the database names a folder COLMAP's GUI finds from anywhere.
+  const fs::path out_dir = fs::absolute(out_dir_arg).lexically_normal();
   CandidateFrames(recording, options);  // a bad --frames fails before anything is written
   std::error_code ec;
   fs::create_directories(out_dir, ec);
@@ -333,7 +336,8 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
       "--image_list_path", list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
       "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
       "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
-      "--SiftExtraction.max_num_features", std::to_string(options.max_num_features)};
+      "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
+      "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations)};
   std::string inputs = Joined(extract_args);
   for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
 
@@ -359,8 +363,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   std::vector<std::string> match_args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
                                       "--database_path", database.string(),
                                       "--SiftMatching.use_gpu", "0",
-                                      "--SiftMatching.num_threads", threads,
-                                      "--SiftMatching.max_num_trials", std::to_string(options.max_ransac_trials)};
+                                      "--SiftMatching.num_threads", threads};
   if (!exhaustive) {
     match_args.insert(match_args.end(), {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
                                          "--SequentialMatching.quadratic_overlap",
@@ -375,7 +378,13 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                                        "--Mapper.num_threads", threads,
                                        "--Mapper.ba_refine_focal_length", refine,
                                        "--Mapper.ba_refine_principal_point", refine,
-                                       "--Mapper.ba_refine_extra_params", refine};
+                                       "--Mapper.ba_refine_extra_params", refine,
+                                       "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
+                                       "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
+                                       "--Mapper.ba_global_max_num_iterations",
+                                       std::to_string(options.ba_global_max_iterations),
+                                       "--Mapper.ba_local_max_num_iterations",
+                                       std::to_string(options.ba_local_max_iterations)};
   mapper_args.insert(mapper_args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
   inputs += "--\n" + Joined(mapper_args);
   stage(

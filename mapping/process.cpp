@@ -98,6 +98,7 @@ InterruptGuard::InterruptGuard() {
 InterruptGuard::~InterruptGuard() {
   ::sigaction(SIGINT, &g_old_int, nullptr);
   ::sigaction(SIGTERM, &g_old_term, nullptr);
+  g_interrupted = 0;  // an interruption belongs to the guard's scope, not to later runs
 }
 
 bool InterruptGuard::Interrupted() { return g_interrupted != 0; }

@@ -88,6 +88,18 @@ TEST(RunProcess, InterruptStopsTheChildPromptly) {
   fs::remove(pid_file);
 }
 
+TEST(RunProcess, AnInterruptDoesNotOutliveItsGuard) {
+  {
+    InterruptGuard guard;
+    ::kill(::getpid(), SIGINT);
+    EXPECT_TRUE(InterruptGuard::Interrupted());
+  }
+  EXPECT_FALSE(InterruptGuard::Interrupted());
+  const fs::path log = TempLog("after.log");
+  EXPECT_TRUE(RunProcess({"true"}, log, {}).ok());
+  fs::remove(log);
+}
+
 TEST(FindExecutable, FindsShellAndRejectsUnknown) {
   EXPECT_FALSE(FindExecutable("sh").empty());
   EXPECT_TRUE(FindExecutable("arview-no-such-program-xyz").empty());
