@@ -1,5 +1,5 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive]
-//            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--colmap-defaults]
+//            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--colmap-defaults]
 // arview map info <map-dir>
 
 #include <unistd.h>
@@ -29,6 +29,7 @@ struct MapArgs {
   int threads = 2;
   std::string colmap = "colmap";
   bool colmap_defaults = false;
+  int max_features = mapping::MapBuildOptions{}.max_num_features;
   std::string info_dir;
 };
 
@@ -85,6 +86,7 @@ void RunMap(const MapArgs& args) {
   options.refine_intrinsics = args.refine_intrinsics;
   options.threads = args.threads;
   options.colmap = args.colmap;
+  options.max_num_features = args.max_features;
   if (args.colmap_defaults) options.UseColmapDefaults();
   ProgressBar bar;
   mapping::MapBuildCallbacks callbacks;
@@ -177,6 +179,10 @@ void AddMapCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(-1, 256));
   cmd->add_option("--colmap", args->colmap, "The COLMAP executable")->capture_default_str();
+  cmd->add_option("--max-features", args->max_features,
+                  "SIFT features per image (COLMAP's SiftExtraction.max_num_features): fewer map faster")
+      ->capture_default_str()
+      ->check(CLI::Range(64, 100000));
   cmd->add_flag("--colmap-defaults", args->colmap_defaults,
                 "COLMAP's default feature and bundle-adjustment settings instead of arview's faster ones");
 
