@@ -33,7 +33,7 @@ struct TrackArgs {
   std::string frames;
   std::string stats;
   std::string solver = "kneip";
-  int max_features = 2000;
+  int max_features = 1000;
   double ratio = 0.8;
   double ransac_threshold_px = 4.0;
   int ransac_iterations = 1000;
@@ -42,6 +42,7 @@ struct TrackArgs {
   int tracking_min_inliers = 30;
   int replenish_below = 150;
   double guided_radius_px = 10;
+  int index_checks = 32;
   unsigned seed = 0;
   int threads = 1;
   double smoothing_min_cutoff = 1.0;
@@ -69,6 +70,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
   o.smoothing.beta = a.smoothing_beta;
   o.index.seed = a.seed;
+  o.index.checks = a.index_checks;
   return o;
 }
 
@@ -263,6 +265,8 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0, 100000));
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
+  cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
   cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")
       ->capture_default_str()->check(CLI::Range(1, 256));

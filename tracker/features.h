@@ -10,7 +10,7 @@
 namespace arview::tracker {
 
 struct FeatureOptions {
-  int max_features = 2000;  // strongest responses kept (0 = all)
+  int max_features = 1000;  // strongest responses kept (0 = all)
   int octave_layers = 3;
   double contrast_threshold = 0.04;
   double edge_threshold = 10;

@@ -103,6 +103,9 @@ Tracker::Tracker(const mapping::Map& map, const TrackerOptions& options)
   ValidateMap(map, options.min_map_points);
   index_ = mapping::DescriptorIndex(map.descriptors, options.index);
   relocalizer_ = std::make_unique<Relocalizer>(map_, index_, options.relocalization);
+  FeatureOptions guided_features = options.relocalization.features;
+  guided_features.max_features = options.tracking.guided_max_features;
+  guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   point_stamp_.assign(map.points.size(), 0);
   point_keyframes_.resize(map.points.size());
   for (size_t k = 0; k < map.keyframes.size(); ++k)
@@ -260,7 +263,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
   // 2. Guided matching when the flow tracks have thinned out.
   if (result->flow_tracks < opt.replenish_below) {
     const auto extract_start = std::chrono::steady_clock::now();
-    const Features& features = extracted->emplace(relocalizer_->extractor().Extract(gray));
+    const Features& features = extracted->emplace(guided_extractor_->Extract(gray));
     result->keypoints = static_cast<int>(features.keypoints.size());
     result->times.extract_ms = MillisecondsSince(extract_start);
     const auto match_start = std::chrono::steady_clock::now();
@@ -294,6 +297,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
   AbsolutePoseOptions pose_options = options_.relocalization.pose;
   pose_options.ransac_max_iterations = opt.ransac_max_iterations;
   pose_options.min_inliers = opt.min_inliers;
+  pose_options.max_rms_px = opt.max_rms_px;
   pose_options.seed += frame_counter_;
   pose_options.prior = predicted;
   AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
