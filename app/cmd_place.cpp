@@ -1,11 +1,50 @@
+// arview place: put a character on the dominant plane of a map and write its scene file.
+
+#include <cstdio>
+
 #include "app/commands.h"
+#include "app/place_character.h"
+#include "mapping/map_file.h"
 
 namespace arview::app {
 
+namespace {
+
+struct PlaceArgs {
+  std::string map_dir;
+  std::string character;
+  std::string out;
+  PlaceCharacterOptions options;
+};
+
+}  // namespace
+
 void AddPlaceCommand(CLI::App& app) {
+  auto a = std::make_shared<PlaceArgs>();
   auto* cmd = app.add_subcommand("place", "Place a character on the dominant plane of a map and write a scene file");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("place"); });
+  cmd->add_option("map-dir", a->map_dir, "Map folder written by 'arview map'")->required();
+  cmd->add_option("--character", a->character, "Character asset (glTF, FBX, Collada, .X, BVH)")->required();
+  cmd->add_option("--out", a->out, "Scene file to write (YAML)")->required();
+  cmd->add_option("--keys", a->options.keys, "Look-at key animations generated around the character")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 64));
+  cmd->add_option("--height", a->options.height_fraction,
+                  "Character height as a fraction of the median camera distance to it")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 10.0));
+  cmd->add_option("--base-clip", a->options.base_clip, "Clip the look-at keys are built on (default: the first clip)");
+  cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
+  cmd->callback([a] {
+    const mapping::Map map = mapping::LoadMap(a->map_dir);
+    PlacedCharacter placed = PlaceCharacter(map, a->character, a->options);
+    placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
+    WriteSceneFile(placed, a->out);
+    const Anchor& anchor = placed.anchor;
+    std::printf("placed %s at (%.4f, %.4f, %.4f), up (%.3f, %.3f, %.3f), scale %.5g (rest height %.4g units)\n",
+                placed.name.c_str(), anchor.position.x(), anchor.position.y(), anchor.position.z(),
+                anchor.rotation(0, 1), anchor.rotation(1, 1), anchor.rotation(2, 1), anchor.scale, placed.rest_height);
+    std::printf("wrote %s with %d look-at keys\n", a->out.c_str(), placed.key_count);
+  });
 }
 
 }  // namespace arview::app

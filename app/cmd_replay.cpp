@@ -1,11 +1,100 @@
+// arview replay: the whole pipeline on a recording (track, animate, render, composite).
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "app/ar_session.h"
 #include "app/commands.h"
+#include "app/interrupt.h"
+#include "app/output_file.h"
+#include "app/pipeline_report.h"
+#include "mapping/map_file.h"
+#include "recordings/recording.h"
+#include "render/offscreen.h"
 
 namespace arview::app {
 
+namespace {
+
+struct ReplayArgs {
+  std::string recording, map_dir, scene, out, trajectory, stats, frames, gl = "auto";
+  bool hmd = false, paced = false, drop = false;
+  double ipd = 0.064, hold = 0.5, fade = 1.0;
+  int gl_threads = 1;
+};
+
+}  // namespace
+
+// Flags shared by replay and run: what is drawn and how.
+void AddRenderingFlags(CLI::App* cmd, std::string& gl, int& gl_threads, bool& hmd, double& ipd, double& hold,
+                       double& fade) {
+  cmd->add_flag("--hmd", hmd, "Head-mounted display: side-by-side stereo, one render per eye");
+  cmd->add_option("--ipd", ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--gl", gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
+  cmd->add_option("--gl-threads", gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
+  cmd->add_option("--hold", hold, "Seconds the character holds its last view after tracking is lost")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  cmd->add_option("--fade", fade, "Seconds to fade to the idle clip, and back after relocalization")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+}
+
 void AddReplayCommand(CLI::App& app) {
+  auto a = std::make_shared<ReplayArgs>();
   auto* cmd = app.add_subcommand("replay", "Run the whole pipeline on a recording: track, animate, render, composite");
-  cmd->allow_extras();
-  cmd->callback([] { NotBuiltYet("replay"); });
+  cmd->add_option("recording", a->recording, "Recording folder")->required();
+  cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map'")->required();
+  cmd->add_option("--scene", a->scene, "Scene file (see 'arview place'); without it only the video is tracked");
+  cmd->add_option("--out", a->out, "Output: a video file (.mp4, .avi, .mkv), a PNG folder, or 'window'")->required();
+  cmd->add_option("--trajectory", a->trajectory, "Also write the tracked poses (TUM, camera-to-world)");
+  cmd->add_option("--stats", a->stats, "Also write per-stage timings and per-frame tracking as JSON");
+  cmd->add_option("--frames", a->frames, "Frames to replay, e.g. 1-46:2 (default: all)");
+  cmd->add_flag("--paced", a->paced, "Deliver frames at the recorded rate, dropping frames when a stage is slower");
+  AddRenderingFlags(cmd, a->gl, a->gl_threads, a->hmd, a->ipd, a->hold, a->fade);
+  cmd->callback([a] {
+    const recordings::Recording recording = recordings::LoadRecording(a->recording);
+    recordings::ReplayOptions replay;
+    replay.paced = a->paced;
+    if (!a->frames.empty()) replay.frames = recordings::ParseFrameSpec(a->frames, static_cast<int>(recording.frames.size()));
+    const long expected = replay.frames.empty() ? static_cast<long>(recording.frames.size()) : static_cast<long>(replay.frames.size());
+
+    SessionOptions o;
+    o.scene_file = a->scene;
+    o.trajectory_out = a->trajectory;
+    o.stats_out = a->stats;
+    o.compositor.gl.backend = render::ParseGlBackend(a->gl);
+    o.compositor.gl.threads = a->gl_threads;
+    o.compositor.hmd = a->hmd;
+    o.compositor.ipd_m = a->ipd;
+    o.fade = {a->hold, a->fade};
+    o.pipeline.drop_frames = a->paced;
+    o.expected_frames = expected;
+    o.sink_fps = MedianFrameRate(recording.frames);
+    InterruptFlag interrupt;
+    o.stop = interrupt.flag();
+
+    const bool to_file = a->out != "window" && a->out.rfind("window:", 0) != 0;
+    std::unique_ptr<PendingOutput> pending;
+    if (to_file && std::filesystem::path(a->out).has_extension()) {
+      pending = std::make_unique<PendingOutput>(a->out);
+      o.sink = pending->partial().string();
+    } else {
+      o.sink = a->out;
+    }
+    recordings::RecordingSource source(recording, replay);
+    const mapping::Map map = mapping::LoadMap(a->map_dir);
+    const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
+    if (interrupt.raised()) throw CommandError("interrupted: " + a->out + " not written", 130);
+    if (pending) pending->Commit();
+    std::printf("%s", PipelineReportText(result.report).c_str());
+    std::printf("renderer: %s\nwrote %s\n", result.renderer.c_str(), a->out.c_str());
+  });
 }
 
 }  // namespace arview::app

@@ -1,0 +1,45 @@
+#pragma once
+// The render stage of the pipeline on render::ArRenderer: the GL context is created on the render
+// thread (BindToThread), the characters are drawn where the tracker says the camera is, and
+// lost frames show the video alone.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/ar_pipeline.h"
+#include "render/ar_renderer.h"
+#include "render/offscreen.h"
+
+namespace arview::app {
+
+struct CompositorOptions {
+  render::OffscreenOptions gl;
+  render::ArOptions ar;
+  bool hmd = false;   // side-by-side stereo
+  double ipd_m = 0.064;
+};
+
+class ArCompositor : public FrameCompositor {
+ public:
+  // The characters must outlive the compositor.
+  ArCompositor(const calib::Camera& camera, std::vector<const anim::AnimatedCharacter*> characters,
+               const CompositorOptions& options);
+  void BindToThread() override;
+  cv::Mat Compose(const FrameToCompose& input) override;
+  // The GL context's description; empty until BindToThread ran.
+  std::string Description() const { return description_; }
+  cv::Size OutputSize() const;
+
+ private:
+  calib::Camera camera_;
+  std::vector<const anim::AnimatedCharacter*> characters_;
+  CompositorOptions options_;
+  std::unique_ptr<render::OffscreenContext> context_;
+  std::unique_ptr<render::ArRenderer> renderer_;
+  std::vector<anim::FrameOutput> outputs_;
+  std::vector<const anim::FrameOutput*> output_ptrs_;
+  std::string description_;
+};
+
+}  // namespace arview::app

@@ -1,0 +1,185 @@
+#include "app/ar_pipeline.h"
+
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include "anim/lookat.h"
+#include "app/bounded_queue.h"
+
+namespace arview::app {
+
+namespace {
+
+struct InFlight {
+  recordings::Frame frame;
+  Clock::time_point arrival;
+  tracker::FrameResult track;
+  cv::Mat output;
+};
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// The first exception any stage throws; the others stop when they see it.
+class ErrorSlot {
+ public:
+  void Set(std::exception_ptr e) {
+    std::lock_guard lock(mutex_);
+    if (!error_) error_ = e;
+    failed_ = true;
+  }
+  bool failed() const { return failed_; }
+  void RethrowIfAny() {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::exception_ptr error_;
+  std::atomic<bool> failed_{false};
+};
+
+}  // namespace
+
+std::optional<double> GazeErrorDeg(const anim::AnimatedCharacter& character, std::span<const Eigen::Matrix4d> model,
+                                   const Eigen::Vector3d& camera_center_map) {
+  const anim::LookAtChain& chain = character.lookat_chain();
+  if (chain.joints.empty()) return std::nullopt;
+  const Eigen::Matrix4d to_map = character.spec().ModelToMap();
+  const Eigen::Vector3d forward_model = anim::HeadForward(chain, model);
+  const Eigen::Vector3d head_model = model[chain.joints.back()].block<3, 1>(0, 3);
+  const Eigen::Vector3d forward = (to_map.block<3, 3>(0, 0) * forward_model).normalized();
+  const Eigen::Vector3d head = (to_map * head_model.homogeneous()).head<3>();
+  const Eigen::Vector3d to_camera = (camera_center_map - head).normalized();
+  return std::acos(std::clamp(forward.dot(to_camera), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
+                           FrameCompositor& compositor, render::FrameSink& sink, const PipelineOptions& options,
+                           const std::function<void(const PipelineReport&)>& on_frame,
+                           const std::function<bool()>& stop) {
+  const OverflowPolicy policy = options.drop_frames ? OverflowPolicy::kDropOldest : OverflowPolicy::kBlock;
+  BoundedQueue<InFlight> to_track(options.queue_capacity, policy);
+  BoundedQueue<InFlight> to_render(options.queue_capacity, policy);
+  BoundedQueue<InFlight> to_sink(options.queue_capacity, policy);
+  StageStats stats;
+  ErrorSlot error;
+  PipelineReport report;
+  std::mutex report_mutex;
+  const Clock::time_point start = Clock::now();
+
+  auto guarded = [&](auto&& body, auto&... downstream) {
+    return [&, body] {
+      try {
+        body();
+      } catch (...) {
+        error.Set(std::current_exception());
+        // Unblock every other stage, upstream ones included.
+        to_track.Close();
+        to_render.Close();
+        to_sink.Close();
+      }
+      (downstream.Close(), ...);
+    };
+  };
+
+  std::thread capture(guarded(
+      [&] {
+        size_t read = 0;
+        while (!error.failed() && !(stop && stop()) && !sink.StopRequested()) {
+          InFlight item;
+          if (!source.Next(item.frame)) break;
+          item.arrival = Clock::now();
+          ++read;
+          if (!to_track.Push(std::move(item))) break;
+        }
+        std::lock_guard lock(report_mutex);
+        report.frames_read = read;
+      },
+      to_track));
+
+  std::thread track(guarded(
+      [&] {
+        while (auto item = to_track.Pop()) {
+          if (error.failed()) break;
+          const Clock::time_point t0 = Clock::now();
+          item->track = tracker.Track(item->frame.image, item->frame.timestamp);
+          stats.Record("track", MsSince(t0));
+          if (!to_render.Push(std::move(*item))) break;
+        }
+      },
+      to_render));
+
+  std::thread render(guarded(
+      [&] {
+        compositor.BindToThread();
+        while (auto item = to_render.Pop()) {
+          if (error.failed()) break;
+          FrameLog log;
+          log.index = item->frame.index;
+          log.timestamp = item->frame.timestamp;
+          log.track = item->track;
+          const bool localized = item->track.status != tracker::TrackStatus::kLost;
+          FrameToCompose compose{&item->frame, &item->track, {}};
+          if (!animators.empty()) {
+            const Clock::time_point t0 = Clock::now();
+            std::optional<Eigen::Vector3d> centre;
+            if (localized) centre = item->track.smoothed_center;
+            for (LayeredAnimator* animator : animators) {
+              compose.animations.push_back(&animator->Update(centre, item->frame.timestamp));
+            }
+            log.idle_weight = compose.animations.front()->idle_weight;
+            if (localized) {
+              log.gaze_error_deg = GazeErrorDeg(animators.front()->character(), compose.animations.front()->model,
+                                                item->track.center);
+            }
+            stats.Record("animate", MsSince(t0));
+          }
+          const Clock::time_point t1 = Clock::now();
+          item->output = compositor.Compose(compose);
+          stats.Record("render", MsSince(t1));
+          {
+            std::lock_guard lock(report_mutex);
+            if (localized) {
+              ++report.frames_localized;
+              report.trajectory.push_back({item->frame.timestamp, item->track.pose});
+            }
+            report.frames.push_back(std::move(log));
+          }
+          if (!to_sink.Push(std::move(*item))) break;
+        }
+      },
+      to_sink));
+
+  std::thread write(guarded([&] {
+    while (auto item = to_sink.Pop()) {
+      if (error.failed()) break;
+      const Clock::time_point t0 = Clock::now();
+      sink.Write(item->output);
+      stats.Record("sink", MsSince(t0));
+      stats.Record("latency", MsSince(item->arrival));
+      std::lock_guard lock(report_mutex);
+      ++report.frames_processed;
+      if (on_frame) on_frame(report);
+    }
+  }));
+
+  capture.join();
+  track.join();
+  render.join();
+  write.join();
+  if (!error.failed()) sink.Close();
+  error.RethrowIfAny();
+
+  report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
+  report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  report.fps = report.wall_seconds > 0 ? report.frames_processed / report.wall_seconds : 0;
+  report.stages = stats.Summaries();
+  return report;
+}
+
+}  // namespace arview::app

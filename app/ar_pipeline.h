@@ -1,0 +1,81 @@
+#pragma once
+// The real-time pipeline: capture → track → animate → render + composite → sink, each on its
+// own thread, joined by bounded queues. Live sources drop the oldest waiting frame when a stage
+// falls behind (and count it); replays of a recording may instead process every frame.
+// Per-stage times and the end-to-end latency (frame arrival to output) are measured.
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "app/layered_animator.h"
+#include "app/stage_stats.h"
+#include "recordings/frame_source.h"
+#include "recordings/trajectory.h"
+#include "render/sinks.h"
+#include "tracker/tracker.h"
+
+namespace arview::app {
+
+using Clock = std::chrono::steady_clock;
+
+// What the render stage gets for one frame.
+struct FrameToCompose {
+  const recordings::Frame* frame = nullptr;
+  const tracker::FrameResult* track = nullptr;
+  std::vector<const AnimatedFrame*> animations;  // one per character (none: no character)
+};
+
+class FrameCompositor {
+ public:
+  virtual ~FrameCompositor() = default;
+  // Called once on the render thread before the first frame (e.g. to bind a GL context).
+  virtual void BindToThread() {}
+  // The output picture: the video frame, with the character drawn over it when tracked.
+  virtual cv::Mat Compose(const FrameToCompose& input) = 0;
+};
+
+struct PipelineOptions {
+  // Live sources: a slower stage makes the oldest waiting frame drop. Replays: every frame.
+  bool drop_frames = false;
+  size_t queue_capacity = 2;
+};
+
+struct FrameLog {
+  int64_t index = 0;
+  double timestamp = 0;
+  tracker::FrameResult track;
+  double idle_weight = 0;
+  std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
+};
+
+struct PipelineReport {
+  size_t frames_read = 0;
+  size_t frames_processed = 0;  // reached the sink
+  size_t frames_dropped = 0;
+  size_t frames_localized = 0;
+  double wall_seconds = 0;
+  double fps = 0;  // frames processed per wall-clock second
+  std::map<std::string, TimingSummary> stages;  // track, animate, render, sink, latency
+  std::vector<FrameLog> frames;                 // in processing order
+  recordings::Trajectory trajectory;            // raw poses of localized frames
+};
+
+// Runs until the source ends (or `stop()` returns true, checked between frames). Rethrows on the
+// caller's thread the first error any stage raised, after every thread has stopped.
+PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
+                           FrameCompositor& compositor, render::FrameSink& sink, const PipelineOptions& options,
+                           const std::function<void(const PipelineReport&)>& on_frame = {},
+                           const std::function<bool()>& stop = {});
+
+// Angle in degrees between the head's forward axis and the direction from the head to the camera
+// centre, in map coordinates. Nothing when the character has no look-at chain.
+std::optional<double> GazeErrorDeg(const anim::AnimatedCharacter& character, std::span<const Eigen::Matrix4d> model,
+                                   const Eigen::Vector3d& camera_center_map);
+
+}  // namespace arview::app

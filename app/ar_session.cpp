@@ -1,0 +1,91 @@
+#include "app/ar_session.h"
+
+#include <cstdio>
+#include <fstream>
+#include <algorithm>
+#include <memory>
+
+#include "app/pipeline_report.h"
+#include "app/progress.h"
+#include "render/sinks.h"
+#include "tracker/tracker.h"
+
+namespace arview::app {
+
+namespace {
+
+void WriteTextFile(const std::filesystem::path& file, const std::string& text) {
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error(file.string() + ": cannot write here");
+    out << text;
+    if (!out) throw std::runtime_error(file.string() + ": write failed");
+  }
+  std::filesystem::rename(tmp, file);
+}
+
+}  // namespace
+
+double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
+  std::vector<double> dt;
+  for (size_t i = 1; i < frames.size(); ++i) dt.push_back(frames[i].timestamp - frames[i - 1].timestamp);
+  if (dt.empty()) return 30;
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  const double median = dt[dt.size() / 2];
+  // Still-photo datasets are stamped one second apart; a 1 fps video of them would be a slide show.
+  if (median <= 0 || median >= 0.5) return median >= 0.5 ? 10 : 30;
+  return 1.0 / median;
+}
+
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const mapping::Map& map,
+                         const std::string& map_name, const SessionOptions& o) {
+  if (source_size != map.camera.Size()) {
+    throw std::runtime_error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
+                             std::to_string(source_size.height) + " but the map " + map_name +
+                             " was built for a " + std::to_string(map.camera.width) + "x" +
+                             std::to_string(map.camera.height) + " camera");
+  }
+  tracker::Tracker tracker(map);
+
+  std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
+  std::vector<std::unique_ptr<LayeredAnimator>> animators;
+  std::vector<LayeredAnimator*> animator_ptrs;
+  std::vector<const anim::AnimatedCharacter*> character_ptrs;
+  if (!o.scene_file.empty()) {
+    const anim::Scene scene = anim::LoadScene(o.scene_file);
+    for (const anim::CharacterSpec& spec : scene.characters) {
+      characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
+      animators.push_back(std::make_unique<LayeredAnimator>(*characters.back(), "", o.fade));
+      animator_ptrs.push_back(animators.back().get());
+      character_ptrs.push_back(characters.back().get());
+    }
+  }
+
+  ArCompositor compositor(map.camera, character_ptrs, o.compositor);
+  std::unique_ptr<render::FrameSink> sink = render::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
+
+  Progress progress("augmenting frames");
+  const std::atomic<bool>* stop = o.stop;
+  PipelineReport report = RunPipeline(
+      source, tracker, animator_ptrs, compositor, *sink, o.pipeline,
+      [&](const PipelineReport& r) {
+        if (o.quiet) return;
+        char detail[96];
+        std::snprintf(detail, sizeof(detail), "%zu localized, %zu dropped", r.frames_localized, r.frames_dropped);
+        progress.Update(static_cast<long>(r.frames_processed), o.expected_frames > 0 ? o.expected_frames
+                                                                                      : static_cast<long>(r.frames_processed),
+                        detail);
+      },
+      [stop] { return stop && stop->load(); });
+  progress.Finish();
+
+  SessionResult result{std::move(report), compositor.Description()};
+  if (!o.trajectory_out.empty()) {
+    recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
+  }
+  if (!o.stats_out.empty()) WriteTextFile(o.stats_out, PipelineReportJson(result.report, result.renderer));
+  return result;
+}
+
+}  // namespace arview::app

@@ -1,0 +1,48 @@
+#pragma once
+// One augmented-reality session, shared by `arview replay`, `arview run` and `arview demo`:
+// load the map and the scene, build the tracker, the characters' animators and the compositor,
+// run the pipeline from a frame source into a sink, and write the trajectory and stats.
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "app/ar_compositor.h"
+#include "app/ar_pipeline.h"
+#include "app/layered_animator.h"
+#include "mapping/map.h"
+#include "recordings/frame_source.h"
+#include "recordings/recording.h"
+
+namespace arview::app {
+
+struct SessionOptions {
+  std::filesystem::path scene_file;          // empty: no character (tracking + video only)
+  std::string sink = "window";               // render::OpenSink target
+  double sink_fps = 30;
+  std::filesystem::path trajectory_out;      // optional TUM file
+  std::filesystem::path stats_out;           // optional stats.json
+  CompositorOptions compositor;
+  FadeOptions fade;
+  PipelineOptions pipeline;
+  long expected_frames = 0;                  // for the progress line (0: unknown)
+  const std::atomic<bool>* stop = nullptr;   // Ctrl-C
+  bool quiet = false;
+};
+
+struct SessionResult {
+  PipelineReport report;
+  std::string renderer;
+};
+
+// Frames per second of a recording from its median frame interval: 30 for a single frame, 10
+// for still-photo datasets (stamped a second apart), so that their videos are watchable.
+double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
+
+// `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
+// names the map in messages.
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const mapping::Map& map,
+                         const std::string& map_name, const SessionOptions& options);
+
+}  // namespace arview::app

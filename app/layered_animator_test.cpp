@@ -1,0 +1,70 @@
+#include "app/layered_animator.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/support/test_data.h"
+
+namespace arview::app {
+namespace {
+
+// The Fox with 8 generated look-at keys on the horizon, standing at the map origin.
+anim::CharacterSpec FoxSpec() {
+  const auto fox = arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb");
+  std::string yaml = "characters:\n  - name: fox\n    asset: " + fox.string() +
+                     "\n    lookat:\n      base_clip: Survey\n    keys:\n";
+  for (int k = 0; k < 8; ++k) yaml += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
+  return anim::ParseScene(yaml, "fox-test.yaml").characters.at(0);
+}
+
+double MaxJump(std::span<const Eigen::Matrix4f> a, const std::vector<Eigen::Matrix4f>& b) {
+  double m = 0;
+  for (size_t j = 0; j < a.size(); ++j) m = std::max(m, static_cast<double>((a[j] - b[j]).cwiseAbs().maxCoeff()));
+  return m;
+}
+
+TEST(LayeredAnimator, HoldsThenFadesToIdleAndBackWithoutJumps) {
+  ARVIEW_REQUIRE_DATA_PATH(arview::testing::SharedData("characters/Fox"), "../shared/data");
+  anim::AnimatedCharacter fox(FoxSpec());
+  LayeredAnimator animator(fox, "", {0.5, 1.0});
+  ASSERT_NE(animator.idle_clip(), nullptr);
+  EXPECT_EQ(animator.idle_clip()->name, "Survey");
+
+  const double dt = 1.0 / 30;
+  const Eigen::Vector3d camera(2, 0.5, 1);  // to the fox's front-left
+  std::vector<Eigen::Matrix4f> previous;
+  double worst_jump_tracked = 0, worst_jump_fading = 0;
+  for (int i = 0; i < 150; ++i) {
+    const double t = i * dt;
+    // Tracked for 1 s, lost for 2 s, tracked again for 2 s.
+    const bool lost = i >= 30 && i < 90;
+    const AnimatedFrame& f = animator.Update(lost ? std::nullopt : std::optional(camera), t);
+    if (i < 30) {
+      EXPECT_EQ(f.idle_weight, 0);
+    } else if (i < 30 + 14) {
+      EXPECT_EQ(f.idle_weight, 0) << "holds for 0.5 s";
+    } else if (i >= 30 + 15 + 31 && i < 90) {
+      EXPECT_EQ(f.idle_weight, 1) << "faded fully after 1 s";
+    } else if (i >= 90 + 31) {
+      EXPECT_EQ(f.idle_weight, 0) << "faded back after relocalization";
+    }
+    std::vector<Eigen::Matrix4f> current(f.skinning_matrices.begin(), f.skinning_matrices.end());
+    if (!previous.empty()) {
+      const double jump = MaxJump(f.skinning_matrices, previous);
+      const bool fading = f.idle_weight > 0 && f.idle_weight < 1;
+      double& worst = fading ? worst_jump_fading : worst_jump_tracked;
+      worst = std::max(worst, jump);
+    }
+    previous = current;
+  }
+  // The fade changes the pose no faster than the animation itself does.
+  EXPECT_LT(worst_jump_fading, 2.0 * worst_jump_tracked + 1e-3);
+}
+
+TEST(LayeredAnimator, UnknownIdleClipIsAnError) {
+  ARVIEW_REQUIRE_DATA_PATH(arview::testing::SharedData("characters/Fox"), "../shared/data");
+  anim::AnimatedCharacter fox(FoxSpec());
+  EXPECT_THROW(LayeredAnimator(fox, "Dance"), anim::Error);
+}
+
+}  // namespace
+}  // namespace arview::app

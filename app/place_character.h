@@ -1,0 +1,24 @@
+#pragma once
+// `arview place` as a function (the demo calls it too): a character from an asset, standing on
+// the dominant plane of a map, with look-at keys around it.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "app/scene_writer.h"
+#include "mapping/map.h"
+
+namespace arview::app {
+
+struct PlaceCharacterOptions {
+  int keys = 8;
+  double height_fraction = 0.3;  // of the median camera distance to the anchor
+  std::string base_clip;         // empty: the asset's first clip
+  std::uint64_t seed = 1;
+};
+
+PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::path& asset,
+                               const PlaceCharacterOptions& options);
+
+}  // namespace arview::app
