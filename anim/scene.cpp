@@ -334,7 +334,9 @@ void AnimatedCharacter::Build() {
     } catch (const Error& e) {
       throw Error(where + ": " + e.what());
     }
-    if (!spec_.lookat.base_clip.empty()) {
+    if (spec_.lookat.base_clip == "rest" && !c.FindClip("rest")) {
+      lookat_base = nullptr;  // a static look from the rest pose
+    } else if (!spec_.lookat.base_clip.empty()) {
       lookat_base = c.FindClip(spec_.lookat.base_clip);
       if (!lookat_base)
         throw Error(where + ": lookat.base_clip '" + spec_.lookat.base_clip + "' does not exist in " + c.source +

@@ -75,7 +75,7 @@ struct KeySpec {
 };
 
 struct LookAtSpec {
-  std::string base_clip;             // empty: the first clip, or the rest pose if none
+  std::string base_clip;             // empty: the first clip, or the rest pose if none; "rest": the rest pose
   std::vector<std::string> chain;    // empty: DefaultLookAtChain()
   std::vector<double> limits_deg;    // empty: defaults
 };

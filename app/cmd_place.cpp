@@ -15,6 +15,7 @@ struct PlaceArgs {
   std::string character;
   std::string out;
   PlaceCharacterOptions options;
+  std::optional<double> elevation;
 };
 
 }  // namespace
@@ -32,9 +33,14 @@ void AddPlaceCommand(CLI::App& app) {
                   "Character height as a fraction of the median camera distance to it")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 10.0));
-  cmd->add_option("--base-clip", a->options.base_clip, "Clip the look-at keys are built on (default: the first clip)");
+  cmd->add_option("--base-clip", a->options.base_clip,
+                  "Clip the look-at keys are built on, or 'rest' for the rest pose (default: the first clip)");
+  cmd->add_option("--elevation", a->elevation,
+                  "Elevation of the keys in degrees (default: the median elevation of the map's cameras)")
+      ->check(CLI::Range(-89.0, 89.0));
   cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
   cmd->callback([a] {
+    if (a->elevation) a->options.key_elevation_deg = *a->elevation;
     const mapping::Map map = mapping::LoadMap(a->map_dir);
     PlacedCharacter placed = PlaceCharacter(map, a->character, a->options);
     placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
@@ -43,7 +49,8 @@ void AddPlaceCommand(CLI::App& app) {
     std::printf("placed %s at (%.4f, %.4f, %.4f), up (%.3f, %.3f, %.3f), scale %.5g (rest height %.4g units)\n",
                 placed.name.c_str(), anchor.position.x(), anchor.position.y(), anchor.position.z(),
                 anchor.rotation(0, 1), anchor.rotation(1, 1), anchor.rotation(2, 1), anchor.scale, placed.rest_height);
-    std::printf("wrote %s with %d look-at keys\n", a->out.c_str(), placed.key_count);
+    std::printf("wrote %s with %d look-at keys at %.1f deg elevation\n", a->out.c_str(), placed.key_count,
+                placed.key_elevation_deg);
   });
 }
 

@@ -11,10 +11,12 @@ LayeredAnimator::LayeredAnimator(anim::AnimatedCharacter& character, const std::
   if (!idle_clip.empty()) {
     idle_ = c.FindClip(idle_clip);
     if (!idle_) throw anim::Error(c.source + ": has no clip '" + idle_clip + "' for the idle layer");
-  } else if (!character.spec().lookat.base_clip.empty()) {
-    idle_ = c.FindClip(character.spec().lookat.base_clip);
+  } else if (character.spec().lookat.base_clip == "rest") {
+    idle_ = c.FindClip("rest");  // usually none: the idle layer is then the rest pose
+  } else {
+    if (!character.spec().lookat.base_clip.empty()) idle_ = c.FindClip(character.spec().lookat.base_clip);
+    if (!idle_ && !c.clips.empty()) idle_ = &c.clips.front();
   }
-  if (!idle_ && !c.clips.empty()) idle_ = &c.clips.front();
   const int n = c.skeleton.size();
   idle_pose_ = anim::LocalPose::Rest(c.skeleton);
   idle_model_.resize(n);

@@ -36,7 +36,7 @@ struct AnimatedFrame {
 class LayeredAnimator {
  public:
   // `character` must outlive the animator. The idle layer is `idle_clip` of the asset, or the
-  // scene's look-at base clip, or the asset's first clip, or the rest pose.
+  // scene's look-at base clip ("rest": the rest pose), or the asset's first clip, or the rest pose.
   explicit LayeredAnimator(anim::AnimatedCharacter& character, const std::string& idle_clip = "",
                            const FadeOptions& options = {});
 

@@ -1,5 +1,8 @@
 #include "app/place_character.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "anim/character.h"
 #include "app/character_bounds.h"
 
@@ -11,7 +14,7 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   const anim::Character character = anim::LoadCharacter(asset);
   const double height = RestHeight(character, Eigen::Vector3d::UnitY());
 
-  std::vector<Eigen::Vector3d> points, centres;
+  std::vector<Eigen::Vector3d> points, centres, up_axes;
   points.reserve(map.points.size());
   for (const auto& p : map.points) points.push_back(p.xyz);
   // The first keyframe (lowest frame index) goes first: the character faces it.
@@ -22,6 +25,7 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   if (first) centres.push_back(first->pose.Center());
   for (const auto& k : map.keyframes) {
     if (&k != first) centres.push_back(k.pose.Center());
+    up_axes.push_back(-(k.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitY()));
   }
   PlacementOptions options;
   options.height_fraction = o.height_fraction;
@@ -30,8 +34,22 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   PlacedCharacter placed;
   placed.name = asset.stem().string();
   placed.asset = asset;
-  placed.anchor = PlaceOnDominantPlane(points, centres, height, options);
+  placed.anchor = PlaceOnDominantPlane(points, centres, up_axes, height, options);
   placed.rest_height = height;
+  // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
+  // seen from the anchor (a character on a table is looked at from above).
+  std::vector<double> elevations;
+  const Eigen::Vector3d up = placed.anchor.rotation.col(1);
+  for (const auto& c : centres) {
+    const Eigen::Vector3d d = c - placed.anchor.position;
+    if (d.norm() > 0) elevations.push_back(std::asin(std::clamp(up.dot(d.normalized()), -1.0, 1.0)) * 180 / M_PI);
+  }
+  if (!elevations.empty() && o.key_elevation_deg.has_value() == false) {
+    std::nth_element(elevations.begin(), elevations.begin() + elevations.size() / 2, elevations.end());
+    placed.key_elevation_deg = std::clamp(elevations[elevations.size() / 2], -60.0, 60.0);
+  } else {
+    placed.key_elevation_deg = o.key_elevation_deg.value_or(0.0);
+  }
   placed.key_count = o.keys;
   placed.base_clip = o.base_clip;
   if (placed.base_clip.empty() && !character.clips.empty()) placed.base_clip = character.clips.front().name;

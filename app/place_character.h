@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "app/scene_writer.h"
@@ -14,7 +15,8 @@ namespace arview::app {
 struct PlaceCharacterOptions {
   int keys = 8;
   double height_fraction = 0.3;  // of the median camera distance to the anchor
-  std::string base_clip;         // empty: the asset's first clip
+  std::string base_clip;         // empty: the asset's first clip; "rest": the rest pose
+  std::optional<double> key_elevation_deg;  // empty: the median elevation of the map's cameras
   std::uint64_t seed = 1;
 };
 

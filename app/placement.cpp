@@ -63,6 +63,7 @@ Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& all_points, const Pla
   if (points.size() < 3) points = all_points;
   const double threshold = o.inlier_distance > 0 ? o.inlier_distance : 0.01 * extent;
 
+  const double cos_max_tilt = std::cos(o.max_tilt_deg * M_PI / 180);
   std::mt19937_64 rng(o.seed);
   std::uniform_int_distribution<size_t> pick(0, points.size() - 1);
   Plane best;
@@ -75,25 +76,53 @@ Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& all_points, const Pla
     if (n.norm() < 1e-12) continue;
     Plane h;
     h.normal = n.normalized();
+    if (o.up_prior && std::abs(h.normal.dot(*o.up_prior)) < cos_max_tilt) continue;
     h.offset = -h.normal.dot(a);
     for (const auto& p : points) h.inliers += std::abs(h.Distance(p)) < threshold;
     if (h.inliers > best.inliers) best = h;
   }
-  if (best.inliers < 3) throw PlacementError("no plane holds 3 or more of the map's points (the points are degenerate)");
+  if (best.inliers < 3) {
+    throw PlacementError(o.up_prior ? "no floor-like plane (within the tilt limit of up) holds 3 or more of the map's points"
+                                    : "no plane holds 3 or more of the map's points (the points are degenerate)");
+  }
   return RefitPlane(points, best, threshold);
 }
 
+Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const std::vector<Eigen::Vector3d>& up_axes) {
+  Eigen::Vector3d mean_up = Eigen::Vector3d::Zero();
+  for (const auto& u : up_axes) mean_up += u.normalized();
+  Eigen::Vector3d up = mean_up;
+  if (centres.size() >= 3) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& c : centres) mean += c;
+    mean /= centres.size();
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& c : centres) cov += (c - mean) * (c - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    // A plane of centres: the two larger spreads are comparable, the third much smaller.
+    if (eig.eigenvalues()(1) > 0.05 * eig.eigenvalues()(2) && eig.eigenvalues()(0) < 0.3 * eig.eigenvalues()(1)) {
+      up = eig.eigenvectors().col(0);
+      if (up.dot(mean_up) < 0) up = -up;
+    }
+  }
+  if (up.norm() < 1e-9) throw PlacementError("cannot tell which way is up from the map's cameras");
+  return up.normalized();
+}
+
 Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
-                            const std::vector<Eigen::Vector3d>& camera_centres, double character_height,
+                            const std::vector<Eigen::Vector3d>& camera_centres,
+                            const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
                             const PlacementOptions& o) {
   if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
-  Plane plane = FitDominantPlane(points, o.plane);
+  PlaneFitOptions plane_options = o.plane;
+  if (!plane_options.up_prior) plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
+  Plane plane = FitDominantPlane(points, plane_options);
 
   // Up is the side of the plane the cameras are on.
-  int above = 0;
-  for (const auto& c : camera_centres) above += plane.Distance(c) > 0 ? 1 : -1;
-  if (above < 0) {
+  double side = 0;
+  for (const auto& c : camera_centres) side += plane.Distance(c);
+  if (side < 0) {
     plane.normal = -plane.normal;
     plane.offset = -plane.offset;
   }

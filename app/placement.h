@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -28,6 +29,9 @@ struct PlaneFitOptions {
   double middle_fraction = 0.5; // use the points within this fraction of the extent around the median
   int iterations = 500;
   std::uint64_t seed = 1;
+  // When set, only planes whose normal lies within max_tilt_deg of this direction are floors.
+  std::optional<Eigen::Vector3d> up_prior;
+  double max_tilt_deg = 30;
 };
 
 // Throws PlacementError when there are fewer than 3 points or no plane holds enough of them.
@@ -45,10 +49,19 @@ struct PlacementOptions {
   double height_fraction = 0.3;
 };
 
+// Which way is up, from the cameras: people film a scene walking around it or along it at about
+// the same height, so the normal of the plane the camera centres lie in is up; when the centres
+// do not span a plane (a straight walk), the mean of the cameras' own up axes (−y of the image)
+// is. Signed towards the cameras' side.
+Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& camera_centres,
+                              const std::vector<Eigen::Vector3d>& camera_up_axes);
+
 // Character frame convention (glTF): +Y up, +Z forward (the direction the character faces).
-// `character_height` is the height of the character's bind pose in its own units.
+// `character_height` is the height of the character's bind pose in its own units. The floor is
+// the dominant plane among those within options.plane.max_tilt_deg of UpFromCameras().
 Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
-                            const std::vector<Eigen::Vector3d>& camera_centres, double character_height,
+                            const std::vector<Eigen::Vector3d>& camera_centres,
+                            const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
                             const PlacementOptions& options);
 
 }  // namespace arview::app

@@ -39,7 +39,7 @@ TEST(Placement, FindsTheDominantPlaneDespiteClutter) {
 TEST(Placement, UpPointsTowardsTheCamerasAndFacesTheFirstOne) {
   for (bool below : {false, true}) {
     const Scene s = MakeScene(below);
-    const Anchor a = PlaceOnDominantPlane(s.points, s.cameras, 1.8, {});
+    const Anchor a = PlaceOnDominantPlane(s.points, s.cameras, {}, 1.8, {});
     const Eigen::Vector3d up = a.rotation.col(1);
     EXPECT_GT(up.dot(below ? -s.normal : s.normal), 0.999);
     EXPECT_NEAR((a.rotation.transpose() * a.rotation - Eigen::Matrix3d::Identity()).norm(), 0, 1e-9);
@@ -53,12 +53,24 @@ TEST(Placement, UpPointsTowardsTheCamerasAndFacesTheFirstOne) {
   }
 }
 
+// A wall as large as the floor: the cameras' ring says which one is the floor.
+TEST(Placement, TheCamerasRingTellsTheFloorFromAWall) {
+  Scene s = MakeScene(false);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  for (int i = 0; i < 2500; ++i) s.points.push_back(tilt * Eigen::Vector3d(0.3, u(rng), 1 + u(rng)) + Eigen::Vector3d(5, 0, 0));
+  const Anchor a = PlaceOnDominantPlane(s.points, s.cameras, {}, 1.8, {});
+  EXPECT_GT(a.rotation.col(1).dot(s.normal), 0.99);
+  EXPECT_GT(UpFromCameras(s.cameras, {}).cwiseAbs().dot(s.normal.cwiseAbs()), 0.99);
+}
+
 TEST(Placement, DegenerateInputsAreClearErrors) {
   EXPECT_THROW(FitDominantPlane({Eigen::Vector3d::Zero()}, {}), PlacementError);
   std::vector<Eigen::Vector3d> line;
   for (int i = 0; i < 50; ++i) line.emplace_back(i, 0, 0);
   EXPECT_THROW(FitDominantPlane(line, {}), PlacementError);
-  EXPECT_THROW(PlaceOnDominantPlane(MakeScene(false).points, {}, 1.0, {}), PlacementError);
+  EXPECT_THROW(PlaceOnDominantPlane(MakeScene(false).points, {}, {}, 1.0, {}), PlacementError);
 }
 
 }  // namespace

@@ -18,6 +18,16 @@ std::string Num(double v) {
   return buf;
 }
 
+// Double-quoted so that a path holding " #" or ": " reads back as written.
+std::string Quoted(const std::string& text) {
+  std::string q = "\"";
+  for (char ch : text) {
+    if (ch == '"' || ch == '\\') q += '\\';
+    q += ch;
+  }
+  return q + "\"";
+}
+
 }  // namespace
 
 std::string SceneYaml(const PlacedCharacter& c) {
@@ -27,7 +37,7 @@ std::string SceneYaml(const PlacedCharacter& c) {
   y << "# Written by 'arview place'; edit freely (format: docs/anim.md).\n";
   y << "characters:\n";
   y << "  - name: " << c.name << "\n";
-  y << "    asset: " << c.asset.string() << "\n";
+  y << "    asset: " << Quoted(c.asset.string()) << "\n";
   y << "    scale: 1\n";
   y << "    anchor:\n";
   y << "      position: [" << Num(c.anchor.position.x()) << ", " << Num(c.anchor.position.y()) << ", "
@@ -43,7 +53,7 @@ std::string SceneYaml(const PlacedCharacter& c) {
   y << "    keys:\n";
   for (int k = 0; k < c.key_count; ++k) {
     y << "      - azimuth: " << Num(360.0 * k / c.key_count) << "\n";
-    y << "        elevation: 0\n";
+    y << "        elevation: " << Num(c.key_elevation_deg) << "\n";
     y << "        generate: lookat\n";
   }
   return y.str();

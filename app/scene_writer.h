@@ -14,6 +14,7 @@ struct PlacedCharacter {
   std::filesystem::path asset;  // absolute
   Anchor anchor;
   int key_count = 8;
+  double key_elevation_deg = 0;  // of every key, above the character's horizon
   std::string base_clip;  // empty: the asset's first clip
   std::string comment;    // written at the top of the file
   double rest_height = 0; // the asset's rest-pose height, asset units (for messages)
