@@ -4,18 +4,16 @@ namespace arview::app {
 
 ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::AnimatedCharacter*> characters,
                            const CompositorOptions& options)
-    : camera_(camera), characters_(std::move(characters)), options_(options) {}
-
-void ArCompositor::BindToThread() {
-  if (!context_) {
-    context_ = render::OffscreenContext::Create(options_.gl);
-    renderer_ = std::make_unique<render::ArRenderer>(*context_, camera_, options_.ar);
-    for (const anim::AnimatedCharacter* c : characters_) renderer_->AddCharacter(c->character(), c->spec());
-    description_ = context_->Description();
-  } else {
-    context_->MakeCurrent();
-  }
+    : camera_(camera), characters_(std::move(characters)), options_(options) {
+  // Created here, before the pipeline's threads start: creating a context sets LP_NUM_THREADS
+  // in the environment, which must not race with other threads.
+  context_ = render::OffscreenContext::Create(options_.gl);
+  renderer_ = std::make_unique<render::ArRenderer>(*context_, camera_, options_.ar);
+  for (const anim::AnimatedCharacter* c : characters_) renderer_->AddCharacter(c->character(), c->spec());
+  description_ = context_->Description();
 }
+
+void ArCompositor::BindToThread() { context_->MakeCurrent(); }
 
 cv::Size ArCompositor::OutputSize() const {
   return {options_.hmd ? 2 * camera_.width : camera_.width, camera_.height};

@@ -1,6 +1,6 @@
 #pragma once
-// The render stage of the pipeline on render::ArRenderer: the GL context is created on the render
-// thread (BindToThread), the characters are drawn where the tracker says the camera is, and
+// The render stage of the pipeline on render::ArRenderer: the GL context is created with the
+// compositor and bound to the render thread (BindToThread); the characters are drawn where the tracker says the camera is, and
 // lost frames show the video alone.
 
 #include <memory>
@@ -27,7 +27,7 @@ class ArCompositor : public FrameCompositor {
                const CompositorOptions& options);
   void BindToThread() override;
   cv::Mat Compose(const FrameToCompose& input) override;
-  // The GL context's description; empty until BindToThread ran.
+  // The GL context's description.
   std::string Description() const { return description_; }
   cv::Size OutputSize() const;
 

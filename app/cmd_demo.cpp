@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 struct DemoArgs {
   std::string out;
   std::string work = "arview-demo";
-  int frames = 450;
+  int frames = 300;
   int map_every = 5;
   std::string character = "/usr/share/assimp/models/X/BCN_Epileptic.X";
   std::string gl = "auto";
@@ -56,8 +56,7 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
   o.frames = frames;
   o.seed = seed;
   o.overwrite = true;
-  o.gl = gl;
-  o.gl.threads = 2;  // nothing else runs yet
+  o.gl = gl;  // Mesa reads the thread count once per process: the same as for the replay
   Progress progress("  rendering");
   const render::SynthRoomReport r = render::SynthesizeRoom(o, [&](int done, int total) { progress.Update(done, total); });
   progress.Finish();
@@ -81,7 +80,7 @@ void AddDemoCommand(CLI::App& app) {
       ->check(CLI::Range(1, 30));
   cmd->add_option("--character", a->character, "Character asset")->capture_default_str();
   cmd->add_option("--gl", a->gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
-  cmd->add_option("--gl-threads", a->gl_threads, "llvmpipe threads while replaying")->capture_default_str()->check(CLI::Range(0, 16));
+  cmd->add_option("--gl-threads", a->gl_threads, "llvmpipe rasterizer threads")->capture_default_str()->check(CLI::Range(0, 16));
   cmd->add_flag("--hmd", a->hmd, "Side-by-side stereo output");
   cmd->callback([a] {
     const fs::path work = a->work;
@@ -89,6 +88,7 @@ void AddDemoCommand(CLI::App& app) {
     const fs::path out = a->out.empty() ? work / "demo.mp4" : fs::path(a->out);
     render::OffscreenOptions gl;
     gl.backend = render::ParseGlBackend(a->gl);
+    gl.threads = a->gl_threads;
     InterruptFlag interrupt;
 
     Step(1, "Rendering the first walk through the room (the one to map)");
@@ -100,6 +100,9 @@ void AddDemoCommand(CLI::App& app) {
     mapping::MapBuildOptions map_options;
     map_options.frames_spec = "0-" + std::to_string(a->frames - 1) + ":" + std::to_string(a->map_every);
     map_options.matcher = mapping::MatcherKind::kSequential;
+    // A rendered room at 640x480 has plenty of texture: 2048 features a frame map it, and keep
+    // COLMAP's matching (quadratic in the feature count) to seconds.
+    map_options.max_num_features = 2048;
     Progress map_progress("  colmap");
     std::string stage_shown;
     mapping::MapBuildCallbacks callbacks;
@@ -120,7 +123,9 @@ void AddDemoCommand(CLI::App& app) {
                 built.selected_frames.size(), built.map.points.size(), map_seconds);
 
     Step(4, "Placing the character on the floor with 8 look-at keys");
-    PlacedCharacter placed = PlaceCharacter(built.map, a->character, {});
+    PlaceCharacterOptions place_options;
+    place_options.base_clip = "rest";  // BCN_Epileptic's only clip is a seizure on the floor
+    PlacedCharacter placed = PlaceCharacter(built.map, a->character, place_options);
     placed.comment = "arview demo: " + placed.asset.filename().string() + " on the floor of the rendered room";
     const fs::path scene = work / "scene.yaml";
     WriteSceneFile(placed, scene);
@@ -136,7 +141,6 @@ void AddDemoCommand(CLI::App& app) {
     session.trajectory_out = work / "trajectory.txt";
     session.stats_out = work / "stats.json";
     session.compositor.gl = gl;
-    session.compositor.gl.threads = a->gl_threads;
     session.compositor.hmd = a->hmd;
     session.expected_frames = static_cast<long>(walk_b.frames.size());
     session.stop = interrupt.flag();

@@ -82,3 +82,40 @@ TEST(Cli, CalibrateOnOpenCvPhotos) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+// Every command meets a bad file, device or value with one line naming it and a non-zero exit.
+TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
+  const std::string tmp = std::filesystem::temp_directory_path().string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  } cases[] = {
+      {{"import", "middlebury", "/nonexistent/temple", "--out", tmp + "/arview_cli_imp"}, "/nonexistent/temple"},
+      {{"import", "nonsense", "/tmp", "--out", tmp + "/arview_cli_imp"}, "nonsense"},
+      {{"eval", "/nonexistent/est.txt", "/nonexistent/gt.txt"}, "/nonexistent/est.txt"},
+      {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--seconds", "1"}, "/dev/null"},
+      {{"record", "--device", "/dev/video-none", "--out", tmp + "/arview_cli_rec", "--seconds", "1"}, "/dev/video-none"},
+      {{"anim", "info", "/nonexistent/fox.glb"}, "/nonexistent/fox.glb"},
+      {{"map", "/nonexistent/recording", "--out", tmp + "/arview_cli_map"}, "/nonexistent/recording"},
+      {{"map", "info", "/nonexistent/map"}, "/nonexistent/map"},
+      {{"track", "/nonexistent/recording", "--map", "/nonexistent/map", "--out", tmp + "/t.txt"}, "/nonexistent/"},
+      {{"place", "/nonexistent/map", "--character", "/nonexistent/fox.glb", "--out", tmp + "/s.yaml"}, "/nonexistent/"},
+      {{"replay", "/nonexistent/recording", "--map", "/nonexistent/map", "--out", tmp + "/o.mp4"}, "/nonexistent/recording"},
+      {{"run", "--device", "/dev/null", "--map", "/nonexistent/map"}, "/nonexistent/map"},
+      {{"demo", "--frames", "5"}, "--frames"},
+  };
+  for (const Case& c : cases) {
+    const auto r = RunArview(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.args[0] << " " << c.message;
+    EXPECT_EQ(LineCount(r.err), 1) << c.args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args[0] << ": " << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp + "/o.mp4"));
+  EXPECT_FALSE(std::filesystem::exists(tmp + "/o.partial.mp4"));
+}
+
+}  // namespace
+}  // namespace arview
