@@ -91,26 +91,14 @@ std::string FormatParams(const std::vector<double>& v) {
   return ss.str();
 }
 
-// Parses COLMAP's progress lines into (done, total) for the stage being run.
+// Hands COLMAP's progress lines to the callback for the stage being run.
 class ProgressParser {
  public:
   ProgressParser(std::string stage, int total, const MapBuildCallbacks& cb)
       : stage_(std::move(stage)), total_(total), cb_(cb) {}
   void operator()(const std::string& line) {
     if (!cb_.progress) return;
-    // COLMAP 3.8's progress lines (sscanf rather than std::regex: no allocation per line).
-    const char* text = line.c_str();
-    int a = 0, na = 0, b = 0, nb = 0;
-    if (std::sscanf(text, "Processed file [%d/%d]", &a, &na) == 2 ||
-        std::sscanf(text, "Matching image [%d/%d]", &a, &na) == 2) {
-      cb_.progress(stage_, a, na);
-    } else if (std::sscanf(text, "Matching block [%d/%d, %d/%d]", &a, &na, &b, &nb) == 4) {
-      cb_.progress(stage_, (a - 1) * nb + b, na * nb);
-    } else if (std::sscanf(text, "Registering image #%d (%d)", &b, &a) == 2) {
-      cb_.progress(stage_, a, total_);
-    } else if (line.rfind("Initializing with image pair", 0) == 0) {
-      cb_.progress(stage_, 0, total_);
-    }
+    if (const auto p = ParseColmapProgress(line, total_)) cb_.progress(stage_, p->first, p->second);
   }
 
  private:
@@ -297,6 +285,22 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 }
 
 }  // namespace
+
+std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, int total_images) {
+  // sscanf rather than std::regex: no allocation per line, and no GCC 12 false warnings.
+  const char* text = line.c_str();
+  int a = 0, na = 0, b = 0, nb = 0;
+  if (std::sscanf(text, "Processed file [%d/%d]", &a, &na) == 2 ||
+      std::sscanf(text, "Matching image [%d/%d]", &a, &na) == 2) {
+    return std::make_pair(a, na);
+  }
+  if (std::sscanf(text, "Matching block [%d/%d, %d/%d]", &a, &na, &b, &nb) == 4) {
+    return std::make_pair((a - 1) * nb + b, na * nb);
+  }
+  if (std::sscanf(text, "Registering image #%d (%d)", &b, &a) == 2) return std::make_pair(a, total_images);
+  if (line.rfind("Initializing with image pair", 0) == 0) return std::make_pair(0, total_images);
+  return std::nullopt;
+}
 
 MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir_arg,
                         const MapBuildOptions& options, const MapBuildCallbacks& cb) {

@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,6 +91,11 @@ struct MapBuildResult {
 // InterruptedError from mapping/process.h, recordings::RecordingError for a bad --frames).
 MapBuildResult BuildMap(const recordings::Recording& recording, const std::filesystem::path& out_dir,
                         const MapBuildOptions& options, const MapBuildCallbacks& callbacks = {});
+
+// One line of COLMAP 3.8's output as progress (done, total), or nothing: "Processed file [i/N]",
+// "Matching image [i/N]", "Matching block [a/A, b/B]", "Registering image #id (n)" (n of
+// `total_images`), "Initializing with image pair".
+std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, int total_images);
 
 // The keyframes as a TUM trajectory (camera-to-world, the recording's timestamps).
 void WriteKeyframesTum(const Map& map, const std::filesystem::path& file);

@@ -1,9 +1,16 @@
-// The map of templeRing's 24 even frames, built once with COLMAP (about half a minute on two
+// The map of templeRing's 24 even frames, built with COLMAP (about half a minute on two idle
 // cores) and shared by every check: registration, reprojection error, accuracy against the
 // Middlebury ground truth, the files written, re-use of finished stages, and how the readers
 // handle truncated or corrupted copies of COLMAP's output.
+//
+// ctest runs each test in its own process, so the map lives in a fixed folder
+// ($TMPDIR/arview_temple_map_test_<uid>) under a file lock: the first process builds it, every
+// other one re-uses it through BuildMap's stage records (all three COLMAP stages skipped, the
+// model still read and checked). Each process writes its scratch files in its own sub-folder.
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <fstream>
@@ -29,18 +36,28 @@ class TempleMapTest : public ::testing::Test {
   static void SetUpTestSuite() {
     const fs::path source = testing::SharedData("templeRing");
     if (!fs::exists(source)) return;  // each test skips (or fails under ARVIEW_REQUIRE_DATA=1)
-    root_ = fs::temp_directory_path() / ("arview_temple_map_test_" + std::to_string(::getpid()));
-    fs::remove_all(root_);
-    recordings::ImportMiddlebury(source, root_ / "recording");
+    root_ = fs::temp_directory_path() / ("arview_temple_map_test_" + std::to_string(::getuid()));
+    scratch_ = root_ / ("scratch_" + std::to_string(::getpid()));
+    fs::create_directories(scratch_);
+    const int lock = ::open((root_ / "lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+    ASSERT_GE(lock, 0) << "cannot open " << (root_ / "lock");
+    ::flock(lock, LOCK_EX);
+    struct Unlock {
+      int fd;
+      ~Unlock() { ::close(fd); }  // closing releases the lock
+    } unlock{lock};
+    if (!fs::exists(root_ / "recording" / "frames.txt")) {
+      recordings::ImportOptions io;
+      io.overwrite = true;
+      recordings::ImportMiddlebury(source, root_ / "recording", io);
+    }
     recording_ = std::make_unique<recordings::Recording>(recordings::LoadRecording(root_ / "recording"));
     MapBuildOptions options;
     options.frames_spec = "0-46:2";
-    MapBuildCallbacks callbacks;
-    callbacks.progress = [](const std::string& stage, int done, int total) { progress_[stage] = {done, total}; };
-    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options, callbacks));
+    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options));
   }
   static void TearDownTestSuite() {
-    if (!root_.empty()) fs::remove_all(root_);
+    if (!scratch_.empty()) fs::remove_all(scratch_);
     result_.reset();
     recording_.reset();
   }
@@ -54,7 +71,7 @@ class TempleMapTest : public ::testing::Test {
 
   // A copy of the model folder (and database) with one file cut to `bytes` or overwritten.
   static fs::path BrokenCopy(const std::string& file, const std::function<void(std::vector<char>&)>& damage) {
-    const fs::path dir = root_ / "broken";
+    const fs::path dir = scratch_ / "broken";
     fs::remove_all(dir);
     fs::create_directories(dir);
     for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
@@ -75,18 +92,35 @@ class TempleMapTest : public ::testing::Test {
   static fs::path root_;
   static std::unique_ptr<recordings::Recording> recording_;
   static std::unique_ptr<MapBuildResult> result_;
-  static std::map<std::string, std::pair<int, int>> progress_;  // last (done, total) per stage
+  static fs::path scratch_;
 };
 
 fs::path TempleMapTest::root_;
 std::unique_ptr<recordings::Recording> TempleMapTest::recording_;
 std::unique_ptr<MapBuildResult> TempleMapTest::result_;
-std::map<std::string, std::pair<int, int>> TempleMapTest::progress_;
+fs::path TempleMapTest::scratch_;
 
+// The progress parser on COLMAP's real output (colmap.log, the last run of each command).
 TEST_F(TempleMapTest, ProgressFollowsEveryStageToItsEnd) {
-  EXPECT_EQ(progress_["extract"], std::make_pair(24, 24));
-  EXPECT_EQ(progress_["match"], std::make_pair(1, 1));  // exhaustive: one block of 24 images
-  EXPECT_EQ(progress_["map"], std::make_pair(24, 24));  // every frame registered
+  std::ifstream in(MapDir() / "colmap.log");
+  ASSERT_TRUE(in);
+  std::map<std::string, std::pair<int, int>> last;
+  std::string line, command;
+  while (std::getline(in, line)) {
+    if (line.rfind("$ ", 0) == 0) {
+      command = line.substr(line.find(' ', 2) + 1);
+      command = command.substr(0, command.find(' '));
+      last.erase(command);
+      continue;
+    }
+    if (const auto p = ParseColmapProgress(line, 24)) last[command] = *p;
+  }
+  EXPECT_EQ(last["feature_extractor"], std::make_pair(24, 24));
+  EXPECT_EQ(last["exhaustive_matcher"], std::make_pair(1, 1));  // one block of 24 images
+  EXPECT_EQ(last["mapper"], std::make_pair(24, 24));            // every frame registered
+  EXPECT_EQ(ParseColmapProgress("Matching block [2/3, 1/3] in 1.2s", 0), std::make_pair(4, 9));
+  EXPECT_EQ(ParseColmapProgress("Matching image [5/40] in 0.5s", 0), std::make_pair(5, 40));
+  EXPECT_FALSE(ParseColmapProgress("Bundle adjustment report", 24).has_value());
 }
 
 TEST_F(TempleMapTest, RegistersAllTwentyFourEvenFrames) {
@@ -177,7 +211,7 @@ TEST_F(TempleMapTest, MissingColmapIsAClearError) {
   options.frames_spec = "0-46:2";
   options.colmap = "arview-no-colmap-here";
   try {
-    BuildMap(*recording_, root_ / "no_colmap", options);
+    BuildMap(*recording_, scratch_ / "no_colmap", options);
     FAIL() << "expected MapError";
   } catch (const MapError& e) {
     EXPECT_NE(std::string(e.what()).find("COLMAP not found"), std::string::npos) << e.what();
@@ -185,7 +219,7 @@ TEST_F(TempleMapTest, MissingColmapIsAClearError) {
 }
 
 TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
-  const fs::path fake = root_ / "fake_colmap.sh";
+  const fs::path fake = scratch_ / "fake_colmap.sh";
   {
     std::ofstream out(fake);
     out << "#!/bin/sh\necho \"fake colmap running $1\"\necho 'E: something broke' >&2\nexit 2\n";
@@ -195,7 +229,7 @@ TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
   options.frames_spec = "0-4";
   options.colmap = fake.string();
   try {
-    BuildMap(*recording_, root_ / "failing", options);
+    BuildMap(*recording_, scratch_ / "failing", options);
     FAIL() << "expected ColmapStageError";
   } catch (const ColmapStageError& e) {
     EXPECT_EQ(e.stage, "extract");
