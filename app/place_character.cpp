@@ -37,11 +37,13 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   placed.anchor = PlaceOnDominantPlane(points, centres, up_axes, height, options);
   placed.rest_height = height;
   // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
-  // seen from the anchor (a character on a table is looked at from above).
+  // seen from the character's eyes (a character on a table is looked at from above; a tall one
+  // looks down at cameras held lower than its head). Eyes: 93% of the rest height.
   std::vector<double> elevations;
   const Eigen::Vector3d up = placed.anchor.rotation.col(1);
+  const Eigen::Vector3d eyes = placed.anchor.position + 0.93 * height * placed.anchor.scale * up;
   for (const auto& c : centres) {
-    const Eigen::Vector3d d = c - placed.anchor.position;
+    const Eigen::Vector3d d = c - eyes;
     if (d.norm() > 0) elevations.push_back(std::asin(std::clamp(up.dot(d.normalized()), -1.0, 1.0)) * 180 / M_PI);
   }
   if (!elevations.empty() && o.key_elevation_deg.has_value() == false) {

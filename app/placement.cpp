@@ -137,7 +137,10 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
   position -= plane.Distance(position) * plane.normal;
 
   // Face the first keyframe: its direction projected onto the plane (any perpendicular if above).
-  const Eigen::Vector3d up = plane.normal;
+  // Stand upright in the viewers' world: up is the cameras' up (signed like the floor's normal);
+  // the floor gives the footing. On a level floor the two agree within the RANSAC noise.
+  Eigen::Vector3d up = *plane_options.up_prior;
+  if (up.dot(plane.normal) < 0) up = -up;
   Eigen::Vector3d forward = camera_centres.front() - position;
   forward -= forward.dot(up) * up;
   if (forward.norm() < 1e-9) forward = up.unitOrthogonal();
