@@ -1,5 +1,8 @@
 #include "app/ar_compositor.h"
 
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
 namespace arview::app {
 
 ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::AnimatedCharacter*> characters,
@@ -35,11 +38,28 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
     }
     for (const anim::FrameOutput& o : outputs_) output_ptrs_.push_back(&o);
   }
-  // Lost: no pose to register the characters with, so the video is shown alone (through the
-  // renderer all the same, so that a distorted camera's frames stay undistorted like the others).
-  const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
-  if (options_.hmd) return renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m);
-  return renderer_->Render(input.frame->image, pose, output_ptrs_);
+  if (localized || characters_.empty()) {
+    const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
+    if (options_.hmd) return renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m);
+    return renderer_->Render(input.frame->image, pose, output_ptrs_);
+  }
+  // Lost: no pose to register the characters with, so the video is shown alone, undistorted
+  // like the augmented frames (the renderer's maps: same K, pinhole output).
+  cv::Mat frame = input.frame->image;
+  if (frame.channels() == 1) cv::cvtColor(frame, frame, cv::COLOR_GRAY2BGR);
+  if (camera_.HasDistortion()) {
+    if (undistort_x_.empty()) {
+      cv::initUndistortRectifyMap(camera_.K(), camera_.DistCoeffs(), cv::noArray(), camera_.K(), camera_.Size(), CV_16SC2,
+                                  undistort_x_, undistort_y_);
+    }
+    cv::Mat undistorted;
+    cv::remap(frame, undistorted, undistort_x_, undistort_y_, cv::INTER_LINEAR);
+    frame = undistorted;
+  }
+  if (!options_.hmd) return frame.clone();
+  cv::Mat both;
+  cv::hconcat(frame, frame, both);
+  return both;
 }
 
 }  // namespace arview::app

@@ -40,6 +40,7 @@ class ArCompositor : public FrameCompositor {
   std::vector<anim::FrameOutput> outputs_;
   std::vector<const anim::FrameOutput*> output_ptrs_;
   std::string description_;
+  cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
 };
 
 }  // namespace arview::app

@@ -1,10 +1,10 @@
 // arview demo: everything on the embedded default, with no camera and no downloads.
 //
-// The project renders its own room twice (two hand-held walks with different seeds, exact ground
-// truth), maps the first walk with COLMAP, places the humanoid BCN_Epileptic (Debian
-// assimp-testmodels) on the floor with eight look-at keys, replays the second walk through the
-// whole pipeline (tracking, view-adaptive animation, rendering, compositing) into an MP4, and
-// judges the tracking against the ground truth.
+// The project renders its own room (a hand-held walk twice round it, exact ground truth), maps
+// the first lap with COLMAP, places the humanoid BCN_Epileptic (Debian assimp-testmodels) on the
+// floor with eight look-at keys, replays the second lap — which holds the path's fast turn —
+// through the whole pipeline (tracking, view-adaptive animation, rendering, compositing) into an
+// MP4, and judges the tracking against the ground truth.
 
 #include <cstdio>
 #include <filesystem>
@@ -29,8 +29,8 @@ namespace fs = std::filesystem;
 struct DemoArgs {
   std::string out;
   std::string work = "arview-demo";
-  int frames = 300;
-  int map_every = 5;
+  int frames = 1340;  // two laps of the room path (one lap: 22.2 s at 30 fps)
+  int map_every = 7;
   std::string character = "/usr/share/assimp/models/X/BCN_Epileptic.X";
   std::string gl = "auto";
   int gl_threads = 1;
@@ -72,10 +72,10 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--out", a->out, "The augmented video (default: <work>/demo.mp4)");
   cmd->add_option("--work", a->work, "Folder for the recordings, the map and the reports (reused by a re-run)")
       ->capture_default_str();
-  cmd->add_option("--frames", a->frames, "Frames per walk through the room (30 fps)")
+  cmd->add_option("--frames", a->frames, "Frames of the walk through the room (30 fps); the first half is mapped")
       ->capture_default_str()
-      ->check(CLI::Range(60, 3000));
-  cmd->add_option("--map-every", a->map_every, "Map from every N-th frame of the first walk")
+      ->check(CLI::Range(60, 6000));
+  cmd->add_option("--map-every", a->map_every, "Map from every N-th frame of the first half")
       ->capture_default_str()
       ->check(CLI::Range(1, 30));
   cmd->add_option("--character", a->character, "Character asset")->capture_default_str();
@@ -91,14 +91,17 @@ void AddDemoCommand(CLI::App& app) {
     gl.threads = a->gl_threads;
     InterruptFlag interrupt;
 
-    Step(1, "Rendering the first walk through the room (the one to map)");
-    const recordings::Recording walk_a = RenderWalk(work / "walk-map", a->frames, 1, gl);
-    Step(2, "Rendering a second, different walk (the one to track)");
-    const recordings::Recording walk_b = RenderWalk(work / "walk-live", a->frames, 2, gl);
+    Step(1, "Rendering a walk twice round the room, with exact ground truth");
+    const recordings::Recording walk = RenderWalk(work / "room", a->frames, 1, gl);
+    const int half = a->frames / 2;
 
-    Step(3, "Mapping the first walk with COLMAP");
+    Step(2, "Checking the recording");
+    std::printf("  frames 0-%d (first lap) build the map; frames %d-%d (second lap, with the fast turn) are tracked\n",
+                half - 1, half, a->frames - 1);
+
+    Step(3, "Mapping the first lap with COLMAP");
     mapping::MapBuildOptions map_options;
-    map_options.frames_spec = "0-" + std::to_string(a->frames - 1) + ":" + std::to_string(a->map_every);
+    map_options.frames_spec = "0-" + std::to_string(half - 1) + ":" + std::to_string(a->map_every);
     map_options.matcher = mapping::MatcherKind::kSequential;
     // A rendered room at 640x480 has plenty of texture: 2048 features a frame map it, and keep
     // COLMAP's matching (quadratic in the feature count) to seconds.
@@ -115,7 +118,7 @@ void AddDemoCommand(CLI::App& app) {
       map_progress.Update(done, total > 0 ? total : done);
     };
     callbacks.note = [&](const std::string& message) { std::printf("  %s\n", message.c_str()); };
-    const mapping::MapBuildResult built = mapping::BuildMap(walk_a, work / "map", map_options, callbacks);
+    const mapping::MapBuildResult built = mapping::BuildMap(walk, work / "map", map_options, callbacks);
     map_progress.Finish();
     double map_seconds = 0;
     for (const auto& t : built.timings) map_seconds += t.seconds;
@@ -132,35 +135,40 @@ void AddDemoCommand(CLI::App& app) {
     std::printf("  %s at (%.3f, %.3f, %.3f) in map units -> %s\n", placed.name.c_str(), placed.anchor.position.x(),
                 placed.anchor.position.y(), placed.anchor.position.z(), scene.c_str());
 
-    Step(5, "Replaying the second walk: track, animate, render, composite");
+    Step(5, "Replaying the second lap: track, animate, render, composite");
     SessionOptions session;
     session.scene_file = scene;
     PendingOutput video(out);
     session.sink = video.partial().string();
-    session.sink_fps = MedianFrameRate(walk_b.frames);
+    session.sink_fps = MedianFrameRate(walk.frames);
     session.trajectory_out = work / "trajectory.txt";
     session.stats_out = work / "stats.json";
     session.compositor.gl = gl;
     session.compositor.hmd = a->hmd;
-    session.expected_frames = static_cast<long>(walk_b.frames.size());
+    session.expected_frames = a->frames - half;
     session.stop = interrupt.flag();
-    recordings::RecordingSource source(walk_b);
-    const SessionResult result = RunSession(source, walk_b.camera.Size(), built.map, (work / "map").string(), session);
+    recordings::ReplayOptions replay;
+    for (int i = half; i < a->frames; ++i) replay.frames.push_back(i);
+    recordings::RecordingSource source(walk, replay);
+    const SessionResult result = RunSession(source, walk.camera.Size(), built.map, (work / "map").string(), session);
     if (interrupt.raised()) throw CommandError("interrupted: " + out.string() + " not written", 130);
     video.Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
 
     Step(6, "Tracking accuracy against the exact ground truth");
     // The map lives in COLMAP's frame; the alignment to the room is fitted on the map's
-    // keyframes against the first walk's ground truth, never on the frames being judged.
+    // keyframes (first lap), never on the frames being judged (second lap).
     recordings::Trajectory keyframes;
     for (const auto& k : built.map.keyframes) keyframes.push_back({k.timestamp, k.pose});
-    const recordings::Sim3 to_room = recordings::FitAlignment(keyframes, *walk_a.groundtruth, recordings::AlignMode::kSim3, 1e-3);
+    const recordings::Sim3 to_room =
+        recordings::FitAlignment(keyframes, *walk.groundtruth, recordings::AlignMode::kSim3, 1e-3);
     recordings::AccuracyOptions accuracy;
     accuracy.align = recordings::AlignMode::kNone;
+    accuracy.max_dt = 1e-3;
+    const recordings::Trajectory second_lap(walk.groundtruth->begin() + half, walk.groundtruth->end());
     const recordings::AccuracyReport report = recordings::EvaluateTrajectory(
-        recordings::TransformTrajectory(result.report.trajectory, to_room), *walk_b.groundtruth, accuracy);
-    recordings::PlotTrajectories(report, *walk_b.groundtruth, work / "trajectory.png");
+        recordings::TransformTrajectory(result.report.trajectory, to_room), second_lap, accuracy);
+    recordings::PlotTrajectories(report, second_lap, work / "trajectory.png");
     std::printf("  localized %zu of %zu frames (%.1f%%)\n", result.report.frames_localized, result.report.frames_processed,
                 100.0 * result.report.frames_localized / std::max<size_t>(1, result.report.frames_processed));
     std::printf("  camera centre error: median %.1f mm, RMSE %.1f mm, max %.1f mm; rotation median %.2f deg\n",
