@@ -14,7 +14,7 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   const anim::Character character = anim::LoadCharacter(asset);
   const double height = RestHeight(character, Eigen::Vector3d::UnitY());
 
-  std::vector<Eigen::Vector3d> points, centres, up_axes, axes;
+  std::vector<Eigen::Vector3d> points, centres, up_axes;
   points.reserve(map.points.size());
   for (const auto& p : map.points) points.push_back(p.xyz);
   // The first keyframe (lowest frame index) goes first: the character faces it.
@@ -22,14 +22,10 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   for (const auto& k : map.keyframes) {
     if (!first || k.frame_index < first->frame_index) first = &k;
   }
-  auto add_camera = [&](const mapping::Keyframe& k) {
-    centres.push_back(k.pose.Center());
-    axes.push_back(k.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitZ());
-    up_axes.push_back(-(k.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitY()));
-  };
-  if (first) add_camera(*first);
+  if (first) centres.push_back(first->pose.Center());
   for (const auto& k : map.keyframes) {
-    if (&k != first) add_camera(k);
+    if (&k != first) centres.push_back(k.pose.Center());
+    up_axes.push_back(-(k.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitY()));
   }
   PlacementOptions options;
   options.height_fraction = o.height_fraction;
@@ -38,7 +34,7 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   PlacedCharacter placed;
   placed.name = asset.stem().string();
   placed.asset = asset;
-  placed.anchor = PlaceOnDominantPlane(points, centres, up_axes, height, options, axes);
+  placed.anchor = PlaceOnDominantPlane(points, centres, up_axes, height, options);
   placed.rest_height = height;
   // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
   // seen from the character's eyes (a character on a table is looked at from above; a tall one

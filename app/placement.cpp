@@ -112,7 +112,7 @@ Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const
 Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_centres,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
-                            const PlacementOptions& o, const std::vector<Eigen::Vector3d>& camera_axes) {
+                            const PlacementOptions& o) {
   if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
   PlaneFitOptions plane_options = o.plane;
@@ -134,18 +134,6 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
     if (std::abs(plane.Distance(p)) < limit) on_plane.push_back(p);
   }
   Eigen::Vector3d position = on_plane.empty() ? middle : ComponentMedian(on_plane);
-  // Where the viewers look, when enough of them look at the floor: the median of the points
-  // where their optical axes meet it (in front of them, not beyond the scene). Cameras that
-  // circle an object look at its middle; cameras walking round a room look at the floor ahead.
-  std::vector<Eigen::Vector3d> looked_at;
-  const double reach = 3 * MedianDistance(camera_centres, position);
-  for (size_t i = 0; i < camera_centres.size() && i < camera_axes.size(); ++i) {
-    const double along = camera_axes[i].dot(plane.normal);
-    if (std::abs(along) < 1e-6) continue;
-    const double s = -plane.Distance(camera_centres[i]) / along;
-    if (s > 0 && s < reach) looked_at.push_back(camera_centres[i] + s * camera_axes[i]);
-  }
-  if (looked_at.size() >= 3 && 2 * looked_at.size() >= camera_axes.size() / 2) position = ComponentMedian(looked_at);
   position -= plane.Distance(position) * plane.normal;
 
   // Face the first keyframe: its direction projected onto the plane (any perpendicular if above).

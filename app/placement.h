@@ -58,12 +58,10 @@ Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& camera_centres
 
 // Character frame convention (glTF): +Y up, +Z forward (the direction the character faces).
 // `character_height` is the height of the character's bind pose in its own units. The floor is
-// the dominant plane among those within options.plane.max_tilt_deg of UpFromCameras(). The
-// character stands where the cameras' optical axes (`camera_axes`, unit, world) meet the floor
-// (their median) when at least a quarter of them do, else at the median of the floor's points.
+// the dominant plane among those within options.plane.max_tilt_deg of UpFromCameras().
 Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_centres,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
-                            const PlacementOptions& options, const std::vector<Eigen::Vector3d>& camera_axes = {});
+                            const PlacementOptions& options);
 
 }  // namespace arview::app
