@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "app/interrupt.h"
 #include "app/output_file.h"
+#include "app/session_flags.h"
 #include "app/pipeline_report.h"
 #include "mapping/map_file.h"
 #include "recordings/recording.h"
@@ -18,45 +19,22 @@ namespace arview::app {
 namespace {
 
 struct ReplayArgs {
-  std::string recording, map_dir, scene, out, trajectory, stats, frames, gl = "auto";
-  bool hmd = false, paced = false, drop = false;
-  double ipd = 0.064, hold = 0.5, fade = 1.0;
-  int gl_threads = 1;
+  std::string recording, map_dir, out, frames;
+  bool paced = false;
+  SessionFlags session;
 };
 
 }  // namespace
-
-// Flags shared by replay and run: what is drawn and how.
-void AddRenderingFlags(CLI::App* cmd, std::string& gl, int& gl_threads, bool& hmd, double& ipd, double& hold,
-                       double& fade) {
-  cmd->add_flag("--hmd", hmd, "Head-mounted display: side-by-side stereo, one render per eye");
-  cmd->add_option("--ipd", ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--gl", gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
-  cmd->add_option("--gl-threads", gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 16));
-  cmd->add_option("--hold", hold, "Seconds the character holds its last view after tracking is lost")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0));
-  cmd->add_option("--fade", fade, "Seconds to fade to the idle clip, and back after relocalization")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0));
-}
 
 void AddReplayCommand(CLI::App& app) {
   auto a = std::make_shared<ReplayArgs>();
   auto* cmd = app.add_subcommand("replay", "Run the whole pipeline on a recording: track, animate, render, composite");
   cmd->add_option("recording", a->recording, "Recording folder")->required();
   cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map'")->required();
-  cmd->add_option("--scene", a->scene, "Scene file (see 'arview place'); without it only the video is tracked");
   cmd->add_option("--out", a->out, "Output: a video file (.mp4, .avi, .mkv), a PNG folder, or 'window'")->required();
-  cmd->add_option("--trajectory", a->trajectory, "Also write the tracked poses (TUM, camera-to-world)");
-  cmd->add_option("--stats", a->stats, "Also write per-stage timings and per-frame tracking as JSON");
   cmd->add_option("--frames", a->frames, "Frames to replay, e.g. 1-46:2 (default: all)");
   cmd->add_flag("--paced", a->paced, "Deliver frames at the recorded rate, dropping frames when a stage is slower");
-  AddRenderingFlags(cmd, a->gl, a->gl_threads, a->hmd, a->ipd, a->hold, a->fade);
+  AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     const recordings::Recording recording = recordings::LoadRecording(a->recording);
     recordings::ReplayOptions replay;
@@ -65,14 +43,7 @@ void AddReplayCommand(CLI::App& app) {
     const long expected = replay.frames.empty() ? static_cast<long>(recording.frames.size()) : static_cast<long>(replay.frames.size());
 
     SessionOptions o;
-    o.scene_file = a->scene;
-    o.trajectory_out = a->trajectory;
-    o.stats_out = a->stats;
-    o.compositor.gl.backend = render::ParseGlBackend(a->gl);
-    o.compositor.gl.threads = a->gl_threads;
-    o.compositor.hmd = a->hmd;
-    o.compositor.ipd_m = a->ipd;
-    o.fade = {a->hold, a->fade};
+    ApplySessionFlags(a->session, o);
     o.pipeline.drop_frames = a->paced;
     o.expected_frames = expected;
     o.sink_fps = MedianFrameRate(recording.frames);

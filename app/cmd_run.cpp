@@ -6,22 +6,18 @@
 #include "app/commands.h"
 #include "app/interrupt.h"
 #include "app/pipeline_report.h"
+#include "app/session_flags.h"
 #include "mapping/map_file.h"
 #include "recordings/v4l2_source.h"
 #include "render/offscreen.h"
 
 namespace arview::app {
 
-void AddRenderingFlags(CLI::App* cmd, std::string& gl, int& gl_threads, bool& hmd, double& ipd, double& hold,
-                       double& fade);
-
 namespace {
 
 struct RunArgs {
-  std::string device = "/dev/video0", map_dir, scene, out = "window", trajectory, stats, format = "auto", gl = "auto";
-  bool hmd = false;
-  double ipd = 0.064, hold = 0.5, fade = 1.0;
-  int gl_threads = 1;
+  std::string device = "/dev/video0", map_dir, out = "window", format = "auto";
+  SessionFlags session;
 };
 
 }  // namespace
@@ -31,23 +27,13 @@ void AddRunCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run the whole pipeline live on a V4L2 camera or HMD");
   cmd->add_option("--device", a->device, "V4L2 capture device")->capture_default_str();
   cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (made with this camera)")->required();
-  cmd->add_option("--scene", a->scene, "Scene file (see 'arview place')");
   cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
   cmd->add_option("--format", a->format, "Camera pixel format: auto, yuyv or mjpeg")->capture_default_str();
-  cmd->add_option("--trajectory", a->trajectory, "Also write the tracked poses (TUM, camera-to-world)");
-  cmd->add_option("--stats", a->stats, "Also write per-stage timings and per-frame tracking as JSON");
-  AddRenderingFlags(cmd, a->gl, a->gl_threads, a->hmd, a->ipd, a->hold, a->fade);
+  AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     SessionOptions o;
-    o.scene_file = a->scene;
+    ApplySessionFlags(a->session, o);
     o.sink = a->out;
-    o.trajectory_out = a->trajectory;
-    o.stats_out = a->stats;
-    o.compositor.gl.backend = render::ParseGlBackend(a->gl);
-    o.compositor.gl.threads = a->gl_threads;
-    o.compositor.hmd = a->hmd;
-    o.compositor.ipd_m = a->ipd;
-    o.fade = {a->hold, a->fade};
     o.pipeline.drop_frames = true;  // live: never fall behind the camera
     InterruptFlag interrupt;
     o.stop = interrupt.flag();

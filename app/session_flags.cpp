@@ -1,0 +1,38 @@
+#include "app/session_flags.h"
+
+#include "render/offscreen.h"
+
+namespace arview::app {
+
+void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
+  cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
+  cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)");
+  cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON");
+  cmd->add_flag("--hmd", f.hmd, "Head-mounted display: side-by-side stereo, one render per eye");
+  cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--gl", f.gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
+  cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
+  cmd->add_option("--hold", f.hold, "Seconds the character holds its last view after tracking is lost")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  cmd->add_option("--fade", f.fade, "Seconds to fade to the idle clip, and back after relocalization")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+}
+
+void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
+  o.scene_file = f.scene;
+  o.trajectory_out = f.trajectory;
+  o.stats_out = f.stats;
+  o.compositor.gl.backend = render::ParseGlBackend(f.gl);
+  o.compositor.gl.threads = f.gl_threads;
+  o.compositor.hmd = f.hmd;
+  o.compositor.ipd_m = f.ipd;
+  o.fade = {f.hold, f.fade};
+}
+
+}  // namespace arview::app

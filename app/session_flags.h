@@ -1,0 +1,22 @@
+#pragma once
+// The flags `arview replay` and `arview run` share: what is drawn, how, and where the results go.
+
+#include <string>
+
+#include "app/ar_session.h"
+#include "app/commands.h"
+
+namespace arview::app {
+
+struct SessionFlags {
+  std::string scene, trajectory, stats, gl = "auto";
+  bool hmd = false;
+  double ipd = 0.064, hold = 0.5, fade = 1.0;
+  int gl_threads = 1;
+};
+
+void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
+// Fills the session options these flags control (throws on a bad --gl value).
+void ApplySessionFlags(const SessionFlags& flags, SessionOptions& options);
+
+}  // namespace arview::app
