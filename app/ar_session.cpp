@@ -1,31 +1,16 @@
 #include "app/ar_session.h"
 
 #include <cstdio>
-#include <fstream>
 #include <algorithm>
 #include <memory>
 
+#include "app/output_file.h"
 #include "app/pipeline_report.h"
 #include "app/progress.h"
 #include "render/sinks.h"
 #include "tracker/tracker.h"
 
 namespace arview::app {
-
-namespace {
-
-void WriteTextFile(const std::filesystem::path& file, const std::string& text) {
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error(file.string() + ": cannot write here");
-    out << text;
-    if (!out) throw std::runtime_error(file.string() + ": write failed");
-  }
-  std::filesystem::rename(tmp, file);
-}
-
-}  // namespace
 
 double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
   std::vector<double> dt;
@@ -34,8 +19,8 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
   std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
   const double median = dt[dt.size() / 2];
   // Still-photo datasets are stamped one second apart; a 1 fps video of them would be a slide show.
-  if (median <= 0 || median >= 0.5) return median >= 0.5 ? 10 : 30;
-  return 1.0 / median;
+  if (median >= 0.5) return 10;
+  return median > 0 ? 1.0 / median : 30;
 }
 
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const mapping::Map& map,
@@ -84,7 +69,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
-  if (!o.stats_out.empty()) WriteTextFile(o.stats_out, PipelineReportJson(result.report, result.renderer));
+  if (!o.stats_out.empty()) WriteTextFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer));
   return result;
 }
 

@@ -3,6 +3,8 @@
 // an interrupted or failed run never leaves a file that looks finished.
 
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <string>
 
 namespace arview::app {
@@ -33,5 +35,22 @@ class PendingOutput {
   std::filesystem::path final_, partial_;
   bool committed_ = false;
 };
+
+// Writes `text` to a sibling temporary file and renames it into place; throws naming `file`.
+inline void WriteTextFileAtomically(const std::filesystem::path& file, const std::string& text) {
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error(file.string() + ": cannot write here");
+    out << text;
+    if (!out) throw std::runtime_error(file.string() + ": write failed");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(file.string() + ": cannot write (" + ec.message() + ")");
+  }
+}
 
 }  // namespace arview::app

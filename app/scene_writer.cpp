@@ -1,12 +1,12 @@
 #include "app/scene_writer.h"
 
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include <Eigen/Geometry>
 
 #include "anim/scene.h"
+#include "app/output_file.h"
 
 namespace arview::app {
 
@@ -62,16 +62,7 @@ std::string SceneYaml(const PlacedCharacter& c) {
 void WriteSceneFile(const PlacedCharacter& c, const std::filesystem::path& file) {
   const std::string text = SceneYaml(c);
   anim::ParseScene(text, file);  // throws anim::Error when the text would not load
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error(file.string() + ": cannot write here");
-    out << text;
-    if (!out) throw std::runtime_error(file.string() + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw std::runtime_error(file.string() + ": cannot write (" + ec.message() + ")");
+  WriteTextFileAtomically(file, text);
 }
 
 }  // namespace arview::app
