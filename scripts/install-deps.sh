@@ -15,6 +15,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
   ffmpeg
+  libyaml-cpp-dev nlohmann-json3-dev
 )
 
 missing=()
