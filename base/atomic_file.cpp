@@ -1,0 +1,98 @@
+#include "base/atomic_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+#include <system_error>
+
+#include "base/error.h"
+
+namespace arview {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A sibling of `file` that no concurrent writer of the same file picks too.
+fs::path TemporaryFor(const fs::path& file) {
+  return file.string() + ".tmp." + std::to_string(::getpid());
+}
+
+std::string Reason(int err) { return std::strerror(err); }
+
+// Writes everything, retrying short writes and EINTR; returns 0 or the errno.
+int WriteAll(int fd, std::string_view bytes) {
+  const char* p = bytes.data();
+  size_t left = bytes.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  return 0;
+}
+
+[[noreturn]] void Fail(const fs::path& file, const fs::path& tmp, const std::string& what) {
+  std::error_code ec;
+  fs::remove(tmp, ec);
+  throw Error(file.string() + ": cannot write (" + what + ")");
+}
+
+}  // namespace
+
+void WriteFileAtomically(const fs::path& file, std::string_view bytes) {
+  const fs::path tmp = TemporaryFor(file);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(file.string() + ": cannot write here (" + Reason(errno) + ")");
+  if (const int err = WriteAll(fd, bytes)) {
+    ::close(fd);
+    Fail(file, tmp, Reason(err));
+  }
+  // The data must be on disk before the rename makes it the file: otherwise a crash right after
+  // could leave the new name pointing at an empty file.
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    Fail(file, tmp, "fsync: " + Reason(err));
+  }
+  if (::close(fd) != 0) Fail(file, tmp, "close: " + Reason(errno));
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) Fail(file, tmp, ec.message());
+}
+
+void WriteFileAtomically(const fs::path& file, const std::function<void(std::ostream&)>& write) {
+  std::ostringstream buffer(std::ios::binary);
+  write(buffer);
+  WriteFileAtomically(file, buffer.view());
+}
+
+PendingOutput::PendingOutput(fs::path final_path) : final_(std::move(final_path)) {
+  partial_ = final_.parent_path() / (final_.stem().string() + ".partial" + final_.extension().string());
+}
+
+PendingOutput::~PendingOutput() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove(partial_, ec);
+  }
+}
+
+void PendingOutput::Commit() {
+  std::error_code ec;
+  if (!fs::exists(partial_, ec)) throw Error(final_.string() + ": cannot write (nothing was written)");
+  fs::rename(partial_, final_, ec);
+  if (ec) {
+    fs::remove(partial_, ec);
+    throw Error(final_.string() + ": cannot write (" + ec.message() + ")");
+  }
+  committed_ = true;
+}
+
+}  // namespace arview

@@ -1,0 +1,48 @@
+#pragma once
+// Files that appear complete or not at all. Every file arview owns (maps, trajectories,
+// recordings, camera files, stats, scenes, images) is written to a sibling temporary, every
+// write and the final flush and close are checked, the data is fsync'ed, and only then is the
+// temporary renamed over the final name. A failure at any step removes the temporary and throws
+// an arview::Error naming the final file: an interrupted or failed run never leaves a file that
+// looks finished, and never destroys the previous good copy.
+
+#include <filesystem>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+
+namespace arview {
+
+// Writes `bytes` (text or binary, written as is) to `file` atomically.
+void WriteFileAtomically(const std::filesystem::path& file, std::string_view bytes);
+
+// Streams into memory through `write`, then writes the result atomically. An exception from
+// `write` propagates and nothing is written.
+void WriteFileAtomically(const std::filesystem::path& file, const std::function<void(std::ostream&)>& write);
+
+// An output that a library other than ours writes (a video encoder, COLMAP, a sink that grows
+// frame by frame) under a partial name; renamed into place by Commit() once complete, removed
+// on destruction if never committed.
+class PendingOutput {
+ public:
+  // "out.mp4" is written as "out.partial.mp4": the extension is kept, as writers choose their
+  // format by it.
+  explicit PendingOutput(std::filesystem::path final_path);
+  ~PendingOutput();
+  PendingOutput(const PendingOutput&) = delete;
+  PendingOutput& operator=(const PendingOutput&) = delete;
+
+  const std::filesystem::path& partial() const { return partial_; }
+  const std::filesystem::path& final_path() const { return final_; }
+  bool committed() const { return committed_; }
+  // Renames the partial file over the final one; throws arview::Error naming the final file
+  // (and removes the partial) if the partial file is missing or the rename fails.
+  void Commit();
+
+ private:
+  std::filesystem::path final_, partial_;
+  bool committed_ = false;
+};
+
+}  // namespace arview
