@@ -65,7 +65,7 @@ struct Setup {
     for (int k = 0; k < keys; ++k) {
       clips.push_back(MakeClip(rng, skeleton));
       poses.emplace_back(skeleton.size());
-      SamplingJob{&skeleton, &clips.back(), 0.77, true, &poses.back()}.Run();
+      MustRun(SamplingJob{&skeleton, &clips.back(), 0.77, true, &poses.back()}, "bench setup");
     }
     for (auto& p : poses) ptrs.push_back(&p);
     // Weights from Eq. 2 for keys around the horizon and a viewpoint between two of them.
@@ -96,7 +96,7 @@ void BM_Blend(benchmark::State& state) {
   job.converged = &converged;
   job.max_iterations = &iterations;
   for (auto _ : state) {
-    job.Run();
+    if (!job.Run()) return state.SkipWithError("blending job refused its inputs");
     benchmark::DoNotOptimize(s.out.rigid.data());
   }
   state.counters["max_iter"] = iterations;
@@ -111,9 +111,10 @@ void SampleBlend(benchmark::State& state, bool nlerp) {
   double t = 0;
   for (auto _ : state) {
     t += 1.0 / 60;
+    bool ok = job.Validate();
     for (std::size_t k = 0; k < s.clips.size(); ++k)
-      SamplingJob{&s.skeleton, &s.clips[k], t, true, &s.poses[k], nlerp}.Run();
-    job.Run();
+      ok = SamplingJob{&s.skeleton, &s.clips[k], t, true, &s.poses[k], nlerp}.Run() && ok;
+    if (!ok || !job.Run()) return state.SkipWithError("a job refused its inputs");
     benchmark::DoNotOptimize(s.out.rigid.data());
   }
   state.SetLabel(method == BlendMethod::kDlb ? "DLB" : "DIB");
@@ -151,16 +152,16 @@ void BM_Skinning(benchmark::State& state) {
     mesh.weights.push_back(ws / ws.sum());
   }
   LocalPose pose(sk.size());
-  SamplingJob{&sk, &clip, 0.5, true, &pose}.Run();
+  MustRun(SamplingJob{&sk, &clip, 0.5, true, &pose}, "bench setup");
   std::vector<Eigen::Matrix4d> model(sk.size());
-  LocalToModelJob{&sk, &pose, model}.Run();
+  MustRun(LocalToModelJob{&sk, &pose, model}, "bench setup");
   std::vector<Eigen::Matrix4f> skin(sk.size());
   std::vector<DualQuatf> dq(sk.size());
-  SkinningMatricesJob{&sk, model, skin, dq}.Run();
+  MustRun(SkinningMatricesJob{&sk, model, skin, dq}, "bench setup");
   std::vector<Eigen::Vector3f> pos(mesh.positions.size()), nrm(mesh.positions.size());
   const SkinningJob job{&mesh, method, skin, dq, pos, nrm};
   for (auto _ : state) {
-    job.Run();
+    if (!job.Run()) return state.SkipWithError("skinning job refused its inputs");
     benchmark::DoNotOptimize(pos.data());
   }
   state.SetLabel(method == SkinningMethod::kLinear ? "LBS" : "DQS");

@@ -22,6 +22,7 @@
 // BVH files carry no skin: their Character has a skeleton and clips and no meshes.
 
 #include "anim/dual_quat.h"
+#include "base/error.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -37,8 +38,8 @@ namespace arview::anim {
 
 // Every failure in anim/ (bad file, bad scene, bad argument) throws this, with a message that
 // names the file and the problem.
-struct Error : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct Error : arview::Error {
+  using arview::Error::Error;
 };
 
 // Local transform of a joint relative to its parent: M = T · R · S (glTF order).

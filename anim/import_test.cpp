@@ -193,8 +193,8 @@ TEST(Import, NlerpSamplingStaysCloseToSlerp) {
       LocalPose a(c.skeleton.size()), b(c.skeleton.size());
       for (int s = 0; s < 997; ++s) {
         const double t = clip.duration * s / 997.0;
-        SamplingJob{&c.skeleton, &clip, t, true, &a, false}.Run();
-        SamplingJob{&c.skeleton, &clip, t, true, &b, true}.Run();
+        ASSERT_TRUE((SamplingJob{&c.skeleton, &clip, t, true, &a, false}.Run()));
+        ASSERT_TRUE((SamplingJob{&c.skeleton, &clip, t, true, &b, true}.Run()));
         for (int j = 0; j < c.skeleton.size(); ++j)
           worst = std::max(worst, a.rigid[j].Rotation().angularDistance(b.rigid[j].Rotation()));
       }

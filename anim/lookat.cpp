@@ -40,7 +40,7 @@ Eigen::Matrix3d RotationOf(const Eigen::Matrix4d& m) {
 
 std::vector<Eigen::Matrix4d> ModelPose(const Skeleton& sk, const LocalPose& pose) {
   std::vector<Eigen::Matrix4d> model(sk.size());
-  LocalToModelJob{&sk, &pose, model}.Run();
+  MustRun(LocalToModelJob{&sk, &pose, model}, "look-at");
   return model;
 }
 
@@ -207,7 +207,7 @@ Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain&
   for (int j : chain.joints) clip.tracks[j].rotation.clear();
   LocalPose pose(sk.size());
   for (double t : times) {
-    if (base) SamplingJob{&sk, base, t, false, &pose}.Run();
+    if (base) MustRun(SamplingJob{&sk, base, t, false, &pose}, "look-at base clip");
     else pose = LocalPose::Rest(sk);
     std::vector<Eigen::Matrix4d> model = ModelPose(sk, pose);
     ApplyLookAt(sk, chain, target, pose, model);

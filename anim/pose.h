@@ -1,15 +1,16 @@
 #pragma once
 // Per-frame animation jobs in ozz-animation's style: a plain struct of inputs and outputs,
 // Validate() says whether they fit together, Run() validates then computes and returns false on
-// invalid input. Jobs never allocate: outputs are sized by the caller (LocalPose::Resize once).
+// invalid input ([[nodiscard]]: a skeleton/clip mismatch must not pass as a stale pose). Jobs
+// never allocate: outputs are sized by the caller (LocalPose::Resize once).
 //
 //   LocalPose pose(skeleton.size());
-//   SamplingJob{&skeleton, &clip, time, /*loop=*/true, &pose}.Run();
+//   if (!SamplingJob{&skeleton, &clip, time, /*loop=*/true, &pose}.Run()) ...;
 //   std::vector<Eigen::Matrix4d> model(skeleton.size());
-//   LocalToModelJob{&skeleton, &pose, model}.Run();
+//   MustRun(LocalToModelJob{&skeleton, &pose, model}, "where");   // throws Error on failure
 //   std::vector<Eigen::Matrix4f> skin(skeleton.size());
 //   std::vector<DualQuatf> skin_dq(skeleton.size());
-//   SkinningMatricesJob{&skeleton, model, skin, skin_dq}.Run();   // upload to the GPU
+//   MustRun(SkinningMatricesJob{&skeleton, model, skin, skin_dq}, "where");   // upload to the GPU
 //
 // A pose is, per joint, the local rigid transform as a unit dual quaternion plus a scale
 // (applied first, M = T·R·S); blending (BlendingJob) works on the dual quaternions and blends
@@ -19,6 +20,7 @@
 #include "anim/character.h"
 
 #include <span>
+#include <string>
 #include <vector>
 
 namespace arview::anim {
@@ -49,7 +51,7 @@ struct SamplingJob {
   bool nlerp = false;
 
   bool Validate() const;
-  bool Run() const;
+  [[nodiscard]] bool Run() const;
 };
 
 enum class BlendMethod { kDlb, kDib };
@@ -69,7 +71,7 @@ struct BlendingJob {
   int* max_iterations = nullptr;
 
   bool Validate() const;
-  bool Run() const;
+  [[nodiscard]] bool Run() const;
 };
 
 // Local poses → model-space matrices (root_parent · … · parent · local).
@@ -79,7 +81,7 @@ struct LocalToModelJob {
   std::span<Eigen::Matrix4d> output;
 
   bool Validate() const;
-  bool Run() const;
+  [[nodiscard]] bool Run() const;
 };
 
 // Model-space joint matrices → skinning matrices (model · inverse_bind), as float matrices and,
@@ -92,7 +94,7 @@ struct SkinningMatricesJob {
   std::span<DualQuatf> dual_quats;
 
   bool Validate() const;
-  bool Run() const;
+  [[nodiscard]] bool Run() const;
 };
 
 // Whether every skinning matrix is rigid (rotation + translation) to `tolerance`; DQ skinning
@@ -111,7 +113,15 @@ struct SkinningJob {
   std::span<Eigen::Vector3f> normals_out;
 
   bool Validate() const;
-  bool Run() const;
+  [[nodiscard]] bool Run() const;
 };
+
+// Runs a job whose inputs the caller built to fit (sizes fixed at construction): a false Run()
+// is then a programming error (a skeleton, clip or buffer that disagrees), reported as an Error
+// naming `what` instead of leaving a stale pose. Costs one branch on the per-frame path.
+template <class Job>
+void MustRun(const Job& job, const char* what) {
+  if (!job.Run()) throw Error(std::string(what) + ": animation job inputs disagree (skeleton, clip or buffer sizes)");
+}
 
 }  // namespace arview::anim

@@ -295,23 +295,32 @@ Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what)
   return v.normalized();
 }
 
-namespace {
-std::vector<Eigen::Vector3d> KeyDirections(const CharacterSpec& spec) {
-  std::vector<Eigen::Vector3d> dirs;
-  for (const KeySpec& k : spec.keys) dirs.push_back(k.viewpoint);
-  return dirs;
-}
-}  // namespace
-
 AnimatedCharacter::AnimatedCharacter(const CharacterSpec& spec)
     : AnimatedCharacter(std::make_shared<const Character>(LoadCharacter(spec.asset)), spec) {}
 
 AnimatedCharacter::AnimatedCharacter(std::shared_ptr<const Character> character, const CharacterSpec& spec)
-    : character_(std::move(character)), spec_(spec), sphere_(KeyDirections(spec), spec.weights) {
-  Build();
+    : character_(std::move(character)), spec_(spec) {
+  const std::string where = spec_.where.empty() ? spec_.asset.string() : spec_.where;
+  ViewAdaptiveOptions options;
+  options.weights = spec_.weights;
+  options.blend = spec_.blend;
+  options.dib = spec_.dib;
+  options.phase = spec_.phase;
+  options.nlerp_sampling = spec_.nlerp_sampling;
+  std::vector<ViewAdaptiveKey> keys = BuildKeys();
+  try {
+    blend_ = std::make_shared<ViewAdaptiveBlend>(shared_skeleton(), std::move(keys), options);
+  } catch (const Error& e) {
+    throw Error(where + ": " + e.what());
+  }
+  const Skeleton& sk = character_->skeleton;
+  blended_ = LocalPose::Rest(sk);
+  model_.assign(sk.size(), Eigen::Matrix4d::Identity());
+  skin_.assign(sk.size(), Eigen::Matrix4f::Identity());
+  skin_dq_.assign(sk.size(), DualQuatf());
 }
 
-void AnimatedCharacter::Build() {
+std::vector<ViewAdaptiveKey> AnimatedCharacter::BuildKeys() {
   const Character& c = *character_;
   const Skeleton& sk = c.skeleton;
   const std::string where = spec_.where.empty() ? spec_.asset.string() : spec_.where;
@@ -345,26 +354,27 @@ void AnimatedCharacter::Build() {
       lookat_base = &c.clips.front();
     }
   }
+  std::vector<std::shared_ptr<const Clip>> key_clips;
   for (const KeySpec& k : spec_.keys) {
     switch (k.source) {
       case KeySpec::Source::kClip:
         // Alias into the character: no copy.
-        key_clips_.push_back(std::shared_ptr<const Clip>(character_, &find_clip(k, k.clip)));
+        key_clips.push_back(std::shared_ptr<const Clip>(character_, &find_clip(k, k.clip)));
         break;
       case KeySpec::Source::kLookAt:
-        key_clips_.push_back(std::make_shared<const Clip>(GenerateLookAtClip(sk, lookat_base, chain_, k.viewpoint)));
+        key_clips.push_back(std::make_shared<const Clip>(GenerateLookAtClip(sk, lookat_base, chain_, k.viewpoint)));
         break;
       case KeySpec::Source::kRestPose: {
         Clip rest;
         rest.name = "rest";
         rest.tracks.resize(sk.size());
-        key_clips_.push_back(std::make_shared<const Clip>(std::move(rest)));
+        key_clips.push_back(std::make_shared<const Clip>(std::move(rest)));
         break;
       }
       case KeySpec::Source::kStaticPose: {
         const Clip& from = find_clip(k, k.clip);
         LocalPose pose(sk.size());
-        SamplingJob{&sk, &from, k.pose_time, false, &pose}.Run();
+        MustRun(SamplingJob{&sk, &from, k.pose_time, false, &pose}, "static pose key");
         Clip still;
         still.name = k.clip + "@" + std::to_string(k.pose_time);
         still.tracks.resize(sk.size());
@@ -373,67 +383,26 @@ void AnimatedCharacter::Build() {
           still.tracks[j].translation.push_back({0.0, pose.rigid[j].Translation()});
           still.tracks[j].scale.push_back({0.0, pose.scale[j]});
         }
-        key_clips_.push_back(std::make_shared<const Clip>(std::move(still)));
+        key_clips.push_back(std::make_shared<const Clip>(std::move(still)));
         break;
       }
     }
   }
-  // The shared phase runs at the mean length of the animated key clips.
-  std::set<const Clip*> distinct;
-  double total = 0;
-  for (const auto& clip : key_clips_)
-    if (clip->duration > 0 && distinct.insert(clip.get()).second) total += clip->duration;
-  shared_period_ = distinct.empty() ? 0.0 : total / double(distinct.size());
-
-  const int K = static_cast<int>(spec_.keys.size());
-  if (K > BlendingJob::kMaxInputs)
-    throw Error(where + ": " + std::to_string(K) + " keys; at most " + std::to_string(BlendingJob::kMaxInputs));
-  weights_.assign(K, 0.0);
-  key_poses_.assign(K, LocalPose(sk.size()));
-  active_ptrs_.assign(K, nullptr);
-  active_weights_.assign(K, 0.0);
-  blended_ = LocalPose::Rest(sk);
-  model_.assign(sk.size(), Eigen::Matrix4d::Identity());
-  skin_.assign(sk.size(), Eigen::Matrix4f::Identity());
-  skin_dq_.assign(sk.size(), DualQuatf());
-}
-
-double AnimatedCharacter::KeyTime(int key, double time_seconds) const {
-  const double d = key_clips_[key]->duration;
-  if (spec_.phase == PhaseMode::kIndependent || shared_period_ <= 0 || d <= 0) return time_seconds;
-  double phase = std::fmod(time_seconds / shared_period_, 1.0);
-  if (phase < 0) phase += 1.0;
-  return phase * d;
+  std::vector<ViewAdaptiveKey> keys;
+  for (std::size_t k = 0; k < spec_.keys.size(); ++k) keys.push_back({spec_.keys[k].viewpoint, key_clips[k]});
+  return keys;
 }
 
 const FrameOutput& AnimatedCharacter::Update(const Eigen::Vector3d& viewpoint, double time_seconds) {
   const Skeleton& sk = character_->skeleton;
-  const int K = static_cast<int>(key_clips_.size());
-  sphere_.Weights(viewpoint, weights_);
-  int active = 0;
-  for (int k = 0; k < K; ++k) {
-    if (weights_[k] <= 0) continue;
-    SamplingJob{&sk, key_clips_[k].get(), KeyTime(k, std::isfinite(time_seconds) ? time_seconds : 0.0), true,
-                &key_poses_[k], spec_.nlerp_sampling}
-        .Run();
-    active_ptrs_[active] = &key_poses_[k];
-    active_weights_[active] = weights_[k];
-    ++active;
-  }
-  out_.converged = true;
-  out_.max_iterations = 0;
-  BlendingJob blend;
-  blend.inputs = std::span<const LocalPose* const>(active_ptrs_.data(), active);
-  blend.weights = std::span<const double>(active_weights_.data(), active);
-  blend.method = spec_.blend;
-  blend.dib = spec_.dib;
-  blend.output = &blended_;
-  blend.converged = &out_.converged;
-  blend.max_iterations = &out_.max_iterations;
-  blend.Run();
-  LocalToModelJob{&sk, &blended_, model_}.Run();
-  SkinningMatricesJob{&sk, model_, skin_, skin_dq_}.Run();
-  out_.weights = weights_;
+  FrameInputs inputs;
+  inputs.viewpoint = viewpoint;
+  if (!blend_->Sample(time_seconds, inputs, blended_)) throw Error(spec_.where + ": view-adaptive blend: key clips and skeleton disagree");
+  MustRun(LocalToModelJob{&sk, &blended_, model_}, "local to model");
+  MustRun(SkinningMatricesJob{&sk, model_, skin_, skin_dq_}, "skinning matrices");
+  out_.weights = blend_->weights();
+  out_.converged = blend_->converged();
+  out_.max_iterations = blend_->max_iterations();
   out_.model = model_;
   out_.skinning_matrices = skin_;
   out_.skinning_dual_quats = skin_dq_;

@@ -47,6 +47,7 @@
 #include "anim/character.h"
 #include "anim/lookat.h"
 #include "anim/pose.h"
+#include "anim/view_adaptive.h"
 #include "anim/view_sphere.h"
 
 #include <filesystem>
@@ -56,8 +57,6 @@
 #include <vector>
 
 namespace arview::anim {
-
-enum class PhaseMode { kShared, kIndependent };
 
 struct Anchor {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
@@ -126,6 +125,9 @@ struct FrameOutput {
   int max_iterations = 0;                           // DIB, worst joint
 };
 
+// A scene's character: the asset loaded, its keys built (clips from the asset, generated
+// look-at keys, static poses), and the runtime view-adaptive blend over them, with local-to-model
+// and skinning after it.
 class AnimatedCharacter {
  public:
   // Loads spec.asset and prepares one clip per key (from the asset, generated, or static).
@@ -135,33 +137,28 @@ class AnimatedCharacter {
 
   const Character& character() const { return *character_; }
   std::shared_ptr<const Character> shared_character() const { return character_; }
+  std::shared_ptr<const Skeleton> shared_skeleton() const { return {character_, &character_->skeleton}; }
   const CharacterSpec& spec() const { return spec_; }
-  const ViewSphere& view_sphere() const { return sphere_; }
+  const ViewSphere& view_sphere() const { return blend_->view_sphere(); }
   // One clip per key (shared between keys that name the same clip).
-  const Clip& key_clip(int key) const { return *key_clips_[key]; }
+  const Clip& key_clip(int key) const { return *blend_->key(key).clip; }
   // The look-at chain used for generated keys (empty joints if none).
   const LookAtChain& lookat_chain() const { return chain_; }
+  // The runtime blend, to schedule it as an action (anim/schedule.h).
+  std::shared_ptr<ViewAdaptiveBlend> view_adaptive() const { return blend_; }
 
   // Weights for `viewpoint` (character frame), then every key clip sampled at `time_seconds`,
   // blended, and converted to skinning transforms. Valid until the next call.
   const FrameOutput& Update(const Eigen::Vector3d& viewpoint, double time_seconds);
 
  private:
-  void Build();
-  double KeyTime(int key, double time_seconds) const;
+  std::vector<ViewAdaptiveKey> BuildKeys();
 
   std::shared_ptr<const Character> character_;
   CharacterSpec spec_;
-  ViewSphere sphere_;
   LookAtChain chain_;
-  std::vector<std::shared_ptr<const Clip>> key_clips_;
-  double shared_period_ = 0;
+  std::shared_ptr<ViewAdaptiveBlend> blend_;
   // Per-frame buffers.
-  std::vector<double> weights_;
-  std::vector<LocalPose> key_poses_;
-  std::vector<const LocalPose*> key_pose_ptrs_;
-  std::vector<const LocalPose*> active_ptrs_;
-  std::vector<double> active_weights_;
   LocalPose blended_;
   std::vector<Eigen::Matrix4d> model_;
   std::vector<Eigen::Matrix4f> skin_;

@@ -154,9 +154,9 @@ TEST(Scene, RuntimeOnAKeyPlaysThatClip) {
     const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(120, 0), 0.3);
     EXPECT_DOUBLE_EQ(out.weights[1], 1.0);
     LocalPose walk(c.skeleton.size());
-    SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run();
+    ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run()));
     std::vector<Eigen::Matrix4d> model(c.skeleton.size());
-    LocalToModelJob{&c.skeleton, &walk, model}.Run();
+    ASSERT_TRUE((LocalToModelJob{&c.skeleton, &walk, model}.Run()));
     for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
     EXPECT_TRUE(out.converged);
     // Between keys every joint is a proper blend, and DIB converges.
@@ -178,9 +178,9 @@ TEST(Scene, SharedPhaseStretchesKeyClips) {
   // A quarter of the shared period plays a quarter of the Run clip.
   const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(180, 0), 0.25 * period);
   LocalPose expect(c.skeleton.size());
-  SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run();
+  ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run()));
   std::vector<Eigen::Matrix4d> model(c.skeleton.size());
-  LocalToModelJob{&c.skeleton, &expect, model}.Run();
+  ASSERT_TRUE((LocalToModelJob{&c.skeleton, &expect, model}.Run()));
   for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
 }
 

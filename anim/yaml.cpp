@@ -2,6 +2,11 @@
 
 #include "anim/character.h"  // Error
 
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/exceptions.h>
+#include <yaml-cpp/mark.h>
+#include <yaml-cpp/parser.h>
+
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -9,275 +14,184 @@
 namespace arview::anim::yaml {
 namespace {
 
-struct Line {
-  int number = 0;   // 1-based
-  int indent = 0;
-  std::string text; // without indentation and comment, right-trimmed
-};
-
-std::string RightTrim(std::string s) {
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\r')) s.pop_back();
-  return s;
-}
-
-std::string Trim(const std::string& s) {
-  std::size_t a = 0, b = s.size();
-  while (a < b && s[a] == ' ') ++a;
-  while (b > a && s[b - 1] == ' ') --b;
-  return s.substr(a, b - a);
-}
-
-class Parser {
+// Builds our Node tree from yaml-cpp's events, refusing what scene files do not allow.
+class TreeBuilder : public YAML::EventHandler {
  public:
-  Parser(const std::string& text, std::string file) : file_(std::move(file)) { Split(text); }
+  explicit TreeBuilder(std::string file) : file_(std::move(file)) {}
 
-  Node Document() {
-    if (lines_.empty()) {
-      Node n;
-      n.kind = Node::Kind::kMapping;
-      return n;
-    }
-    if (lines_[0].indent != 0) Fail(lines_[0].number, "the document must start at column 1");
-    Node n = Block(0);
-    if (pos_ < lines_.size()) Fail(lines_[pos_].number, "unexpected indentation or content");
-    return n;
+  bool has_root() const { return has_root_; }
+  Node TakeRoot() { return std::move(root_); }
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    NoAnchor(mark, anchor);
+    Node n;  // `key:` with nothing (or ~, null): an empty scalar, on the key's line
+    n.line = Line(mark);
+    Add(std::move(n), /*is_null=*/true);
   }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
+    Fail(Line(mark), "anchors, aliases and tags are not supported");
+  }
+  void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                const std::string& value) override {
+    NoAnchor(mark, anchor);
+    NoTag(mark, tag);
+    Node n;
+    n.line = Line(mark);
+    n.scalar = value;
+    n.quoted = tag == "!";  // yaml-cpp tags quoted scalars "!", plain ones "?"
+    Add(std::move(n), false);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
+    Open(mark, tag, anchor, Node::Kind::kSequence);
+  }
+  void OnSequenceEnd() override { Close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
+    Open(mark, tag, anchor, Node::Kind::kMapping);
+  }
+  void OnMapEnd() override { Close(); }
 
- private:
   [[noreturn]] void Fail(int line, const std::string& what) const {
     throw Error(file_ + ":" + std::to_string(line) + ": " + what);
   }
 
-  // Removes comments (a `#` at the start or after a space, outside quotes).
-  std::string StripComment(const std::string& s, int number) const {
-    char quote = 0;
-    for (std::size_t i = 0; i < s.size(); ++i) {
-      const char c = s[i];
-      if (quote) {
-        if (c == '\\' && quote == '"') ++i;
-        else if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') {
-        quote = c;
-      } else if (c == '#' && (i == 0 || s[i - 1] == ' ')) {
-        return s.substr(0, i);
-      }
-    }
-    if (quote) Fail(number, "unterminated quoted string");
-    return s;
+ private:
+  struct Frame {
+    Node node;
+    bool has_key = false;  // mappings: a key read, its value pending
+    std::string key;
+    int key_line = 0;
+    std::set<std::string> keys;
+  };
+
+  static int Line(const YAML::Mark& mark) { return mark.line + 1; }
+
+  void NoAnchor(const YAML::Mark& mark, YAML::anchor_t anchor) const {
+    if (anchor != YAML::NullAnchor) Fail(Line(mark), "anchors, aliases and tags are not supported");
+  }
+  void NoTag(const YAML::Mark& mark, const std::string& tag) const {
+    if (!tag.empty() && tag != "?" && tag != "!") Fail(Line(mark), "anchors, aliases and tags are not supported");
   }
 
-  void Split(const std::string& text) {
-    std::istringstream in(text);
-    std::string raw;
-    int number = 0;
-    while (std::getline(in, raw)) {
-      ++number;
-      std::size_t indent = 0;
-      while (indent < raw.size() && raw[indent] == ' ') ++indent;
-      if (indent < raw.size() && raw[indent] == '\t') Fail(number, "tab in indentation (use spaces)");
-      std::string body = RightTrim(StripComment(raw.substr(indent), number));
-      if (body.empty()) continue;
-      if (body == "---" && lines_.empty()) continue;
-      if (body == "---" || body == "...") Fail(number, "only one YAML document is supported");
-      if (body[0] == '&' || body[0] == '*' || body[0] == '!' || body[0] == '|' || body[0] == '>')
-        Fail(number, "anchors, aliases, tags and block scalars are not supported");
-      lines_.push_back({number, static_cast<int>(indent), body});
-    }
+  void Open(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor, Node::Kind kind) {
+    NoAnchor(mark, anchor);
+    NoTag(mark, tag);
+    if (!stack_.empty() && stack_.back().node.IsMapping() && !stack_.back().has_key)
+      Fail(Line(mark), "mapping keys must be plain names, not lists or mappings");
+    Frame f;
+    f.node.kind = kind;
+    f.node.line = Line(mark);
+    stack_.push_back(std::move(f));
   }
 
-  static bool IsSeqItem(const std::string& t) { return t == "-" || t.rfind("- ", 0) == 0; }
-
-  // Position of the `:` that ends a mapping key (followed by a space or end of line), outside
-  // quotes and flow brackets; npos if none.
-  static std::size_t KeyColon(const std::string& t) {
-    char quote = 0;
-    int depth = 0;
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      const char c = t[i];
-      if (quote) {
-        if (c == '\\' && quote == '"') ++i;
-        else if (c == quote) quote = 0;
-        continue;
-      }
-      if (c == '"' || c == '\'') quote = c;
-      else if (c == '[' || c == '{') ++depth;
-      else if (c == ']' || c == '}') --depth;
-      else if (c == ':' && depth == 0 && (i + 1 == t.size() || t[i + 1] == ' ')) return i;
-    }
-    return std::string::npos;
+  void Close() {
+    Node n = std::move(stack_.back().node);
+    stack_.pop_back();
+    Add(std::move(n), false);
   }
 
-  Node Block(int indent) {
-    const Line& first = lines_[pos_];
-    if (IsSeqItem(first.text)) return Sequence(indent);
-    return Mapping(indent);
-  }
-
-  Node Sequence(int indent) {
-    Node n;
-    n.kind = Node::Kind::kSequence;
-    n.line = lines_[pos_].number;
-    while (pos_ < lines_.size() && lines_[pos_].indent == indent && IsSeqItem(lines_[pos_].text)) {
-      Line& l = lines_[pos_];
-      if (l.text == "-") {
-        ++pos_;
-        if (pos_ >= lines_.size() || lines_[pos_].indent <= indent) Fail(l.number, "empty sequence item");
-        n.items.push_back(Block(lines_[pos_].indent));
-        continue;
-      }
-      // "- rest": treat rest as a line of its own, indented to where it starts.
-      std::size_t skip = 1;
-      while (skip < l.text.size() && l.text[skip] == ' ') ++skip;
-      l.indent += static_cast<int>(skip);
-      l.text = l.text.substr(skip);
-      if (IsSeqItem(l.text)) Fail(l.number, "nested '- - ' sequences are not supported");
-      if (KeyColon(l.text) != std::string::npos) {
-        n.items.push_back(Mapping(l.indent));
-      } else {
-        n.items.push_back(FlowValue(l.text, l.number));
-        ++pos_;
-      }
+  void Add(Node n, bool is_null) {
+    if (stack_.empty()) {
+      root_ = std::move(n);
+      has_root_ = true;
+      return;
     }
-    return n;
-  }
-
-  Node Mapping(int indent) {
-    Node n;
-    n.kind = Node::Kind::kMapping;
-    n.line = lines_[pos_].number;
-    std::set<std::string> seen;
-    while (pos_ < lines_.size() && lines_[pos_].indent == indent) {
-      const Line l = lines_[pos_];
-      if (IsSeqItem(l.text)) Fail(l.number, "a sequence item where a 'key: value' was expected");
-      const std::size_t colon = KeyColon(l.text);
-      if (colon == std::string::npos) Fail(l.number, "expected 'key: value', got '" + l.text + "'");
-      const std::string key = Unquote(Trim(l.text.substr(0, colon)), l.number);
-      if (key.empty()) Fail(l.number, "empty key");
-      if (!seen.insert(key).second) Fail(l.number, "duplicate key '" + key + "'");
-      const std::string rest = Trim(l.text.substr(colon + 1));
-      ++pos_;
-      if (!rest.empty()) {
-        n.entries.emplace_back(key, FlowValue(rest, l.number));
-        continue;
-      }
-      // Nested block: deeper lines, or a sequence at the same indentation.
-      if (pos_ < lines_.size() && (lines_[pos_].indent > indent ||
-                                   (lines_[pos_].indent == indent && IsSeqItem(lines_[pos_].text)))) {
-        const int child = lines_[pos_].indent;
-        Node value = IsSeqItem(lines_[pos_].text) ? Sequence(child) : Mapping(child);
-        n.entries.emplace_back(key, std::move(value));
-      } else {
-        Node empty;  // `key:` with nothing: an empty scalar
-        empty.line = l.number;
-        n.entries.emplace_back(key, std::move(empty));
-      }
+    Frame& top = stack_.back();
+    if (top.node.IsSequence()) {
+      top.node.items.push_back(std::move(n));
+      return;
     }
-    if (pos_ < lines_.size() && lines_[pos_].indent > indent)
-      Fail(lines_[pos_].number, "unexpected indentation");
-    return n;
-  }
-
-  std::string Unquote(const std::string& s, int number) const {
-    if (s.size() >= 2 && (s[0] == '"' || s[0] == '\'')) {
-      if (s.back() != s[0]) Fail(number, "bad quoted string " + s);
-      std::string out;
-      for (std::size_t i = 1; i + 1 < s.size(); ++i) {
-        if (s[0] == '"' && s[i] == '\\' && i + 2 < s.size()) {
-          const char e = s[++i];
-          out += e == 'n' ? '\n' : e == 't' ? '\t' : e;
-        } else if (s[0] == '\'' && s[i] == '\'' && i + 2 < s.size() && s[i + 1] == '\'') {
-          out += '\'';
-          ++i;
-        } else {
-          out += s[i];
-        }
-      }
-      return out;
+    if (!top.has_key) {
+      if (n.scalar.empty()) Fail(n.line, "empty key");
+      if (!top.keys.insert(n.scalar).second) Fail(n.line, "duplicate key '" + n.scalar + "'");
+      top.key = std::move(n.scalar);
+      top.key_line = n.line;
+      top.has_key = true;
+      return;
     }
-    return s;
-  }
-
-  // A value on one line: flow collection or scalar.
-  Node FlowValue(const std::string& text, int number) {
-    std::size_t i = 0;
-    Node n = Flow(text, i, number, /*in_flow=*/false);
-    while (i < text.size() && text[i] == ' ') ++i;
-    if (i != text.size()) Fail(number, "unexpected text after value: '" + text.substr(i) + "'");
-    return n;
-  }
-
-  Node Flow(const std::string& t, std::size_t& i, int number, bool in_flow) {
-    while (i < t.size() && t[i] == ' ') ++i;
-    Node n;
-    n.line = number;
-    if (i < t.size() && (t[i] == '[' || t[i] == '{')) {
-      const bool seq = t[i] == '[';
-      const char close = seq ? ']' : '}';
-      n.kind = seq ? Node::Kind::kSequence : Node::Kind::kMapping;
-      ++i;
-      std::set<std::string> seen;
-      while (true) {
-        while (i < t.size() && t[i] == ' ') ++i;
-        if (i >= t.size()) Fail(number, std::string("missing '") + close + "' (flow collections must fit on one line)");
-        if (t[i] == close) {
-          ++i;
-          break;
-        }
-        if (seq) {
-          n.items.push_back(Flow(t, i, number, true));
-        } else {
-          const Node key = Flow(t, i, number, true);
-          if (!key.IsScalar()) Fail(number, "flow mapping key must be a scalar");
-          while (i < t.size() && t[i] == ' ') ++i;
-          if (i >= t.size() || t[i] != ':') Fail(number, "expected ':' after key '" + key.scalar + "'");
-          ++i;
-          if (!seen.insert(key.scalar).second) Fail(number, "duplicate key '" + key.scalar + "'");
-          n.entries.emplace_back(key.scalar, Flow(t, i, number, true));
-        }
-        while (i < t.size() && t[i] == ' ') ++i;
-        if (i < t.size() && t[i] == ',') ++i;
-        else if (i < t.size() && t[i] != close) Fail(number, std::string("expected ',' or '") + close + "'");
-      }
-      return n;
-    }
-    // Scalar.
-    n.kind = Node::Kind::kScalar;
-    if (i < t.size() && (t[i] == '"' || t[i] == '\'')) {
-      const char q = t[i];
-      std::size_t j = i + 1;
-      for (; j < t.size(); ++j) {
-        if (q == '"' && t[j] == '\\') ++j;
-        else if (t[j] == q) {
-          if (q == '\'' && j + 1 < t.size() && t[j + 1] == '\'') ++j;
-          else break;
-        }
-      }
-      if (j >= t.size()) Fail(number, "unterminated quoted string");
-      n.scalar = Unquote(t.substr(i, j + 1 - i), number);
-      n.quoted = true;
-      i = j + 1;
-      return n;
-    }
-    std::size_t j = i;
-    while (j < t.size()) {
-      const char c = t[j];
-      if (in_flow && (c == ',' || c == ']' || c == '}')) break;
-      if (in_flow && c == ':' && (j + 1 == t.size() || t[j + 1] == ' ')) break;
-      ++j;
-    }
-    n.scalar = Trim(t.substr(i, j - i));
-    if (!n.scalar.empty() && (n.scalar[0] == '&' || n.scalar[0] == '*' || n.scalar[0] == '!'))
-      Fail(number, "anchors, aliases and tags are not supported");
-    i = j;
-    return n;
+    if (is_null) n.line = top.key_line;
+    top.node.entries.emplace_back(std::move(top.key), std::move(n));
+    top.has_key = false;
   }
 
   std::string file_;
-  std::vector<Line> lines_;
-  std::size_t pos_ = 0;
+  std::vector<Frame> stack_;
+  Node root_;
+  bool has_root_ = false;
 };
 
+bool IsFlowOpen(char c) { return c == '[' || c == '{'; }
+bool IsFlowClose(char c) { return c == ']' || c == '}'; }
+
 }  // namespace
+
+DepthScan ScanNestingDepth(const std::string& text, int limit) {
+  DepthScan scan;
+  std::vector<std::size_t> block;  // columns of the open block levels
+  int flow = 0;
+  char quote = 0;  // open quote carried across lines
+  int quote_line = 0;
+  std::size_t start = 0;
+  for (int line = 1; start <= text.size(); ++line) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view s(text.data() + start, end - start);
+    std::size_t i = 0;
+    while (i < s.size() && s[i] == ' ') ++i;
+    const bool content = i < s.size() && s[i] != '#' && s[i] != '\r';
+    if (content && flow == 0 && quote == 0) {
+      // Block structure: a line at column c closes the levels at or right of c and opens one;
+      // each "- " or "? " on the line opens one more (`- - - x` nests three deep on one line).
+      auto open_at = [&](std::size_t column) {
+        while (!block.empty() && block.back() >= column) block.pop_back();
+        block.push_back(column);
+      };
+      open_at(i);
+      while (i + 1 < s.size() && (s[i] == '-' || s[i] == '?') && s[i + 1] == ' ') {
+        i += 2;
+        while (i < s.size() && s[i] == ' ') ++i;
+        if (i < s.size()) open_at(i);
+      }
+    }
+    // Flow brackets: only where a flow collection can begin (inside one, or where a value or
+    // an item starts), so that a plain scalar such as `clip: Walk[1]` does not count.
+    char previous = 0;  // last non-space character outside quotes on this line
+    for (; content && i < s.size(); ++i) {
+      const char c = s[i];
+      if (quote) {
+        if (quote == '"' && c == '\\') ++i;
+        else if (c == quote) quote = 0;
+        continue;
+      }
+      if (c == '#' && (i == 0 || s[i - 1] == ' ' || s[i - 1] == '\t')) break;
+      if (c == '"' || c == '\'') {
+        if (flow > 0 || previous == 0 || previous == ':' || previous == '-' || previous == ',' || IsFlowOpen(previous)) {
+          quote = c;
+          quote_line = line;
+        }
+      } else if (IsFlowOpen(c) && (flow > 0 || previous == 0 || previous == ':' || previous == '-' || previous == '?')) {
+        ++flow;
+      } else if (IsFlowClose(c) && flow > 0) {
+        --flow;
+      }
+      if (c != ' ' && c != '\t') previous = c;
+      const int depth = static_cast<int>(block.size()) + flow;
+      if (depth > scan.max_depth) scan.max_depth = depth;
+      if (depth > limit && scan.first_line_over == 0) scan.first_line_over = line;
+    }
+    const int depth = static_cast<int>(block.size()) + flow;
+    if (depth > scan.max_depth) scan.max_depth = depth;
+    if (depth > limit && scan.first_line_over == 0) scan.first_line_over = line;
+    if (scan.first_line_over) return scan;  // nothing after it matters
+    start = end + 1;
+  }
+  if (quote) scan.unterminated_quote_line = quote_line;
+  return scan;
+}
 
 const Node* Node::Find(const std::string& key) const {
   for (const auto& [k, v] : entries)
@@ -285,11 +199,54 @@ const Node* Node::Find(const std::string& key) const {
   return nullptr;
 }
 
-Node Parse(const std::string& text, const std::string& file) { return Parser(text, file).Document(); }
+Node Parse(const std::string& text, const std::string& file) {
+  if (text.size() > kMaxFileBytes)
+    throw Error(file + ": " + std::to_string(text.size()) + " bytes; scene files are limited to " +
+                std::to_string(kMaxFileBytes) + " bytes");
+  const DepthScan depth = ScanNestingDepth(text, kMaxDepth);
+  if (depth.first_line_over)
+    throw Error(file + ":" + std::to_string(depth.first_line_over) + ": nested deeper than " + std::to_string(kMaxDepth) +
+                " levels");
+  if (depth.unterminated_quote_line)
+    throw Error(file + ":" + std::to_string(depth.unterminated_quote_line) + ": unterminated quoted string");
+  std::istringstream in(text);
+  TreeBuilder builder(file);
+  try {
+    YAML::Parser parser(in);
+    if (!parser.HandleNextDocument(builder) || !builder.has_root()) {
+      Node empty;
+      empty.kind = Node::Kind::kMapping;
+      return empty;
+    }
+    // A second document (after `---`) is refused: a scene is one document.
+    TreeBuilder second(file);
+    if (parser.HandleNextDocument(second)) {
+      const std::size_t at = text.find("\n---", 0);
+      int line = 1;
+      for (std::size_t i = 0; i < at && i < text.size(); ++i) line += text[i] == '\n';
+      builder.Fail(at == std::string::npos ? 1 : line + 1, "only one YAML document is supported");
+    }
+  } catch (const YAML::Exception& e) {
+    throw Error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  Node root = builder.TakeRoot();
+  if (root.IsScalar() && root.scalar.empty() && !root.quoted) {
+    Node empty;  // a document holding only comments, or `~`
+    empty.kind = Node::Kind::kMapping;
+    return empty;
+  }
+  return root;
+}
 
 Node ParseFile(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path.string() + ": no such file");
+  if (!std::filesystem::exists(path, ec)) throw Error(path.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path.string() + ": not a regular file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error(path.string() + ": cannot read its size: " + ec.message());
+  if (size > kMaxFileBytes)
+    throw Error(path.string() + ": " + std::to_string(size) + " bytes; scene files are limited to " +
+                std::to_string(kMaxFileBytes) + " bytes");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string() + ": cannot open for reading");
   std::stringstream ss;

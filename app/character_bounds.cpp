@@ -21,7 +21,7 @@ double RestHeight(const anim::Character& c, const Eigen::Vector3d& up_axis) {
   if (hi > lo) return hi - lo;
   const anim::LocalPose rest = anim::LocalPose::Rest(c.skeleton);
   std::vector<Eigen::Matrix4d> model(c.skeleton.size());
-  anim::LocalToModelJob{&c.skeleton, &rest, model}.Run();
+  anim::MustRun(anim::LocalToModelJob{&c.skeleton, &rest, model}, "character bounds");
   for (const Eigen::Matrix4d& m : model) {
     const double h = up.dot(m.block<3, 1>(0, 3));
     lo = std::min(lo, h);

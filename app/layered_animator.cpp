@@ -58,8 +58,8 @@ const AnimatedFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d
 
 void LayeredAnimator::MixWithIdle(std::span<const Eigen::Matrix4d> adaptive, double w) {
   const anim::Skeleton& skeleton = character_.character().skeleton;
-  if (idle_) anim::SamplingJob{&skeleton, idle_, last_time_.value_or(0), true, &idle_pose_}.Run();
-  anim::LocalToModelJob{&skeleton, &idle_pose_, idle_model_}.Run();
+  if (idle_) anim::MustRun(anim::SamplingJob{&skeleton, idle_, last_time_.value_or(0), true, &idle_pose_}, "idle layer");
+  anim::MustRun(anim::LocalToModelJob{&skeleton, &idle_pose_, idle_model_}, "idle layer");
   for (size_t j = 0; j < mixed_model_.size(); ++j) {
     const anim::Transform a = anim::Transform::FromMatrix(adaptive[j]);
     const anim::Transform b = anim::Transform::FromMatrix(idle_model_[j]);
@@ -69,7 +69,7 @@ void LayeredAnimator::MixWithIdle(std::span<const Eigen::Matrix4d> adaptive, dou
     m.scale = (1 - w) * a.scale + w * b.scale;
     mixed_model_[j] = m.ToMatrix();
   }
-  anim::SkinningMatricesJob{&skeleton, mixed_model_, skin_, skin_dq_}.Run();
+  anim::MustRun(anim::SkinningMatricesJob{&skeleton, mixed_model_, skin_, skin_dq_}, "idle layer");
 }
 
 }  // namespace arview::app

@@ -1,9 +1,8 @@
 #include "app/scene_writer.h"
 
-#include <cstdio>
-#include <sstream>
-
 #include <Eigen/Geometry>
+#include <yaml-cpp/emitter.h>
+#include <yaml-cpp/emittermanip.h>
 
 #include "anim/scene.h"
 #include "app/output_file.h"
@@ -12,51 +11,61 @@ namespace arview::app {
 
 namespace {
 
-std::string Num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.9g", v);
-  return buf;
-}
-
-// Double-quoted so that a path holding " #" or ": " reads back as written.
-std::string Quoted(const std::string& text) {
-  std::string q = "\"";
-  for (char ch : text) {
-    if (ch == '"' || ch == '\\') q += '\\';
-    q += ch;
-  }
-  return q + "\"";
+void EmitVector(YAML::Emitter& y, const char* key, std::initializer_list<double> values) {
+  y << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (double v : values) y << v;
+  y << YAML::EndSeq;
 }
 
 }  // namespace
 
 std::string SceneYaml(const PlacedCharacter& c) {
   const Eigen::Quaterniond q(c.anchor.rotation);
-  std::ostringstream y;
-  if (!c.comment.empty()) y << "# " << c.comment << "\n";
-  y << "# Written by 'arview place'; edit freely (format: docs/anim.md).\n";
-  y << "characters:\n";
-  y << "  - name: " << c.name << "\n";
-  y << "    asset: " << Quoted(c.asset.string()) << "\n";
-  y << "    scale: 1\n";
-  y << "    anchor:\n";
-  y << "      position: [" << Num(c.anchor.position.x()) << ", " << Num(c.anchor.position.y()) << ", "
-    << Num(c.anchor.position.z()) << "]\n";
-  y << "      rotation: [" << Num(q.x()) << ", " << Num(q.y()) << ", " << Num(q.z()) << ", " << Num(q.w()) << "]\n";
-  y << "      scale: " << Num(c.anchor.scale) << "\n";
-  y << "    weights: {mode: inverse-distance, distance: geodesic, alpha: 3}\n";
-  y << "    blend: {method: dlb, precision: 0.001, max_iterations: 32}\n";
+  YAML::Emitter y;
+  y.SetDoublePrecision(9);  // %.9g as before: metres to the nanometre, quaternions to 1e-9
+  y.SetIndent(2);
+  y.SetSeqFormat(YAML::Block);
+  std::string comment = c.comment;  // one line: a newline would end the comment
+  for (char& ch : comment)
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  if (!comment.empty()) y << YAML::Comment(comment) << YAML::Newline;
+  y << YAML::Comment("Written by 'arview place'; edit freely (format: docs/anim.md).") << YAML::Newline;
+  y << YAML::BeginMap;
+  y << YAML::Key << "characters" << YAML::Value << YAML::BeginSeq << YAML::BeginMap;
+  y << YAML::Key << "name" << YAML::Value << c.name;
+  // Double-quoted so that a path holding " #" or ": " reads back as written.
+  y << YAML::Key << "asset" << YAML::Value << YAML::DoubleQuoted << c.asset.string();
+  y << YAML::Key << "scale" << YAML::Value << 1;
+  y << YAML::Key << "anchor" << YAML::Value << YAML::BeginMap;
+  EmitVector(y, "position", {c.anchor.position.x(), c.anchor.position.y(), c.anchor.position.z()});
+  EmitVector(y, "rotation", {q.x(), q.y(), q.z(), q.w()});
+  y << YAML::Key << "scale" << YAML::Value << c.anchor.scale;
+  y << YAML::EndMap;
+  y << YAML::Key << "weights" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  y << YAML::Key << "mode" << YAML::Value << "inverse-distance" << YAML::Key << "distance" << YAML::Value << "geodesic"
+    << YAML::Key << "alpha" << YAML::Value << 3;
+  y << YAML::EndMap;
+  y << YAML::Key << "blend" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  y << YAML::Key << "method" << YAML::Value << "dlb" << YAML::Key << "precision" << YAML::Value << 0.001
+    << YAML::Key << "max_iterations" << YAML::Value << 32;
+  y << YAML::EndMap;
   if (!c.base_clip.empty()) {
-    y << "    lookat:\n";
-    y << "      base_clip: " << c.base_clip << "\n";
+    y << YAML::Key << "lookat" << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "base_clip" << YAML::Value << c.base_clip;
+    y << YAML::EndMap;
   }
-  y << "    keys:\n";
+  y << YAML::Key << "keys" << YAML::Value << YAML::BeginSeq;
   for (int k = 0; k < c.key_count; ++k) {
-    y << "      - azimuth: " << Num(360.0 * k / c.key_count) << "\n";
-    y << "        elevation: " << Num(c.key_elevation_deg) << "\n";
-    y << "        generate: lookat\n";
+    y << YAML::BeginMap;
+    y << YAML::Key << "azimuth" << YAML::Value << 360.0 * k / c.key_count;
+    y << YAML::Key << "elevation" << YAML::Value << c.key_elevation_deg;
+    y << YAML::Key << "generate" << YAML::Value << "lookat";
+    y << YAML::EndMap;
   }
-  return y.str();
+  y << YAML::EndSeq;
+  y << YAML::EndMap << YAML::EndSeq << YAML::EndMap;
+  if (!y.good()) throw anim::Error("scene writer: " + y.GetLastError());
+  return std::string(y.c_str()) + "\n";
 }
 
 void WriteSceneFile(const PlacedCharacter& c, const std::filesystem::path& file) {

@@ -1,0 +1,71 @@
+#include "anim/view_adaptive.h"
+
+#include <cmath>
+#include <set>
+
+namespace arview::anim {
+namespace {
+
+std::vector<Eigen::Vector3d> Directions(const std::vector<ViewAdaptiveKey>& keys) {
+  std::vector<Eigen::Vector3d> dirs;
+  for (const ViewAdaptiveKey& k : keys) dirs.push_back(k.viewpoint);
+  return dirs;
+}
+
+}  // namespace
+
+ViewAdaptiveBlend::ViewAdaptiveBlend(std::shared_ptr<const Skeleton> skeleton, std::vector<ViewAdaptiveKey> keys,
+                                     const ViewAdaptiveOptions& options)
+    : skeleton_(std::move(skeleton)), keys_(std::move(keys)), options_(options), sphere_(Directions(keys_), options.weights) {
+  const int K = key_count();
+  if (K > BlendingJob::kMaxInputs)
+    throw Error(std::to_string(K) + " keys; at most " + std::to_string(BlendingJob::kMaxInputs));
+  for (const ViewAdaptiveKey& k : keys_)
+    if (!k.clip || static_cast<int>(k.clip->tracks.size()) != skeleton_->size())
+      throw Error("key clip '" + (k.clip ? k.clip->name : std::string("?")) + "' does not fit the skeleton");
+  // The shared phase runs at the mean length of the distinct animated key clips.
+  std::set<const Clip*> distinct;
+  double total = 0;
+  for (const ViewAdaptiveKey& k : keys_)
+    if (k.clip->duration > 0 && distinct.insert(k.clip.get()).second) total += k.clip->duration;
+  shared_period_ = distinct.empty() ? 0.0 : total / double(distinct.size());
+  weights_.assign(K, 0.0);
+  key_poses_.assign(K, LocalPose(skeleton_->size()));
+  active_ptrs_.assign(K, nullptr);
+  active_weights_.assign(K, 0.0);
+}
+
+double ViewAdaptiveBlend::KeyTime(int key, double t) const {
+  const double d = keys_[key].clip->duration;
+  if (options_.phase == PhaseMode::kIndependent || shared_period_ <= 0 || d <= 0) return t;
+  double phase = std::fmod(t / shared_period_, 1.0);
+  if (phase < 0) phase += 1.0;
+  return phase * d;
+}
+
+bool ViewAdaptiveBlend::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
+  if (!std::isfinite(t)) t = 0;
+  sphere_.Weights(inputs.viewpoint, weights_);
+  int active = 0;
+  for (int k = 0; k < key_count(); ++k) {
+    if (weights_[k] <= 0) continue;
+    if (!SamplingJob{skeleton_.get(), keys_[k].clip.get(), KeyTime(k, t), true, &key_poses_[k], options_.nlerp_sampling}.Run())
+      return false;
+    active_ptrs_[active] = &key_poses_[k];
+    active_weights_[active] = weights_[k];
+    ++active;
+  }
+  converged_ = true;
+  max_iterations_ = 0;
+  BlendingJob blend;
+  blend.inputs = std::span<const LocalPose* const>(active_ptrs_.data(), active);
+  blend.weights = std::span<const double>(active_weights_.data(), active);
+  blend.method = options_.blend;
+  blend.dib = options_.dib;
+  blend.output = &out;
+  blend.converged = &converged_;
+  blend.max_iterations = &max_iterations_;
+  return blend.Run();
+}
+
+}  // namespace arview::anim

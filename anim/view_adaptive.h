@@ -1,0 +1,74 @@
+#pragma once
+// The view-adaptive blend (PAPERS.md §1, Algorithm 2) as a runtime object: K key clips tied to
+// key viewpoints, weighted by the current viewpoint (view_sphere.h) and blended joint by joint
+// (DLB or DIB). Built once from clips already prepared (anim_authoring/ loads assets and
+// generates look-at and gesture keys); sampled every frame without allocating. It is a
+// Blendable (unbounded: it plays as long as it is scheduled), so a schedule can fade it in and
+// out like any action; the viewpoint comes from FrameInputs.
+//
+//   ViewAdaptiveBlend blend(skeleton, keys, options);
+//   if (!blend.Sample(t, {viewpoint}, pose)) ...;   blend.weights()[k]
+
+#include "anim/blendable.h"
+#include "anim/view_sphere.h"
+
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace arview::anim {
+
+enum class PhaseMode { kShared, kIndependent };
+
+struct ViewAdaptiveKey {
+  Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // unit, character frame
+  std::shared_ptr<const Clip> clip;                       // keys may share clips
+};
+
+struct ViewAdaptiveOptions {
+  ViewSphereOptions weights;
+  BlendMethod blend = BlendMethod::kDlb;
+  DibOptions<double> dib;
+  PhaseMode phase = PhaseMode::kShared;
+  bool nlerp_sampling = false;
+};
+
+class ViewAdaptiveBlend : public Blendable {
+ public:
+  // Throws Error when there are no keys, more than BlendingJob::kMaxInputs, or a clip does not
+  // fit the skeleton.
+  ViewAdaptiveBlend(std::shared_ptr<const Skeleton> skeleton, std::vector<ViewAdaptiveKey> keys,
+                    const ViewAdaptiveOptions& options = {});
+
+  double Duration() const override { return kUnbounded; }
+  // Weights for inputs.viewpoint (a zero viewpoint: equal weights), every key with weight > 0
+  // sampled at t (the shared phase or its own loop) and blended.
+  bool Sample(double t, const FrameInputs& inputs, LocalPose& out) override;
+  int joint_count() const override { return skeleton_->size(); }
+
+  int key_count() const { return static_cast<int>(keys_.size()); }
+  const ViewAdaptiveKey& key(int k) const { return keys_[k]; }
+  const ViewSphere& view_sphere() const { return sphere_; }
+  const ViewAdaptiveOptions& options() const { return options_; }
+  // Of the last Sample.
+  std::span<const double> weights() const { return weights_; }
+  bool converged() const { return converged_; }
+  int max_iterations() const { return max_iterations_; }
+
+ private:
+  double KeyTime(int key, double t) const;
+
+  std::shared_ptr<const Skeleton> skeleton_;
+  std::vector<ViewAdaptiveKey> keys_;
+  ViewAdaptiveOptions options_;
+  ViewSphere sphere_;
+  double shared_period_ = 0;
+  std::vector<double> weights_;
+  std::vector<LocalPose> key_poses_;
+  std::vector<const LocalPose*> active_ptrs_;
+  std::vector<double> active_weights_;
+  bool converged_ = true;
+  int max_iterations_ = 0;
+};
+
+}  // namespace arview::anim

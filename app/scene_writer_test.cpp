@@ -1,0 +1,48 @@
+#include "app/scene_writer.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "anim/scene.h"
+
+namespace arview::app {
+namespace {
+
+PlacedCharacter Placed() {
+  PlacedCharacter c;
+  c.name = "fox";
+  c.asset = "/data/odd: name # here/Fox \"v2\".glb";  // quotes, ": " and " #" must survive
+  c.anchor.position = Eigen::Vector3d(0.123456789, -2.5, 1e-7);
+  c.anchor.rotation = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  c.anchor.scale = 0.0123;
+  c.key_count = 6;
+  c.key_elevation_deg = 12.5;
+  c.base_clip = "Survey";
+  c.comment = "two\nlines";
+  return c;
+}
+
+TEST(SceneWriter, WritesWhatTheSceneReaderReadsBack) {
+  const PlacedCharacter c = Placed();
+  const std::string text = SceneYaml(c);
+  const anim::Scene s = anim::ParseScene(text, "/tmp/placed.yaml");
+  ASSERT_EQ(s.characters.size(), 1u);
+  const anim::CharacterSpec& spec = s.characters[0];
+  EXPECT_EQ(spec.name, "fox");
+  EXPECT_EQ(spec.asset, std::filesystem::path(c.asset));
+  EXPECT_LT((spec.anchor.position - c.anchor.position).norm(), 1e-9);
+  EXPECT_LT((spec.anchor.rotation.toRotationMatrix() - c.anchor.rotation).norm(), 1e-8);
+  EXPECT_NEAR(spec.anchor.scale, 0.0123, 1e-12);
+  EXPECT_EQ(spec.lookat.base_clip, "Survey");
+  ASSERT_EQ(spec.keys.size(), 6u);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(spec.keys[k].source, anim::KeySpec::Source::kLookAt);
+    EXPECT_NEAR(std::asin(spec.keys[k].viewpoint.y()) * 180 / M_PI, 12.5, 1e-9);
+  }
+  // The comment stays one comment line.
+  EXPECT_EQ(text.rfind("# two lines\n", 0), 0u) << text;
+}
+
+}  // namespace
+}  // namespace arview::app
