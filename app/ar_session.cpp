@@ -23,7 +23,7 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
   return median > 0 ? 1.0 / median : 30;
 }
 
-SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const mapping::Map& map,
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& o) {
   if (source_size != map.camera.Size()) {
     throw std::runtime_error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +

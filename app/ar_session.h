@@ -11,7 +11,7 @@
 #include "app/ar_compositor.h"
 #include "app/ar_pipeline.h"
 #include "app/layered_animator.h"
-#include "mapping/map.h"
+#include "map/map.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
 
@@ -42,7 +42,7 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
 
 // `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
 // names the map in messages.
-SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const mapping::Map& map,
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& options);
 
 }  // namespace arview::app

@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
-#include "mapping/map_file.h"
 #include "mapping/process.h"
 
 namespace arview::app {
@@ -101,7 +101,7 @@ void RunMap(const MapArgs& args) {
     mapping::InterruptGuard interrupt_guard;
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
     bar.Finish();
-    const auto stats = mapping::ComputeStats(result.map);
+    const auto stats = map::ComputeStats(result.map);
     std::cout << "registered " << result.map.keyframes.size() << " of " << result.selected_frames.size()
               << " frames; " << stats.points << " points, mean track length " << Fixed(stats.mean_track_length, 2)
               << ", mean reprojection error " << Fixed(stats.mean_reprojection_error, 3) << " px\n";
@@ -112,7 +112,7 @@ void RunMap(const MapArgs& args) {
       total += t.seconds;
     }
     std::cout << " (total " << Fixed(total, 1) << " s)\n";
-    std::cout << "wrote " << args.out << "/{" << mapping::kMapFileName
+    std::cout << "wrote " << args.out << "/{" << map::kMapFileName
               << ", keyframes.txt, map.png, database.db}, COLMAP model " << result.model_dir.string() << "\n";
   } catch (const mapping::ColmapStageError& e) {
     bar.Finish();
@@ -124,7 +124,7 @@ void RunMap(const MapArgs& args) {
     throw CommandError(std::string(e.what()) + "; re-run the same command to continue (finished stages are kept)", 130);
   } catch (const mapping::ProcessError& e) {
     throw CommandError(e.what());
-  } catch (const mapping::MapError& e) {
+  } catch (const map::MapError& e) {
     throw CommandError(e.what());
   } catch (const recordings::RecordingError& e) {
     throw CommandError(e.what());
@@ -134,9 +134,9 @@ void RunMap(const MapArgs& args) {
 void RunInfo(const std::string& dir) {
   try {
     const auto start = std::chrono::steady_clock::now();
-    const mapping::Map map = mapping::LoadMap(dir);
+    const map::Map map = map::LoadMap(dir);
     const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    const auto s = mapping::ComputeStats(map);
+    const auto s = map::ComputeStats(map);
     int first = -1, last = -1;
     for (const auto& k : map.keyframes) {
       if (first < 0 || k.frame_index < first) first = k.frame_index;
@@ -156,7 +156,7 @@ void RunInfo(const std::string& dir) {
               << "descriptors:         " << s.descriptors << " (128 x uint8, "
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
-  } catch (const mapping::MapError& e) {
+  } catch (const map::MapError& e) {
     throw CommandError(e.what());
   }
 }

@@ -4,7 +4,7 @@
 
 #include "app/commands.h"
 #include "app/place_character.h"
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 
 namespace arview::app {
 
@@ -41,7 +41,7 @@ void AddPlaceCommand(CLI::App& app) {
   cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
   cmd->callback([a] {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
-    const mapping::Map map = mapping::LoadMap(a->map_dir);
+    const map::Map map = map::LoadMap(a->map_dir);
     PlacedCharacter placed = PlaceCharacter(map, a->character, a->options);
     placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
     WriteSceneFile(placed, a->out);

@@ -10,7 +10,7 @@
 #include "app/output_file.h"
 #include "app/session_flags.h"
 #include "app/pipeline_report.h"
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "recordings/recording.h"
 #include "render/offscreen.h"
 
@@ -59,7 +59,7 @@ void AddReplayCommand(CLI::App& app) {
       o.sink = a->out;
     }
     recordings::RecordingSource source(recording, replay);
-    const mapping::Map map = mapping::LoadMap(a->map_dir);
+    const map::Map map = map::LoadMap(a->map_dir);
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (interrupt.raised()) throw CommandError("interrupted: " + a->out + " not written", 130);
     if (pending) pending->Commit();

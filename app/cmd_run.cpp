@@ -7,7 +7,7 @@
 #include "app/interrupt.h"
 #include "app/pipeline_report.h"
 #include "app/session_flags.h"
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "recordings/v4l2_source.h"
 #include "render/offscreen.h"
 
@@ -42,7 +42,7 @@ void AddRunCommand(CLI::App& app) {
     recordings::V4l2Options v4l2;
     v4l2.format = a->format;
     v4l2.stop = interrupt.flag();
-    const mapping::Map map = mapping::LoadMap(a->map_dir);
+    const map::Map map = map::LoadMap(a->map_dir);
     v4l2.width = map.camera.width;
     v4l2.height = map.camera.height;
     recordings::V4l2Source source(a->device, v4l2);

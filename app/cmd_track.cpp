@@ -16,7 +16,7 @@
 #include "app/json_writer.h"
 #include "app/progress.h"
 #include "app/stage_stats.h"
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
 #include "recordings/trajectory.h"
@@ -168,10 +168,10 @@ void RunTrack(const TrackArgs& args) {
     throw CommandError(e.what());
   }
   const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
-  mapping::Map map;
+  map::Map map;
   try {
-    map = mapping::LoadMap(args.map);
-  } catch (const mapping::MapError& e) {
+    map = map::LoadMap(args.map);
+  } catch (const map::MapError& e) {
     throw CommandError(e.what());
   }
   if (map.camera.Size() != rec.camera.Size()) {
@@ -186,7 +186,7 @@ void RunTrack(const TrackArgs& args) {
     tracker = std::make_unique<tracker::Tracker>(map, options);
   } catch (const tracker::TrackerError& e) {
     throw CommandError(args.map + ": " + e.what());
-  } catch (const mapping::DescriptorIndexError& e) {
+  } catch (const map::DescriptorIndexError& e) {
     throw CommandError(args.map + ": " + e.what());
   }
 

@@ -8,7 +8,7 @@
 
 namespace arview::app {
 
-PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::path& asset_path,
+PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path& asset_path,
                                const PlaceCharacterOptions& o) {
   const std::filesystem::path asset = std::filesystem::absolute(asset_path);
   const anim::Character character = anim::LoadCharacter(asset);
@@ -18,7 +18,7 @@ PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::p
   points.reserve(map.points.size());
   for (const auto& p : map.points) points.push_back(p.xyz);
   // The first keyframe (lowest frame index) goes first: the character faces it.
-  const mapping::Keyframe* first = nullptr;
+  const map::Keyframe* first = nullptr;
   for (const auto& k : map.keyframes) {
     if (!first || k.frame_index < first->frame_index) first = &k;
   }

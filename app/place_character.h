@@ -8,7 +8,7 @@
 #include <string>
 
 #include "app/scene_writer.h"
-#include "mapping/map.h"
+#include "map/map.h"
 
 namespace arview::app {
 
@@ -20,7 +20,7 @@ struct PlaceCharacterOptions {
   std::uint64_t seed = 1;
 };
 
-PlacedCharacter PlaceCharacter(const mapping::Map& map, const std::filesystem::path& asset,
+PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path& asset,
                                const PlaceCharacterOptions& options);
 
 }  // namespace arview::app

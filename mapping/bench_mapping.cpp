@@ -16,9 +16,9 @@
 #include <iostream>
 #include <memory>
 
+#include "map/descriptor_index.h"
+#include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
-#include "mapping/descriptor_index.h"
-#include "mapping/map_file.h"
 #include "recordings/importers.h"
 #include "tests/support/test_data.h"
 
@@ -29,7 +29,7 @@ using namespace arview;
 
 struct BenchData {
   fs::path map_dir;
-  mapping::Map map;
+  map::Map map;
   cv::Mat queries;                      // 2000 rows of the odd-frame map
   std::vector<std::uint32_t> truth;     // true nearest row of each query
 };
@@ -55,11 +55,11 @@ const BenchData& Data() {
     d->map = mapping::BuildMap(rec, dir / "even", options).map;  // re-uses finished stages
     d->map_dir = dir / "even";
     options.frames_spec = "1-45:2";
-    const mapping::Map odd = mapping::BuildMap(rec, dir / "odd", options).map;
+    const map::Map odd = mapping::BuildMap(rec, dir / "odd", options).map;
     const int n = std::min(2000, odd.descriptors.rows);
     const int step = std::max(1, odd.descriptors.rows / n);
     for (int r = 0; r < n; ++r) d->queries.push_back(odd.descriptors.row(r * step));
-    const mapping::DescriptorIndex exact(d->map.descriptors, {.kind = mapping::IndexKind::kLinear});
+    const map::DescriptorIndex exact(d->map.descriptors, {.kind = map::IndexKind::kLinear});
     for (const auto& nn : exact.Knn(d->queries, 1)) d->truth.push_back(nn.at(0).row);
     std::cerr << "bench data: map " << d->map.descriptors.rows << " descriptors, " << d->queries.rows << " queries\n";
     return d;
@@ -70,17 +70,17 @@ const BenchData& Data() {
 void BM_LoadMap(benchmark::State& state) {
   const BenchData& d = Data();
   for (auto _ : state) {
-    mapping::Map m = mapping::LoadMap(d.map_dir);
+    map::Map m = map::LoadMap(d.map_dir);
     benchmark::DoNotOptimize(m.points.data());
   }
   state.counters["descriptors"] = d.map.descriptors.rows;
-  state.counters["file_MiB"] = static_cast<double>(fs::file_size(d.map_dir / mapping::kMapFileName)) / (1 << 20);
+  state.counters["file_MiB"] = static_cast<double>(fs::file_size(d.map_dir / map::kMapFileName)) / (1 << 20);
 }
 BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond);
 
-mapping::IndexParams Params(const benchmark::State& state) {
-  mapping::IndexParams p;
-  p.kind = static_cast<mapping::IndexKind>(state.range(0));
+map::IndexParams Params(const benchmark::State& state) {
+  map::IndexParams p;
+  p.kind = static_cast<map::IndexKind>(state.range(0));
   p.trees = static_cast<int>(state.range(1));
   p.branching = static_cast<int>(state.range(1));
   p.checks = static_cast<int>(state.range(2));
@@ -89,17 +89,17 @@ mapping::IndexParams Params(const benchmark::State& state) {
 
 void BM_BuildIndex(benchmark::State& state) {
   const BenchData& d = Data();
-  const mapping::IndexParams p = Params(state);
+  const map::IndexParams p = Params(state);
   for (auto _ : state) {
-    mapping::DescriptorIndex index(d.map.descriptors, p);
+    map::DescriptorIndex index(d.map.descriptors, p);
     benchmark::DoNotOptimize(index.size());
   }
 }
 
 void BM_Knn(benchmark::State& state) {
   const BenchData& d = Data();
-  const mapping::DescriptorIndex index(d.map.descriptors, Params(state));
-  std::vector<std::vector<mapping::Neighbor>> result;
+  const map::DescriptorIndex index(d.map.descriptors, Params(state));
+  std::vector<std::vector<map::Neighbor>> result;
   for (auto _ : state) {
     result = index.Knn(d.queries, 2);
     benchmark::DoNotOptimize(result.data());

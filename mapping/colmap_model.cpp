@@ -25,9 +25,9 @@ class BinaryReader {
  public:
   explicit BinaryReader(const fs::path& path) : path_(path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw MapError(path.string() + ": missing or unreadable");
+    if (!in) throw map::MapError(path.string() + ": missing or unreadable");
     data_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) throw MapError(path.string() + ": read error");
+    if (in.bad()) throw map::MapError(path.string() + ": read error");
   }
 
   template <typename T>
@@ -65,7 +65,7 @@ class BinaryReader {
     if (Remaining() != 0) Fail(std::to_string(Remaining()) + " unexpected bytes after the last record");
   }
   [[noreturn]] void Fail(const std::string& problem) const {
-    throw MapError(path_.string() + ": " + problem + " (at byte " + std::to_string(pos_) + ")");
+    throw map::MapError(path_.string() + ": " + problem + " (at byte " + std::to_string(pos_) + ")");
   }
 
  private:
@@ -112,13 +112,13 @@ calib::Camera ToCamera(int model_id, std::uint64_t width, std::uint64_t height, 
       break;
     case 6:  // FULL_OPENCV: OpenCV's rational model; arview uses it only for k3 (k4..k6 = 0)
       if (p[9] != 0 || p[10] != 0 || p[11] != 0) {
-        throw MapError(file.string() + ": FULL_OPENCV camera with rational terms k4..k6 is not supported");
+        throw map::MapError(file.string() + ": FULL_OPENCV camera with rational terms k4..k6 is not supported");
       }
       c.fx = p[0]; c.fy = p[1]; c.cx = p[2]; c.cy = p[3];
       c.dist = {p[4], p[5], p[6], p[7], p[8]};
       break;
     default:
-      throw MapError(file.string() + ": camera model " + std::to_string(model_id) +
+      throw map::MapError(file.string() + ": camera model " + std::to_string(model_id) +
                      " has no OpenCV radial-tangential equivalent (arview maps use OPENCV)");
   }
   c.cx -= 0.5;
@@ -126,7 +126,7 @@ calib::Camera ToCamera(int model_id, std::uint64_t width, std::uint64_t height, 
   try {
     c.Validate(file.string());
   } catch (const calib::CameraError& e) {
-    throw MapError(e.what());
+    throw map::MapError(e.what());
   }
   return c;
 }
@@ -207,7 +207,7 @@ struct TrackElement {
 
 struct ColmapPoint {
   std::uint64_t id = 0;
-  MapPoint point;
+  map::MapPoint point;
   std::vector<TrackElement> track;
 };
 
@@ -243,7 +243,7 @@ class Database {
  public:
   explicit Database(const fs::path& path) : path_(path) {
     std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw MapError(path.string() + ": COLMAP database missing");
+    if (!fs::is_regular_file(path, ec)) throw map::MapError(path.string() + ": COLMAP database missing");
     sqlite3* db = nullptr;
     const int rc = sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
     db_.reset(db);
@@ -300,7 +300,7 @@ class Database {
 
   [[noreturn]] void Fail(const std::string& problem) {
     std::string detail = db_ ? sqlite3_errmsg(db_.get()) : "out of memory";
-    throw MapError(path_.string() + ": " + problem + " (SQLite: " + detail + ")");
+    throw map::MapError(path_.string() + ": " + problem + " (SQLite: " + detail + ")");
   }
 
   fs::path path_;
@@ -318,28 +318,28 @@ std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
   return r.Read<std::uint64_t>("registered image count");
 }
 
-Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames) {
+map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
   const fs::path images_file = sparse_dir / "images.bin";
   const fs::path points_file = sparse_dir / "points3D.bin";
   const auto cameras = ReadCameras(cameras_file);
   auto images = ReadImages(images_file);
   const auto points = ReadPoints(points_file);
-  if (images.empty()) throw MapError(images_file.string() + ": the model has no registered images");
-  if (points.empty()) throw MapError(points_file.string() + ": the model has no 3D points");
+  if (images.empty()) throw map::MapError(images_file.string() + ": the model has no registered images");
+  if (points.empty()) throw map::MapError(points_file.string() + ": the model has no 3D points");
 
   // One camera for all keyframes (arview runs COLMAP with --ImageReader.single_camera 1).
   const std::uint32_t camera_id = images.front().camera_id;
-  Map map;
+  map::Map map;
   for (const auto& im : images) {
     if (im.camera_id != camera_id) {
-      throw MapError(images_file.string() + ": images use several cameras (" + std::to_string(camera_id) + ", " +
+      throw map::MapError(images_file.string() + ": images use several cameras (" + std::to_string(camera_id) + ", " +
                      std::to_string(im.camera_id) + "); arview maps have one");
     }
   }
   const auto cam = cameras.find(camera_id);
   if (cam == cameras.end()) {
-    throw MapError(images_file.string() + ": camera id " + std::to_string(camera_id) + " is not in " +
+    throw map::MapError(images_file.string() + ": camera id " + std::to_string(camera_id) + " is not in " +
                    cameras_file.string());
   }
   map.camera = cam->second;
@@ -348,7 +348,7 @@ Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const Fr
     if (frames.empty()) return FrameInfo{};
     const auto it = frames.find(im.name);
     if (it == frames.end()) {
-      throw MapError(images_file.string() + ": image '" + im.name + "' is not a frame of the recording");
+      throw map::MapError(images_file.string() + ": image '" + im.name + "' is not a frame of the recording");
     }
     return it->second;
   };
@@ -360,10 +360,10 @@ Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const Fr
   std::unordered_map<std::uint32_t, std::uint32_t> keyframe_of_image;
   for (const auto& im : images) {
     if (!keyframe_of_image.emplace(im.id, static_cast<std::uint32_t>(map.keyframes.size())).second) {
-      throw MapError(images_file.string() + ": image id " + std::to_string(im.id) + " appears twice");
+      throw map::MapError(images_file.string() + ": image id " + std::to_string(im.id) + " appears twice");
     }
     const FrameInfo info = frame_of(im);
-    Keyframe kf;
+    map::Keyframe kf;
     kf.colmap_image_id = im.id;
     kf.name = im.name;
     kf.frame_index = info.frame_index;
@@ -376,23 +376,23 @@ Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const Fr
   std::size_t rows = 0;
   for (const auto& p : points) {
     if (!point_index.emplace(p.id, static_cast<std::uint32_t>(point_index.size())).second) {
-      throw MapError(points_file.string() + ": 3D point id " + std::to_string(p.id) + " appears twice");
+      throw map::MapError(points_file.string() + ": 3D point id " + std::to_string(p.id) + " appears twice");
     }
     rows += p.track.size();
   }
-  if (rows > std::numeric_limits<std::uint32_t>::max()) throw MapError(points_file.string() + ": tracks too long");
+  if (rows > std::numeric_limits<std::uint32_t>::max()) throw map::MapError(points_file.string() + ": tracks too long");
 
   // Track elements must name registered images and 2D points that point back at them.
   for (const auto& p : points) {
     for (const auto& e : p.track) {
       const auto kf = keyframe_of_image.find(e.image_id);
       if (kf == keyframe_of_image.end()) {
-        throw MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + " is seen by image id " +
+        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + " is seen by image id " +
                        std::to_string(e.image_id) + ", which is not in " + images_file.string());
       }
       const auto& im = images[kf->second];
       if (e.point2d_idx >= im.point3d_ids.size() || im.point3d_ids[e.point2d_idx] != p.id) {
-        throw MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
+        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
                        std::to_string(e.point2d_idx) + " of image '" + im.name + "', which does not refer back to it");
       }
     }
@@ -409,14 +409,14 @@ Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const Fr
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> wanted(images.size());  // (2D idx, row)
   std::uint32_t row = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    MapPoint& mp = map.points[i];
+    map::MapPoint& mp = map.points[i];
     mp = points[i].point;
     mp.first_descriptor = row;
     mp.descriptor_count = static_cast<std::uint32_t>(points[i].track.size());
     for (const auto& e : points[i].track) {
       const std::uint32_t kf = keyframe_of_image.at(e.image_id);
       if (!row_of.emplace(Key(e.image_id, e.point2d_idx), row).second) {
-        throw MapError(points_file.string() + ": 2D point " + std::to_string(e.point2d_idx) + " of image id " +
+        throw map::MapError(points_file.string() + ": 2D point " + std::to_string(e.point2d_idx) + " of image id " +
                        std::to_string(e.image_id) + " is in two tracks");
       }
       map.descriptor_point[row] = static_cast<std::uint32_t>(i);
@@ -429,24 +429,24 @@ Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const Fr
     const auto& im = images[k];
     const std::string db_name = db.ImageName(im.id);
     if (db_name != im.name) {
-      throw MapError(database.string() + ": image id " + std::to_string(im.id) + " is '" + db_name + "' but " +
+      throw map::MapError(database.string() + ": image id " + std::to_string(im.id) + " is '" + db_name + "' but " +
                      images_file.string() + " calls it '" + im.name + "' (a different database?)");
     }
     const cv::Mat desc = db.Descriptors(im.id);
     if (static_cast<std::size_t>(desc.rows) != im.xy.size()) {
-      throw MapError(database.string() + ": image '" + im.name + "' has " + std::to_string(desc.rows) +
+      throw map::MapError(database.string() + ": image '" + im.name + "' has " + std::to_string(desc.rows) +
                      " descriptors but " + std::to_string(im.xy.size()) + " 2D points in " + images_file.string());
     }
     for (const auto& [idx, r] : wanted[k]) desc.row(static_cast<int>(idx)).copyTo(map.descriptors.row(static_cast<int>(r)));
 
-    Keyframe& kf = map.keyframes[k];
+    map::Keyframe& kf = map.keyframes[k];
     for (std::uint32_t idx = 0; idx < im.point3d_ids.size(); ++idx) {
       const std::uint64_t pid = im.point3d_ids[idx];
       if (pid == kInvalidPoint3D) continue;
       const auto pi = point_index.find(pid);
       const auto ri = row_of.find(Key(im.id, idx));
       if (pi == point_index.end() || ri == row_of.end()) {
-        throw MapError(images_file.string() + ": 2D point " + std::to_string(idx) + " of '" + im.name +
+        throw map::MapError(images_file.string() + ": 2D point " + std::to_string(idx) + " of '" + im.name +
                        "' refers to 3D point " + std::to_string(pid) + ", whose track does not list it");
       }
       const Eigen::Vector2d px = im.xy[idx] - Eigen::Vector2d(0.5, 0.5);  // COLMAP → OpenCV pixels

@@ -10,8 +10,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "map/map_file.h"
 #include "mapping/colmap_model.h"
-#include "mapping/map_file.h"
 #include "mapping/process.h"
 #include "recordings/trajectory.h"
 
@@ -23,7 +23,7 @@ MatcherKind ParseMatcherKind(const std::string& text) {
   if (text == "auto") return MatcherKind::kAuto;
   if (text == "sequential") return MatcherKind::kSequential;
   if (text == "exhaustive") return MatcherKind::kExhaustive;
-  throw MapError("--matcher must be auto, sequential or exhaustive (got '" + text + "')");
+  throw map::MapError("--matcher must be auto, sequential or exhaustive (got '" + text + "')");
 }
 
 std::string ToString(MatcherKind kind) {
@@ -63,7 +63,7 @@ class StageRecord {
     fs::create_directories(dir_);
     std::ofstream out(dir_ / (stage + ".inputs"), std::ios::trunc);
     out << inputs;
-    if (!out.flush()) throw MapError((dir_ / (stage + ".inputs")).string() + ": cannot write");
+    if (!out.flush()) throw map::MapError((dir_ / (stage + ".inputs")).string() + ": cannot write");
   }
 
  private:
@@ -73,7 +73,7 @@ class StageRecord {
 std::string FileIdentity(const fs::path& file) {
   std::error_code ec;
   const auto size = fs::file_size(file, ec);
-  if (ec) throw MapError(file.string() + ": missing or unreadable");
+  if (ec) throw map::MapError(file.string() + ": missing or unreadable");
   const auto mtime = fs::last_write_time(file, ec).time_since_epoch().count();
   return std::to_string(size) + " " + std::to_string(mtime);
 }
@@ -112,7 +112,7 @@ class ColmapRunner {
   ColmapRunner(const MapBuildOptions& options, const fs::path& out_dir, const MapBuildCallbacks& cb)
       : options_(options), log_(out_dir / "colmap.log"), cb_(cb) {
     if (FindExecutable(options.colmap).empty()) {
-      throw MapError("COLMAP not found: '" + options.colmap + "' is not " +
+      throw map::MapError("COLMAP not found: '" + options.colmap + "' is not " +
                      (options.colmap.find('/') == std::string::npos ? "on PATH" : "an executable file") +
                      " (install COLMAP: apt-get install colmap)");
     }
@@ -196,14 +196,14 @@ ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& ou
       if (!cap.read(frame) || frame.empty()) throw recordings::RecordingError(video.string() + ": ends early");
       if (i != (*selected)[next]) continue;
       const fs::path png = set.root / FrameName(i);
-      if (!cv::imwrite(png.string(), frame)) throw MapError(png.string() + ": cannot write");
+      if (!cv::imwrite(png.string(), frame)) throw map::MapError(png.string() + ": cannot write");
       ++next;
     }
     std::ofstream out(list);
     for (int f : *selected) out << f << "\n";
     stages.Save("select", inputs.str());
   }
-  if (selected->empty()) throw MapError(video.string() + ": no usable frames were selected");
+  if (selected->empty()) throw map::MapError(video.string() + ": no usable frames were selected");
   for (int f : *selected) {
     set.names.push_back(FrameName(f));
     set.lookup[set.names.back()] = {f, rec.frames.at(static_cast<size_t>(f)).timestamp};
@@ -246,7 +246,7 @@ void ClearMatches(const fs::path& database) {
       sqlite3_exec(db, "DELETE FROM matches; DELETE FROM two_view_geometries;", nullptr, nullptr, &error) != SQLITE_OK) {
     const std::string why = error ? error : (db ? sqlite3_errmsg(db) : "cannot open");
     sqlite3_free(error);
-    throw MapError(database.string() + ": cannot clear old matches (" + why + ")");
+    throw map::MapError(database.string() + ": cannot clear old matches (" + why + ")");
   }
 }
 
@@ -310,7 +310,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   CandidateFrames(recording, options);  // a bad --frames fails before anything is written
   std::error_code ec;
   fs::create_directories(out_dir, ec);
-  if (ec || !fs::is_directory(out_dir)) throw MapError(out_dir.string() + ": cannot create the map directory");
+  if (ec || !fs::is_directory(out_dir)) throw map::MapError(out_dir.string() + ": cannot create the map directory");
   MapBuildResult result;
   StageRecord stages(out_dir);
   ColmapRunner colmap(options, out_dir, cb);
@@ -320,13 +320,13 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                               ? PrepareVideoImages(recording, out_dir, options, cb, stages, &result.selected_frames)
                               : PrepareStillImages(recording, options, cb, &result.selected_frames);
   result.timings.push_back({"select", Seconds(t0), false});
-  if (images.names.size() < 2) throw MapError("a map needs at least 2 frames (got " + std::to_string(images.names.size()) + ")");
+  if (images.names.size() < 2) throw map::MapError("a map needs at least 2 frames (got " + std::to_string(images.names.size()) + ")");
   const int n = static_cast<int>(images.names.size());
   const fs::path list = out_dir / "image_list.txt";
   {
     std::ofstream out(list, std::ios::trunc);
     for (const auto& name : images.names) out << name << "\n";
-    if (!out.flush()) throw MapError(list.string() + ": cannot write");
+    if (!out.flush()) throw map::MapError(list.string() + ": cannot write");
   }
   const fs::path database = out_dir / "database.db";
   const fs::path sparse = out_dir / "sparse";
@@ -409,19 +409,19 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   }
   result.map = ReadColmapMap(result.model_dir, database, images.lookup);
   WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
-  SaveMap(result.map, out_dir / kMapFileName);
+  map::SaveMap(result.map, out_dir / map::kMapFileName);
   WriteTopView(result.map, out_dir / "map.png");
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
 }
 
-void WriteKeyframesTum(const Map& map, const fs::path& file) {
+void WriteKeyframesTum(const map::Map& map, const fs::path& file) {
   recordings::Trajectory trajectory;
-  for (const Keyframe& k : map.keyframes) trajectory.push_back({k.timestamp, k.pose});
+  for (const map::Keyframe& k : map.keyframes) trajectory.push_back({k.timestamp, k.pose});
   try {
     recordings::WriteTum(trajectory, file, "arview map: the frames COLMAP registered (the keyframes of the map)");
   } catch (const std::exception& e) {
-    throw MapError(file.string() + ": cannot write keyframes (" + e.what() + ")");
+    throw map::MapError(file.string() + ": cannot write keyframes (" + e.what() + ")");
   }
 }
 

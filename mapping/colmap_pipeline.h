@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "map/map.h"
 #include "mapping/frame_selection.h"
-#include "mapping/map.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -57,10 +57,10 @@ struct MapBuildOptions {
 
 // A COLMAP stage that failed: the message says which and why; `log_tail` holds the last lines
 // COLMAP printed (the full output is in `log`).
-struct ColmapStageError : MapError {
+struct ColmapStageError : map::MapError {
   ColmapStageError(const std::string& message, std::string stage_name, std::filesystem::path log_file,
                    std::vector<std::string> tail)
-      : MapError(message), stage(std::move(stage_name)), log(std::move(log_file)), log_tail(std::move(tail)) {}
+      : map::MapError(message), stage(std::move(stage_name)), log(std::move(log_file)), log_tail(std::move(tail)) {}
   std::string stage;
   std::filesystem::path log;
   std::vector<std::string> log_tail;
@@ -80,7 +80,7 @@ struct StageTiming {
 };
 
 struct MapBuildResult {
-  Map map;
+  map::Map map;
   std::vector<int> selected_frames;  // indices into the recording's frames.txt
   std::vector<StageTiming> timings;
   int models = 0;                    // models COLMAP produced
@@ -98,10 +98,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const std::files
 std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, int total_images);
 
 // The keyframes as a TUM trajectory (camera-to-world, the recording's timestamps).
-void WriteKeyframesTum(const Map& map, const std::filesystem::path& file);
+void WriteKeyframesTum(const map::Map& map, const std::filesystem::path& file);
 
 // A top view of the map: the points (their colours) seen along the axis normal to the plane the
 // cameras move in, with the camera path drawn over them. Throws MapError when it cannot write.
-void WriteTopView(const Map& map, const std::filesystem::path& png, int size = 800);
+void WriteTopView(const map::Map& map, const std::filesystem::path& png, int size = 800);
 
 }  // namespace arview::mapping

@@ -17,10 +17,10 @@
 #include <map>
 #include <memory>
 
+#include "map/descriptor_index.h"
+#include "map/map_file.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_pipeline.h"
-#include "mapping/descriptor_index.h"
-#include "mapping/map_file.h"
 #include "recordings/accuracy.h"
 #include "recordings/importers.h"
 #include "recordings/trajectory.h"
@@ -66,7 +66,7 @@ class TempleMapTest : public ::testing::Test {
     ASSERT_TRUE(result_) << "building the map failed in SetUpTestSuite";
   }
 
-  static const Map& map() { return result_->map; }
+  static const map::Map& map() { return result_->map; }
   static fs::path MapDir() { return root_ / "map"; }
 
   // A copy of the model folder (and database) with one file cut to `bytes` or overwritten.
@@ -142,7 +142,7 @@ TEST_F(TempleMapTest, CameraComesBackInOpenCvPixels) {
 }
 
 TEST_F(TempleMapTest, ReprojectionErrorBelowOnePixel) {
-  const MapStats s = ComputeStats(map());
+  const map::MapStats s = map::ComputeStats(map());
   EXPECT_GT(s.points, 1000u);
   EXPECT_GT(s.mean_track_length, 2.5);
   EXPECT_LE(s.mean_reprojection_error, 1.0);
@@ -162,7 +162,7 @@ TEST_F(TempleMapTest, KeyframeCentresMatchGroundTruthAfterSim3) {
 }
 
 TEST_F(TempleMapTest, CompactFileLoadsTheSameMap) {
-  const Map loaded = LoadMap(MapDir());
+  const map::Map loaded = map::LoadMap(MapDir());
   ASSERT_EQ(loaded.keyframes.size(), map().keyframes.size());
   ASSERT_EQ(loaded.points.size(), map().points.size());
   EXPECT_EQ(loaded.descriptor_point, map().descriptor_point);
@@ -181,7 +181,7 @@ TEST_F(TempleMapTest, DescriptorsAreColmapUint8Sift) {
     EXPECT_NEAR(std::sqrt(row.dot(row)), 512, 40) << "row " << r;
   }
   // The descriptors of one point's track resemble each other far more than random rows.
-  const DescriptorIndex index(map().descriptors);
+  const map::DescriptorIndex index(map().descriptors);
   int same_point = 0, tried = 0;
   for (int r = 0; r < map().descriptors.rows; r += 13, ++tried) {
     const auto nn = index.Knn(map().descriptors.ptr<std::uint8_t>(r), 2);
@@ -213,7 +213,7 @@ TEST_F(TempleMapTest, MissingColmapIsAClearError) {
   try {
     BuildMap(*recording_, scratch_ / "no_colmap", options);
     FAIL() << "expected MapError";
-  } catch (const MapError& e) {
+  } catch (const map::MapError& e) {
     EXPECT_NE(std::string(e.what()).find("COLMAP not found"), std::string::npos) << e.what();
   }
 }
@@ -248,7 +248,7 @@ TEST_F(TempleMapTest, TruncatedModelFilesAreClearErrors) {
       try {
         ReadColmapMap(dir, dir / "database.db");
         ADD_FAILURE() << file << " cut to " << keep << " bytes was accepted";
-      } catch (const MapError& e) {
+      } catch (const map::MapError& e) {
         EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
       }
     }
@@ -258,18 +258,18 @@ TEST_F(TempleMapTest, TruncatedModelFilesAreClearErrors) {
 TEST_F(TempleMapTest, CorruptedCountsAndIdsAreClearErrors) {
   // A huge image count: refused before any allocation.
   fs::path dir = BrokenCopy("images.bin", [](std::vector<char>& b) { b[6] = 0x7f; });
-  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), map::MapError);
   // A track element pointing to a 2D point that does not point back (first track's image id).
   dir = BrokenCopy("points3D.bin", [](std::vector<char>& b) { b[8 + 8 + 24 + 3 + 8 + 8] ^= 0x55; });
-  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), map::MapError);
   // The database cut short or missing.
   dir = BrokenCopy("database.db", [](std::vector<char>& b) { b.resize(b.size() / 3); });
-  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), map::MapError);
   dir = BrokenCopy("database.db", [](std::vector<char>& b) { std::fill(b.begin(), b.begin() + 100, 'x'); });
-  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), MapError);
-  EXPECT_THROW(ReadColmapMap(dir, dir / "no_such.db"), MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "database.db"), map::MapError);
+  EXPECT_THROW(ReadColmapMap(dir, dir / "no_such.db"), map::MapError);
   // A model whose images are not the recording's frames.
-  EXPECT_THROW(ReadColmapMap(result_->model_dir, MapDir() / "database.db", FrameLookup{{"other.png", {}}}), MapError);
+  EXPECT_THROW(ReadColmapMap(result_->model_dir, MapDir() / "database.db", FrameLookup{{"other.png", {}}}), map::MapError);
 }
 
 }  // namespace

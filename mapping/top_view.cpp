@@ -15,11 +15,11 @@ namespace {
 // Two in-plane axes (rows 0, 1) and the normal (row 2): the normal is the direction in which the
 // camera centres spread least, turned to point where the cameras' "up" (−y) points on average.
 // With fewer than 3 cameras the points decide the plane.
-Eigen::Matrix3d ViewAxes(const Map& map) {
+Eigen::Matrix3d ViewAxes(const map::Map& map) {
   std::vector<Eigen::Vector3d> samples;
-  for (const Keyframe& k : map.keyframes) samples.push_back(k.pose.Center());
+  for (const map::Keyframe& k : map.keyframes) samples.push_back(k.pose.Center());
   if (samples.size() < 3) {
-    for (const MapPoint& p : map.points) samples.push_back(p.xyz);
+    for (const map::MapPoint& p : map.points) samples.push_back(p.xyz);
   }
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& s : samples) mean += s;
@@ -29,7 +29,7 @@ Eigen::Matrix3d ViewAxes(const Map& map) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);  // eigenvalues ascending
   Eigen::Vector3d normal = eig.eigenvectors().col(0);
   Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  for (const Keyframe& k : map.keyframes) up += k.pose.CameraToWorldRotation() * Eigen::Vector3d(0, -1, 0);
+  for (const map::Keyframe& k : map.keyframes) up += k.pose.CameraToWorldRotation() * Eigen::Vector3d(0, -1, 0);
   if (normal.dot(up) < 0) normal = -normal;
   Eigen::Vector3d a = eig.eigenvectors().col(2);
   Eigen::Vector3d b = normal.cross(a);
@@ -49,18 +49,18 @@ double Percentile(std::vector<double> v, double q) {
 
 }  // namespace
 
-void WriteTopView(const Map& map, const std::filesystem::path& png, int size) {
+void WriteTopView(const map::Map& map, const std::filesystem::path& png, int size) {
   const Eigen::Matrix3d axes = ViewAxes(map);
   auto plane = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((axes * p).head<2>()); };
   // The extent covers the cameras and all but the 1% outermost points on each side.
   std::vector<double> xs, ys;
-  for (const MapPoint& p : map.points) {
+  for (const map::MapPoint& p : map.points) {
     const Eigen::Vector2d q = plane(p.xyz);
     xs.push_back(q.x());
     ys.push_back(q.y());
   }
   double x0 = Percentile(xs, 0.01), x1 = Percentile(xs, 0.99), y0 = Percentile(ys, 0.01), y1 = Percentile(ys, 0.99);
-  for (const Keyframe& k : map.keyframes) {
+  for (const map::Keyframe& k : map.keyframes) {
     const Eigen::Vector2d q = plane(k.pose.Center());
     x0 = std::min(x0, q.x()), x1 = std::max(x1, q.x()), y0 = std::min(y0, q.y()), y1 = std::max(y1, q.y());
   }
@@ -75,16 +75,16 @@ void WriteTopView(const Map& map, const std::filesystem::path& png, int size) {
   };
 
   cv::Mat image(size, size, CV_8UC3, cv::Scalar(255, 255, 255));
-  for (const MapPoint& p : map.points) {
+  for (const map::MapPoint& p : map.points) {
     const cv::Point px = pixel(p.xyz);
     if (px.x < 0 || px.y < 0 || px.x >= size || px.y >= size) continue;
     image.at<cv::Vec3b>(px) = cv::Vec3b(p.rgb[2], p.rgb[1], p.rgb[0]);
   }
   std::vector<cv::Point> path;
-  for (const Keyframe& k : map.keyframes) path.push_back(pixel(k.pose.Center()));
+  for (const map::Keyframe& k : map.keyframes) path.push_back(pixel(k.pose.Center()));
   cv::polylines(image, path, false, cv::Scalar(200, 80, 0), 1, cv::LINE_AA);
   for (size_t i = 0; i < map.keyframes.size(); ++i) {
-    const Keyframe& k = map.keyframes[i];
+    const map::Keyframe& k = map.keyframes[i];
     // A short stroke along the viewing direction, projected into the view plane.
     const Eigen::Vector3d ahead = k.pose.Center() + k.pose.CameraToWorldRotation() * Eigen::Vector3d(0, 0, 0.04 * span);
     cv::line(image, path[i], pixel(ahead), cv::Scalar(0, 0, 220), 1, cv::LINE_AA);
@@ -99,7 +99,7 @@ void WriteTopView(const Map& map, const std::filesystem::path& png, int size) {
   } catch (const cv::Exception&) {
     ok = false;
   }
-  if (!ok) throw MapError(png.string() + ": cannot write the top view");
+  if (!ok) throw map::MapError(png.string() + ": cannot write the top view");
 }
 
 }  // namespace arview::mapping

@@ -22,7 +22,7 @@
 #include <memory>
 #include <string>
 
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "recordings/accuracy.h"
 #include "recordings/recording.h"
 #include "tracker/test_planar_scene.h"
@@ -158,7 +158,7 @@ BENCHMARK(BM_PoseSolver_OpenCV_RansacRefineLM)
 // Real frames: a recording + its map, or renderings of a real photograph on a plane.
 
 struct RealFrames {
-  mapping::Map map;
+  map::Map map;
   std::vector<cv::Mat> frames;  // in sequence order
   std::string source;
   // Per frame, the true camera centre in the map's world (ground truth mapped by the inverse
@@ -172,7 +172,7 @@ std::string g_map_dir, g_recording_dir, g_frames_spec;
 std::unique_ptr<RealFrames> LoadRealFrames() {
   auto real = std::make_unique<RealFrames>();
   if (!g_map_dir.empty()) {
-    real->map = mapping::LoadMap(g_map_dir);
+    real->map = map::LoadMap(g_map_dir);
     const recordings::Recording rec = recordings::LoadRecording(g_recording_dir);
     const std::vector<int> indices =
         recordings::ParseFrameSpec(g_frames_spec.empty() ? "0-" + std::to_string(rec.frames.size() - 1) : g_frames_spec,
@@ -304,7 +304,7 @@ const RealCorrespondences* RealMatches() {
     const RealFrames* real = Real();
     if (!real) return nullptr;
     auto out = std::make_unique<RealCorrespondences>();
-    const mapping::DescriptorIndex index(real->map.descriptors);
+    const map::DescriptorIndex index(real->map.descriptors);
     const SiftExtractor sift;
     for (size_t f = 0; f < real->frames.size(); ++f) {
       const Features features = sift.Extract(real->frames[f]);

@@ -1,6 +1,6 @@
 #pragma once
 // SIFT features of a frame with descriptors in COLMAP's uint8 convention, so that they can be
-// matched against the map's descriptors (mapping/map.h).
+// matched against the map's descriptors (map/map.h).
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>

@@ -9,8 +9,8 @@
 
 namespace arview::tracker {
 
-std::vector<MapMatch> MatchToMap(const Features& features, const mapping::Map& map,
-                                 const mapping::DescriptorIndex& index, const MatchOptions& options) {
+std::vector<MapMatch> MatchToMap(const Features& features, const map::Map& map,
+                                 const map::DescriptorIndex& index, const MatchOptions& options) {
   std::vector<MapMatch> matches;
   if (features.descriptors.empty() || index.empty()) return matches;
   const auto neighbours = index.Knn(features.descriptors, options.knn);
@@ -38,7 +38,7 @@ std::vector<MapMatch> MatchToMap(const Features& features, const mapping::Map& m
   return matches;
 }
 
-void GatherCorrespondences(const Features& features, const mapping::Map& map,
+void GatherCorrespondences(const Features& features, const map::Map& map,
                            const std::vector<MapMatch>& matches,
                            std::vector<Eigen::Vector2d>* pixels,
                            std::vector<Eigen::Vector3d>* points) {
@@ -53,7 +53,7 @@ void GatherCorrespondences(const Features& features, const mapping::Map& map,
   }
 }
 
-Relocalizer::Relocalizer(const mapping::Map& map, const mapping::DescriptorIndex& index,
+Relocalizer::Relocalizer(const map::Map& map, const map::DescriptorIndex& index,
                          const RelocalizerOptions& options)
     : map_(map), index_(index), options_(options), extractor_(options.features) {}
 

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "mapping/descriptor_index.h"
-#include "mapping/map.h"
+#include "map/descriptor_index.h"
+#include "map/map.h"
 #include "tracker/absolute_pose.h"
 #include "tracker/features.h"
 
@@ -30,8 +30,8 @@ struct MapMatch {
 };
 
 // Global matching; each map point keeps only its closest keypoint.
-std::vector<MapMatch> MatchToMap(const Features& features, const mapping::Map& map,
-                                 const mapping::DescriptorIndex& index, const MatchOptions& options);
+std::vector<MapMatch> MatchToMap(const Features& features, const map::Map& map,
+                                 const map::DescriptorIndex& index, const MatchOptions& options);
 
 // The correspondences of a localisation, kept for the next frame's optical flow.
 struct Track2D3D {
@@ -57,7 +57,7 @@ struct RelocalizationResult {
 class Relocalizer {
  public:
   // `map` and `index` must outlive the relocalizer.
-  Relocalizer(const mapping::Map& map, const mapping::DescriptorIndex& index,
+  Relocalizer(const map::Map& map, const map::DescriptorIndex& index,
               const RelocalizerOptions& options);
   RelocalizationResult Relocalize(const cv::Mat& gray) const;
   // Features already extracted (e.g. by guided matching of the same frame).
@@ -66,14 +66,14 @@ class Relocalizer {
   const SiftExtractor& extractor() const { return extractor_; }
 
  private:
-  const mapping::Map& map_;
-  const mapping::DescriptorIndex& index_;
+  const map::Map& map_;
+  const map::DescriptorIndex& index_;
   RelocalizerOptions options_;
   SiftExtractor extractor_;
 };
 
 // Pixels and world points of `matches`, in order, for the pose solver.
-void GatherCorrespondences(const Features& features, const mapping::Map& map,
+void GatherCorrespondences(const Features& features, const map::Map& map,
                            const std::vector<MapMatch>& matches,
                            std::vector<Eigen::Vector2d>* pixels,
                            std::vector<Eigen::Vector3d>* points);

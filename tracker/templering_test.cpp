@@ -42,7 +42,7 @@ class TempleRingTest : public ::testing::Test {
     options.frames_spec = "0-46:2";
     options.matcher = mapping::MatcherKind::kExhaustive;
     options.max_num_features = 2048;
-    map_ = std::make_unique<mapping::Map>(mapping::BuildMap(*recording_, dir_ / "map", options).map);
+    map_ = std::make_unique<map::Map>(mapping::BuildMap(*recording_, dir_ / "map", options).map);
   }
   static void TearDownTestSuite() {
     map_.reset();
@@ -63,11 +63,11 @@ class TempleRingTest : public ::testing::Test {
 
   static fs::path dir_;
   static std::unique_ptr<recordings::Recording> recording_;
-  static std::unique_ptr<mapping::Map> map_;
+  static std::unique_ptr<map::Map> map_;
 };
 fs::path TempleRingTest::dir_;
 std::unique_ptr<recordings::Recording> TempleRingTest::recording_;
-std::unique_ptr<mapping::Map> TempleRingTest::map_;
+std::unique_ptr<map::Map> TempleRingTest::map_;
 
 TEST_F(TempleRingTest, LocalizesEveryOddFrameToAboutAMillimetre) {
   ASSERT_EQ(map_->keyframes.size(), 24u);

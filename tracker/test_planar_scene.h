@@ -11,7 +11,7 @@
 
 #include "calib/camera.h"
 #include "calib/pose.h"
-#include "mapping/map.h"
+#include "map/map.h"
 #include "tracker/features.h"
 
 namespace arview::tracker::testing {
@@ -74,12 +74,12 @@ class PlanarWorld {
 
   // A map whose points are the SIFT keypoints of renderings from `keyframes`, each keypoint its
   // own point with one descriptor, placed exactly on the plane.
-  mapping::Map MakeMap(const std::vector<calib::Pose>& keyframes, const SiftExtractor& sift) const {
-    mapping::Map map;
+  map::Map MakeMap(const std::vector<calib::Pose>& keyframes, const SiftExtractor& sift) const {
+    map::Map map;
     map.camera = camera_;
     std::vector<cv::Mat> rows;
     for (size_t k = 0; k < keyframes.size(); ++k) {
-      mapping::Keyframe kf;
+      map::Keyframe kf;
       kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
       kf.name = "kf" + std::to_string(k);
       kf.frame_index = static_cast<int>(k);
@@ -92,7 +92,7 @@ class PlanarWorld {
         if (!Intersect(keyframes[k], camera_.Unproject({p.x, p.y}), &X)) continue;
         const auto id = static_cast<std::uint32_t>(map.points.size());
         const auto row = static_cast<std::uint32_t>(map.descriptor_point.size());
-        mapping::MapPoint mp;
+        map::MapPoint mp;
         mp.xyz = X;
         mp.first_descriptor = row;
         mp.descriptor_count = 1;

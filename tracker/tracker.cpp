@@ -9,7 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "tracker/timing.h"
 
 namespace arview::tracker {
@@ -83,7 +83,7 @@ Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const c
   return out;
 }
 
-void ValidateMap(const mapping::Map& map, int min_points) {
+void ValidateMap(const map::Map& map, int min_points) {
   if (static_cast<int>(map.points.size()) < min_points) {
     std::ostringstream msg;
     msg << "map has " << map.points.size() << " points, at least " << min_points
@@ -91,17 +91,17 @@ void ValidateMap(const mapping::Map& map, int min_points) {
     throw TrackerError(msg.str());
   }
   try {
-    mapping::ValidateMap(map, "map");
-  } catch (const mapping::MapError& e) {
+    map::ValidateMap(map, "map");
+  } catch (const map::MapError& e) {
     throw TrackerError(e.what());
   }
   if (map.descriptors.rows == 0) throw TrackerError("map has no descriptors to match against");
 }
 
-Tracker::Tracker(const mapping::Map& map, const TrackerOptions& options)
+Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
     : map_(map), options_(options), smoother_(options.smoothing) {
   ValidateMap(map, options.min_map_points);
-  index_ = mapping::DescriptorIndex(map.descriptors, options.index);
+  index_ = map::DescriptorIndex(map.descriptors, options.index);
   relocalizer_ = std::make_unique<Relocalizer>(map_, index_, options.relocalization);
   FeatureOptions guided_features = options.relocalization.features;
   guided_features.max_features = options.tracking.guided_max_features;
@@ -163,7 +163,7 @@ struct Tracker::Guided {
   };
 
   static std::vector<MapMatch> Match(const Features& features, const std::vector<Candidate>& cands,
-                                     const mapping::Map& map, double radius, double ratio,
+                                     const map::Map& map, double radius, double ratio,
                                      const cv::Size& size) {
     const int cell = std::max(4, static_cast<int>(std::ceil(radius)));
     const int gw = size.width / cell + 1, gh = size.height / cell + 1;
@@ -187,7 +187,7 @@ struct Tracker::Guided {
           for (int i : grid[gy * gw + gx]) {
             const Candidate& c = cands[i];
             if ((c.pixel - Eigen::Vector2d(kp.x, kp.y)).squaredNorm() > r2) continue;
-            const mapping::MapPoint& mp = map.points[c.point];
+            const map::MapPoint& mp = map.points[c.point];
             int d = std::numeric_limits<int>::max();
             for (std::uint32_t r = 0; r < mp.descriptor_count; ++r)
               d = std::min(d, SquaredDistance(desc, map.descriptors.ptr<std::uint8_t>(

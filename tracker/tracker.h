@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "mapping/descriptor_index.h"
-#include "mapping/map.h"
+#include "map/descriptor_index.h"
+#include "map/map.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
 
@@ -60,8 +60,8 @@ struct TrackingOptions {
 
 // FLANN's default 64 leaves per query, halved: on templeRing and the synthetic room the same
 // frames localise with the same accuracy, and global matching is ~1.5x faster.
-inline mapping::IndexParams DefaultIndexParams() {
-  mapping::IndexParams p;
+inline map::IndexParams DefaultIndexParams() {
+  map::IndexParams p;
   p.checks = 32;
   return p;
 }
@@ -70,7 +70,7 @@ struct TrackerOptions {
   RelocalizerOptions relocalization;
   TrackingOptions tracking;
   OneEuroOptions smoothing;
-  mapping::IndexParams index = DefaultIndexParams();
+  map::IndexParams index = DefaultIndexParams();
   int min_map_points = 30;  // a map with fewer points is refused at construction
 };
 
@@ -103,7 +103,7 @@ class Tracker {
  public:
   // Validates the map and builds its descriptor index. `map` must outlive the tracker.
   // Throws TrackerError when the map has too few points or inconsistent descriptors.
-  Tracker(const mapping::Map& map, const TrackerOptions& options = {});
+  Tracker(const map::Map& map, const TrackerOptions& options = {});
   ~Tracker();
 
   // image: 8-bit grey or BGR at the map camera's resolution; timestamp in seconds.
@@ -121,9 +121,9 @@ class Tracker {
   std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
   std::vector<int> CovisibleKeyframes(const std::vector<std::uint32_t>& points) const;
 
-  const mapping::Map& map_;
+  const map::Map& map_;
   TrackerOptions options_;
-  mapping::DescriptorIndex index_;
+  map::DescriptorIndex index_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<SiftExtractor> guided_extractor_;
   OneEuroFilter smoother_;
@@ -145,7 +145,7 @@ class Tracker {
 Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size);
 
 // Throws TrackerError naming the problem when `map` cannot be tracked against.
-void ValidateMap(const mapping::Map& map, int min_points);
+void ValidateMap(const map::Map& map, int min_points);
 
 // Constant-velocity prediction: apply the last inter-frame motion once more.
 calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity);

@@ -29,7 +29,7 @@ class PlanarTrackerTest : public ::testing::Test {
     if (texture.empty()) return;
     world_ = std::make_unique<PlanarWorld>(texture, TestCamera(), 0.0015);
     const SiftExtractor sift;
-    map_ = std::make_unique<mapping::Map>(world_->MakeMap(
+    map_ = std::make_unique<map::Map>(world_->MakeMap(
         {LookAt({0, 0, -0.9}, {0, 0, 0}), LookAt({0.3, 0, -0.85}, {0.05, 0, 0}),
          LookAt({-0.3, 0.1, -0.85}, {-0.05, 0, 0}), LookAt({0, -0.25, -0.85}, {0, -0.05, 0})},
         sift));
@@ -54,10 +54,10 @@ class PlanarTrackerTest : public ::testing::Test {
   }
 
   static std::unique_ptr<PlanarWorld> world_;
-  static std::unique_ptr<mapping::Map> map_;
+  static std::unique_ptr<map::Map> map_;
 };
 std::unique_ptr<PlanarWorld> PlanarTrackerTest::world_;
-std::unique_ptr<mapping::Map> PlanarTrackerTest::map_;
+std::unique_ptr<map::Map> PlanarTrackerTest::map_;
 
 TEST_F(PlanarTrackerTest, RelocalizesANovelView) {
   Tracker tracker(*map_);
@@ -125,7 +125,7 @@ TEST_F(PlanarTrackerTest, BlackAndTinyFramesAreLost) {
 }
 
 TEST_F(PlanarTrackerTest, MapWithTooFewPointsIsAClearErrorAtLoad) {
-  mapping::Map small = *map_;
+  map::Map small = *map_;
   small.points.resize(10);
   small.keyframes.clear();
   small.descriptors = small.descriptors.rowRange(0, 10).clone();
@@ -139,7 +139,7 @@ TEST_F(PlanarTrackerTest, MapWithTooFewPointsIsAClearErrorAtLoad) {
 }
 
 TEST_F(PlanarTrackerTest, InconsistentMapIsRefusedWithTheReason) {
-  mapping::Map broken = *map_;
+  map::Map broken = *map_;
   broken.descriptor_point.pop_back();
   try {
     Tracker tracker(broken);

@@ -1,4 +1,4 @@
-#include "mapping/descriptor_index.h"
+#include "map/descriptor_index.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-namespace arview::mapping {
+namespace arview::map {
 namespace {
 
 // Clustered random descriptors: like SIFT, many rows share structure, and each query is a
@@ -100,4 +100,4 @@ TEST(DescriptorIndex, RejectsWrongMatrices) {
 }
 
 }  // namespace
-}  // namespace arview::mapping
+}  // namespace arview::map

@@ -3,7 +3,7 @@
 // COLMAP's uint8 convention). The tracker queries it with its own frame's descriptors converted
 // the same way (L1-normalise, square root, x512, round, clamp to 255).
 //
-// The index type was chosen by measurement (docs/mapping.md, "Descriptor index"): recall of the
+// The index type was chosen by measurement (docs/map.md, "Descriptor index"): recall of the
 // true nearest neighbour against query time on the templeRing map.
 
 #include <opencv2/core.hpp>
@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace arview::mapping {
+namespace arview::map {
 
 struct DescriptorIndexError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -72,4 +72,4 @@ class DescriptorIndex {
   IndexParams params_;
 };
 
-}  // namespace arview::mapping
+}  // namespace arview::map

@@ -1,4 +1,4 @@
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 
 #include <algorithm>
 #include <bit>
@@ -7,7 +7,7 @@
 #include <fstream>
 #include <type_traits>
 
-namespace arview::mapping {
+namespace arview::map {
 
 namespace fs = std::filesystem;
 
@@ -328,4 +328,4 @@ MapStats ComputeStats(const Map& map) {
   return s;
 }
 
-}  // namespace arview::mapping
+}  // namespace arview::map

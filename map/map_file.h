@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <string>
 
-#include "mapping/map.h"
+#include "map/map.h"
 
-namespace arview::mapping {
+namespace arview::map {
 
 inline constexpr const char* kMapFileName = "map.arvmap";
 inline constexpr std::uint32_t kMapFileVersion = 1;
@@ -43,4 +43,4 @@ struct MapStats {
 
 MapStats ComputeStats(const Map& map);
 
-}  // namespace arview::mapping
+}  // namespace arview::map

@@ -1,7 +1,7 @@
 #pragma once
 // The Map the tracker loads: COLMAP's sparse model and feature descriptors, in memory, in the
-// map's world frame. This header is the contract between mapping/ (which builds, saves and
-// loads it) and tracker/ (which only reads it).
+// map's world frame. This library (map/) is the contract between mapping/ (which builds it from
+// COLMAP's output) and tracker/ (which loads and reads it); it needs neither COLMAP nor SQLite.
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -15,7 +15,7 @@
 #include "calib/camera.h"
 #include "calib/pose.h"
 
-namespace arview::mapping {
+namespace arview::map {
 
 struct MapError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -52,10 +52,10 @@ struct Map {
   // One row per track element: uint8 SIFT in COLMAP's convention (L1-root, ×512, clamp 255).
   cv::Mat descriptors;                      // N x 128, CV_8U
   std::vector<std::uint32_t> descriptor_point;  // row → index into points
-  // Added by mapping/: row → index into keyframes (the keyframe whose keypoint gave the row).
+  // Filled by mapping/: row → index into keyframes (the keyframe whose keypoint gave the row).
   std::vector<std::uint32_t> descriptor_keyframe;
 };
 
-// Reading and writing maps, and what `arview map info` prints: mapping/map_file.h.
+// Reading and writing maps, and what `arview map info` prints: map/map_file.h.
 
-}  // namespace arview::mapping
+}  // namespace arview::map

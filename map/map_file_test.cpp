@@ -1,4 +1,4 @@
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <random>
 
-namespace arview::mapping {
+namespace arview::map {
 namespace {
 
 namespace fs = std::filesystem;
@@ -156,4 +156,4 @@ TEST_F(MapFileTest, InconsistentMapsAreRefused) {
 }
 
 }  // namespace
-}  // namespace arview::mapping
+}  // namespace arview::map

@@ -1,11 +1,11 @@
-#include "mapping/descriptor_index.h"
+#include "map/descriptor_index.h"
 
 #include <flann/flann.hpp>
 
 #include <cmath>
 #include <string>
 
-namespace arview::mapping {
+namespace arview::map {
 
 namespace {
 
@@ -89,4 +89,4 @@ std::vector<Neighbor> DescriptorIndex::Knn(const std::uint8_t* descriptor, int k
   return Knn(row, k).front();
 }
 
-}  // namespace arview::mapping
+}  // namespace arview::map
