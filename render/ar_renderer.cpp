@@ -3,6 +3,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+
 namespace arview::render {
 
 Antialiasing ParseAntialiasing(const std::string& name) {
@@ -26,8 +28,73 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
 }
 
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
-  characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character)});
+  characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
+                         std::make_unique<CastShadow>(context_->gl())});
+  if (options_.lighting == LightingMode::kShShadowed) {
+    const CharacterTransfer transfer = ComputeShadowedTransfer(character, options_.prt);
+    characters_.back().renderer->SetTransfer(transfer);
+    prt_seconds_ += transfer.seconds;
+  }
   return static_cast<int>(characters_.size()) - 1;
+}
+
+void ArRenderer::SetRoomLight(const RoomLight& light) {
+  room_light_ = light;
+  has_room_light_ = true;
+  current_sh_ = light.sh;
+  follower_ = std::make_unique<ExposureFollower>(light.thumbnails, options_.exposure_smoothing);
+  SetOccluders(light.occluder_triangles);
+}
+
+void ArRenderer::SetOccluders(const std::vector<Eigen::Vector3f>& triangles) {
+  if (triangles.empty()) {
+    occluders_.reset();
+    return;
+  }
+  occluders_ = std::make_unique<DepthProxy>(context_->gl(), triangles);
+}
+
+void ArRenderer::FollowExposure(const cv::Mat& background, const calib::Pose& pose) {
+  if (options_.lighting == LightingMode::kFixed) return;
+  if (!has_room_light_) {
+    throw RenderError("lighting '" + LightingModeName(options_.lighting) +
+                      "' needs the room's light (a .light.yml from 'arview place --recording')");
+  }
+  const Eigen::Vector3d gain = background.empty() ? follower_->gain() : follower_->Update(background, pose);
+  current_sh_ = Scaled(room_light_.sh, gain);
+}
+
+bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const {
+  if (!options_.cast_shadow || !has_room_light_ || frame.model.empty()) return false;
+  const anim::CharacterSpec& spec = *placed.spec;
+  const Eigen::Matrix4d model_to_map = spec.ModelToMap();
+  const double scale = model_to_map.topLeftCorner<3, 3>().colwise().norm().maxCoeff();
+  const std::vector<float>& radii = placed.renderer->joint_radii();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Eigen::Matrix4d& joint : frame.model) {
+    const Eigen::Vector3d p = (model_to_map * joint.col(3)).head<3>();
+    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3d centre = (lo + hi) / 2;
+  double radius = 0;
+  for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
+    if (radii[j] <= 0) continue;
+    const Eigen::Vector3d p = (model_to_map * frame.model[j].col(3)).head<3>();
+    radius = std::max(radius, (p - centre).norm() + 1.1 * radii[j] * scale);
+  }
+  const Eigen::Vector3d normal = (spec.anchor.rotation.normalized() * spec.up).normalized();
+  // Below 15 degrees of elevation the shadow would stretch across the room: none.
+  return MakeLightView(room_light_.dominant.direction, centre, radius, spec.anchor.position, normal, 15.0, view);
+}
+
+float ArRenderer::CastShadowStrength(const Placed& placed) const {
+  // The share of the floor's irradiance the dominant light brings: what the character's shadow removes.
+  const Eigen::Vector3d normal = (placed.spec->anchor.rotation.normalized() * placed.spec->up).normalized();
+  const Eigen::Vector3d w = LuminanceWeights();
+  const double total = IrradianceSh(room_light_.sh, normal).dot(w);
+  const double direct = room_light_.dominant.color.dot(w) * std::max(0.0, room_light_.dominant.direction.dot(normal));
+  if (!(total > 0)) return 0.f;
+  return static_cast<float>(std::clamp(direct / total, 0.0, double(options_.cast_shadow_max_strength)));
 }
 
 cv::Mat ArRenderer::PrepareBackground(const cv::Mat& background) {
@@ -108,6 +175,10 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     if (options_.shadow && Shadow(placed, frame, &e)) {
       for (int k = 0; k < 4; ++k) add(e.center + (k & 1 ? 1.0 : -1.0) * e.axis_u + (k & 2 ? 1.0 : -1.0) * e.axis_v);
     }
+    LightView light;
+    if (CastShadowView(placed, frame, &light)) {
+      for (const Eigen::Vector3d& corner : light.floor_corners) add(corner);
+    }
     if (behind) return full;
   }
   if (u0 > u1) return {};
@@ -127,20 +198,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   if (rect.empty()) return;  // nothing in view: the video frame as it is
 
   const GlApi& gl = context_->gl();
-  target_.Bind();
-  target_.Scissor(rect);
-  gl.ClearColor(0, 0, 0, 0);
-  gl.ClearDepth(1.0);
-  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
-  const Eigen::Matrix4d view = ViewMatrix(eye);
-  for (size_t i = 0; i < characters_.size(); ++i) {
-    Placed& placed = characters_[i];
-    const anim::FrameOutput& out = *frames[i];
-    ShadowEllipse e;
-    if (options_.shadow && Shadow(placed, out, &e)) {
-      shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
-    }
+  auto character_draw = [&](const Placed& placed, const anim::FrameOutput& out) {
     const Eigen::Matrix3d rotation = placed.spec->anchor.rotation.normalized().toRotationMatrix();
     CharacterDraw draw;
     draw.model_to_map = placed.spec->ModelToMap();
@@ -152,7 +210,45 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     // contact shadow straight below it is plausible.
     draw.light_direction_map =
         (rotation * (placed.spec->up.normalized() + 0.6 * placed.spec->forward.normalized())).normalized();
-    placed.renderer->Draw(projection, view, draw);
+    draw.lighting = options_.lighting;
+    draw.sh = current_sh_;
+    return draw;
+  };
+  // Cast shadows first: each character's silhouette seen from the light, in its own target.
+  std::vector<LightView> light_views(characters_.size());
+  std::vector<bool> casts(characters_.size(), false);
+  for (size_t i = 0; i < characters_.size(); ++i) {
+    Placed& placed = characters_[i];
+    if (!CastShadowView(placed, *frames[i], &light_views[i])) continue;
+    casts[i] = true;
+    CharacterDraw draw = character_draw(placed, *frames[i]);
+    draw.silhouette = true;
+    draw.cull_back_faces = false;
+    placed.cast->BeginSilhouette();
+    placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
+    placed.cast->EndSilhouette();
+  }
+  target_.Bind();
+  target_.Scissor(rect);
+  gl.ClearColor(0, 0, 0, 0);
+  gl.ClearDepth(1.0);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
+  const Eigen::Matrix4d view = ViewMatrix(eye);
+  // Real things in front of the characters: depth only, before anything is drawn.
+  if (options_.occlusion && occluders_) occluders_->Draw(projection, view);
+  for (size_t i = 0; i < characters_.size(); ++i) {
+    Placed& placed = characters_[i];
+    const anim::FrameOutput& out = *frames[i];
+    ShadowEllipse e;
+    if (options_.shadow && Shadow(placed, out, &e)) {
+      shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
+    }
+    if (casts[i]) {
+      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed),
+                                options_.cast_shadow_softness);
+    }
+    placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
   target_.Scissor({});
@@ -174,6 +270,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
 
 cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
                            std::span<const anim::FrameOutput* const> frames) {
+  FollowExposure(background, pose);
   cv::Mat frame = PrepareBackground(background);
   Compose(frame, pose, frames);
   return frame;
@@ -182,6 +279,7 @@ cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
 cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
                                      std::span<const anim::FrameOutput* const> frames, double ipd_m) {
   if (!(ipd_m >= 0 && ipd_m < 0.5)) throw RenderError("interpupillary distance must be in [0, 0.5) m");
+  FollowExposure(background, pose);
   const cv::Mat video = PrepareBackground(background);
   cv::Mat both(camera_.height, 2 * camera_.width, CV_8UC3);
   cv::Mat left = both(cv::Rect(0, 0, camera_.width, camera_.height));

@@ -24,6 +24,8 @@
 #include "render/character_renderer.h"
 #include "render/offscreen.h"
 #include "render/projection.h"
+#include "render/room_light.h"
+#include "render/scene_depth.h"
 
 namespace arview::render {
 
@@ -46,6 +48,15 @@ struct ArOptions {
   float shadow_strength = 0.55f;
   cv::Scalar empty_background{128, 128, 128};  // BGR, when no camera image is given
   bool full_frame = false;  // draw and read the whole frame (for checking the bounds)
+  // The room's light (SetRoomLight) for kShUnshadowed / kShShadowed; kShShadowed ray casts
+  // each character's PRT transfer in AddCharacter (prt_seconds() says how long it took).
+  LightingMode lighting = LightingMode::kFixed;
+  bool cast_shadow = true;      // from the room light's dominant direction, when there is a room light
+  bool occlusion = true;        // the room light's occluder triangles in the depth buffer first
+  float cast_shadow_softness = 0.03f;  // blur radius, share of the character's bounding diameter
+  float cast_shadow_max_strength = 0.8f;
+  double exposure_smoothing = 0.25;    // ExposureFollower's per-frame share
+  PrtOptions prt;
 };
 
 class ArRenderer {
@@ -68,6 +79,17 @@ class ArRenderer {
   cv::Mat RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
                            std::span<const anim::FrameOutput* const> frames, double ipd_m);
 
+  // The room's light: SH and dominant light for the SH lighting modes and the cast shadow, the
+  // keyframe thumbnails the live exposure is followed against, the occluder triangles.
+  void SetRoomLight(const RoomLight& light);
+  // Replaces the depth-only occluders (map frame, 3 corners a triangle); empty: none.
+  void SetOccluders(const std::vector<Eigen::Vector3f>& triangles);
+  // The SH light of the last frame (the room light times the followed exposure gain).
+  const ShRgb& current_sh() const { return current_sh_; }
+  Eigen::Vector3d exposure_gain() const { return follower_ ? follower_->gain() : Eigen::Vector3d::Ones(); }
+  // Total PRT precomputation time of the characters added so far, seconds.
+  double prt_seconds() const { return prt_seconds_; }
+
   const calib::Camera& pinhole() const { return pinhole_; }
   const ArOptions& options() const { return options_; }
   // Whether the last Render had to skin a character linearly because its joints scale.
@@ -78,6 +100,7 @@ class ArRenderer {
     const anim::Character* character;
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
+    std::unique_ptr<CastShadow> cast;
   };
   struct ShadowEllipse {
     Eigen::Vector3d center, axis_u, axis_v;
@@ -86,6 +109,10 @@ class ArRenderer {
   // Draws the characters seen from `eye` and blends them over `frame` (in place).
   void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
   bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
+  // The cast shadow's light view for this frame (false: no cast shadow).
+  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const;
+  float CastShadowStrength(const Placed& placed) const;
+  void FollowExposure(const cv::Mat& background, const calib::Pose& pose);
   // The screen rectangle that contains everything drawn (empty when nothing is in view).
   cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) const;
 
@@ -97,6 +124,12 @@ class ArRenderer {
   ContactShadow shadow_;
   std::vector<Placed> characters_;
   bool used_linear_fallback_ = false;
+  bool has_room_light_ = false;
+  RoomLight room_light_;
+  ShRgb current_sh_{};
+  std::unique_ptr<ExposureFollower> follower_;
+  std::unique_ptr<DepthProxy> occluders_;
+  double prt_seconds_ = 0;
 };
 
 }  // namespace arview::render

@@ -27,6 +27,9 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
 layout(location = 3) in uvec4 joints;
 layout(location = 4) in vec4 weights;
+layout(location = 5) in vec3 transfer0;  // PRT: SH coefficients 0-2 (bind pose, model space)
+layout(location = 6) in vec3 transfer1;  // 3-5
+layout(location = 7) in vec3 transfer2;  // 6-8
 uniform mat4 mvp;            // projection · view · model_to_map
 uniform mat4 model;          // model_to_map
 uniform mat3 normal_matrix;  // inverse transpose of model_to_map's 3x3
@@ -34,14 +37,40 @@ uniform int method;          // 0: linear blend, 1: dual quaternion
 uniform mat4 skin[JOINTS];
 uniform vec4 dq_real[JOINTS];  // quaternion (x, y, z, w)
 uniform vec4 dq_dual[JOINTS];
+uniform int lighting;        // 0: fixed key + ambient, 1: SH irradiance, 2: SH with PRT transfer
+uniform mat3 model_rotation; // model_to_map's rotation, without its scale
+uniform vec3 sh[9];          // incident radiance (map frame), RGB
 out vec3 v_normal;
 out vec2 v_uv;
+out vec3 v_prt;              // lighting 2: radiance / albedo at the vertex
 
 vec3 rotate(vec4 q, vec3 v) { return v + 2.0 * cross(q.xyz, cross(q.xyz, v) + q.w * v); }
+
+mat3 quat_matrix(vec4 q) {
+  return mat3(rotate(q, vec3(1, 0, 0)), rotate(q, vec3(0, 1, 0)), rotate(q, vec3(0, 0, 1)));
+}
+
+// Dynamic PRT: the vertex's bind-pose transfer rotated by its skinning rotation r (band 1 as a
+// vector, band 2 as the symmetric matrix Q of f(w) = wQw, Q' = r Q rT), dotted with the light.
+vec3 prt_radiance(mat3 r) {
+  const float k1 = 1.092548430592079, k0 = 0.315391565252520, k2 = 0.546274215296040;
+  float t[9] = float[9](transfer0.x, transfer0.y, transfer0.z, transfer1.x, transfer1.y, transfer1.z,
+                        transfer2.x, transfer2.y, transfer2.z);
+  vec3 b1 = r * vec3(t[3], t[1], t[2]);
+  mat3 q = mat3(-k0 * t[6] + k2 * t[8], 0.5 * k1 * t[4], 0.5 * k1 * t[7],
+                0.5 * k1 * t[4], -k0 * t[6] - k2 * t[8], 0.5 * k1 * t[5],
+                0.5 * k1 * t[7], 0.5 * k1 * t[5], 2.0 * k0 * t[6]);
+  mat3 qr = r * q * transpose(r);
+  vec3 l = sh[0] * t[0] + sh[1] * b1.y + sh[2] * b1.z + sh[3] * b1.x +
+           sh[4] * (2.0 * qr[1][0] / k1) + sh[5] * (2.0 * qr[2][1] / k1) + sh[6] * (qr[2][2] / (2.0 * k0)) +
+           sh[7] * (2.0 * qr[2][0] / k1) + sh[8] * ((qr[0][0] - qr[1][1]) / (2.0 * k2));
+  return max(l, vec3(0.0)) / 3.14159265358979;
+}
 
 void main() {
   vec3 p;
   vec3 n;
+  mat3 skin_rotation;
   if (method == 1) {
     // Kavan et al. 2007: blend in the hemisphere of the first joint, normalise, apply.
     vec4 r0 = dq_real[joints.x];
@@ -61,13 +90,21 @@ void main() {
     vec3 t = 2.0 * (real.w * dual.xyz - dual.w * real.xyz + cross(real.xyz, dual.xyz));
     p = rotate(real, position) + t;
     n = rotate(real, normal);
+    if (lighting == 2) skin_rotation = quat_matrix(real);
   } else {
     mat4 m = weights.x * skin[joints.x] + weights.y * skin[joints.y] + weights.z * skin[joints.z] +
              weights.w * skin[joints.w];
     p = (m * vec4(position, 1.0)).xyz;
     n = mat3(m) * normal;
+    if (lighting == 2) {
+      // The rotation of the blended matrix (Gram-Schmidt): SH rotation needs an orthogonal one.
+      vec3 x = normalize(m[0].xyz);
+      vec3 y = normalize(m[1].xyz - dot(m[1].xyz, x) * x);
+      skin_rotation = mat3(x, y, cross(x, y));
+    }
   }
   v_normal = normal_matrix * n;
+  v_prt = lighting == 2 ? prt_radiance(model_rotation * skin_rotation) : vec3(0.0);
   // Assimp's texture coordinates have v = 0 at the image's bottom; textures are uploaded top
   // row first.
   v_uv = vec2(uv.x, 1.0 - uv.y);
@@ -79,17 +116,40 @@ void main() {
 const char* kFragmentShader = R"(#version 450 core
 in vec3 v_normal;
 in vec2 v_uv;
+in vec3 v_prt;
 uniform sampler2D albedo;
 uniform vec4 base_color;
 uniform vec3 light;  // map frame, towards the light
 uniform float key;
 uniform float ambient;
+uniform int lighting;
+uniform int silhouette;  // 1: white coverage only (the cast shadow's light view)
+uniform vec3 sh[9];
 out vec4 frag_color;
+
+// Ramamoorthi and Hanrahan 2001: irradiance from order-2 SH, divided by pi (Lambertian radiance / albedo).
+vec3 sh_irradiance(vec3 n) {
+  const float a0 = 3.14159265358979, a1 = 2.09439510239320, a2 = 0.785398163397448;
+  vec3 e = a0 * 0.282094791773878 * sh[0] +
+           a1 * 0.488602511902920 * (sh[1] * n.y + sh[2] * n.z + sh[3] * n.x) +
+           a2 * (1.092548430592079 * (sh[4] * n.x * n.y + sh[5] * n.y * n.z + sh[7] * n.x * n.z) +
+                 0.315391565252520 * sh[6] * (3.0 * n.z * n.z - 1.0) +
+                 0.546274215296040 * sh[8] * (n.x * n.x - n.y * n.y));
+  return max(e, vec3(0.0)) / 3.14159265358979;
+}
+
 void main() {
+  if (silhouette == 1) {
+    frag_color = vec4(1.0);
+    return;
+  }
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;
   vec4 c = texture(albedo, v_uv) * base_color;
-  float shade = ambient + key * max(dot(n, light), 0.0);
+  vec3 shade;
+  if (lighting == 1) shade = sh_irradiance(n);
+  else if (lighting == 2) shade = v_prt;
+  else shade = vec3(ambient + key * max(dot(n, light), 0.0));
   frag_color = vec4(c.rgb * shade, 1.0);
 }
 )";
@@ -137,7 +197,9 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   loc_ = {Uniform(gl, p, "mvp"),     Uniform(gl, p, "model"),   Uniform(gl, p, "normal_matrix"),
           Uniform(gl, p, "method"),  Uniform(gl, p, "skin"),    Uniform(gl, p, "dq_real"),
           Uniform(gl, p, "dq_dual"), Uniform(gl, p, "light"),   Uniform(gl, p, "key"),
-          Uniform(gl, p, "ambient"), Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo")};
+          Uniform(gl, p, "ambient"), Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo"),
+          Uniform(gl, p, "lighting"), Uniform(gl, p, "model_rotation"), Uniform(gl, p, "sh"),
+          Uniform(gl, p, "silhouette")};
   white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
   for (const anim::Texture& t : character.textures) {
     textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, kCharacterAnisotropy, true}));
@@ -198,6 +260,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     attribute(4, 4, offsetof(CharacterVertex, weights));
     gl.BindVertexArray(0);
     gpu.index_count = static_cast<GLsizei>(mesh.indices.size());
+    gpu.vertex_count = static_cast<int>(n);
     triangles_ += gpu.index_count / 3;
     if (mesh.material >= 0 && mesh.material < static_cast<int>(character.materials.size())) {
       const anim::Material& material = character.materials[mesh.material];
@@ -208,6 +271,32 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   }
   dq_upload_.resize(static_cast<size_t>(joints_) * 8);
   CheckGl(gl, "character upload (" + character.source + ")");
+}
+
+void CharacterRenderer::SetTransfer(const CharacterTransfer& transfer) {
+  const GlApi& gl = *gl_;
+  if (transfer.meshes.size() != meshes_.size()) {
+    throw RenderError("PRT transfer has " + std::to_string(transfer.meshes.size()) + " meshes, the character " +
+                      std::to_string(meshes_.size()));
+  }
+  for (size_t m = 0; m < meshes_.size(); ++m) {
+    if (static_cast<int>(transfer.meshes[m].size()) != meshes_[m].vertex_count) {
+      throw RenderError("PRT transfer of mesh " + std::to_string(m) + " has " + std::to_string(transfer.meshes[m].size()) +
+                        " vertices, the mesh " + std::to_string(meshes_[m].vertex_count));
+    }
+  }
+  for (size_t m = 0; m < meshes_.size(); ++m) {
+    GpuMesh& mesh = meshes_[m];
+    gl.BindVertexArray(mesh.vao.get());
+    mesh.transfer_vbo = MakeBuffer(gl, GL_ARRAY_BUFFER, transfer.meshes[m].data(), transfer.meshes[m].size() * sizeof(Sh9f));
+    for (GLuint k = 0; k < 3; ++k) {
+      gl.EnableVertexAttribArray(5 + k);
+      gl.VertexAttribPointer(5 + k, 3, GL_FLOAT, GL_FALSE, sizeof(Sh9f), reinterpret_cast<void*>(k * 3 * sizeof(float)));
+    }
+    gl.BindVertexArray(0);
+  }
+  has_transfer_ = true;
+  CheckGl(gl, "PRT transfer upload");
 }
 
 void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const CharacterDraw& d) {
@@ -253,6 +342,19 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   } else {
     gl.UniformMatrix4fv(loc_.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
   }
+  const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
+  gl.Uniform1i(loc_.lighting, d.silhouette ? 0 : static_cast<int>(lighting));
+  gl.Uniform1i(loc_.silhouette, d.silhouette ? 1 : 0);
+  if (lighting != LightingMode::kFixed && !d.silhouette) {
+    float sh[27];
+    for (int k = 0; k < 9; ++k)
+      for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
+    gl.Uniform3fv(loc_.sh, 9, sh);
+    Eigen::Matrix3d rotation = d.model_to_map.topLeftCorner<3, 3>();
+    rotation /= std::cbrt(std::abs(rotation.determinant()));  // uniform scale out
+    const Eigen::Matrix3f r = rotation.cast<float>();
+    gl.UniformMatrix3fv(loc_.model_rotation, 1, GL_FALSE, r.data());
+  }
   gl.Uniform3f(loc_.light, light.x(), light.y(), light.z());
   gl.Uniform1f(loc_.key, d.key);
   gl.Uniform1f(loc_.ambient, d.ambient);
@@ -265,6 +367,22 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
     gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   }
   gl.BindVertexArray(0);
+}
+
+LightingMode ParseLightingMode(const std::string& name) {
+  if (name == "fixed") return LightingMode::kFixed;
+  if (name == "sh") return LightingMode::kShUnshadowed;
+  if (name == "prt") return LightingMode::kShShadowed;
+  throw RenderError("unknown lighting '" + name + "' (expected fixed, sh or prt)");
+}
+
+std::string LightingModeName(LightingMode mode) {
+  switch (mode) {
+    case LightingMode::kFixed: return "fixed";
+    case LightingMode::kShUnshadowed: return "sh";
+    case LightingMode::kShShadowed: return "prt";
+  }
+  return "?";
 }
 
 namespace {

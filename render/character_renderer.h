@@ -6,13 +6,24 @@
 #include <Eigen/Core>
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "anim/character.h"
 #include "anim/pose.h"
 #include "render/gl_objects.h"
+#include "render/prt.h"
+#include "render/sh.h"
 
 namespace arview::render {
+
+// How the character is shaded: the old fixed key + ambient light; the room's SH light as
+// diffuse irradiance at each pixel's normal (unshadowed); or the room's SH light through the
+// per-vertex PRT transfer (self-shadowed, rotated with the skinning).
+enum class LightingMode { kFixed, kShUnshadowed, kShShadowed };
+// "fixed" | "sh" | "prt"; throws RenderError otherwise.
+LightingMode ParseLightingMode(const std::string& name);
+std::string LightingModeName(LightingMode mode);
 
 struct CharacterDraw {
   Eigen::Matrix4d model_to_map = Eigen::Matrix4d::Identity();
@@ -25,6 +36,10 @@ struct CharacterDraw {
   // Skip triangles facing away (counter-clockwise front faces, as anim/ imports them): half the
   // rasterisation for closed meshes; off for assets with open, single-sided parts.
   bool cull_back_faces = true;
+  LightingMode lighting = LightingMode::kFixed;
+  ShRgb sh{};  // the room's incident radiance (map frame, RGB) for the SH modes
+  // Coverage only (white, no shading): the cast shadow's view from the light.
+  bool silhouette = false;
 };
 
 class CharacterRenderer {
@@ -42,11 +57,16 @@ class CharacterRenderer {
   // every skinned vertex stays within these spheres around the posed joints (for rigid joints),
   // which bounds the character on screen.
   const std::vector<float>& joint_radii() const { return joint_radii_; }
+  // Uploads per-vertex PRT transfer (ComputeShadowedTransfer of the same character); needed by
+  // LightingMode::kShShadowed. Throws RenderError when the vertex counts differ.
+  void SetTransfer(const CharacterTransfer& transfer);
+  bool has_transfer() const { return has_transfer_; }
 
  private:
   struct GpuMesh {
-    GlName vao, vbo, ibo;
+    GlName vao, vbo, ibo, transfer_vbo;
     GLsizei index_count = 0;
+    int vertex_count = 0;
     Eigen::Vector4f base_color = Eigen::Vector4f::Ones();
     int texture = -1;  // index into textures_, −1: white
   };
@@ -58,10 +78,12 @@ class CharacterRenderer {
   GlName white_;
   std::vector<GpuMesh> meshes_;
   bool used_linear_fallback_ = false;
+  bool has_transfer_ = false;
   std::vector<float> joint_radii_;
   std::vector<float> dq_upload_;
   struct Locations {
     GLint mvp, model, normal_matrix, method, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
+    GLint lighting, model_rotation, sh, silhouette;
   } loc_{};
 };
 

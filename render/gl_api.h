@@ -82,6 +82,7 @@ namespace arview::render {
   X(void, Uniform2f, (GLint, GLfloat, GLfloat))                                                       \
   X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                              \
   X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                     \
+  X(void, Uniform3fv, (GLint, GLsizei, const GLfloat*))                                               \
   X(void, Uniform4fv, (GLint, GLsizei, const GLfloat*))                                               \
   X(void, UniformMatrix3fv, (GLint, GLsizei, GLboolean, const GLfloat*))                              \
   X(void, UniformMatrix4fv, (GLint, GLsizei, GLboolean, const GLfloat*))                              \

@@ -1,0 +1,474 @@
+// The room's light at the character (issue 14): SH estimation on an analytic environment, PRT
+// transfer and its per-vertex rotation, the cast shadow's direction, occlusion by a pillar, and
+// the character's colour following a coloured light and an exposure ramp in the rendered room.
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include "anim/scene.h"
+#include "render/ar_renderer.h"
+#include "render/prt.h"
+#include "render/room_light.h"
+#include "render/scene_proxy.h"
+#include "render/synth_room.h"
+#include "render/test_scene.h"
+#include "tests/support/test_data.h"
+
+namespace arview::render {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::SharedContext;
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180 / M_PI;
+}
+
+std::vector<Eigen::Vector3d> FibonacciSphere(int n) {
+  std::vector<Eigen::Vector3d> out;
+  const double golden = M_PI * (3 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z);
+    out.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return out;
+}
+
+calib::Pose LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, Eigen::Vector3d up = Eigen::Vector3d::UnitZ()) {
+  const Eigen::Vector3d forward = (target - eye).normalized();
+  if (std::abs(forward.dot(up)) > 0.99) up = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d right = forward.cross(up).normalized();
+  Eigen::Matrix3d r_wc;
+  r_wc << right, forward.cross(right), forward;
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
+}
+
+// Triangles of the box [lo, hi].
+std::vector<Eigen::Vector3f> BoxTriangles(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const auto c = testing::BoxCorners(lo, hi, Eigen::Isometry3d::Identity());
+  const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+  std::vector<Eigen::Vector3f> out;
+  for (const auto& f : faces)
+    for (int k : {0, 1, 2, 0, 2, 3}) out.push_back(c[f[k]].cast<float>());
+  return out;
+}
+
+// Points spread uniformly by area over triangles.
+std::vector<Eigen::Vector3d> SamplePoints(const std::vector<Eigen::Vector3f>& tris, int count, std::uint64_t seed) {
+  std::vector<double> cumulative;
+  double total = 0;
+  for (size_t i = 0; i + 2 < tris.size(); i += 3) {
+    total += 0.5 * (tris[i + 1] - tris[i]).cross(tris[i + 2] - tris[i]).norm();
+    cumulative.push_back(total);
+  }
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Eigen::Vector3d> points;
+  for (int n = 0; n < count; ++n) {
+    const size_t t = std::lower_bound(cumulative.begin(), cumulative.end(), unit(rng) * total) - cumulative.begin();
+    double a = unit(rng), b = unit(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const Eigen::Vector3d p0 = tris[3 * t].cast<double>(), p1 = tris[3 * t + 1].cast<double>(), p2 = tris[3 * t + 2].cast<double>();
+    points.push_back(p0 + a * (p1 - p0) + b * (p2 - p0));
+  }
+  return points;
+}
+
+// ---------------------------------------------------------------- SH algebra
+
+TEST(Sh, CapClosedFormMatchesQuadratureAndRotates) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  const double half = 20 * M_PI / 180;
+  const ShRgb exact = CapSh(axis, half, {1, 2, 3});
+  const ShRgb numeric = ProjectRadiance([&](const Eigen::Vector3d& d) {
+    return d.dot(axis) >= std::cos(half) ? Eigen::Vector3d(1, 2, 3) : Eigen::Vector3d::Zero();
+  }, 400000);
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR((exact[k] - numeric[k]).norm(), 0, 2e-3) << k;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
+  const ShRgb rotated = RotateSh(exact, r);
+  const ShRgb direct = CapSh(r * axis, half, {1, 2, 3});
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR((rotated[k] - direct[k]).norm(), 0, 1e-9) << k;
+}
+
+TEST(Sh, DominantLightOfADirectionalLightPlusAmbientIsExact) {
+  const Eigen::Vector3d d = Eigen::Vector3d(-0.4, 0.2, 0.9).normalized();
+  // A directional light c: L_lm = c Y_lm(d).
+  ShRgb sh = ConstantSh({0.1, 0.2, 0.3});
+  const Sh9 y = ShBasis(d);
+  for (int k = 0; k < 9; ++k) sh[k] += Eigen::Vector3d(2.0, 1.5, 1.0) * y[k];
+  const DominantLight light = ExtractDominantLight(sh);
+  EXPECT_LT(AngleDeg(light.direction, d), 1e-6);
+  EXPECT_NEAR((light.color - Eigen::Vector3d(2.0, 1.5, 1.0)).norm(), 0, 1e-9);
+  EXPECT_NEAR((light.ambient - Eigen::Vector3d(0.1, 0.2, 0.3)).norm(), 0, 1e-9);
+}
+
+// ---------------------------------------------------------------- analytic environment
+
+// One directional light (a 4-degree cap) plus ambient, "painted" on the walls of a 6 x 5 x 3 m
+// room so that, seen from the character's position, every wall point has the environment's
+// radiance in its direction; 30 keyframes (HDR, float) rendered by ray casting from cameras
+// near the character looking every way.
+struct AnalyticRoom {
+  Eigen::Vector3d position{0.5, 0.3, 0.9};
+  Eigen::Vector3d light_direction = Eigen::Vector3d(-0.5, 0.4, 0.75).normalized();
+  double half_angle = 4 * M_PI / 180;
+  Eigen::Vector3d light_radiance{46, 40, 30};
+  Eigen::Vector3d ambient{0.15, 0.14, 0.12};
+  std::vector<Eigen::Vector3f> walls = BoxTriangles({-3, -2.5, 0}, {3, 2.5, 3});
+  ShRgb Exact() const { return ConstantSh(ambient) + CapSh(light_direction, half_angle, light_radiance); }
+  Eigen::Vector3d Radiance(const Eigen::Vector3d& d) const {
+    return ambient + (d.dot(light_direction) >= std::cos(half_angle) ? light_radiance : Eigen::Vector3d::Zero());
+  }
+  std::vector<LightKeyframe> Keyframes() const {
+    const TriangleBvh bvh(walls);
+    const calib::Camera camera = calib::Camera::Pinhole(320, 240, 277, 277, 159.5, 119.5);
+    std::vector<LightKeyframe> keys;
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> offset(-0.5, 0.5);
+    for (const Eigen::Vector3d& look : FibonacciSphere(30)) {
+      const Eigen::Vector3d eye = position + Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
+      LightKeyframe key{camera, LookAt(eye, eye + look), cv::Mat(240, 320, CV_32FC3)};
+      const Eigen::Matrix3d r_wc = key.pose.CameraToWorldRotation().toRotationMatrix();
+      for (int v = 0; v < 240; ++v)
+        for (int u = 0; u < 320; ++u) {
+          const Eigen::Vector3f dir = (r_wc * Eigen::Vector3d((u - 159.5) / 277, (v - 119.5) / 277, 1).normalized()).cast<float>();
+          const RayHit hit = bvh.Nearest(eye.cast<float>(), dir, 1e-4f, 1e30f);
+          const Eigen::Vector3d x = eye + double(hit.distance) * dir.cast<double>();
+          const Eigen::Vector3d rgb = Radiance((x - position).normalized());
+          key.image.at<cv::Vec3f>(v, u) = cv::Vec3f(float(rgb.z()), float(rgb.y()), float(rgb.x()));
+        }
+      keys.push_back(std::move(key));
+    }
+    return keys;
+  }
+};
+
+const RoomLight& AnalyticEstimate() {
+  static const RoomLight light = [] {
+    const AnalyticRoom room;
+    // The geometry as a map gives it: 4000 points on the walls, planes fitted to them.
+    SceneProxy proxy = BuildPlaneProxy(SamplePoints(room.walls, 4000, 3));
+    const TriangleBvh scene(proxy.Triangles());
+    const auto keys = room.Keyframes();
+    return EstimateRoomLight(keys, scene, room.position);
+  }();
+  return light;
+}
+
+TEST(RoomLight, AnalyticEnvironmentIrradianceWithin2PercentAndDirectionWithin5Degrees) {
+  const AnalyticRoom room;
+  const RoomLight& light = AnalyticEstimate();
+  const ShRgb exact = room.Exact();
+  double worst = 0;
+  for (const Eigen::Vector3d& n : FibonacciSphere(1000)) {
+    const Eigen::Vector3d e = IrradianceSh(light.sh, n), t = IrradianceSh(exact, n);
+    worst = std::max(worst, ((e - t).cwiseQuotient(t)).cwiseAbs().maxCoeff());
+  }
+  const double angle = AngleDeg(light.dominant.direction, room.light_direction);
+  const DominantLight truth = ExtractDominantLight(exact);
+  std::printf("analytic room: %d keyframes, %.1f%% of directions seen, irradiance worst %.2f%% off the closed form, "
+              "dominant direction %.2f deg off; colour (%.3f %.3f %.3f) vs (%.3f %.3f %.3f); estimated in %.2f s\n",
+              light.keyframes, 100 * light.seen_fraction, 100 * worst, angle, light.dominant.color.x(),
+              light.dominant.color.y(), light.dominant.color.z(), truth.color.x(), truth.color.y(), truth.color.z(),
+              light.seconds);
+  EXPECT_GT(light.seen_fraction, 0.95);
+  EXPECT_LT(worst, 0.02);
+  EXPECT_LT(angle, 5.0);
+}
+
+TEST(RoomLight, SavesAndLoadsAndRejectsBadFiles) {
+  const RoomLight& light = AnalyticEstimate();
+  const fs::path dir = fs::temp_directory_path() / ("arview_light_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  SaveRoomLight(light, dir / "a.light.yml");
+  const RoomLight back = LoadRoomLight(dir / "a.light.yml");
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR((back.sh[k] - light.sh[k]).norm(), 0, 1e-9);
+  EXPECT_EQ(back.thumbnails.size(), light.thumbnails.size());
+  EXPECT_EQ(back.occluder_triangles.size(), light.occluder_triangles.size());
+  EXPECT_THROW(LoadRoomLight(dir / "missing.light.yml"), LightError);
+  { std::ofstream(dir / "bad.light.yml") << "%YAML:1.0\nformat: something else\n"; }
+  EXPECT_THROW(LoadRoomLight(dir / "bad.light.yml"), LightError);
+  fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------- PRT
+
+anim::Character RigidCharacter(anim::Mesh mesh, const Eigen::Quaterniond& rest_rotation = Eigen::Quaterniond::Identity()) {
+  anim::Character c;
+  c.source = "synthetic";
+  c.skeleton.names = {"root"};
+  c.skeleton.parents = {-1};
+  anim::Transform rest;
+  rest.rotation = rest_rotation;
+  c.skeleton.rest = {rest};
+  c.skeleton.inverse_bind = {Eigen::Matrix4d::Identity()};
+  mesh.joints.assign(mesh.positions.size(), {0, 0, 0, 0});
+  mesh.weights.assign(mesh.positions.size(), Eigen::Vector4f(1, 0, 0, 0));
+  mesh.material = 0;
+  c.materials.push_back({"grey", Eigen::Vector4f(0.8f, 0.8f, 0.8f, 1.f), -1});
+  c.meshes.push_back(std::move(mesh));
+  return c;
+}
+
+// A UV sphere (or, with `height` > 0, a closed cylinder of that height standing on y = 0).
+anim::Mesh SphereOrCylinder(double radius, double height, int rings = 24, int segments = 48) {
+  anim::Mesh m;
+  m.name = "shape";
+  for (int r = 0; r <= rings; ++r) {
+    const double t = double(r) / rings;
+    for (int s = 0; s < segments; ++s) {
+      const double a = 2 * M_PI * s / segments;
+      Eigen::Vector3f p, n;
+      if (height > 0) {
+        p = Eigen::Vector3f(radius * std::cos(a), height * t, radius * std::sin(a));
+        n = Eigen::Vector3f(std::cos(a), 0, std::sin(a));
+      } else {
+        const double polar = M_PI * t;
+        n = Eigen::Vector3f(std::sin(polar) * std::cos(a), std::cos(polar), std::sin(polar) * std::sin(a));
+        p = radius * n;
+      }
+      m.positions.push_back(p);
+      m.normals.push_back(n);
+    }
+  }
+  for (int r = 0; r < rings; ++r)
+    for (int s = 0; s < segments; ++s) {
+      const std::uint32_t a = r * segments + s, b = r * segments + (s + 1) % segments;
+      // Counter-clockwise seen from outside.
+      m.indices.insert(m.indices.end(), {a, a + segments, b, b, a + segments, b + segments});
+    }
+  return m;
+}
+
+TEST(Prt, ConvexShapeIsUnshadowedWithTheAdjacencyRelaxation) {
+  const anim::Character sphere = RigidCharacter(SphereOrCylinder(0.5, 0));
+  PrtOptions options;
+  const CharacterTransfer relaxed = ComputeShadowedTransfer(sphere, options);
+  options.skip_adjacent = false;
+  options.min_hit_fraction = 0;
+  const CharacterTransfer raw = ComputeShadowedTransfer(sphere, options);
+  std::printf("sphere (%zu vertices): occluded share %.4f with the relaxations, %.4f without; %.3f s\n",
+              sphere.meshes[0].positions.size(), relaxed.occluded_share, raw.occluded_share, relaxed.seconds);
+  EXPECT_LT(relaxed.occluded_share, 0.002);
+  EXPECT_GT(raw.occluded_share, 10 * relaxed.occluded_share + 0.01);
+}
+
+TEST(Prt, FootOfAWallSeesHalfTheUniformSky) {
+  // A floor plate (normal +y) and a tall wall at x = 0 (normal +x), as two segments.
+  anim::Character c = RigidCharacter(anim::Mesh{});
+  c.meshes.clear();
+  auto quad = [](Eigen::Vector3f o, Eigen::Vector3f u, Eigen::Vector3f v, int n) {
+    anim::Mesh m;
+    const Eigen::Vector3f normal = u.cross(v).normalized();
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        m.positions.push_back(o + u * (float(i) / n) + v * (float(j) / n));
+        m.normals.push_back(normal);
+      }
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const std::uint32_t a = i * (n + 1) + j;
+        m.indices.insert(m.indices.end(), {a, a + std::uint32_t(n + 1), a + 1, a + 1, a + std::uint32_t(n + 1), a + std::uint32_t(n + 2)});
+      }
+    m.joints.assign(m.positions.size(), {0, 0, 0, 0});
+    m.weights.assign(m.positions.size(), Eigen::Vector4f(1, 0, 0, 0));
+    return m;
+  };
+  c.meshes.push_back(quad({0, 0, 5}, {10, 0, 0}, {0, 0, -10}, 20));   // floor x ∈ [0, 10], normal +y
+  c.meshes.push_back(quad({0, 0, -5}, {0, 10, 0}, {0, 0, 10}, 20));  // wall at x = 0, normal +x
+  PrtOptions options;
+  options.directions = 4096;
+  const CharacterTransfer t = ComputeShadowedTransfer(c, options);
+  // Floor vertex (i = 1, j = 10): x = 0.5, at the middle of the wall's 10 m width.
+  const Sh9 unshadowed = UnshadowedTransfer(Eigen::Vector3d::UnitY());
+  Sh9 at_foot{};
+  for (int k = 0; k < 9; ++k) at_foot[k] = t.meshes[0][1 * 21 + 10][k];
+  const double sky = DotSh(ConstantSh({1, 1, 1}), at_foot).x() / DotSh(ConstantSh({1, 1, 1}), unshadowed).x();
+  // The exact share: cosine-weighted directions of the upper hemisphere that miss the wall
+  // rectangle (x = 0, y in [0, 10], z in [-5, 5]) seen from (0.5, 0, 0), by a fine midpoint rule.
+  double open = 0, all = 0;
+  constexpr int kSteps = 1000;
+  for (int a = 0; a < kSteps; ++a)
+    for (int b = 0; b < 2 * kSteps; ++b) {
+      const double polar = (a + 0.5) * (M_PI / 2) / kSteps, azimuth = (b + 0.5) * M_PI / kSteps;
+      const Eigen::Vector3d d(std::sin(polar) * std::cos(azimuth), std::cos(polar), std::sin(polar) * std::sin(azimuth));
+      const double w = d.y() * std::sin(polar);
+      all += w;
+      bool blocked = false;
+      if (d.x() < 0) {
+        const double t = 0.5 / -d.x();
+        blocked = t * d.y() <= 10 && std::abs(t * d.z()) <= 5;
+      }
+      if (!blocked) open += w;
+    }
+  const double expected = open / all;
+  std::printf("foot of a wall: %.3f of the unshadowed irradiance (exact %.3f)\n", sky, expected);
+  EXPECT_NEAR(sky, expected, 0.02);
+}
+
+// The shader's per-vertex rotation of the transfer (dynamic PRT) against the closed-form
+// irradiance at the rotated normal: for a convex, unshadowed sphere rotated by its joint, both
+// lighting modes must give the same image.
+TEST(Prt, ShaderRotatesTheTransferWithTheSkinning) {
+  auto sphere = std::make_shared<const anim::Character>(
+      RigidCharacter(SphereOrCylinder(0.4, 0, 32, 64), Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d(0.3, 1, 0.2).normalized()))));
+  anim::CharacterSpec spec;
+  spec.name = "sphere";
+  spec.anchor.position = {0, 0, 0.5};
+  anim::KeySpec key;
+  key.source = anim::KeySpec::Source::kRestPose;
+  spec.keys.push_back(key);
+  anim::AnimatedCharacter animated(sphere, spec);
+  const calib::Camera camera = calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5);
+  const calib::Pose pose = LookAt({0, -2, 0.8}, {0, 0, 0.5});
+  RoomLight light;
+  light.sh = ConstantSh({0.3, 0.3, 0.3}) + CapSh(Eigen::Vector3d(1, -1, 1).normalized(), 0.3, {9, 7, 5});
+  light.dominant = ExtractDominantLight(light.sh);
+  cv::Mat images[2];
+  for (int mode = 0; mode < 2; ++mode) {
+    ArOptions options;
+    options.lighting = mode == 0 ? LightingMode::kShUnshadowed : LightingMode::kShShadowed;
+    options.shadow = false;
+    options.cast_shadow = false;
+    ArRenderer renderer(SharedContext(), camera, options);
+    renderer.AddCharacter(animated.character(), animated.spec());
+    renderer.SetRoomLight(light);
+    const anim::FrameOutput* out = &animated.Update(spec.ViewpointFromCamera(pose.Center()), 0);
+    images[mode] = renderer.Render(cv::Mat(), pose, {&out, 1});
+  }
+  cv::Mat diff, grey;
+  cv::absdiff(images[0], images[1], diff);
+  cv::cvtColor(images[0], grey, cv::COLOR_BGR2GRAY);
+  const cv::Mat sphere_pixels = cv::abs(grey - 128) > 0;
+  const cv::Scalar mean = cv::mean(diff, sphere_pixels);
+  const cv::Scalar level = cv::mean(images[0], sphere_pixels);
+  double worst = 0;
+  cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+  std::printf("rotated sphere (%d px, mean level %.0f %.0f %.0f): per-pixel SH vs per-vertex rotated PRT: mean |diff| "
+              "%.2f %.2f %.2f, worst %.0f levels\n",
+              cv::countNonZero(sphere_pixels), level[0], level[1], level[2], mean[0], mean[1], mean[2], worst);
+  EXPECT_GT(cv::countNonZero(sphere_pixels), 10000);
+  EXPECT_LT(std::max({mean[0], mean[1], mean[2]}), 1.0);
+  EXPECT_LT(worst, 12);
+}
+
+// ---------------------------------------------------------------- cast shadow
+
+TEST(CastShadow, FallsAwayFromTheDominantLightWithin10Degrees) {
+  const AnalyticRoom room;
+  const RoomLight& light = AnalyticEstimate();
+  // A 1.6 m post standing on the floor below the light's measuring point.
+  auto post = std::make_shared<const anim::Character>(RigidCharacter(SphereOrCylinder(0.15, 1.6, 16, 32)));
+  anim::CharacterSpec spec;
+  spec.name = "post";
+  spec.anchor.position = {room.position.x(), room.position.y(), 0};
+  spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
+  anim::KeySpec key;
+  key.source = anim::KeySpec::Source::kRestPose;
+  spec.keys.push_back(key);
+  anim::AnimatedCharacter animated(post, spec);
+  // Straight down from 6 m.
+  const calib::Camera camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  const Eigen::Vector3d above = spec.anchor.position + Eigen::Vector3d(0, 0, 6);
+  const calib::Pose pose = LookAt(above, spec.anchor.position, Eigen::Vector3d::UnitY());
+  cv::Mat images[2];
+  for (int with = 0; with < 2; ++with) {
+    ArOptions options;
+    options.lighting = LightingMode::kShUnshadowed;
+    options.shadow = false;
+    options.cast_shadow = with == 1;
+    options.occlusion = false;
+    options.full_frame = true;
+    ArRenderer renderer(SharedContext(), camera, options);
+    renderer.AddCharacter(animated.character(), animated.spec());
+    renderer.SetRoomLight(light);
+    const anim::FrameOutput* out = &animated.Update(spec.ViewpointFromCamera(pose.Center()), 0);
+    images[with] = renderer.Render(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(200)), pose, {&out, 1});
+  }
+  cv::Mat diff, grey;
+  cv::subtract(images[0], images[1], diff);
+  cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+  const cv::Moments m = cv::moments(grey);
+  ASSERT_GT(m.m00, 1000);
+  // Shadow centroid, back to the floor (z = 0) through the camera.
+  const cv::Point2d c(m.m10 / m.m00, m.m01 / m.m00);
+  const Eigen::Vector3d ray = pose.CameraToWorldRotation() * Eigen::Vector3d((c.x - 319.5) / 500, (c.y - 239.5) / 500, 1);
+  const Eigen::Vector3d floor = above + ray * (-above.z() / ray.z());
+  Eigen::Vector3d fall = floor - spec.anchor.position;
+  fall.z() = 0;
+  Eigen::Vector3d away = -light.dominant.direction;
+  away.z() = 0;
+  Eigen::Vector3d truth = -room.light_direction;
+  truth.z() = 0;
+  const double angle = AngleDeg(fall, truth);
+  std::printf("cast shadow: %d px darkened, falls %.2f deg from the true light's away direction (%.2f deg from the "
+              "estimated light's)\n",
+              cv::countNonZero(grey > 2), angle, AngleDeg(fall, away));
+  EXPECT_LT(angle, 10.0);
+}
+
+// ---------------------------------------------------------------- occlusion
+
+cv::Mat CoveredMask(ArRenderer& renderer, const calib::Pose& pose, const anim::FrameOutput* out, const cv::Size& size) {
+  const cv::Mat black = renderer.Render(cv::Mat(size, CV_8UC3, cv::Scalar::all(0)), pose, {&out, 1});
+  const cv::Mat white = renderer.Render(cv::Mat(size, CV_8UC3, cv::Scalar::all(255)), pose, {&out, 1});
+  cv::Mat diff, grey;
+  cv::absdiff(black, white, diff);
+  cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+  return grey < 8;  // the background does not show through
+}
+
+double IoU(const cv::Mat& a, const cv::Mat& b) {
+  return double(cv::countNonZero(a & b)) / std::max(1, cv::countNonZero(a | b));
+}
+
+TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
+  const fs::path asset = arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb");
+  ARVIEW_REQUIRE_DATA_PATH(asset, "../shared/data");
+  const anim::Scene scene = anim::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
+                                                 "\n    scale: 0.01\n    anchor:\n      position: [0, 0, 0]\n"
+                                                 "      rotation_deg: [90, 0, 0]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
+                                                 "        clip: Survey\n",
+                                             "pillar_test.yaml");
+  anim::AnimatedCharacter fox(scene.characters[0]);
+  const calib::Camera camera = calib::Camera::Pinhole(640, 480, 525, 525, 319.5, 239.5);
+  const calib::Pose pose = LookAt({2.4, -0.6, 1.1}, {0, 0, 0.35});
+  // A 0.3 m square pillar 1.1 m in front of the Fox, covering about half of it.
+  const Eigen::Vector3d pillar_centre(1.1, -0.05, 0);
+  const auto pillar = BoxTriangles(pillar_centre + Eigen::Vector3d(-0.15, -0.15, 0), pillar_centre + Eigen::Vector3d(0.15, 0.15, 2.4));
+  // What a map would hold: points on the pillar, the floor and a back wall.
+  std::vector<Eigen::Vector3f> room = BoxTriangles({-2, -2, 0}, {3, 2, 2.6});
+  std::vector<Eigen::Vector3d> points = SamplePoints(pillar, 1200, 5);
+  for (const auto& p : SamplePoints(room, 3000, 6)) points.push_back(p);
+  SceneProxy proxy = BuildPlaneProxy(points);
+  proxy.RemovePlane(Eigen::Vector3d::UnitZ(), 0, 10, 0.05);  // the floor the Fox stands on
+  const std::vector<Eigen::Vector3f> proxy_triangles = proxy.Triangles();
+  const anim::FrameOutput* out = &fox.Update(fox.spec().ViewpointFromCamera(pose.Center()), 0.5);
+  cv::Mat masks[3];
+  for (int which = 0; which < 3; ++which) {
+    ArOptions options;
+    options.shadow = false;
+    ArRenderer renderer(SharedContext(), camera, options);
+    renderer.AddCharacter(fox.character(), fox.spec());
+    if (which == 1) renderer.SetOccluders(proxy_triangles);
+    if (which == 2) renderer.SetOccluders(pillar);
+    masks[which] = CoveredMask(renderer, pose, out, camera.Size());
+  }
+  const double iou = IoU(masks[1], masks[2]);
+  std::printf("pillar: %zu proxy patches (%zu triangles) from %zu points; Fox %d px unoccluded, %d px behind the exact "
+              "pillar visible, %d with the proxy; IoU %.4f\n",
+              proxy.patches.size(), proxy_triangles.size() / 3, points.size(), cv::countNonZero(masks[0]),
+              cv::countNonZero(masks[2]), cv::countNonZero(masks[1]), iou);
+  ASSERT_LT(cv::countNonZero(masks[2]), 0.8 * cv::countNonZero(masks[0]));  // the pillar really hides part of it
+  ASSERT_GT(cv::countNonZero(masks[2]), 0.2 * cv::countNonZero(masks[0]));
+  EXPECT_GE(iou, 0.9);
+}
+
+}  // namespace
+}  // namespace arview::render

@@ -1,0 +1,175 @@
+#include "render/scene_depth.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+
+#include "render/offscreen.h"
+
+namespace arview::render {
+namespace {
+
+const char* kReceiverVertex = R"(#version 450 core
+uniform mat4 mvp;          // projection · view (map → clip)
+uniform vec3 corners[4];   // the floor parallelogram, map frame
+out vec3 v_world;
+void main() {
+  const int order[6] = int[6](0, 1, 2, 0, 2, 3);
+  v_world = corners[order[gl_VertexID]];
+  gl_Position = mvp * vec4(v_world, 1.0);
+}
+)";
+
+const char* kReceiverFragment = R"(#version 450 core
+in vec3 v_world;
+uniform mat4 light;        // map → light clip (orthographic)
+uniform sampler2D silhouette;
+uniform float strength;
+uniform float softness;    // blur radius, texture units
+out vec4 frag_color;
+void main() {
+  vec2 uv = (light * vec4(v_world, 1.0)).xy * 0.5 + 0.5;
+  const vec2 disc[12] = vec2[12](vec2(-0.326, -0.406), vec2(-0.840, -0.074), vec2(-0.696, 0.457),
+                                 vec2(-0.203, 0.621), vec2(0.962, -0.195), vec2(0.473, -0.480),
+                                 vec2(0.519, 0.767), vec2(0.185, -0.893), vec2(0.507, 0.064),
+                                 vec2(0.896, 0.412), vec2(-0.322, -0.933), vec2(-0.792, -0.598));
+  float coverage = 0.0;
+  for (int i = 0; i < 12; ++i) coverage += textureLod(silhouette, uv + softness * disc[i], 2.0).r;
+  frag_color = vec4(0.0, 0.0, 0.0, strength * coverage / 12.0);
+}
+)";
+
+const char* kDepthVertex = R"(#version 450 core
+layout(location = 0) in vec3 position;
+uniform mat4 mvp;
+void main() { gl_Position = mvp * vec4(position, 1.0); }
+)";
+
+const char* kDepthFragment = R"(#version 450 core
+out vec4 frag_color;
+void main() { frag_color = vec4(0.0); }
+)";
+
+}  // namespace
+
+bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& centre, double radius,
+                   const Eigen::Vector3d& floor_point, const Eigen::Vector3d& floor_normal, double min_elevation_deg,
+                   LightView* view) {
+  const Eigen::Vector3d d = towards_light.normalized();
+  const Eigen::Vector3d n = floor_normal.normalized();
+  if (!(radius > 0) || d.dot(n) < std::sin(min_elevation_deg * M_PI / 180)) return false;
+  const Eigen::Vector3d x = d.unitOrthogonal();
+  const Eigen::Vector3d y = d.cross(x);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
+  m.row(0) << x.transpose() / radius, -x.dot(centre) / radius;
+  m.row(1) << y.transpose() / radius, -y.dot(centre) / radius;
+  m.row(2) << -d.transpose() / radius, d.dot(centre) / radius;
+  m(3, 3) = 1;
+  view->map_to_clip = m;
+  const double signs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d q = centre + radius * (signs[k][0] * x + signs[k][1] * y);
+    view->floor_corners[k] = q - d * ((q - floor_point).dot(n) / d.dot(n));
+  }
+  return true;
+}
+
+CastShadow::CastShadow(const GlApi& gl, int size) : gl_(&gl), size_(size) {
+  texture_ = MakeTexture(gl, cv::Mat(size, size, CV_8UC3, cv::Scalar::all(0)), {true, 1.f, false});
+  GLuint fbo = 0;
+  gl.GenFramebuffers(1, &fbo);
+  fbo_ = GlName(&gl, fbo, [](const GlApi& g, GLuint n) { g.DeleteFramebuffers(1, &n); });
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture_.get(), 0);
+  if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw RenderError("cast shadow: silhouette framebuffer incomplete");
+  }
+  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  program_ = MakeProgram(gl, "cast shadow", kReceiverVertex, kReceiverFragment);
+  const GLuint p = program_.get();
+  mvp_ = Uniform(gl, p, "mvp");
+  light_ = Uniform(gl, p, "light");
+  corners_ = Uniform(gl, p, "corners");
+  strength_ = Uniform(gl, p, "strength");
+  softness_ = Uniform(gl, p, "softness");
+  silhouette_ = Uniform(gl, p, "silhouette");
+  vao_ = MakeVertexArray(gl);
+  CheckGl(gl, "cast shadow setup");
+}
+
+void CastShadow::BeginSilhouette() {
+  const GlApi& gl = *gl_;
+  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
+  gl.Viewport(0, 0, size_, size_);
+  gl.Disable(GL_SCISSOR_TEST);
+  gl.ClearColor(0, 0, 0, 0);
+  gl.Clear(GL_COLOR_BUFFER_BIT);
+}
+
+void CastShadow::EndSilhouette() {
+  const GlApi& gl = *gl_;
+  gl.BindTexture(GL_TEXTURE_2D, texture_.get());
+  gl.GenerateMipmap(GL_TEXTURE_2D);
+}
+
+void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
+                              float strength, float softness) {
+  const GlApi& gl = *gl_;
+  const Eigen::Matrix4f mvp = (projection * view).cast<float>();
+  const Eigen::Matrix4f to_light = light.map_to_clip.cast<float>();
+  float corners[12];
+  for (int k = 0; k < 4; ++k)
+    for (int c = 0; c < 3; ++c) corners[3 * k + c] = static_cast<float>(light.floor_corners[k][c]);
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthMask(GL_FALSE);
+  gl.Disable(GL_CULL_FACE);
+  gl.Enable(GL_BLEND);
+  gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  gl.UseProgram(program_.get());
+  gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
+  gl.UniformMatrix4fv(light_, 1, GL_FALSE, to_light.data());
+  gl.Uniform3fv(corners_, 4, corners);
+  gl.Uniform1f(strength_, strength);
+  gl.Uniform1f(softness_, softness);
+  gl.Uniform1i(silhouette_, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindTexture(GL_TEXTURE_2D, texture_.get());
+  gl.BindVertexArray(vao_.get());
+  gl.DrawArrays(GL_TRIANGLES, 0, 6);
+  gl.BindVertexArray(0);
+  gl.Disable(GL_BLEND);
+  gl.DepthMask(GL_TRUE);
+}
+
+DepthProxy::DepthProxy(const GlApi& gl, const std::vector<Eigen::Vector3f>& triangles) : gl_(&gl) {
+  program_ = MakeProgram(gl, "depth proxy", kDepthVertex, kDepthFragment);
+  mvp_ = Uniform(gl, program_.get(), "mvp");
+  vao_ = MakeVertexArray(gl);
+  gl.BindVertexArray(vao_.get());
+  count_ = static_cast<GLsizei>(triangles.size() / 3 * 3);
+  vbo_ = MakeBuffer(gl, GL_ARRAY_BUFFER, triangles.data(), std::max<size_t>(1, count_) * sizeof(Eigen::Vector3f));
+  gl.EnableVertexAttribArray(0);
+  gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector3f), nullptr);
+  gl.BindVertexArray(0);
+  CheckGl(gl, "depth proxy upload");
+}
+
+void DepthProxy::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view) const {
+  if (count_ == 0) return;
+  const GlApi& gl = *gl_;
+  const Eigen::Matrix4f mvp = (projection * view).cast<float>();
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  gl.DepthMask(GL_TRUE);
+  gl.Disable(GL_CULL_FACE);
+  gl.Disable(GL_BLEND);
+  gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  gl.UseProgram(program_.get());
+  gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
+  gl.BindVertexArray(vao_.get());
+  gl.DrawArrays(GL_TRIANGLES, 0, count_);
+  gl.BindVertexArray(0);
+  gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
+}  // namespace arview::render

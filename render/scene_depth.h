@@ -1,0 +1,68 @@
+#pragma once
+// Two things the room adds to the character layer (issue 14, items 3 and 4):
+//  - CastShadow: the character's soft shadow on its floor plane from the room's dominant light.
+//    The skinned character is drawn as a white silhouette into a 256 x 256 texture, seen along
+//    the light (orthographic, around the character's bounding sphere); the floor's
+//    parallelogram under that view is then drawn into the layer, each pixel darkened by the
+//    silhouette coverage at its point projected along the light, averaged over a 12-tap disc
+//    from a blurred mip level (a soft, percentage-closer-style edge).
+//  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
+//    only, before the character, so real things in front of the character hide it.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+#include "render/gl_objects.h"
+
+namespace arview::render {
+
+// The orthographic view along a light: map → light clip space, covering a sphere.
+struct LightView {
+  Eigen::Matrix4d map_to_clip = Eigen::Matrix4d::Identity();
+  // The floor's corners under the view (map frame): the shadow can only fall inside them.
+  std::array<Eigen::Vector3d, 4> floor_corners;
+};
+// `towards_light` unit; the floor plane through `floor_point` with unit normal `floor_normal`.
+// Returns false when the light is within `min_elevation_deg` of the floor's horizon (the shadow
+// would stretch without bound) or below it.
+bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& centre, double radius,
+                   const Eigen::Vector3d& floor_point, const Eigen::Vector3d& floor_normal, double min_elevation_deg,
+                   LightView* view);
+
+class CastShadow {
+ public:
+  explicit CastShadow(const GlApi& gl, int size = 256);
+  // Binds the silhouette target (cleared, viewport set): draw the character with
+  // LightView::map_to_clip as projection, an identity view, and CharacterDraw::silhouette.
+  void BeginSilhouette();
+  // Mipmaps the silhouette; the caller then binds its own framebuffer again.
+  void EndSilhouette();
+  // Into the bound framebuffer, premultiplied black: alpha = strength × coverage.
+  // `softness`: the blur radius as a share of the light view's width.
+  void DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
+                    float strength, float softness);
+
+ private:
+  const GlApi* gl_;
+  int size_;
+  GlName texture_, fbo_, program_, vao_;
+  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, softness_ = -1, silhouette_ = -1;
+};
+
+class DepthProxy {
+ public:
+  DepthProxy(const GlApi& gl, const std::vector<Eigen::Vector3f>& triangles);
+  int triangle_count() const { return count_ / 3; }
+  // Depth only (colour writes off), depth test on.
+  void Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view) const;
+
+ private:
+  const GlApi* gl_;
+  GlName program_, vao_, vbo_;
+  GLsizei count_ = 0;
+  GLint mvp_ = -1;
+};
+
+}  // namespace arview::render
