@@ -12,6 +12,7 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   // in the environment, which must not race with other threads.
   context_ = render::OffscreenContext::Create(options_.gl);
   renderer_ = std::make_unique<render::ArRenderer>(*context_, camera_, options_.ar);
+  if (options_.room_light) renderer_->SetRoomLight(*options_.room_light);
   for (const anim::AnimatedCharacter* c : characters_) renderer_->AddCharacter(c->character(), c->spec());
   description_ = context_->Description();
 }

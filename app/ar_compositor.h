@@ -4,6 +4,7 @@
 // lost frames show the video alone.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@ struct CompositorOptions {
   render::ArOptions ar;
   bool hmd = false;   // side-by-side stereo
   double ipd_m = 0.064;
+  std::optional<render::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
 };
 
 class ArCompositor : public FrameCompositor {

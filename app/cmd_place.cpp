@@ -4,6 +4,7 @@
 
 #include "app/commands.h"
 #include "app/place_character.h"
+#include "app/scene_lighting.h"
 #include "map/map_file.h"
 
 namespace arview::app {
@@ -16,6 +17,8 @@ struct PlaceArgs {
   std::string out;
   PlaceCharacterOptions options;
   std::optional<double> elevation;
+  std::string recording;  // where still keyframe images are (video maps keep theirs in <map>/images)
+  bool no_light = false;
 };
 
 }  // namespace
@@ -39,6 +42,9 @@ void AddPlaceCommand(CLI::App& app) {
                   "Elevation of the keys in degrees (default: the median elevation of the map's cameras)")
       ->check(CLI::Range(-89.0, 89.0));
   cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
+  cmd->add_option("--recording", a->recording,
+                  "Recording the map was built from, for its keyframe images (the room's light; video maps need none)");
+  cmd->add_flag("--no-light", a->no_light, "Do not estimate the room's light (no <scene>.light.yml)");
   cmd->callback([a] {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
     const map::Map map = map::LoadMap(a->map_dir);
@@ -51,6 +57,7 @@ void AddPlaceCommand(CLI::App& app) {
                 anchor.rotation(0, 1), anchor.rotation(1, 1), anchor.rotation(2, 1), anchor.scale, placed.rest_height);
     std::printf("wrote %s with %d look-at keys at %.1f deg elevation\n", a->out.c_str(), placed.key_count,
                 placed.key_elevation_deg);
+    if (!a->no_light) WritePlacedLight(map, a->map_dir, a->recording, placed, a->out);
   });
 }
 

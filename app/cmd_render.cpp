@@ -4,11 +4,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 
 #include "anim/scene.h"
 #include "app/commands.h"
+#include "app/scene_lighting.h"
 #include "calib/camera.h"
 #include "render/ar_renderer.h"
 
@@ -24,6 +26,8 @@ struct RenderArgs {
   double ipd = 0.064;
   std::string antialiasing = "msaa";
   bool no_shadow = false;
+  std::string lighting = "auto", light;
+  bool no_cast_shadow = false, no_occlusion = false;
   std::string backend = "auto";
   int threads = 1;
 };
@@ -47,6 +51,12 @@ calib::Pose ParsePose(const std::string& text) {
   return calib::Pose::FromCameraToWorld(q.normalized(), {v[0], v[1], v[2]});
 }
 
+std::string Fixed3(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", x);
+  return text;
+}
+
 void RunRender(const RenderArgs& args) {
   const calib::Pose pose = ParsePose(args.pose);
   calib::Camera camera;
@@ -65,6 +75,7 @@ void RunRender(const RenderArgs& args) {
   try {
     const anim::Scene scene = anim::LoadScene(args.scene);
     if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
+    const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
     std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
     for (const anim::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
 
@@ -76,7 +87,12 @@ void RunRender(const RenderArgs& args) {
     options.antialiasing = render::ParseAntialiasing(args.antialiasing);
     options.shadow = !args.no_shadow;
     options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
+    options.lighting = lighting.mode;
+    options.cast_shadow = !args.no_cast_shadow;
+    options.occlusion = !args.no_occlusion;
+    options.exposure_smoothing = 1.0;  // one frame: its own exposure
     render::ArRenderer renderer(*context, camera, options);
+    if (lighting.light) renderer.SetRoomLight(*lighting.light);
     std::vector<const anim::FrameOutput*> frames;
     for (auto& c : characters) {
       renderer.AddCharacter(c->character(), c->spec());
@@ -88,7 +104,10 @@ void RunRender(const RenderArgs& args) {
     std::cout << "wrote " << args.out << " (" << image.cols << "x" << image.rows << ", "
               << characters.size() << " character" << (characters.size() == 1 ? "" : "s")
               << (camera.HasDistortion() ? ", undistorted view" : "")
-              << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ") ["
+              << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ", lighting "
+              << render::LightingModeName(lighting.mode)
+              << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s)" : "")
+              << ") ["
               << context->Description() << "]\n";
   } catch (const anim::Error& e) {
     throw CommandError(e.what());
@@ -118,6 +137,14 @@ void AddRenderCommand(CLI::App& app) {
       ->default_val(args->antialiasing)
       ->check(CLI::IsMember({"msaa", "none"}));
   cmd->add_flag("--no-shadow", args->no_shadow, "No contact shadow");
+  cmd->add_option("--lighting", args->lighting,
+                  "auto (prt when the scene has a .light.yml), fixed (key + ambient), sh (room SH, unshadowed) or prt "
+                  "(room SH through self-shadowed PRT)")
+      ->default_val(args->lighting)
+      ->check(CLI::IsMember({"auto", "fixed", "sh", "prt"}));
+  cmd->add_option("--light", args->light, "Room light file (default: the scene's <scene>.light.yml)");
+  cmd->add_flag("--no-cast-shadow", args->no_cast_shadow, "No shadow from the room's dominant light");
+  cmd->add_flag("--no-occlusion", args->no_occlusion, "Do not let the scene proxy hide the character");
   cmd->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
       ->default_val(args->backend)
       ->check(CLI::IsMember({"auto", "osmesa", "egl"}));

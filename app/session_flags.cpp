@@ -1,5 +1,6 @@
 #include "app/session_flags.h"
 
+#include "app/scene_lighting.h"
 #include "render/offscreen.h"
 
 namespace arview::app {
@@ -16,6 +17,10 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  cmd->add_option("--lighting", f.lighting, "auto (prt when the scene has a .light.yml), fixed, sh or prt")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "fixed", "sh", "prt"}));
+  cmd->add_option("--light", f.light, "Room light file (default: the scene's <scene>.light.yml)");
   cmd->add_option("--hold", f.hold, "Seconds the character holds its last view after tracking is lost")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 60.0));
@@ -33,6 +38,9 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.compositor.hmd = f.hmd;
   o.compositor.ipd_m = f.ipd;
   o.fade = {f.hold, f.fade};
+  const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
+  o.compositor.ar.lighting = lighting.mode;
+  o.compositor.room_light = lighting.light;
 }
 
 }  // namespace arview::app

@@ -42,7 +42,7 @@ void ArRenderer::SetRoomLight(const RoomLight& light) {
   room_light_ = light;
   has_room_light_ = true;
   current_sh_ = light.sh;
-  follower_ = std::make_unique<ExposureFollower>(light.thumbnails, options_.exposure_smoothing);
+  follower_ = std::make_unique<ExposureFollower>(light.thumbnails, light.scene_triangles, camera_, options_.exposure_smoothing);
   SetOccluders(light.occluder_triangles);
 }
 

@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "anim/scene.h"
@@ -468,6 +469,128 @@ TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
   ASSERT_LT(cv::countNonZero(masks[2]), 0.8 * cv::countNonZero(masks[0]));  // the pillar really hides part of it
   ASSERT_GT(cv::countNonZero(masks[2]), 0.2 * cv::countNonZero(masks[0]));
   EXPECT_GE(iou, 0.9);
+}
+
+// ---------------------------------------------------------------- the rendered room
+
+// The synthetic room under a coloured light (every radiance times a tint) and an exposure ramp
+// (times e, then 8-bit with clipping), as the camera would film it.
+cv::Mat Film(const cv::Mat& render, const Eigen::Vector3d& tint_rgb, double exposure) {
+  cv::Mat out;
+  cv::multiply(render, cv::Scalar(tint_rgb.z() * exposure, tint_rgb.y() * exposure, tint_rgb.x() * exposure), out, 1.0,
+               CV_8UC3);
+  return out;
+}
+
+TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  const fs::path asset = arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb");
+  ARVIEW_REQUIRE_DATA_PATH(asset, "../shared/data");
+  RoomScene room = MakeRoomScene();
+  // A grey card (albedo 0.5, the room's paint is white) standing beside the Fox, facing the room.
+  TriangleBatch card;
+  card.texture = 0;
+  const Eigen::Vector3d corners[4] = {{2.8, 0.4, 0.45}, {2.8, 0.0, 0.45}, {2.8, 0.0, 0.05}, {2.8, 0.4, 0.05}};
+  AppendQuad(card, corners, Eigen::Vector4f(0, 0, 1, 1), Eigen::Vector3f::Constant(0.5f));
+  room.batches.push_back(card);
+  const anim::Scene scene = anim::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
+                                                 "\n    scale: 0.01\n    anchor:\n      position: [2.8, -0.5, 0]\n"
+                                                 "      rotation: [0.5, -0.5, -0.5, 0.5]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
+                                                 "        clip: Survey\n",
+                                             "room_test.yaml");
+  anim::AnimatedCharacter fox(scene.characters[0]);
+  OffscreenContext& context = SharedContext();
+  RoomRenderer camera_view(context, room, RoomCamera(), 4);
+  const RoomPath path(10, 1);
+  std::vector<cv::Mat> key_renders;
+  std::vector<calib::Pose> key_poses;
+  for (int i = 0; i < 24; ++i) {
+    key_poses.push_back(path.At((i + 0.5) * 10 / 24));
+    key_renders.push_back(camera_view.Render(key_poses.back()));
+  }
+  // The map's points: spread over the room's surfaces; the planes fitted to them.
+  std::vector<Eigen::Vector3f> surfaces;
+  for (const TriangleBatch& b : room.batches)
+    for (const SceneVertex& v : b.vertices) surfaces.emplace_back(v.position[0], v.position[1], v.position[2]);
+  const SceneProxy proxy = BuildPlaneProxy(SamplePoints(surfaces, 8000, 11));
+  const TriangleBvh geometry(proxy.Triangles());
+  const Eigen::Vector3d position(2.8, -0.5, 0.3);
+
+  // Between keyframes 7 and 8: the live view is none of the keyframes'.
+  const calib::Pose live_pose = path.At(100.0 / 30);
+  const cv::Mat live_render = camera_view.Render(live_pose);
+  const anim::FrameOutput* out = &fox.Update(fox.spec().ViewpointFromCamera(live_pose.Center()), 1.0);
+  cv::Mat fox_mask, card_mask = cv::Mat::zeros(480, 640, CV_8U);
+  {
+    ArOptions options;
+    options.shadow = false;
+    ArRenderer renderer(context, RoomCamera(), options);
+    renderer.AddCharacter(fox.character(), fox.spec());
+    fox_mask = CoveredMask(renderer, live_pose, out, {640, 480});
+    std::vector<cv::Point> polygon;
+    for (const auto& c : corners) {
+      const Eigen::Vector3d p = live_pose.ToCamera(c);
+      const calib::Camera k = RoomCamera();
+      polygon.emplace_back(int(std::lround(k.fx * p.x() / p.z() + k.cx)), int(std::lround(k.fy * p.y() / p.z() + k.cy)));
+    }
+    cv::fillConvexPoly(card_mask, polygon, 255);
+    cv::erode(card_mask, card_mask, cv::Mat(), {-1, -1}, 3);
+    card_mask &= ~fox_mask;
+  }
+  ASSERT_GT(cv::countNonZero(fox_mask), 2000);
+  ASSERT_GT(cv::countNonZero(card_mask), 500);
+
+  const Eigen::Vector3d white(1, 1, 1), warm(1.0, 0.75, 0.5);
+  const double exposures[] = {0.5, 0.7, 1.0, 1.4};
+  struct Measure {
+    Eigen::Vector3d fox, card, gain;
+  };
+  std::map<std::pair<int, int>, Measure> measured;
+  for (int t = 0; t < 2; ++t) {
+    const Eigen::Vector3d tint = t == 0 ? white : warm;
+    std::vector<LightKeyframe> keys;
+    for (size_t i = 0; i < key_renders.size(); ++i) keys.push_back({RoomCamera(), key_poses[i], Film(key_renders[i], tint, 1.0)});
+    const RoomLight light = EstimateRoomLight(keys, geometry, position);
+    for (int e = 0; e < 4; ++e) {
+      ArOptions options;
+      options.lighting = LightingMode::kShShadowed;
+      options.shadow = false;
+      options.cast_shadow = false;
+      options.exposure_smoothing = 1.0;
+      ArRenderer renderer(context, RoomCamera(), options);
+      renderer.AddCharacter(fox.character(), fox.spec());
+      renderer.SetRoomLight(light);
+      const cv::Mat live = Film(live_render, tint, exposures[e]);
+      const cv::Mat frame = renderer.Render(live, live_pose, {&out, 1});
+      const cv::Scalar f = cv::mean(frame, fox_mask), c = cv::mean(live, card_mask);
+      measured[{t, e}] = {{f[2], f[1], f[0]}, {c[2], c[1], c[0]}, renderer.exposure_gain()};
+    }
+  }
+  // Tolerance: 2% of the level the card predicts, plus half a grey level. The half level is
+  // 8-bit rounding: the Fox's dim channels (blue under the warm light at half exposure: 7
+  // levels) have a mean that rounding alone can move by up to 0.5 level (7%). The 2% is the
+  // exposure ratio's error from the live view not being a keyframe's view (measured 0.3%
+  // with no clipping) and from thumbnail pixels left out as clipped at the highest exposure.
+  const Measure& reference = measured[{0, 2}];
+  double worst = 0, worst_excess = -1e9;
+  for (const auto& [key, m] : measured) {
+    const Eigen::Vector3d fox_ratio = m.fox.cwiseQuotient(reference.fox), card_ratio = m.card.cwiseQuotient(reference.card);
+    const double error = (fox_ratio.cwiseQuotient(card_ratio) - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff();
+    worst = std::max(worst, error);
+    const Eigen::Vector3d predicted = reference.fox.cwiseProduct(card_ratio);
+    for (int c = 0; c < 3; ++c) {
+      worst_excess = std::max(worst_excess, std::abs(m.fox[c] - predicted[c]) - (0.02 * predicted[c] + 0.5));
+    }
+    std::printf("%s light, exposure %.1f: Fox mean RGB (%.1f %.1f %.1f) x(%.3f %.3f %.3f), grey card (%.1f %.1f %.1f) "
+                "x(%.3f %.3f %.3f), followed gain (%.3f %.3f %.3f); off by %.2f%%\n",
+                key.first == 0 ? "white" : "warm", exposures[key.second], m.fox.x(), m.fox.y(), m.fox.z(), fox_ratio.x(),
+                fox_ratio.y(), fox_ratio.z(), m.card.x(), m.card.y(), m.card.z(), card_ratio.x(), card_ratio.y(),
+                card_ratio.z(), m.gain.x(), m.gain.y(), m.gain.z(), 100 * error);
+  }
+  std::printf("coloured light + exposure ramp: the Fox's mean colour follows the grey card's within %.2f%% "
+              "(%d Fox pixels, %d card pixels); worst excess over 2%% + 0.5 level: %.2f levels\n",
+              100 * worst, cv::countNonZero(fox_mask), cv::countNonZero(card_mask), worst_excess);
+  EXPECT_LE(worst_excess, 0.0);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <system_error>
 
+#include "base/atomic_file.h"
+
 namespace arview::render {
 namespace {
 
@@ -94,6 +96,14 @@ cv::Mat LinearThumbnail(const cv::Mat& image_in, int width) {
   cv::Mat small, linear;
   cv::resize(image, small, {width, height}, 0, 0, cv::INTER_AREA);
   small.convertTo(linear, CV_32FC3, image.depth() == CV_8U ? 1.0 / 255 : 1.0);
+  if (image.depth() == CV_8U) {
+    // A thumbnail pixel with any clipped camera pixel under it under-reads: marked unusable
+    // (every channel at kClippedThumbnail), so the exposure ratio leaves it out.
+    cv::Mat clipped, any, share;
+    cv::inRange(image, cv::Scalar::all(0), cv::Scalar::all(kClippedLevel - 1), clipped);  // 255: no channel clipped
+    cv::resize(clipped, share, {width, height}, 0, 0, cv::INTER_AREA);
+    linear.setTo(cv::Scalar::all(kClippedThumbnail), share < 255);
+  }
   return linear;
 }
 
@@ -140,7 +150,8 @@ RoomLight EstimateRoomLight(std::span<const LightKeyframe> keyframes, const Tria
         map.sum[i] += PixelRgb(small, y, x);
         ++map.count[i];
       }
-    light.thumbnails.push_back({key.pose, LinearThumbnail(image, options.thumbnail_width)});
+    light.thumbnails.push_back({key.pose, LinearThumbnail(image, options.thumbnail_width),
+                                {key.camera.fx, key.camera.fy, key.camera.cx, key.camera.cy}, image.size()});
   }
   std::vector<Eigen::Vector3d> value(map.sum.size(), Eigen::Vector3d::Zero());
   std::vector<bool> filled(map.sum.size(), false);
@@ -166,15 +177,16 @@ RoomLight EstimateRoomLight(std::span<const LightKeyframe> keyframes, const Tria
   light.dominant = ExtractDominantLight(light.sh);
   light.seen_fraction = seen / (4 * M_PI);
   light.keyframes = static_cast<int>(keyframes.size());
+  light.scene_triangles = scene.vertices();
   light.occluder_triangles = scene.vertices();
   light.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return light;
 }
 
 void SaveRoomLight(const RoomLight& light, const std::filesystem::path& file) {
-  const std::filesystem::path tmp = file.string() + ".tmp.yml";
+  std::string text;
   {
-    cv::FileStorage fs(tmp.string(), cv::FileStorage::WRITE);
+    cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     if (!fs.isOpened()) throw LightError(file.string() + ": cannot write");
     fs << "format" << "arview room light 1";
     fs << "position" << "[" << light.position.x() << light.position.y() << light.position.z() << "]";
@@ -191,17 +203,26 @@ void SaveRoomLight(const RoomLight& light, const std::filesystem::path& file) {
     for (const KeyframeThumbnail& t : light.thumbnails) {
       fs << "{" << "pose";
       WritePose(fs, t.pose);
+      fs << "intrinsics" << "[" << t.intrinsics[0] << t.intrinsics[1] << t.intrinsics[2] << t.intrinsics[3] << "]";
+      fs << "image_size" << "[" << t.image_size.width << t.image_size.height << "]";
       fs << "image" << t.linear_bgr << "}";
     }
     fs << "]";
-    cv::Mat tris(static_cast<int>(light.occluder_triangles.size()), 3, CV_32F);
-    for (int i = 0; i < tris.rows; ++i)
-      for (int c = 0; c < 3; ++c) tris.at<float>(i, c) = light.occluder_triangles[i][c];
-    fs << "occluder_vertices" << tris;
+    auto write_triangles = [&](const char* key, const std::vector<Eigen::Vector3f>& corners) {
+      cv::Mat tris(static_cast<int>(corners.size()), 3, CV_32F);
+      for (int i = 0; i < tris.rows; ++i)
+        for (int c = 0; c < 3; ++c) tris.at<float>(i, c) = corners[i][c];
+      fs << key << tris;
+    };
+    write_triangles("scene_vertices", light.scene_triangles);
+    write_triangles("occluder_vertices", light.occluder_triangles);
+    text = fs.releaseAndGetString();
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw LightError(file.string() + ": cannot write (" + ec.message() + ")");
+  try {
+    WriteFileAtomically(file, text);
+  } catch (const std::exception& e) {
+    throw LightError(e.what());
+  }
 }
 
 RoomLight LoadRoomLight(const std::filesystem::path& file) {
@@ -239,26 +260,43 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
       KeyframeThumbnail thumb;
       thumb.pose.q_cw = Eigen::Quaterniond(pose[0].real(), pose[1].real(), pose[2].real(), pose[3].real()).normalized();
       thumb.pose.t_cw = {pose[4].real(), pose[5].real(), pose[6].real()};
+      const cv::FileNode k = t["intrinsics"], size = t["image_size"];
+      if (!k.isSeq() || k.size() != 4 || !size.isSeq() || size.size() != 2) {
+        throw LightError(file.string() + ": a thumbnail needs intrinsics (4 numbers) and image_size (2)");
+      }
+      thumb.intrinsics = {k[0].real(), k[1].real(), k[2].real(), k[3].real()};
+      thumb.image_size = {static_cast<int>(size[0]), static_cast<int>(size[1])};
+      if (!thumb.intrinsics.allFinite() || thumb.intrinsics[0] <= 0 || thumb.intrinsics[1] <= 0 ||
+          thumb.image_size.width <= 0 || thumb.image_size.height <= 0) {
+        throw LightError(file.string() + ": a thumbnail's camera is not valid");
+      }
       t["image"] >> thumb.linear_bgr;
       if (thumb.linear_bgr.type() != CV_32FC3 || thumb.linear_bgr.empty()) {
         throw LightError(file.string() + ": a thumbnail image is not a float BGR image");
       }
       light.thumbnails.push_back(std::move(thumb));
     }
-    cv::Mat tris;
-    fs["occluder_vertices"] >> tris;
-    if (!tris.empty() && (tris.cols != 3 || tris.type() != CV_32F || tris.rows % 3 != 0 || !cv::checkRange(tris))) {
-      throw LightError(file.string() + ": occluder_vertices must be finite rows of 3 floats, 3 rows a triangle");
-    }
-    for (int i = 0; i < tris.rows; ++i) light.occluder_triangles.emplace_back(tris.at<float>(i, 0), tris.at<float>(i, 1), tris.at<float>(i, 2));
+    auto read_triangles = [&](const char* key, std::vector<Eigen::Vector3f>& corners) {
+      cv::Mat tris;
+      fs[key] >> tris;
+      if (!tris.empty() && (tris.cols != 3 || tris.type() != CV_32F || tris.rows % 3 != 0 || !cv::checkRange(tris))) {
+        throw LightError(file.string() + ": " + key + " must be finite rows of 3 floats, 3 rows a triangle");
+      }
+      for (int i = 0; i < tris.rows; ++i) corners.emplace_back(tris.at<float>(i, 0), tris.at<float>(i, 1), tris.at<float>(i, 2));
+    };
+    read_triangles("scene_vertices", light.scene_triangles);
+    read_triangles("occluder_vertices", light.occluder_triangles);
   } catch (const cv::Exception& e) {
     throw LightError(file.string() + ": unreadable room light file (" + e.msg + ")");
   }
   return light;
 }
 
-ExposureFollower::ExposureFollower(std::vector<KeyframeThumbnail> thumbnails, double smoothing)
-    : thumbnails_(std::move(thumbnails)), smoothing_(std::clamp(smoothing, 1e-3, 1.0)) {
+ExposureFollower::ExposureFollower(std::vector<KeyframeThumbnail> thumbnails,
+                                   const std::vector<Eigen::Vector3f>& scene_triangles, const calib::Camera& live_camera,
+                                   double smoothing)
+    : thumbnails_(std::move(thumbnails)), live_camera_(live_camera), smoothing_(std::clamp(smoothing, 1e-3, 1.0)) {
+  if (!scene_triangles.empty()) scene_ = std::make_unique<TriangleBvh>(scene_triangles);
   if (thumbnails_.size() > 1) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (const auto& t : thumbnails_) mean += t.pose.Center();
@@ -267,6 +305,74 @@ ExposureFollower::ExposureFollower(std::vector<KeyframeThumbnail> thumbnails, do
     for (const auto& t : thumbnails_) spread += (t.pose.Center() - mean).squaredNorm();
     centre_spread_ = std::max(1e-9, std::sqrt(spread / thumbnails_.size()));
   }
+}
+
+namespace {
+
+bool Clipped(const cv::Vec3f& p) { return p[0] >= kClippedThumbnail || p[1] >= kClippedThumbnail || p[2] >= kClippedThumbnail; }
+
+// Bilinear sample of a thumbnail at full-image pixel (u, v); false when outside or next to a clipped pixel.
+bool SampleThumbnail(const KeyframeThumbnail& key, double u, double v, Eigen::Vector3d* rgb) {
+  const cv::Mat& t = key.linear_bgr;
+  const double x = (u + 0.5) * t.cols / key.image_size.width - 0.5, y = (v + 0.5) * t.rows / key.image_size.height - 0.5;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= t.cols || y0 + 1 >= t.rows) return false;
+  const double fx = x - x0, fy = y - y0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int dy = 0; dy < 2; ++dy)
+    for (int dx = 0; dx < 2; ++dx) {
+      const cv::Vec3f p = t.at<cv::Vec3f>(y0 + dy, x0 + dx);
+      if (Clipped(p)) return false;
+      sum += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * Eigen::Vector3d(p[2], p[1], p[0]);
+    }
+  *rgb = sum;
+  return true;
+}
+
+}  // namespace
+
+bool ExposureFollower::Compare(const cv::Mat& now, const calib::Pose& pose, const KeyframeThumbnail& key,
+                               Eigen::Vector3d* live_sum, Eigen::Vector3d* key_sum) const {
+  *live_sum = *key_sum = Eigen::Vector3d::Zero();
+  int used = 0;
+  const Eigen::Matrix3d r_wc = pose.CameraToWorldRotation().toRotationMatrix();
+  const Eigen::Vector3f centre = pose.Center().cast<float>();
+  const Eigen::Vector3f key_centre = key.pose.Center().cast<float>();
+  for (int y = 0; y < now.rows; ++y)
+    for (int x = 0; x < now.cols; ++x) {
+      const cv::Vec3f a = now.at<cv::Vec3f>(y, x);
+      if (Clipped(a)) continue;
+      Eigen::Vector3d b;
+      if (scene_) {
+        // The scene point this live pixel sees, where the keyframe saw it.
+        const double u = (x + 0.5) * live_camera_.width / now.cols - 0.5, v = (y + 0.5) * live_camera_.height / now.rows - 0.5;
+        const Eigen::Vector3f dir =
+            (r_wc * Eigen::Vector3d((u - live_camera_.cx) / live_camera_.fx, (v - live_camera_.cy) / live_camera_.fy, 1)
+                        .normalized())
+                .cast<float>();
+        const RayHit hit = scene_->Nearest(centre, dir, 1e-4f, 1e30f);
+        if (hit.triangle < 0) continue;
+        const Eigen::Vector3f point = centre + hit.distance * dir;
+        const Eigen::Vector3d in_key = key.pose.ToCamera(point.cast<double>());
+        if (in_key.z() <= 0) continue;
+        const Eigen::Vector3f back = point - key_centre;
+        const float distance = back.norm();
+        const RayHit block = scene_->Nearest(key_centre, back / distance, 1e-4f, 0.99f * distance);
+        if (block.triangle >= 0) continue;  // the keyframe did not see this point
+        const double ku = key.intrinsics[0] * in_key.x() / in_key.z() + key.intrinsics[2];
+        const double kv = key.intrinsics[1] * in_key.y() / in_key.z() + key.intrinsics[3];
+        if (!SampleThumbnail(key, ku, kv, &b)) continue;
+      } else {
+        if (y >= key.linear_bgr.rows || x >= key.linear_bgr.cols) continue;
+        const cv::Vec3f p = key.linear_bgr.at<cv::Vec3f>(y, x);
+        if (Clipped(p)) continue;
+        b = {p[2], p[1], p[0]};
+      }
+      *live_sum += Eigen::Vector3d(a[2], a[1], a[0]);
+      *key_sum += b;
+      ++used;
+    }
+  return used >= 30 && (key_sum->array() > 1e-3).all() && (live_sum->array() > 1e-3).all();
 }
 
 Eigen::Vector3d ExposureFollower::Update(const cv::Mat& live, const calib::Pose& pose) {
@@ -282,21 +388,10 @@ Eigen::Vector3d ExposureFollower::Update(const cv::Mat& live, const calib::Pose&
     if (score < best_score) best_score = score, best = static_cast<int>(i);
   }
   last_keyframe_ = best;
-  const cv::Mat& reference = thumbnails_[best].linear_bgr;
-  const cv::Mat now = LinearThumbnail(live, reference.cols);
-  if (now.size() != reference.size()) return gain_;
-  Eigen::Vector3d live_sum = Eigen::Vector3d::Zero(), key_sum = Eigen::Vector3d::Zero();
-  constexpr float kSaturated = 0.97f;
-  for (int y = 0; y < now.rows; ++y)
-    for (int x = 0; x < now.cols; ++x) {
-      const cv::Vec3f a = now.at<cv::Vec3f>(y, x), b = reference.at<cv::Vec3f>(y, x);
-      bool clipped = false;
-      for (int c = 0; c < 3; ++c) clipped = clipped || a[c] >= kSaturated || b[c] >= kSaturated;
-      if (clipped) continue;
-      live_sum += Eigen::Vector3d(a[2], a[1], a[0]);
-      key_sum += Eigen::Vector3d(b[2], b[1], b[0]);
-    }
-  if ((key_sum.array() < 1e-3).any() || (live_sum.array() < 1e-3).any()) return gain_;
+  const KeyframeThumbnail& key = thumbnails_[best];
+  const cv::Mat now = LinearThumbnail(live, key.linear_bgr.cols);
+  Eigen::Vector3d live_sum, key_sum;
+  if (!Compare(now, pose, key, &live_sum, &key_sum)) return gain_;
   const Eigen::Vector3d measured = live_sum.cwiseQuotient(key_sum);
   if (!started_) {
     gain_ = measured;

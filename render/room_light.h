@@ -24,6 +24,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -48,6 +49,9 @@ struct LightKeyframe {
 struct KeyframeThumbnail {
   calib::Pose pose;
   cv::Mat linear_bgr;  // CV_32FC3, 40 x 30
+  // The keyframe camera (pinhole part: fx, fy, cx, cy) and image size, to project into it.
+  Eigen::Vector4d intrinsics = Eigen::Vector4d::Zero();
+  cv::Size image_size;
 };
 
 struct RoomLight {
@@ -58,7 +62,8 @@ struct RoomLight {
   int keyframes = 0;
   double seconds = 0;        // estimation time
   std::vector<KeyframeThumbnail> thumbnails;
-  std::vector<Eigen::Vector3f> occluder_triangles;  // depth-only proxy of the scene (map frame)
+  std::vector<Eigen::Vector3f> scene_triangles;     // the proxy the light was measured through (map frame)
+  std::vector<Eigen::Vector3f> occluder_triangles;  // depth-only occluders (map frame): the proxy without the floor
 };
 
 struct LightEstimateOptions {
@@ -72,6 +77,10 @@ RoomLight EstimateRoomLight(std::span<const LightKeyframe> keyframes, const Tria
                             const Eigen::Vector3d& position, const LightEstimateOptions& options = {});
 
 // The thumbnail ExposureFollower compares: area-averaged, linear (8-bit / 255), BGR float.
+// Thumbnail pixels over a clipped camera pixel (any channel ≥ kClippedLevel) are set to
+// kClippedThumbnail in every channel and left out of the comparison.
+inline constexpr int kClippedLevel = 250;
+inline constexpr float kClippedThumbnail = 1.0f;
 cv::Mat LinearThumbnail(const cv::Mat& image, int width);
 
 // YAML (OpenCV FileStorage), written atomically; Load throws LightError naming the file.
@@ -81,7 +90,13 @@ RoomLight LoadRoomLight(const std::filesystem::path& file);
 class ExposureFollower {
  public:
   // `smoothing` in (0, 1]: the share of the new ratio taken each frame (in log units).
-  explicit ExposureFollower(std::vector<KeyframeThumbnail> thumbnails, double smoothing = 0.25);
+  // `scene_triangles`: the proxy; with it each live thumbnail pixel is compared with what the
+  // chosen keyframe saw of the same scene point (its ray cast into the proxy, the point
+  // projected into the keyframe, seen unoccluded), so a live view between keyframes and the
+  // pixels left out as clipped compare like with like. Without it, pixel with pixel.
+  // `live_camera`: the live camera (its pinhole part is used).
+  ExposureFollower(std::vector<KeyframeThumbnail> thumbnails, const std::vector<Eigen::Vector3f>& scene_triangles,
+                   const calib::Camera& live_camera, double smoothing = 0.25);
   // The live frame (8-bit BGR or grey, raw camera image) and its pose; returns the smoothed
   // per-channel gain (RGB) to apply to the stored light. Without thumbnails the gain stays 1.
   Eigen::Vector3d Update(const cv::Mat& live, const calib::Pose& pose);
@@ -90,7 +105,12 @@ class ExposureFollower {
   int last_keyframe() const { return last_keyframe_; }
 
  private:
+  // Σ live and Σ keyframe over the comparable thumbnail pixels (RGB); false when too few.
+  bool Compare(const cv::Mat& live_thumbnail, const calib::Pose& pose, const KeyframeThumbnail& key,
+               Eigen::Vector3d* live_sum, Eigen::Vector3d* key_sum) const;
   std::vector<KeyframeThumbnail> thumbnails_;
+  std::unique_ptr<TriangleBvh> scene_;
+  calib::Camera live_camera_;
   double smoothing_;
   double centre_spread_ = 1;
   Eigen::Vector3d gain_ = Eigen::Vector3d::Ones();
