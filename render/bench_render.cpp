@@ -5,6 +5,9 @@
 //                                upload + resolve + read-back: Fox, CesiumMan, and a synthetic
 //                                25 000-triangle skinned tube (10 joints, 2 influences)
 //   BM_ArFrameNoAa/<character>   the same without antialiasing
+//   BM_ArFrameLit[NoAa]/<c>     the same with the room's light (issue 14): SH through self-shadowed
+//                                PRT, exposure follower, cast shadow, depth-only occluder proxy;
+//                                counter prt_precompute_s: the PRT ray casting at AddCharacter
 //   BM_UndistortBackground       cv::remap of a 640x480 frame with precomputed maps (the cost of
 //                                lens distortion in the AR path)
 //   BM_SynthRoomFrame            one frame of `arview synth room` (render + read-back, no PNG),
@@ -156,7 +159,32 @@ cv::Mat Background() {
   return image;
 }
 
-void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing) {
+// Triangles of the box [lo, hi] (map frame).
+void AppendBox(std::vector<Eigen::Vector3f>& out, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+  auto corner = [&](int i) { return Eigen::Vector3f(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z()); };
+  const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+  for (const auto& f : faces)
+    for (int k : {0, 1, 2, 0, 2, 3}) out.push_back(corner(f[k]));
+}
+
+// A room's light for the lit frames: ambient plus a warm light from above one side, a
+// thumbnail of the bench's background from the bench's camera (so the exposure follower does
+// its full per-frame work), the room as the proxy, and the room plus a pillar beside the
+// character (inside the drawn rectangle, hiding none of it: the depth pass costs in full) as
+// occluders.
+RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_pose) {
+  RoomLight light;
+  light.sh = ConstantSh({0.25, 0.25, 0.27}) + CapSh(Eigen::Vector3d(-0.5, -0.4, 0.77).normalized(), 0.1, {40, 36, 30});
+  light.dominant = ExtractDominantLight(light.sh);
+  const calib::Camera camera = BenchCamera();
+  light.thumbnails.push_back({camera_pose, LinearThumbnail(background, 40), {camera.fx, camera.fy, camera.cx, camera.cy}, camera.Size()});
+  AppendBox(light.scene_triangles, {-3, -3, 0}, {3, 3, 2.8});
+  light.occluder_triangles = light.scene_triangles;
+  AppendBox(light.occluder_triangles, {0.9f, -1.3f, 0}, {1.2f, -1.0f, 2.4f});
+  return light;
+}
+
+void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing, bool lit = false) {
   Subject* subject = GetSubject(name);
   if (subject == nullptr) {
     state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
@@ -164,9 +192,14 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   }
   ArOptions options;
   options.antialiasing = antialiasing;
+  if (lit) options.lighting = LightingMode::kShShadowed;
   ArRenderer renderer(Context(), BenchCamera(), options);
   renderer.AddCharacter(subject->animated->character(), subject->spec);
   const cv::Mat background = Background();
+  if (lit) {
+    renderer.SetRoomLight(BenchRoomLight(background, subject->camera_pose));
+    state.counters["prt_precompute_s"] = renderer.prt_seconds();
+  }
   const Eigen::Vector3d viewpoint = subject->spec.ViewpointFromCamera(subject->camera_pose.Center());
   double time = 0;
   cv::Mat frame;
@@ -191,6 +224,10 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
 
 void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa); }
 void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone); }
+// The room's light (issue 14): SH through self-shadowed PRT, the exposure follower, the cast
+// shadow from the dominant light and a depth-only occluder proxy, on top of BM_ArFrame.
+void BM_ArFrameLit(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa, true); }
+void BM_ArFrameLitNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone, true); }
 
 void BM_UndistortBackground(benchmark::State& state) {
   calib::Camera camera = BenchCamera();
@@ -230,6 +267,12 @@ BENCHMARK_CAPTURE(BM_ArFrame, tube25k, std::string("tube25k"))->Unit(benchmark::
 BENCHMARK_CAPTURE(BM_ArFrameNoAa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameNoAa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameNoAa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLit, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLit, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLit, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -3,11 +3,13 @@
 // the character's colour following a coloured light and an exposure ramp in the rendered room.
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <random>
@@ -591,6 +593,32 @@ TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
               "(%d Fox pixels, %d card pixels); worst excess over 2%% + 0.5 level: %.2f levels\n",
               100 * worst, cv::countNonZero(fox_mask), cv::countNonZero(card_mask), worst_excess);
   EXPECT_LE(worst_excess, 0.0);
+
+  // docs/render.md's pictures: the same composited frame (warm light, exposure 1) lit the old
+  // way (fixed key + ambient, contact shadow) and the new way (room SH through PRT, cast shadow).
+  if (const char* dir = std::getenv("ARVIEW_LIGHTING_PICTURES"); dir && *dir) {
+    std::vector<LightKeyframe> keys;
+    for (size_t i = 0; i < key_renders.size(); ++i) keys.push_back({RoomCamera(), key_poses[i], Film(key_renders[i], warm, 1.0)});
+    const RoomLight light = EstimateRoomLight(keys, geometry, position);
+    const cv::Mat live = Film(live_render, warm, 1.0);
+    cv::Rect box = cv::boundingRect(fox_mask) | cv::boundingRect(card_mask);
+    box = cv::Rect(box.x - 30, box.y - 30, box.width + 60, box.height + 60) & cv::Rect(0, 0, 640, 480);
+    for (int way = 0; way < 2; ++way) {
+      ArOptions options;
+      options.lighting = way == 0 ? LightingMode::kFixed : LightingMode::kShShadowed;
+      options.exposure_smoothing = 1.0;
+      ArRenderer renderer(context, RoomCamera(), options);
+      renderer.AddCharacter(fox.character(), fox.spec());
+      if (way == 1) {
+        renderer.SetRoomLight(light);
+        renderer.SetOccluders({});
+      }
+      const cv::Mat frame = renderer.Render(live, live_pose, {&out, 1});
+      const fs::path file = fs::path(dir) / (way == 0 ? "render-lighting-old.png" : "render-lighting-new.png");
+      ASSERT_TRUE(cv::imwrite(file.string(), frame(box)));
+      std::printf("wrote %s (%dx%d)\n", file.string().c_str(), box.width, box.height);
+    }
+  }
 }
 
 }  // namespace
