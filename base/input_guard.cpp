@@ -1,0 +1,207 @@
+#include "base/input_guard.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <vector>
+
+namespace arview {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string KindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+std::string Bytes(std::uintmax_t n) {
+  std::ostringstream ss;
+  if (n >= (1ull << 30)) ss << (n >> 30) << " GiB";
+  else if (n >= (1ull << 20)) ss << (n >> 20) << " MiB";
+  else if (n >= (1ull << 10)) ss << (n >> 10) << " KiB";
+  else ss << n << " bytes";
+  return ss.str();
+}
+
+void RequireRegularMode(const fs::path& file, const struct stat& st) {
+  if (!S_ISREG(st.st_mode)) throw InputError(file.string() + ": is " + KindOf(st.st_mode) + ", not a data file");
+}
+
+void RequireSizeAtMost(const fs::path& file, std::uintmax_t size, std::uintmax_t max_bytes) {
+  if (size > max_bytes) {
+    throw InputError(file.string() + ": " + Bytes(size) + " is larger than the " + Bytes(max_bytes) +
+                     " such a file may have");
+  }
+}
+
+struct Fd {
+  int fd = -1;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+}  // namespace
+
+std::uintmax_t RequireRegularFile(const fs::path& file) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) {
+    const int err = errno;
+    throw InputError(file.string() + ": " + (err == ENOENT ? "does not exist" : std::strerror(err)));
+  }
+  RequireRegularMode(file, st);
+  return static_cast<std::uintmax_t>(st.st_size);
+}
+
+std::uintmax_t RequireRegularFileUpTo(const fs::path& file, std::uintmax_t max_bytes) {
+  const std::uintmax_t size = RequireRegularFile(file);
+  RequireSizeAtMost(file, size, max_bytes);
+  return size;
+}
+
+std::string ReadFileUpTo(const fs::path& file, std::uintmax_t max_bytes, const CancellationToken& cancel) {
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused right after.
+  Fd in{::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
+  if (in.fd < 0) {
+    const int err = errno;
+    throw InputError(file.string() + ": " + (err == ENOENT ? "does not exist" : "cannot open (" +
+                                                                                   std::string(std::strerror(err)) + ")"));
+  }
+  struct stat st {};
+  if (::fstat(in.fd, &st) != 0) throw InputError(file.string() + ": cannot stat (" + std::strerror(errno) + ")");
+  RequireRegularMode(file, st);
+  const auto size = static_cast<std::uintmax_t>(st.st_size);
+  RequireSizeAtMost(file, size, max_bytes);
+  ::fcntl(in.fd, F_SETFL, ::fcntl(in.fd, F_GETFL) & ~O_NONBLOCK);
+
+  std::string data(static_cast<size_t>(size), '\0');
+  size_t got = 0;
+  constexpr size_t kChunk = 4u << 20;
+  while (got < data.size()) {
+    cancel.ThrowIfCancelled("stopped reading " + file.string());
+    const ssize_t n = ::read(in.fd, data.data() + got, std::min(kChunk, data.size() - got));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw InputError(file.string() + ": read error (" + std::strerror(errno) + ")");
+    if (n == 0) throw InputError(file.string() + ": shrank while being read (" + std::to_string(got) + " of " +
+                                 std::to_string(size) + " bytes)");
+    got += static_cast<size_t>(n);
+  }
+  char extra;
+  ssize_t n;
+  while ((n = ::read(in.fd, &extra, 1)) < 0 && errno == EINTR) {
+  }
+  if (n > 0) throw InputError(file.string() + ": grew while being read");
+  return data;
+}
+
+int YamlNestingDepth(std::string_view text) {
+  std::vector<size_t> indents;  // block indentation levels open at the current line
+  int flow = 0;                 // [ and { open (they may span lines)
+  int deepest = 0;
+  char quote = 0;  // inside a quoted scalar: its quote character
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    size_t i = 0;
+    int line_depth = 0;
+    if (flow == 0 && quote == 0) {
+      while (i < line.size() && line[i] == ' ') ++i;
+      if (i == line.size() || line[i] == '#' || line[i] == '\r') continue;
+      while (!indents.empty() && indents.back() > i) indents.pop_back();
+      if (indents.empty() || indents.back() < i) indents.push_back(i);
+      int dashes = 0;  // "- - - x": one sequence per dash on the same line
+      while (i < line.size() && line[i] == '-' && (i + 1 == line.size() || line[i + 1] == ' ')) {
+        ++dashes;
+        ++i;
+        while (i < line.size() && line[i] == ' ') ++i;
+      }
+      line_depth = static_cast<int>(indents.size()) + dashes;
+    } else {
+      line_depth = static_cast<int>(indents.size());
+    }
+    deepest = std::max(deepest, line_depth + flow);
+    char previous = ' ';
+    for (; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quote != 0) {
+        if (quote == '"' && c == '\\') ++i;
+        else if (c == quote) quote = 0;
+        previous = 'x';
+        continue;
+      }
+      if (c == '#' && (previous == ' ' || previous == '\t')) break;
+      // A quote opens a quoted scalar only where a scalar may start (it is plain text inside "it's").
+      const bool scalar_start = previous == ' ' || previous == '\t' || previous == ':' || previous == ',' ||
+                                previous == '[' || previous == '{' || previous == '-' || previous == '?';
+      if ((c == '"' || c == '\'') && scalar_start) {
+        quote = c;
+      } else if (c == '[' || c == '{') {
+        ++flow;
+        deepest = std::max(deepest, line_depth + flow);
+      } else if ((c == ']' || c == '}') && flow > 0) {
+        --flow;
+      }
+      previous = c;
+    }
+    if (flow == 0 && quote == '\'') quote = 0;  // block context: single-line view of quotes is enough
+    if (deepest > 1000000) break;
+  }
+  return deepest;
+}
+
+void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::string& name) {
+  const int depth = YamlNestingDepth(text);
+  if (depth > max_depth) {
+    throw InputError(name + ": nested " + std::to_string(depth) + " levels deep (at most " +
+                     std::to_string(max_depth) + " allowed)");
+  }
+}
+
+double RequireFiniteInRange(double value, double lo, double hi, const std::string& what) {
+  if (!std::isfinite(value)) {
+    std::ostringstream ss;
+    ss << what << ": " << value << " is not a finite number";
+    throw InputError(ss.str());
+  }
+  if (value < lo || value > hi) {
+    std::ostringstream ss;
+    ss << what << ": " << value << " is outside [" << lo << ", " << hi << "]";
+    throw InputError(ss.str());
+  }
+  return value;
+}
+
+fs::path ResolveInside(const fs::path& folder, const fs::path& relative, const std::string& source) {
+  std::error_code ec;
+  const fs::path root = fs::weakly_canonical(fs::absolute(folder), ec);
+  if (ec) throw InputError(folder.string() + ": cannot resolve (" + ec.message() + ")");
+  const fs::path candidate = relative.is_absolute() ? relative : root / relative;
+  const fs::path resolved = fs::weakly_canonical(candidate, ec);
+  if (ec) throw InputError(source + ": cannot resolve '" + relative.string() + "' (" + ec.message() + ")");
+  auto r = root.begin();
+  auto p = resolved.begin();
+  for (; r != root.end(); ++r, ++p) {
+    if (r->empty()) continue;  // a trailing separator
+    if (p == resolved.end() || *p != *r) {
+      throw InputError(source + ": '" + relative.string() + "' points outside " + folder.string() +
+                       " (refused: paths in a data file must stay inside its folder)");
+    }
+  }
+  return resolved;
+}
+
+}  // namespace arview

@@ -1,0 +1,140 @@
+#include "base/input_guard.h"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+namespace arview {
+namespace {
+
+namespace fs = std::filesystem;
+
+class InputGuard : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("arview_guard_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path Write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path dir_;
+};
+
+std::string MessageOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(InputGuard, ReadsARegularFileWhole) {
+  const fs::path p = Write("a.txt", "hello\nworld\n");
+  EXPECT_EQ(ReadFileUpTo(p, 100), "hello\nworld\n");
+  EXPECT_EQ(RequireRegularFile(p), 12u);
+}
+
+TEST_F(InputGuard, RefusesDevicesEvenBehindASymlink) {
+  fs::create_symlink("/dev/zero", dir_ / "points3D.bin");
+  const auto start = std::chrono::steady_clock::now();
+  const std::string m = MessageOf([&] { ReadFileUpTo(dir_ / "points3D.bin", 1 << 20); });
+  EXPECT_NE(m.find("points3D.bin"), std::string::npos) << m;
+  EXPECT_NE(m.find("character device"), std::string::npos) << m;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+  EXPECT_NE(MessageOf([&] { RequireRegularFile(dir_ / "points3D.bin"); }), "");
+}
+
+TEST_F(InputGuard, RefusesAFifoWithoutWaitingForAWriter) {
+  const fs::path fifo = dir_ / "frames.txt";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto start = std::chrono::steady_clock::now();
+  const std::string m = MessageOf([&] { ReadFileUpTo(fifo, 1 << 20); });
+  EXPECT_NE(m.find("a FIFO"), std::string::npos) << m;
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+}
+
+TEST_F(InputGuard, RefusesDirectoriesMissingFilesAndOversizedOnes) {
+  EXPECT_NE(MessageOf([&] { ReadFileUpTo(dir_, 10); }).find("a directory"), std::string::npos);
+  EXPECT_NE(MessageOf([&] { ReadFileUpTo(dir_ / "none", 10); }).find("does not exist"), std::string::npos);
+  const fs::path big = Write("big.yaml", std::string(2000, 'x'));
+  const std::string m = MessageOf([&] { ReadFileUpTo(big, 1000); });
+  EXPECT_NE(m.find("big.yaml"), std::string::npos) << m;
+  EXPECT_NE(m.find("larger than"), std::string::npos) << m;
+  EXPECT_NE(MessageOf([&] { RequireRegularFileUpTo(big, 1000); }), "");
+}
+
+TEST_F(InputGuard, ACancelledTokenStopsTheRead) {
+  const fs::path p = Write("a.bin", std::string(100, 'x'));
+  CancellationToken token;
+  token.Cancel(SIGTERM);
+  EXPECT_THROW(ReadFileUpTo(p, 1000, token), CancelledError);
+}
+
+TEST(YamlNestingDepth, CountsBlockSequenceAndFlowNesting) {
+  EXPECT_EQ(YamlNestingDepth(""), 0);
+  EXPECT_EQ(YamlNestingDepth("a: 1\nb: 2\n"), 1);
+  EXPECT_EQ(YamlNestingDepth("a:\n  b:\n    c: 1\n"), 3);
+  EXPECT_EQ(YamlNestingDepth("- - - x\n"), 4);
+  EXPECT_EQ(YamlNestingDepth("a: [[[1]]]\n"), 4);
+  EXPECT_EQ(YamlNestingDepth("a: {b: {c: 1}}\n"), 3);
+  // Brackets inside quotes and comments are text.
+  EXPECT_EQ(YamlNestingDepth("a: \"[[[[\" # [[[[\nb: '{{{{'\n"), 1);
+  // An apostrophe inside a plain scalar does not hide the brackets after it.
+  EXPECT_EQ(YamlNestingDepth("a: it's [[[1]]]\n"), 4);
+}
+
+TEST(YamlNestingDepth, TheFuzzersDeepFilesAreRefusedQuickly) {
+  std::string block;
+  for (int i = 0; i < 3000; ++i) block += std::string(static_cast<size_t>(i), ' ') + "a:\n";
+  std::string flow = "a: " + std::string(10000, '[') + std::string(10000, ']') + "\n";
+  std::string unclosed = "a: " + std::string(50000, '{');
+  for (const std::string* text : {&block, &flow, &unclosed}) {
+    const std::string m = MessageOf([&] { RequireYamlDepthAtMost(*text, kMaxYamlDepth, "scene.yaml"); });
+    EXPECT_NE(m.find("scene.yaml: nested"), std::string::npos) << m;
+  }
+  EXPECT_NO_THROW(RequireYamlDepthAtMost("a:\n  b: [1, 2, {c: 3}]\n", kMaxYamlDepth, "ok.yaml"));
+}
+
+TEST(RequireFiniteInRange, RefusesNanInfinityAndOutOfRange) {
+  EXPECT_EQ(RequireFiniteInRange(0.5, 0, 1, "--ratio"), 0.5);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::string m = MessageOf([&] { RequireFiniteInRange(nan, 0, 1, "--ratio"); });
+  EXPECT_NE(m.find("--ratio"), std::string::npos) << m;
+  EXPECT_NE(m.find("not a finite number"), std::string::npos) << m;
+  EXPECT_NE(MessageOf([&] { RequireFinite(INFINITY, "x"); }), "");
+  EXPECT_NE(MessageOf([&] { RequireFinite(1e308, "x"); }), "");
+  EXPECT_NE(MessageOf([&] { RequireFiniteInRange(2, 0, 1, "x"); }).find("outside"), std::string::npos);
+}
+
+TEST_F(InputGuard, PathsFromDataFilesStayInsideTheirFolder) {
+  fs::create_directories(dir_ / "rec" / "frames");
+  Write("rec/frames/000000.png", "x");
+  EXPECT_EQ(ResolveInside(dir_ / "rec", "frames/000000.png", "frames.txt"),
+            fs::weakly_canonical(dir_ / "rec" / "frames" / "000000.png"));
+  EXPECT_NO_THROW(ResolveInside(dir_ / "rec", "frames/./x/../000000.png", "frames.txt"));
+  for (const std::string bad : {"../../../../etc/passwd", "/etc/passwd", "../rec2/x.png"}) {
+    const std::string m = MessageOf([&] { ResolveInside(dir_ / "rec", bad, "rec/frames.txt"); });
+    EXPECT_NE(m.find("rec/frames.txt"), std::string::npos) << bad << ": " << m;
+    EXPECT_NE(m.find("outside"), std::string::npos) << bad << ": " << m;
+  }
+  // A symlink inside the folder that points out of it is refused too.
+  fs::create_symlink("/etc", dir_ / "rec" / "frames" / "escape");
+  EXPECT_NE(MessageOf([&] { ResolveInside(dir_ / "rec", "frames/escape/passwd", "frames.txt"); }), "");
+  // A prefix that is not a path component ("rec" vs "rec2") is not inside.
+  fs::create_directories(dir_ / "rec2");
+  EXPECT_NE(MessageOf([&] { ResolveInside(dir_ / "rec", dir_ / "rec2" / "x.png", "frames.txt"); }), "");
+}
+
+}  // namespace
+}  // namespace arview
