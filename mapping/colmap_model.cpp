@@ -11,6 +11,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "base/input_guard.h"
+
 namespace arview::mapping {
 
 namespace fs = std::filesystem;
@@ -23,11 +25,14 @@ constexpr int kDescriptorSize = 128;
 // A whole file in memory with bounds-checked little-endian reads.
 class BinaryReader {
  public:
-  explicit BinaryReader(const fs::path& path) : path_(path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw map::MapError(path.string() + ": missing or unreadable");
-    data_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) throw map::MapError(path.string() + ": read error");
+  // Only a regular file of a sane size is read (a link to /dev/zero or a FIFO would never
+  // end), in chunks that look at `cancel`.
+  BinaryReader(const fs::path& path, const CancellationToken& cancel) : path_(path) {
+    try {
+      data_ = ReadFileUpTo(path, kMaxBinaryFileBytes, cancel);
+    } catch (const InputError& e) {
+      throw map::MapError(e.what());
+    }
   }
 
   template <typename T>
@@ -74,7 +79,7 @@ class BinaryReader {
   }
 
   fs::path path_;
-  std::vector<char> data_;
+  std::string data_;
   std::size_t pos_ = 0;
 };
 
@@ -131,8 +136,8 @@ calib::Camera ToCamera(int model_id, std::uint64_t width, std::uint64_t height, 
   return c;
 }
 
-std::unordered_map<std::uint32_t, calib::Camera> ReadCameras(const fs::path& file) {
-  BinaryReader r(file);
+std::unordered_map<std::uint32_t, calib::Camera> ReadCameras(const fs::path& file, const CancellationToken& cancel) {
+  BinaryReader r(file, cancel);
   const auto n = r.ReadCount("camera count", 4 + 4 + 8 + 8);
   std::unordered_map<std::uint32_t, calib::Camera> cameras;
   for (std::uint64_t i = 0; i < n; ++i) {
@@ -165,8 +170,8 @@ struct ColmapImage {
   std::vector<std::uint64_t> point3d_ids;   // kInvalidPoint3D when none
 };
 
-std::vector<ColmapImage> ReadImages(const fs::path& file) {
-  BinaryReader r(file);
+std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToken& cancel) {
+  BinaryReader r(file, cancel);
   const auto n = r.ReadCount("registered image count", 4 + 7 * 8 + 4 + 1 + 8);
   std::vector<ColmapImage> images;
   images.reserve(n);
@@ -211,8 +216,8 @@ struct ColmapPoint {
   std::vector<TrackElement> track;
 };
 
-std::vector<ColmapPoint> ReadPoints(const fs::path& file) {
-  BinaryReader r(file);
+std::vector<ColmapPoint> ReadPoints(const fs::path& file, const CancellationToken& cancel) {
+  BinaryReader r(file, cancel);
   const auto n = r.ReadCount("3D point count", 8 + 24 + 3 + 8 + 8);
   std::vector<ColmapPoint> points;
   points.reserve(n);
@@ -314,17 +319,18 @@ std::uint64_t Key(std::uint32_t image_id, std::uint32_t point2d_idx) {
 }  // namespace
 
 std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
-  BinaryReader r(sparse_dir / "images.bin");
+  BinaryReader r(sparse_dir / "images.bin", CancellationToken{});
   return r.Read<std::uint64_t>("registered image count");
 }
 
-map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames) {
+map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+                  const CancellationToken& cancel) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
   const fs::path images_file = sparse_dir / "images.bin";
   const fs::path points_file = sparse_dir / "points3D.bin";
-  const auto cameras = ReadCameras(cameras_file);
-  auto images = ReadImages(images_file);
-  const auto points = ReadPoints(points_file);
+  const auto cameras = ReadCameras(cameras_file, cancel);
+  auto images = ReadImages(images_file, cancel);
+  const auto points = ReadPoints(points_file, cancel);
   if (images.empty()) throw map::MapError(images_file.string() + ": the model has no registered images");
   if (points.empty()) throw map::MapError(points_file.string() + ": the model has no 3D points");
 

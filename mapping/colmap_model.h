@@ -8,6 +8,7 @@
 #include <map>
 #include <string>
 
+#include "base/cancellation.h"
 #include "map/map.h"
 
 namespace arview::mapping {
@@ -26,7 +27,9 @@ std::uint64_t CountRegisteredImages(const std::filesystem::path& sparse_dir);
 // Builds the Map from a sparse model folder and the database it came from. Every registered
 // image must appear in `frames` (unless `frames` is empty: then frame_index = -1, timestamp 0).
 // Keyframes are ordered by frame index (then name), points by COLMAP's point id.
+// Only regular files are read (a link to a device or FIFO is refused), in chunks that look at
+// `cancel` (CancelledError).
 map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::filesystem::path& database,
-                  const FrameLookup& frames = {});
+                  const FrameLookup& frames = {}, const CancellationToken& cancel = {});
 
 }  // namespace arview::mapping

@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "base/process.h"
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
-#include "mapping/process.h"
 #include "recordings/trajectory.h"
 
 namespace arview::mapping {
@@ -122,7 +122,7 @@ class ColmapRunner {
     std::vector<std::string> argv{options_.colmap};
     argv.insert(argv.end(), args.begin(), args.end());
     ProgressParser parser(stage, total, cb_);
-    const ProcessResult r = RunProcess(argv, log_, std::ref(parser));
+    const ProcessResult r = RunProcess(argv, log_, std::ref(parser), options_.cancel);
     if (!r.ok()) {
       const std::string how = r.signaled ? "was killed by signal " + std::to_string(r.signal)
                                          : "exited with code " + std::to_string(r.exit_code);
@@ -177,6 +177,7 @@ ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& ou
   } else {
     stages.Forget("select");
     const FrameSelection s = SelectVideoFrames(rec, candidates, sel, [&](int done, int total) {
+      options.cancel.ThrowIfCancelled("stopped selecting frames; nothing of this stage kept");
       if (cb.progress) cb.progress("select", done, total);
     });
     *selected = s.frames;
@@ -195,6 +196,7 @@ ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& ou
     for (int i = 0; next < selected->size(); ++i) {
       if (!cap.read(frame) || frame.empty()) throw recordings::RecordingError(video.string() + ": ends early");
       if (i != (*selected)[next]) continue;
+      options.cancel.ThrowIfCancelled("stopped writing the selected frames; nothing of this stage kept");
       const fs::path png = set.root / FrameName(i);
       if (!cv::imwrite(png.string(), frame)) throw map::MapError(png.string() + ": cannot write");
       ++next;
@@ -280,6 +282,17 @@ fs::path LargestModel(const fs::path& sparse_root, int* count, const MapBuildCal
   return best;
 }
 
+// "interrupted (SIGINT) during COLMAP's match stage; kept the finished stages (select,
+// extract): re-run the same command to continue"
+std::string InterruptedStageMessage(const CancellationToken& cancel, const std::string& stage,
+                                    const std::vector<StageTiming>& finished) {
+  std::string kept;
+  for (const auto& t : finished) kept += (kept.empty() ? "" : ", ") + t.stage;
+  return "interrupted (" + SignalName(cancel.Signal()) + ") during COLMAP's " + stage + " stage; " +
+         (kept.empty() ? std::string("no stage was finished")
+                       : "kept the finished stages (" + kept + "): re-run the same command to continue");
+}
+
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -355,7 +368,11 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     }
     stages.Forget(name);
     prepare();
-    colmap.Run(name, args, n);
+    try {
+      colmap.Run(name, args, n);
+    } catch (const CancelledError& e) {
+      throw CancelledError(InterruptedStageMessage(options.cancel, name, result.timings), e.signal_number());
+    }
     stages.Save(name, stage_inputs);
     result.timings.push_back({name, Seconds(t0), false});
   };
@@ -407,7 +424,9 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                                "): too few matches between the frames? Its output is in " + colmap.log().string(),
                            "map", colmap.log(), {});
   }
-  result.map = ReadColmapMap(result.model_dir, database, images.lookup);
+  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+  result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel);
+  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
   WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
   map::SaveMap(result.map, out_dir / map::kMapFileName);
   WriteTopView(result.map, out_dir / "map.png");

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "base/cancellation.h"
 #include "map/map.h"
 #include "mapping/frame_selection.h"
 #include "recordings/recording.h"
@@ -53,6 +54,9 @@ struct MapBuildOptions {
     ba_local_max_iterations = 25;
   }
   std::string colmap = "colmap";    // the COLMAP executable (found on PATH)
+  // Cancelled (Ctrl-C, SIGTERM): the running COLMAP stage is stopped, BuildMap throws
+  // CancelledError, and the stages finished before stay recorded for a re-run.
+  CancellationToken cancel;
 };
 
 // A COLMAP stage that failed: the message says which and why; `log_tail` holds the last lines
@@ -88,7 +92,8 @@ struct MapBuildResult {
 };
 
 // Runs everything and writes the map directory. Throws MapError (or ColmapStageError,
-// InterruptedError from mapping/process.h, recordings::RecordingError for a bad --frames).
+// arview::CancelledError when options.cancel is cancelled, arview::ProcessError when COLMAP
+// cannot be started, recordings::RecordingError for a bad --frames).
 MapBuildResult BuildMap(const recordings::Recording& recording, const std::filesystem::path& out_dir,
                         const MapBuildOptions& options, const MapBuildCallbacks& callbacks = {});
 
