@@ -72,6 +72,16 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   std::mutex report_mutex;
   const Clock::time_point start = Clock::now();
 
+  // A stop request closes every queue, so that no stage stays blocked pushing to one that
+  // stopped popping.
+  auto stopped = [&] {
+    if (!(stop && stop())) return false;
+    to_track.Close();
+    to_render.Close();
+    to_sink.Close();
+    return true;
+  };
+
   auto guarded = [&](auto&& body, auto&... downstream) {
     return [&, body] {
       try {
@@ -90,7 +100,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   std::thread capture(guarded(
       [&] {
         size_t read = 0;
-        while (!error.failed() && !(stop && stop()) && !sink.StopRequested()) {
+        while (!error.failed() && !stopped() && !sink.StopRequested()) {
           InFlight item;
           if (!source.Next(item.frame)) break;
           item.arrival = Clock::now();
@@ -105,7 +115,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   std::thread track(guarded(
       [&] {
         while (auto item = to_track.Pop()) {
-          if (error.failed()) break;
+          if (error.failed() || stopped()) break;
           const Clock::time_point t0 = Clock::now();
           item->track = tracker.Track(item->frame.image, item->frame.timestamp);
           stats.Record("track", MsSince(t0));
@@ -118,7 +128,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       [&] {
         compositor.BindToThread();
         while (auto item = to_render.Pop()) {
-          if (error.failed()) break;
+          if (error.failed() || stopped()) break;
           FrameLog log;
           log.index = item->frame.index;
           log.timestamp = item->frame.timestamp;
@@ -157,7 +167,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   std::thread write(guarded([&] {
     while (auto item = to_sink.Pop()) {
-      if (error.failed()) break;
+      if (error.failed() || stopped()) break;
       const Clock::time_point t0 = Clock::now();
       sink.Write(item->output);
       stats.Record("sink", MsSince(t0));

@@ -66,7 +66,8 @@ struct PipelineReport {
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 
-// Runs until the source ends (or `stop()` returns true, checked between frames). Rethrows on the
+// Runs until the source ends (or `stop()` returns true, checked by every stage between frames:
+// a stopped run drains nothing). Rethrows on the
 // caller's thread the first error any stage raised, after every thread has stopped.
 PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
                            FrameCompositor& compositor, render::FrameSink& sink, const PipelineOptions& options,

@@ -51,19 +51,26 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::unique_ptr<render::FrameSink> sink = render::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
 
   Progress progress("augmenting frames");
-  const std::atomic<bool>* stop = o.stop;
   PipelineReport report = RunPipeline(
       source, tracker, animator_ptrs, compositor, *sink, o.pipeline,
       [&](const PipelineReport& r) {
-        if (o.quiet) return;
+        if (o.quiet || o.cancel.IsCancelled()) return;  // after a Ctrl-C: only the one line
         char detail[96];
         std::snprintf(detail, sizeof(detail), "%zu localized, %zu dropped", r.frames_localized, r.frames_dropped);
         progress.Update(static_cast<long>(r.frames_processed), o.expected_frames > 0 ? o.expected_frames
                                                                                       : static_cast<long>(r.frames_processed),
                         detail);
       },
-      [stop] { return stop && stop->load(); });
+      [&o] { return o.cancel.IsCancelled(); });
   progress.Finish();
+  if (o.cancel.IsCancelled() && !o.cancel_ends_normally) {
+    std::string unwritten = o.output_name.empty() ? std::string() : o.output_name;
+    for (const auto& file : {o.trajectory_out, o.stats_out}) {
+      if (!file.empty()) unwritten += (unwritten.empty() ? "" : ", ") + file.string();
+    }
+    o.cancel.ThrowIfCancelled("stopped after " + std::to_string(report.frames_processed) + " frames; " +
+                              (unwritten.empty() ? std::string("nothing to keep") : "not written: " + unwritten));
+  }
 
   SessionResult result{std::move(report), compositor.Description()};
   if (!o.trajectory_out.empty()) {

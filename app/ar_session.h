@@ -9,6 +9,7 @@
 #include <string>
 
 #include "app/ar_compositor.h"
+#include "base/cancellation.h"
 #include "app/ar_pipeline.h"
 #include "app/layered_animator.h"
 #include "map/map.h"
@@ -27,7 +28,13 @@ struct SessionOptions {
   FadeOptions fade;
   PipelineOptions pipeline;
   long expected_frames = 0;                  // for the progress line (0: unknown)
-  const std::atomic<bool>* stop = nullptr;   // Ctrl-C
+  // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory, no stats) and
+  // RunSession throws CancelledError saying so; the caller removes its partial video.
+  CancellationToken cancel;
+  std::string output_name;                   // what the sink's output is called, for that message
+  // Live sessions (`arview run`) end by Ctrl-C: then a cancellation is the normal end, and the
+  // outputs are written.
+  bool cancel_ends_normally = false;
   bool quiet = false;
 };
 
@@ -41,7 +48,7 @@ struct SessionResult {
 double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
 
 // `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
-// names the map in messages.
+// names the map in messages. Throws CancelledError when options.cancel was cancelled.
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& options);
 

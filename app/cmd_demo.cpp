@@ -11,11 +11,11 @@
 
 #include "app/ar_session.h"
 #include "app/commands.h"
-#include "app/interrupt.h"
 #include "app/output_file.h"
 #include "app/pipeline_report.h"
 #include "app/place_character.h"
 #include "app/progress.h"
+#include "base/cancellation.h"
 #include "mapping/colmap_pipeline.h"
 #include "recordings/accuracy.h"
 #include "render/synth_room.h"
@@ -39,7 +39,8 @@ struct DemoArgs {
 
 void Step(int n, const std::string& what) { std::printf("\n[%d/6] %s\n", n, what.c_str()); std::fflush(stdout); }
 
-recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t seed, const render::OffscreenOptions& gl) {
+recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t seed, const render::OffscreenOptions& gl,
+                                 const CancellationToken& cancel) {
   if (fs::exists(dir / "frames.txt")) {
     try {
       recordings::Recording existing = recordings::LoadRecording(dir);
@@ -58,7 +59,11 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
   o.overwrite = true;
   o.gl = gl;  // Mesa reads the thread count once per process: the same as for the replay
   Progress progress("  rendering");
-  const render::SynthRoomReport r = render::SynthesizeRoom(o, [&](int done, int total) { progress.Update(done, total); });
+  const render::SynthRoomReport r = render::SynthesizeRoom(o, [&](int done, int total) {
+    cancel.ThrowIfCancelled("stopped rendering the room after " + std::to_string(done) + " of " +
+                            std::to_string(total) + " frames; a re-run renders it again");
+    progress.Update(done, total);
+  });
   progress.Finish();
   std::printf("  %d frames at 640x480 with exact ground truth -> %s\n", r.frames, dir.c_str());
   return recordings::LoadRecording(dir);
@@ -89,10 +94,10 @@ void AddDemoCommand(CLI::App& app) {
     render::OffscreenOptions gl;
     gl.backend = render::ParseGlBackend(a->gl);
     gl.threads = a->gl_threads;
-    InterruptFlag interrupt;
+    const ScopedSignalCancellation signals;
 
     Step(1, "Rendering a walk twice round the room, with exact ground truth");
-    const recordings::Recording walk = RenderWalk(work / "room", a->frames, 1, gl);
+    const recordings::Recording walk = RenderWalk(work / "room", a->frames, 1, gl, signals.token());
     const int half = a->frames / 2;
 
     Step(2, "Checking the recording");
@@ -106,10 +111,12 @@ void AddDemoCommand(CLI::App& app) {
     // A rendered room at 640x480 has plenty of texture: 2048 features a frame map it, and keep
     // COLMAP's matching (quadratic in the feature count) to seconds.
     map_options.max_num_features = 2048;
+    map_options.cancel = signals.token();
     Progress map_progress("  colmap");
     std::string stage_shown;
     mapping::MapBuildCallbacks callbacks;
     callbacks.progress = [&](const std::string& stage, int done, int total) {
+      if (signals.token().IsCancelled()) return;  // after a Ctrl-C: only the one line
       if (stage != stage_shown) {
         map_progress.Finish();
         map_progress = Progress("  colmap " + stage);
@@ -139,19 +146,19 @@ void AddDemoCommand(CLI::App& app) {
     SessionOptions session;
     session.scene_file = scene;
     PendingOutput video(out);
-    session.sink = video.partial().string();
+    session.sink = video.sink_target();
     session.sink_fps = MedianFrameRate(walk.frames);
     session.trajectory_out = work / "trajectory.txt";
     session.stats_out = work / "stats.json";
     session.compositor.gl = gl;
     session.compositor.hmd = a->hmd;
     session.expected_frames = a->frames - half;
-    session.stop = interrupt.flag();
+    session.cancel = signals.token();
+    session.output_name = out.string();
     recordings::ReplayOptions replay;
     for (int i = half; i < a->frames; ++i) replay.frames.push_back(i);
     recordings::RecordingSource source(walk, replay);
     const SessionResult result = RunSession(source, walk.camera.Size(), built.map, (work / "map").string(), session);
-    if (interrupt.raised()) throw CommandError("interrupted: " + out.string() + " not written", 130);
     video.Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
 

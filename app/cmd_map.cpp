@@ -11,9 +11,10 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "base/cancellation.h"
+#include "base/process.h"
 #include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
-#include "mapping/process.h"
 
 namespace arview::app {
 
@@ -88,9 +89,13 @@ void RunMap(const MapArgs& args) {
   options.colmap = args.colmap;
   options.max_num_features = args.max_features;
   if (args.colmap_defaults) options.UseColmapDefaults();
+  const ScopedSignalCancellation signals;
+  options.cancel = signals.token();
   ProgressBar bar;
   mapping::MapBuildCallbacks callbacks;
-  callbacks.progress = [&](const std::string& stage, int done, int total) { bar.Update(stage, done, total); };
+  callbacks.progress = [&](const std::string& stage, int done, int total) {
+    if (!signals.token().IsCancelled()) bar.Update(stage, done, total);  // after a Ctrl-C: only the one line
+  };
   callbacks.note = [&](const std::string& message) {
     bar.Finish();
     std::cerr << "note: " << message << "\n";
@@ -98,7 +103,6 @@ void RunMap(const MapArgs& args) {
   try {
     options.matcher = mapping::ParseMatcherKind(args.matcher);
     const recordings::Recording recording = recordings::LoadRecording(args.recording);
-    mapping::InterruptGuard interrupt_guard;
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
     bar.Finish();
     const auto stats = map::ComputeStats(result.map);
@@ -119,10 +123,10 @@ void RunMap(const MapArgs& args) {
     std::cerr << "last lines of COLMAP's output (" << e.log.string() << "):\n";
     for (const auto& line : e.log_tail) std::cerr << "  | " << line << "\n";
     throw CommandError(e.what());
-  } catch (const mapping::InterruptedError& e) {
+  } catch (const CancelledError&) {
     bar.Finish();
-    throw CommandError(std::string(e.what()) + "; re-run the same command to continue (finished stages are kept)", 130);
-  } catch (const mapping::ProcessError& e) {
+    throw;  // its message says which stage stopped and what was kept
+  } catch (const ProcessError& e) {
     throw CommandError(e.what());
   } catch (const map::MapError& e) {
     throw CommandError(e.what());

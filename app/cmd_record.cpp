@@ -1,43 +1,20 @@
 // arview record --device /dev/video0 --out <recording> [--size 640x480] [--seconds N]
 //               [--format auto|yuyv|mjpeg] [--camera camera.yaml] [--force]
 
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <regex>
+#include <sstream>
 
 #include "app/commands.h"
+#include "base/cancellation.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
 
 namespace arview::app {
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the Ctrl-C flag is set from a signal handler");
-
-extern "C" void OnStopSignal(int) { g_stop.store(true); }
-
-// Restores the previous SIGINT/SIGTERM handlers when recording ends, however it ends.
-class StopOnSignals {
- public:
-  StopOnSignals() {
-    g_stop.store(false);
-    old_int_ = std::signal(SIGINT, OnStopSignal);
-    old_term_ = std::signal(SIGTERM, OnStopSignal);
-  }
-  ~StopOnSignals() {
-    std::signal(SIGINT, old_int_);
-    std::signal(SIGTERM, old_term_);
-  }
-
- private:
-  void (*old_int_)(int) = SIG_DFL;
-  void (*old_term_)(int) = SIG_DFL;
-};
 
 struct RecordArgs {
   std::string device = "/dev/video0";
@@ -68,12 +45,14 @@ void RunRecord(const RecordArgs& args) {
       throw CommandError(e.what());
     }
   }
-  StopOnSignals signals;
+  // Ctrl-C (or SIGTERM) is how a recording without --seconds ends: the frames written so far
+  // are a valid recording. With --seconds, an early stop says so and exits non-zero.
+  const ScopedSignalCancellation signals;
   recordings::V4l2Options options;
   options.width = size.width;
   options.height = size.height;
   options.format = args.format;
-  options.stop = &g_stop;
+  options.cancel = signals.token();
   try {
     recordings::V4l2Source source(args.device, options);
     if (source.size() != size) {
@@ -95,7 +74,7 @@ void RunRecord(const RecordArgs& args) {
     };
     recordings::RecordStats stats;
     try {
-      stats = recordings::RecordFrames(source, writer, args.seconds, &g_stop, progress);
+      stats = recordings::RecordFrames(source, writer, args.seconds, signals.token(), progress);
     } catch (const recordings::SourceError& e) {
       std::fprintf(stderr, "\n");
       if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
@@ -103,7 +82,16 @@ void RunRecord(const RecordArgs& args) {
                          " frames recorded before stay a valid recording in " + args.out);
     }
     std::fprintf(stderr, "\n");
-    if (writer.RemoveIfEmpty()) throw CommandError("stopped before the first frame; nothing was recorded");
+    if (writer.RemoveIfEmpty()) {
+      signals.token().ThrowIfCancelled("stopped before the first frame; nothing was recorded");
+      throw CommandError("stopped before the first frame; nothing was recorded");
+    }
+    if (args.seconds > 0 && signals.token().IsCancelled()) {
+      std::ostringstream what;
+      what << "stopped after " << stats.seconds << " of " << args.seconds << " s; the " << stats.frames
+           << " frames recorded stay a valid recording in " << args.out;
+      signals.token().ThrowIfCancelled(what.str());
+    }
     std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out;
     if (source.skipped_frames() + stats.skipped > 0) {
       std::cout << " (" << source.skipped_frames() + stats.skipped << " corrupt or out-of-order frames skipped)";

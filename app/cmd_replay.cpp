@@ -6,9 +6,9 @@
 
 #include "app/ar_session.h"
 #include "app/commands.h"
-#include "app/interrupt.h"
 #include "app/output_file.h"
 #include "app/session_flags.h"
+#include "base/cancellation.h"
 #include "app/pipeline_report.h"
 #include "map/map_file.h"
 #include "recordings/recording.h"
@@ -36,6 +36,7 @@ void AddReplayCommand(CLI::App& app) {
   cmd->add_flag("--paced", a->paced, "Deliver frames at the recorded rate, dropping frames when a stage is slower");
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
+    const ScopedSignalCancellation signals;
     const recordings::Recording recording = recordings::LoadRecording(a->recording);
     recordings::ReplayOptions replay;
     replay.paced = a->paced;
@@ -47,21 +48,21 @@ void AddReplayCommand(CLI::App& app) {
     o.pipeline.drop_frames = a->paced;
     o.expected_frames = expected;
     o.sink_fps = MedianFrameRate(recording.frames);
-    InterruptFlag interrupt;
-    o.stop = interrupt.flag();
+    o.cancel = signals.token();
+    o.output_name = a->out;
 
+    // A video or a PNG folder is written under a temporary name and renamed when complete.
     const bool to_file = a->out != "window" && a->out.rfind("window:", 0) != 0;
     std::unique_ptr<PendingOutput> pending;
-    if (to_file && std::filesystem::path(a->out).has_extension()) {
+    if (to_file) {
       pending = std::make_unique<PendingOutput>(a->out);
-      o.sink = pending->partial().string();
+      o.sink = pending->sink_target();
     } else {
       o.sink = a->out;
     }
     recordings::RecordingSource source(recording, replay);
     const map::Map map = map::LoadMap(a->map_dir);
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
-    if (interrupt.raised()) throw CommandError("interrupted: " + a->out + " not written", 130);
     if (pending) pending->Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
     std::printf("renderer: %s\nwrote %s\n", result.renderer.c_str(), a->out.c_str());

@@ -4,9 +4,9 @@
 
 #include "app/ar_session.h"
 #include "app/commands.h"
-#include "app/interrupt.h"
 #include "app/pipeline_report.h"
 #include "app/session_flags.h"
+#include "base/cancellation.h"
 #include "map/map_file.h"
 #include "recordings/v4l2_source.h"
 #include "render/offscreen.h"
@@ -35,13 +35,14 @@ void AddRunCommand(CLI::App& app) {
     ApplySessionFlags(a->session, o);
     o.sink = a->out;
     o.pipeline.drop_frames = true;  // live: never fall behind the camera
-    InterruptFlag interrupt;
-    o.stop = interrupt.flag();
+    const ScopedSignalCancellation signals;
+    o.cancel = signals.token();
+    o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends
 
     // The camera must deliver the map camera's size; the map is read first to know it.
     recordings::V4l2Options v4l2;
     v4l2.format = a->format;
-    v4l2.stop = interrupt.flag();
+    v4l2.cancel = signals.token();
     const map::Map map = map::LoadMap(a->map_dir);
     v4l2.width = map.camera.width;
     v4l2.height = map.camera.height;

@@ -16,6 +16,7 @@
 #include "app/json_writer.h"
 #include "app/progress.h"
 #include "app/stage_stats.h"
+#include "base/cancellation.h"
 #include "map/map_file.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
@@ -157,6 +158,7 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
 }
 
 void RunTrack(const TrackArgs& args) {
+  const ScopedSignalCancellation signals;
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
   recordings::ReplayOptions replay;
@@ -196,20 +198,25 @@ void RunTrack(const TrackArgs& args) {
   Progress progress("track");
   recordings::Frame frame;
   try {
-    while (source.Next(frame)) {
+    while (!signals.token().IsCancelled() && source.Next(frame)) {
       // A frame after a gap in --frames has no valid motion prior.
       if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
       FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp)};
       if (record.result.status != tracker::TrackStatus::kLost)
         trajectory.push_back({record.timestamp, record.result.pose});
       frames.push_back(std::move(record));
-      progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
+      if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
                       tracker::TrackStatusName(frames.back().result.status));
     }
   } catch (const recordings::RecordingError& e) {
     throw CommandError(e.what());
   }
   progress.Finish();
+  // Interrupted: neither the trajectory nor the statistics are written (a partial trajectory
+  // would look complete).
+  signals.token().ThrowIfCancelled("stopped after " + std::to_string(frames.size()) + " of " +
+                                   std::to_string(frame_count) + " frames; not written: " + args.out +
+                                   (args.stats.empty() ? "" : ", " + args.stats));
 
   try {
     recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/commands.h"
+#include "base/cancellation.h"
 
 namespace arview::app {
 
@@ -72,6 +73,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::cerr << "arview: " << OneLine(e.what()) << " (see 'arview --help')\n";
     return e.get_exit_code() != 0 ? e.get_exit_code() : 2;
+  } catch (const arview::CancelledError& e) {
+    // Ctrl-C or SIGTERM: one line saying what stopped and what was kept; 130 / 143 as a shell.
+    std::cerr << "arview: " << OneLine(e.what()) << "\n";
+    return e.exit_code();
   } catch (const CommandError& e) {
     std::cerr << "arview: " << OneLine(e.what()) << "\n";
     return e.code;

@@ -94,13 +94,13 @@ void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
 }
 
 RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double max_seconds,
-                         const std::atomic<bool>* stop, const std::function<void(const RecordStats&)>& progress) {
+                         const CancellationToken& cancel, const std::function<void(const RecordStats&)>& progress) {
   RecordStats stats;
   const auto wall_start = std::chrono::steady_clock::now();
   Frame frame;
   double t0 = 0;
   bool first = true;
-  while (!(stop && stop->load()) && source.Next(frame)) {
+  while (!cancel.IsCancelled() && source.Next(frame)) {
     if (first) {
       t0 = frame.timestamp;
       first = false;

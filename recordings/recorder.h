@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "base/cancellation.h"
 #include "calib/camera.h"
 #include "recordings/frame_source.h"
 
@@ -52,11 +53,12 @@ struct RecordStats {
   double fps = 0;          // frames / wall-clock time so far
 };
 
-// Copies frames from `source` into `writer` until the source ends, `stop` becomes true, or the
+// Copies frames from `source` into `writer` until the source ends, `cancel` is cancelled, or the
 // frame timestamps span `max_seconds` (0 = no limit). Timestamps are stored relative to the
 // first frame. `progress` (optional) is called after every frame. A SourceError from the
 // source propagates; the frames written before it stay a valid recording.
 RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double max_seconds,
-                         const std::atomic<bool>* stop, const std::function<void(const RecordStats&)>& progress = {});
+                         const CancellationToken& cancel,
+                         const std::function<void(const RecordStats&)>& progress = {});
 
 }  // namespace arview::recordings

@@ -16,11 +16,11 @@ calib::Camera SmallCamera() { return calib::Camera::Pinhole(64, 48, 60, 60, 31.5
 // can repeat a timestamp once to imitate a driver glitch.
 class FakeSource : public FrameSource {
  public:
-  FakeSource(int n, std::atomic<bool>* stop_after = nullptr, int stop_at = -1, int repeat_at = -1)
+  FakeSource(int n, const CancellationToken* stop_after = nullptr, int stop_at = -1, int repeat_at = -1)
       : n_(n), stop_(stop_after), stop_at_(stop_at), repeat_at_(repeat_at) {}
   bool Next(Frame& f) override {
     if (i_ == n_) return false;
-    if (i_ == stop_at_ && stop_) stop_->store(true);
+    if (i_ == stop_at_ && stop_) stop_->Cancel(SIGINT);
     f.image = test::MakeImage(64, 48, i_);
     f.timestamp = 1000.0 + (i_ == repeat_at_ ? i_ - 1 : i_) / 30.0;
     f.index = i_++;
@@ -30,7 +30,7 @@ class FakeSource : public FrameSource {
 
  private:
   int n_, i_ = 0;
-  std::atomic<bool>* stop_;
+  const CancellationToken* stop_;
   int stop_at_, repeat_at_;
 };
 
@@ -56,11 +56,11 @@ TEST(RecordingWriter, WritesAValidRecordingFrameByFrame) {
 
 TEST(RecordFrames, StopsOnTheFlagAndLeavesAConsistentRecording) {
   TempDir dir("record_stop");
-  std::atomic<bool> stop{false};
+  const CancellationToken stop;
   FakeSource source(100, &stop, 12);
   RecordingWriter writer(dir.path() / "rec", SmallCamera(), false);
   int calls = 0;
-  const RecordStats stats = RecordFrames(source, writer, 0, &stop, [&](const RecordStats&) { ++calls; });
+  const RecordStats stats = RecordFrames(source, writer, 0, stop, [&](const RecordStats&) { ++calls; });
   // The flag rose while frame 12 was delivered: that frame is kept, nothing after it.
   EXPECT_EQ(stats.frames, 13);
   EXPECT_EQ(calls, 13);
@@ -73,7 +73,7 @@ TEST(RecordFrames, StopsAfterTheRequestedSpanAndSkipsRepeatedTimestamps) {
   TempDir dir("record_span");
   FakeSource source(100, nullptr, -1, 5);
   RecordingWriter writer(dir.path() / "rec", std::nullopt, false);
-  const RecordStats stats = RecordFrames(source, writer, 1.0, nullptr);
+  const RecordStats stats = RecordFrames(source, writer, 1.0, {});
   EXPECT_EQ(stats.skipped, 1);
   EXPECT_EQ(stats.frames, 29);  // t = 0 .. 29/30 s, minus the repeated one
   EXPECT_FALSE(fs::exists(dir.path() / "rec/camera.yaml"));

@@ -320,9 +320,7 @@ TEST(V4l2FakeCamera, SkipsCorruptFramesAndHonoursTheStopFlag) {
   FakeConfig c;
   c.corrupt_frame = 1;
   FakeCamera camera(c);
-  std::atomic<bool> stop{false};
   V4l2Options options;
-  options.stop = &stop;
   V4l2Source source("/dev/video7", options, camera);
   Frame f;
   ASSERT_TRUE(source.Next(f));
@@ -330,7 +328,7 @@ TEST(V4l2FakeCamera, SkipsCorruptFramesAndHonoursTheStopFlag) {
   ASSERT_TRUE(source.Next(f));
   EXPECT_EQ(f.index, 2);
   EXPECT_EQ(source.skipped_frames(), 1);
-  stop = true;
+  options.cancel.Cancel(SIGINT);  // the source holds a copy of the token: the same state
   EXPECT_FALSE(source.Next(f));
 }
 
@@ -341,7 +339,7 @@ TEST(V4l2FakeCamera, RecordingUntilUnplugKeepsAValidRecording) {
   test::TempDir dir("v4l2_record");
   V4l2Source source("/dev/video7", {}, camera);
   RecordingWriter writer(dir.path() / "rec", calib::Camera::Pinhole(64, 48, 60, 60, 31.5, 23.5), false);
-  EXPECT_THROW(RecordFrames(source, writer, 0, nullptr), SourceError);
+  EXPECT_THROW(RecordFrames(source, writer, 0, {}), SourceError);
   const Recording rec = LoadRecording(dir.path() / "rec");
   ASSERT_EQ(rec.frames.size(), 10u);
   EXPECT_DOUBLE_EQ(rec.frames[0].timestamp, 0.0);

@@ -218,7 +218,7 @@ bool V4l2Source::Next(Frame& frame) {
   const auto deadline =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
   for (;;) {
-    if (options_.stop && options_.stop->load()) return false;
+    if (options_.cancel.IsCancelled()) return false;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
     if (left <= 0) {
       Shutdown();
@@ -229,7 +229,7 @@ bool V4l2Source::Next(Frame& frame) {
     pollfd p{fd_, POLLIN, 0};
     const int r = io_.Poll(&p, 1, static_cast<int>(std::min<long long>(left, 100)));
     if (r < 0) {
-      if (errno == EINTR) continue;  // a signal: look at the stop flag again
+      if (errno == EINTR) continue;  // a signal: look at the token again
       const int err = errno;
       Shutdown();
       Fail("poll failed (" + ErrnoText(err) + ")");

@@ -14,6 +14,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "base/cancellation.h"
+
 #include "recordings/frame_source.h"
 
 namespace arview::recordings {
@@ -45,8 +47,8 @@ struct V4l2Options {
   // No frame within this time is an error (a stalled or unplugged camera). The first frame
   // may take up to kFirstFrameTimeout (cameras settle their exposure first).
   double timeout_seconds = 1.0;
-  // When set and true, Next() returns false within ~0.1 s (Ctrl-C handling).
-  const std::atomic<bool>* stop = nullptr;
+  // Once cancelled (Ctrl-C, SIGTERM), Next() returns false within ~0.1 s.
+  CancellationToken cancel;
 };
 
 class V4l2Source : public FrameSource {
