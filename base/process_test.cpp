@@ -1,7 +1,8 @@
-#include "mapping/process.h"
+#include "base/process.h"
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -9,19 +10,39 @@
 #include <sstream>
 #include <thread>
 
-namespace arview::mapping {
+namespace arview {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TempLog(const std::string& name) {
+fs::path TempPath(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("arview_process_test_" + std::to_string(::getpid()) + "_" + name);
   fs::remove(p);
   return p;
 }
 
+// Whether `pid` is a live process (a zombie waiting for its reaper counts as gone).
+bool Alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!std::getline(stat, text)) return false;
+  const auto close = text.rfind(')');
+  return close != std::string::npos && close + 2 < text.size() && text[close + 2] != 'Z';
+}
+
+// Reads the pid a child wrote into `file`, waiting up to 5 s for it to appear.
+pid_t ReadPid(const fs::path& file) {
+  for (int i = 0; i < 250; ++i) {
+    std::ifstream in(file);
+    pid_t pid = 0;
+    if (in >> pid && pid > 0) return pid;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return 0;
+}
+
 TEST(RunProcess, PassesEveryLineAndTheExitCode) {
-  const fs::path log = TempLog("lines.log");
+  const fs::path log = TempPath("lines.log");
   std::vector<std::string> seen;
   const ProcessResult r = RunProcess({"sh", "-c", "echo one; echo two 1>&2; printf 'three\\rfour'; exit 3"}, log,
                                      [&](const std::string& line) { seen.push_back(line); });
@@ -39,15 +60,17 @@ TEST(RunProcess, PassesEveryLineAndTheExitCode) {
 }
 
 TEST(RunProcess, KeepsOnlyTheTail) {
-  const fs::path log = TempLog("tail.log");
-  const ProcessResult r = RunProcess({"sh", "-c", "for i in 1 2 3 4 5 6; do echo $i; done"}, log, {}, 2);
+  const fs::path log = TempPath("tail.log");
+  ProcessOptions options;
+  options.tail_lines = 2;
+  const ProcessResult r = RunProcess({"sh", "-c", "for i in 1 2 3 4 5 6; do echo $i; done"}, log, {}, {}, options);
   EXPECT_TRUE(r.ok());
   EXPECT_EQ(r.tail, (std::vector<std::string>{"5", "6"}));
   fs::remove(log);
 }
 
 TEST(RunProcess, MissingProgramIsAClearError) {
-  const fs::path log = TempLog("missing.log");
+  const fs::path log = TempPath("missing.log");
   try {
     RunProcess({"arview-no-such-program-xyz"}, log, {});
     FAIL() << "expected ProcessError";
@@ -59,45 +82,93 @@ TEST(RunProcess, MissingProgramIsAClearError) {
 }
 
 TEST(RunProcess, ReportsAChildKilledByASignal) {
-  const fs::path log = TempLog("signal.log");
+  const fs::path log = TempPath("signal.log");
   const ProcessResult r = RunProcess({"sh", "-c", "kill -9 $$"}, log, {});
   EXPECT_TRUE(r.signaled);
   EXPECT_EQ(r.signal, 9);
   fs::remove(log);
 }
 
-TEST(RunProcess, InterruptStopsTheChildPromptly) {
-  const fs::path log = TempLog("interrupt.log");
-  const fs::path pid_file = TempLog("child.pid");
-  InterruptGuard guard;
-  std::thread interrupter([] {
+TEST(RunProcess, ACancelledTokenStopsTheWholeGroupPromptly) {
+  const fs::path log = TempPath("cancel.log");
+  const fs::path pid_file = TempPath("grandchild.pid");
+  CancellationToken token;
+  std::thread canceller([token] {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    ::kill(::getpid(), SIGINT);  // as Ctrl-C would: handled by the guard, not fatal
+    token.Cancel(SIGTERM);
   });
   const auto start = std::chrono::steady_clock::now();
-  // The child writes its pid, then sleeps far longer than the test may take.
-  EXPECT_THROW(RunProcess({"sh", "-c", "echo $$ > " + pid_file.string() + "; exec sleep 60"}, log, {}),
-               InterruptedError);
-  interrupter.join();
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);
-  std::ifstream in(pid_file);
-  pid_t child = 0;
-  ASSERT_TRUE(in >> child);
-  EXPECT_NE(::kill(child, 0), 0) << "the child is still running";
+  // The child starts a grandchild in its group that ignores SIGTERM: only SIGKILL to the
+  // group ends it.
+  try {
+    RunProcess({"sh", "-c", "sh -c 'trap \"\" TERM; echo $$ > " + pid_file.string() + "; exec sleep 60' & wait"}, log,
+               {}, token);
+    ADD_FAILURE() << "expected CancelledError";
+  } catch (const CancelledError& e) {
+    EXPECT_EQ(e.signal_number(), SIGTERM);
+    EXPECT_EQ(e.exit_code(), 143);
+    EXPECT_NE(std::string(e.what()).find("interrupted"), std::string::npos);
+  }
+  canceller.join();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  const pid_t grandchild = ReadPid(pid_file);
+  ASSERT_GT(grandchild, 0);
+  for (int i = 0; i < 50 && Alive(grandchild); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(Alive(grandchild)) << "the grandchild outlived the run";
   fs::remove(log);
   fs::remove(pid_file);
 }
 
-TEST(RunProcess, AnInterruptDoesNotOutliveItsGuard) {
-  {
-    InterruptGuard guard;
-    ::kill(::getpid(), SIGINT);
-    EXPECT_TRUE(InterruptGuard::Interrupted());
+TEST(RunProcess, SigintUnderTheScopedHandlerCancelsInsteadOfKilling) {
+  const fs::path log = TempPath("sigint.log");
+  ScopedSignalCancellation signals;
+  std::thread interrupter([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ::kill(::getpid(), SIGINT);  // as Ctrl-C would: handled by the token, not fatal
+  });
+  try {
+    RunProcess({"sleep", "60"}, log, {}, signals.token());
+    ADD_FAILURE() << "expected CancelledError";
+  } catch (const CancelledError& e) {
+    EXPECT_EQ(e.exit_code(), 130);
   }
-  EXPECT_FALSE(InterruptGuard::Interrupted());
-  const fs::path log = TempLog("after.log");
-  EXPECT_TRUE(RunProcess({"true"}, log, {}).ok());
+  interrupter.join();
   fs::remove(log);
+}
+
+TEST(RunProcess, AnAlreadyCancelledTokenStartsNothing) {
+  const fs::path log = TempPath("never.log");
+  const fs::path marker = TempPath("never.marker");
+  CancellationToken token;
+  token.Cancel(SIGINT);
+  EXPECT_THROW(RunProcess({"touch", marker.string()}, log, {}, token), CancelledError);
+  EXPECT_FALSE(fs::exists(marker));
+  fs::remove(log);
+}
+
+// SIGKILL of arview cannot be caught: the kernel must end the child (PR_SET_PDEATHSIG).
+TEST(RunProcess, TheChildDiesWithItsParentEvenBySigkill) {
+  const fs::path log = TempPath("orphan.log");
+  const fs::path pid_file = TempPath("orphan.pid");
+  const pid_t runner = ::fork();
+  ASSERT_GE(runner, 0);
+  if (runner == 0) {
+    try {
+      RunProcess({"sh", "-c", "echo $$ > " + pid_file.string() + "; exec sleep 60"}, log, {});
+    } catch (...) {
+    }
+    ::_exit(0);
+  }
+  const pid_t child = ReadPid(pid_file);
+  ::kill(runner, SIGKILL);
+  int status = 0;
+  ::waitpid(runner, &status, 0);
+  ASSERT_GT(child, 0);
+  for (int i = 0; i < 100 && Alive(child); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(Alive(child)) << "the child outlived its killed parent";
+  if (Alive(child)) ::kill(child, SIGKILL);
+  fs::remove(log);
+  fs::remove(pid_file);
 }
 
 TEST(FindExecutable, FindsShellAndRejectsUnknown) {
@@ -107,4 +178,4 @@ TEST(FindExecutable, FindsShellAndRejectsUnknown) {
 }
 
 }  // namespace
-}  // namespace arview::mapping
+}  // namespace arview
