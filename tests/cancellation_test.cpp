@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "calib/camera.h"
-#include "mapping/map_file.h"
+#include "map/map_file.h"
 #include "tests/support/run_command.h"
 #include "tests/support/spawn_command.h"
 #include "tests/support/test_data.h"
@@ -50,7 +50,7 @@ class Cancellation : public ::testing::Test {
   void SetUp() override {
     ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
     ASSERT_TRUE(fs::exists(Room() / "frames.txt")) << "the rendered room is missing";
-    ASSERT_TRUE(fs::exists(SyntheticMap() / mapping::kMapFileName)) << "the synthetic map is missing";
+    ASSERT_TRUE(fs::exists(SyntheticMap() / map::kMapFileName)) << "the synthetic map is missing";
   }
 
   // ctest runs every test in its own process: the room is rendered once per machine and user
@@ -87,10 +87,10 @@ class Cancellation : public ::testing::Test {
   static void WriteRandomMap(const calib::Camera& camera, const fs::path& dir) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> coord(-1.0, 1.0);
-    mapping::Map map;
+    map::Map map;
     map.camera = camera;
     for (int k = 0; k < 2; ++k) {
-      mapping::Keyframe kf;
+      map::Keyframe kf;
       kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
       kf.name = "frames/" + std::to_string(k) + ".png";
       kf.frame_index = k;
@@ -102,7 +102,7 @@ class Cancellation : public ::testing::Test {
     map.descriptors = cv::Mat(points, 128, CV_8U);
     cv::randu(map.descriptors, 0, 255);
     for (int i = 0; i < points; ++i) {
-      mapping::MapPoint p;
+      map::MapPoint p;
       p.xyz = Eigen::Vector3d(coord(rng), coord(rng), 3.0 + coord(rng));
       p.first_descriptor = static_cast<std::uint32_t>(i);
       p.descriptor_count = 1;
@@ -110,14 +110,14 @@ class Cancellation : public ::testing::Test {
       map.descriptor_point.push_back(static_cast<std::uint32_t>(i));
       const std::uint32_t k = static_cast<std::uint32_t>(i % 2);
       map.descriptor_keyframe.push_back(k);
-      mapping::KeyframeObservation o;
+      map::KeyframeObservation o;
       o.point = static_cast<std::uint32_t>(i);
       o.descriptor = static_cast<std::uint32_t>(i);
       o.pixel = Eigen::Vector2f(static_cast<float>(320 + 100 * p.xyz.x()), static_cast<float>(240 + 100 * p.xyz.y()));
       map.keyframes[k].observations.push_back(o);
     }
     fs::create_directories(dir);
-    mapping::SaveMap(map, dir / mapping::kMapFileName);
+    map::SaveMap(map, dir / map::kMapFileName);
   }
 
   // Everything issue 11 asks of an interrupted command, given the test's folder (no process
@@ -169,7 +169,7 @@ TEST_P(CancellationBySignal, DemoDuringItsColmapStage) {
   ASSERT_TRUE(run.WaitFor([&] { return ColmapRunsFor(work); }, std::chrono::seconds(60))) << run.Stderr();
   ExpectCleanInterruption(run, GetParam(), work,
                           {work / "demo.mp4", work / "demo.partial.mp4", work / "trajectory.txt", work / "stats.json",
-                           work / "map" / mapping::kMapFileName});
+                           work / "map" / map::kMapFileName});
   run.RemoveLogs();
 }
 
@@ -178,7 +178,7 @@ TEST_P(CancellationBySignal, MapDuringColmap) {
   SpawnedArview run({"map", Room().string(), "--out", (work / "map").string(), "--frames", "0-59:4"},
                     work.string() + "_log");
   ASSERT_TRUE(run.WaitFor([&] { return ColmapRunsFor(work); }, std::chrono::seconds(30))) << run.Stderr();
-  ExpectCleanInterruption(run, GetParam(), work, {work / "map" / mapping::kMapFileName, work / "map" / "keyframes.txt"});
+  ExpectCleanInterruption(run, GetParam(), work, {work / "map" / map::kMapFileName, work / "map" / "keyframes.txt"});
   run.RemoveLogs();
 }
 
