@@ -171,6 +171,47 @@ void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::str
   }
 }
 
+std::optional<DuplicateKey> FindDuplicateYamlKey(std::string_view text) {
+  struct Level {
+    size_t indent;
+    std::vector<std::pair<std::string, int>> keys;  // key, line
+  };
+  std::vector<Level> levels;
+  int line_number = 0;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    size_t i = line.find_first_not_of(' ');
+    if (i == std::string_view::npos || line[i] == '#' || line[i] == '%' || line.substr(i, 3) == "---") continue;
+    // A sequence item starts a new mapping one level deeper.
+    while (i + 1 < line.size() && line[i] == '-' && line[i + 1] == ' ') {
+      while (!levels.empty() && levels.back().indent >= i + 1) levels.pop_back();
+      i = line.find_first_not_of(' ', i + 1);
+      if (i == std::string_view::npos) break;
+      levels.push_back({i, {}});
+    }
+    if (i == std::string_view::npos) continue;
+    const char first = line[i];
+    if (first == '"' || first == '\'' || first == '{' || first == '[' || first == '|' || first == '>') continue;
+    const size_t colon = line.find(':', i);
+    if (colon == std::string_view::npos || (colon + 1 < line.size() && line[colon + 1] != ' ')) continue;
+    std::string key(line.substr(i, colon - i));
+    while (!key.empty() && key.back() == ' ') key.pop_back();
+    while (!levels.empty() && levels.back().indent > i) levels.pop_back();
+    if (levels.empty() || levels.back().indent < i) levels.push_back({i, {}});
+    for (const auto& [seen, seen_line] : levels.back().keys) {
+      if (seen == key) return DuplicateKey{key, line_number, seen_line};
+    }
+    levels.back().keys.emplace_back(key, line_number);
+  }
+  return std::nullopt;
+}
+
 double RequireFiniteInRange(double value, double lo, double hi, const std::string& what) {
   if (!std::isfinite(value)) {
     std::ostringstream ss;

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -51,6 +52,16 @@ int YamlNestingDepth(std::string_view text);
 
 // Throws InputError("<name>: nested deeper than <max> levels") when the text is too deep.
 void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::string& name);
+
+// The first key given twice in one block mapping of a YAML text ("key" and its 1-based line),
+// or nothing. Flow mappings ({a: 1, a: 2}) are not looked into: callers whose files use them
+// check duplicates with their parser.
+struct DuplicateKey {
+  std::string key;
+  int line = 0;
+  int first_line = 0;
+};
+std::optional<DuplicateKey> FindDuplicateYamlKey(std::string_view text);
 
 // `value` when finite and within [lo, hi]; else InputError("<what>: ... ").
 double RequireFiniteInRange(double value, double lo, double hi, const std::string& what);
