@@ -4,6 +4,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
+#include <sstream>
+
+#include "base/input_guard.h"
 
 namespace arview::calib {
 
@@ -103,8 +107,11 @@ void Camera::Validate(const std::string& source) const {
   };
   if (width <= 0) fail("image_width", "must be positive (is " + std::to_string(width) + ")");
   if (height <= 0) fail("image_height", "must be positive (is " + std::to_string(height) + ")");
-  if (!(std::isfinite(fx) && fx > 0)) fail("camera_matrix", "fx must be a positive number");
-  if (!(std::isfinite(fy) && fy > 0)) fail("camera_matrix", "fy must be a positive number");
+  // Bounds far beyond any real camera, so that no later pixel arithmetic overflows.
+  if (width > 65536) fail("image_width", "is larger than 65536 (is " + std::to_string(width) + ")");
+  if (height > 65536) fail("image_height", "is larger than 65536 (is " + std::to_string(height) + ")");
+  if (!(std::isfinite(fx) && fx > 0 && fx <= 1e7)) fail("camera_matrix", "fx must be a positive number up to 1e7");
+  if (!(std::isfinite(fy) && fy > 0 && fy <= 1e7)) fail("camera_matrix", "fy must be a positive number up to 1e7");
   if (!(std::isfinite(cx) && cx >= 0 && cx <= width)) {
     fail("camera_matrix", "principal point cx=" + std::to_string(cx) + " lies outside the image width " +
                               std::to_string(width));
@@ -114,7 +121,9 @@ void Camera::Validate(const std::string& source) const {
                               " lies outside the image height " + std::to_string(height));
   }
   for (double d : dist) {
-    if (!std::isfinite(d)) fail("distortion_coefficients", "holds a value that is not a finite number");
+    if (!std::isfinite(d) || std::abs(d) > 1e6) {
+      fail("distortion_coefficients", "holds a value that is not a finite number of at most 1e6");
+    }
   }
 }
 
@@ -143,25 +152,115 @@ int ReadInt(const cv::FileStorage& fs, const std::string& source, const char* na
 
 }  // namespace
 
+namespace {
+
+// The keys OpenCV's calibration samples write besides the camera itself: they describe the
+// calibration run, not the camera, so they are accepted and not used.
+const std::set<std::string>& InformationalKeys() {
+  static const std::set<std::string> keys{
+      "calibration_time", "nframes", "nr_of_frames", "board_width", "board_height", "square_size",
+      "aspectRatio", "fix_aspect_ratio", "flags", "fisheye_model", "avg_reprojection_error",
+      "per_view_reprojection_errors", "extrinsic_parameters", "image_points", "grid_points"};
+  return keys;
+}
+
+// What is checked on the text before OpenCV's FileStorage parses it, because FileStorage
+// itself crashes on it: a matrix header whose rows/cols are not small plain numbers makes it
+// allocate tens of GB, deep nesting overflows its recursive parser's stack, and a key given
+// twice silently keeps the first value.
+void PrecheckCameraText(const std::string& text, const std::string& source) {
+  try {
+    RequireYamlDepthAtMost(text, 8, source);
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
+  }
+  const size_t start = text.find_first_not_of(" \t\r\n");
+  if (start == std::string::npos || text.compare(start, 5, "%YAML") != 0) {
+    throw CameraError(source + ": is not an OpenCV FileStorage YAML camera file (it must begin with %YAML:1.0)");
+  }
+  if (const auto d = FindDuplicateYamlKey(text)) {
+    throw CameraError(source + ": line " + std::to_string(d->line) + ": key '" + d->key + "' given twice (first on line " +
+                      std::to_string(d->first_line) + ")");
+  }
+  std::istringstream lines(text);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    const size_t key_start = line.find_first_not_of(' ');
+    if (key_start == std::string::npos) continue;
+    const size_t colon = line.find(':', key_start);
+    if (colon == std::string::npos) continue;
+    const std::string key = line.substr(key_start, colon - key_start);
+    std::string value = line.substr(colon + 1);
+    value.erase(0, value.find_first_not_of(" \t"));
+    value.erase(value.find_last_not_of(" \t\r") + 1);
+    auto fail = [&](const std::string& problem) {
+      throw CameraError(source + ": line " + std::to_string(number) + ": " + problem);
+    };
+    if (key == "rows" || key == "cols") {
+      const bool small_number = !value.empty() && value.size() <= 2 &&
+                                value.find_first_not_of("0123456789") == std::string::npos && std::stoi(value) > 0 &&
+                                std::stoi(value) <= 16;
+      if (!small_number) fail("matrix " + key + " '" + value + "' is not a number from 1 to 16");
+    } else if (key == "dt" && value != "d" && value != "f") {
+      fail("matrix type dt: " + value + " is not a floating-point type (d or f)");
+    }
+  }
+}
+
+// Every top-level key is either used or known to be informational; anything else (a typo, a
+// field of another camera model) is refused rather than ignored.
+void RefuseUnknownKeys(const cv::FileStorage& fs, const std::string& source) {
+  static const std::set<std::string> used{"image_width", "image_height", "camera_matrix", "distortion_coefficients"};
+  const cv::FileNode root = fs.root();
+  for (const std::string& key : root.keys()) {
+    if (used.count(key) == 0 && InformationalKeys().count(key) == 0) {
+      throw CameraError(source + ": unknown key '" + key + "' (a camera file holds image_width, image_height, " +
+                        "camera_matrix, distortion_coefficients)");
+    }
+  }
+  const cv::FileNode fisheye = fs["fisheye_model"];
+  if (!fisheye.empty() && (!fisheye.isInt() || static_cast<int>(fisheye) != 0)) {
+    throw CameraError(source + ": fisheye_model is set: arview's camera model is the pinhole with radial-tangential "
+                      "distortion, not the fisheye model");
+  }
+}
+
+// K must be [fx 0 cx; 0 fy cy; 0 0 1]: a skew or a last row other than 0 0 1 is a camera
+// model arview does not have, and is refused rather than dropped.
+void RequirePinholeMatrix(const cv::Mat& K, const std::string& source) {
+  auto fail = [&](const std::string& problem) { throw CameraError(source + ": camera_matrix " + problem); };
+  if (K.at<double>(0, 1) != 0.0) fail("has a skew K[0][1] = " + std::to_string(K.at<double>(0, 1)) + ": not supported (must be 0)");
+  if (K.at<double>(1, 0) != 0.0) fail("K[1][0] must be 0 (is " + std::to_string(K.at<double>(1, 0)) + ")");
+  if (K.at<double>(2, 0) != 0.0 || K.at<double>(2, 1) != 0.0 || K.at<double>(2, 2) != 1.0) {
+    fail("last row must be 0 0 1");
+  }
+}
+
+}  // namespace
+
 Camera LoadCamera(const std::filesystem::path& path) {
   const std::string source = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw CameraError(source + ": camera file does not exist or is not a file");
+  std::string text;
+  try {
+    text = ReadFileUpTo(path, kMaxCameraFileBytes);
+  } catch (const InputError& e) {
+    throw CameraError(std::string(e.what()) + " (expected a camera file)");
   }
+  PrecheckCameraText(text, source);
   cv::FileStorage fs;
   try {
-    if (!fs.open(source, cv::FileStorage::READ)) {
+    if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML)) {
       throw CameraError(source + ": cannot be opened as an OpenCV FileStorage file");
     }
   } catch (const cv::Exception& e) {
-    throw CameraError(source + ": is not valid OpenCV FileStorage YAML/XML (" + e.err + ")");
+    throw CameraError(source + ": is not valid OpenCV FileStorage YAML (" + e.err + ")");
   }
   Camera c;
   c.width = ReadInt(fs, source, "image_width");
   c.height = ReadInt(fs, source, "image_height");
   const cv::Mat K = ReadMatrix(fs, source, "camera_matrix");
   if (K.rows != 3 || K.cols != 3) throw CameraError(source + ": field camera_matrix must be 3x3");
+  RequirePinholeMatrix(K, source);
   c.fx = K.at<double>(0, 0);
   c.fy = K.at<double>(1, 1);
   c.cx = K.at<double>(0, 2);
@@ -175,6 +274,7 @@ Camera LoadCamera(const std::filesystem::path& path) {
     }
     for (int i = 0; i < n; ++i) c.dist[i] = d.at<double>(i);
   }
+  RefuseUnknownKeys(fs, source);
   c.Validate(source);
   return c;
 }

@@ -1,6 +1,8 @@
 #include "calib/camera.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <opencv2/calib3d.hpp>
 
 #include <filesystem>
@@ -106,6 +108,76 @@ TEST(Camera, LoadRejectsBadFilesNamingTheField) {
   zero_h.replace(zero_h.find("image_height: 480"), 17, "image_height: 0  ");
   EXPECT_NE(LoadError(zero_h).find("image_height must be positive"), std::string::npos);
   EXPECT_THROW(LoadCamera("/nonexistent/camera.yaml"), CameraError);
+}
+
+// Issue 17's fuzzer reproducers: each was a crash, a huge allocation or a silently wrong camera.
+TEST(Camera, MatrixHeadersThatMadeOpenCvAllocateGigabytesAreRefused) {
+  for (const std::string rows : {"+", "\xd9\xa3" /* ARABIC-INDIC DIGIT THREE */, "99999999", "0", "-3"}) {
+    std::string bad = kGood;
+    bad.replace(bad.find("rows: 3"), 7, "rows: " + rows);
+    const std::string m = LoadError(bad);
+    EXPECT_NE(m.find("arview_camera_bad.yaml: line 6: matrix rows"), std::string::npos) << rows << ": " << m;
+  }
+}
+
+TEST(Camera, DeepNestingIsRefusedBeforeTheParser) {
+  // 50,000 levels overflowed the stack of OpenCV's YAML parser (SIGSEGV).
+  const std::string deep = std::string(kGood) + "x: " + std::string(50000, '[') + std::string(50000, ']') + "\n";
+  EXPECT_NE(LoadError(deep).find("nested"), std::string::npos);
+}
+
+TEST(Camera, SkewAndTheOtherEntriesOfKAreRefusedNotIgnored) {
+  std::string skew = kGood;
+  skew.replace(skew.find("500., 0., 320."), 14, "500., 2., 320.");
+  EXPECT_NE(LoadError(skew).find("skew"), std::string::npos);
+  std::string last_row = kGood;
+  last_row.replace(last_row.find("0., 0., 1."), 10, "0., 0., 2.");
+  EXPECT_NE(LoadError(last_row).find("last row must be 0 0 1"), std::string::npos);
+  std::string k10 = kGood;
+  k10.replace(k10.find("0., 500., 240."), 14, "7., 500., 240.");
+  EXPECT_NE(LoadError(k10).find("K[1][0]"), std::string::npos);
+}
+
+TEST(Camera, IntegerMatrixTypesThatSaturatedAreRefused) {
+  std::string u8 = kGood;
+  u8.replace(u8.find("dt: d"), 5, "dt: u");
+  EXPECT_NE(LoadError(u8).find("dt: u is not a floating-point type"), std::string::npos);
+}
+
+TEST(Camera, AKeyGivenTwiceIsRefusedWithItsLine) {
+  const std::string twice = std::string(kGood) + "image_width: 320\n";
+  EXPECT_NE(LoadError(twice).find("line 10: key 'image_width' given twice (first on line 3)"), std::string::npos)
+      << LoadError(twice);
+}
+
+TEST(Camera, UnknownKeysAreRefusedAndOpenCvsInformationalOnesAccepted) {
+  EXPECT_NE(LoadError(std::string(kGood) + "skew: 0.5\n").find("unknown key 'skew'"), std::string::npos);
+  EXPECT_EQ(LoadError(std::string(kGood) + "avg_reprojection_error: 0.39\nnframes: 13\n"), "");
+  EXPECT_NE(LoadError(std::string(kGood) + "fisheye_model: 1\n").find("fisheye"), std::string::npos);
+}
+
+TEST(Camera, HugeFocalLengthsAndSizesAreRefused) {
+  std::string huge = kGood;
+  huge.replace(huge.find("500., 0., 320."), 4, "1e308");
+  EXPECT_NE(LoadError(huge).find("fx must be a positive number up to"), std::string::npos);
+}
+
+TEST(Camera, DevicesFifosAndDirectoriesAreNotReadAsCameraFiles) {
+  const auto dir = std::filesystem::temp_directory_path() / ("arview_camera_special_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.yaml");
+  ASSERT_EQ(::mkfifo((dir / "fifo.yaml").c_str(), 0600), 0);
+  for (const char* name : {"zero.yaml", "fifo.yaml"}) {
+    try {
+      LoadCamera(dir / name);
+      ADD_FAILURE() << name << " loaded";
+    } catch (const CameraError& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(LoadCamera(dir), CameraError);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
