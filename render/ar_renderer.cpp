@@ -182,6 +182,14 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     if (behind) return full;
   }
   if (u0 > u1) return {};
+  // A pose or camera far outside the scene projects to huge or non-finite bounds: converting
+  // those to int is undefined behaviour. Clamp to a margin around the image first.
+  if (!std::isfinite(u0) || !std::isfinite(u1) || !std::isfinite(v0) || !std::isfinite(v1)) return full;
+  const double limit = 4.0 * std::max(full.width, full.height) + 16;
+  u0 = std::clamp(u0, -limit, limit);
+  u1 = std::clamp(u1, -limit, limit);
+  v0 = std::clamp(v0, -limit, limit);
+  v1 = std::clamp(v1, -limit, limit);
   // Pixel centres are integers: a pixel is touched when its square reaches the bound.
   const cv::Rect box(cv::Point(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2),
                      cv::Point(static_cast<int>(std::ceil(u1)) + 3, static_cast<int>(std::ceil(v1)) + 3));
