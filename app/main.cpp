@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/commands.h"
+#include "app/numeric_flags.h"
 #include "base/cancellation.h"
 
 namespace arview::app {
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   AddReplayCommand(app);
   AddRunCommand(app);
   AddDemoCommand(app);
+  GuardNumericOptions(app);  // NaN, infinities and negative unsigned values are refused
 
   // CLI11 would report an unknown command as a missing subcommand; name it instead.
   if (argc > 1 && argv[1][0] != '-') {

@@ -119,3 +119,33 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 17: CLI11's range checks let NaN through and its unsigned conversion wrapped negative
+// seeds; every numeric flag now refuses them with one line naming the flag.
+TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
+  const std::string tmp = std::filesystem::temp_directory_path().string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string flag;
+  } cases[] = {
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--ratio", "nan"}, "--ratio"},
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--max-rms", "inf"}, "--max-rms"},
+      {{"render", "--scene", "s.yaml", "--camera", "c.yaml", "--pose", "0 0 0 0 0 0 1", "--out", tmp + "/o.png", "--time",
+        "nan"},
+       "--time"},
+      {{"synth", "room", "--out", tmp + "/arview_cli_seed", "--seed", "-1"}, "--seed"},
+  };
+  for (const Case& c : cases) {
+    const auto r = RunArview(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.flag;
+    EXPECT_EQ(LineCount(r.err), 1) << c.flag << ": " << r.err;
+    EXPECT_NE(r.err.find(c.flag), std::string::npos) << c.flag << ": " << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp + "/arview_cli_seed"));
+}
+
+}  // namespace
+}  // namespace arview
