@@ -106,6 +106,21 @@ TEST(YamlNestingDepth, TheFuzzersDeepFilesAreRefusedQuickly) {
   EXPECT_NO_THROW(RequireYamlDepthAtMost("a:\n  b: [1, 2, {c: 3}]\n", kMaxYamlDepth, "ok.yaml"));
 }
 
+TEST(FindDuplicateYamlKey, FindsAKeyGivenTwiceInOneMappingOnly) {
+  EXPECT_FALSE(FindDuplicateYamlKey("a: 1\nb:\n  a: 2\n  c: 3\nc: 4\n"));
+  const auto d = FindDuplicateYamlKey("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nimage_width: 320\n");
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->key, "image_width");
+  EXPECT_EQ(d->line, 5);
+  EXPECT_EQ(d->first_line, 3);
+  const auto nested = FindDuplicateYamlKey("m: !!opencv-matrix\n  rows: 3\n  cols: 3\n  rows: 1\n");
+  ASSERT_TRUE(nested);
+  EXPECT_EQ(nested->key, "rows");
+  // Items of a sequence are separate mappings.
+  EXPECT_FALSE(FindDuplicateYamlKey("l:\n  - name: a\n    x: 1\n  - name: b\n    x: 2\n"));
+  EXPECT_TRUE(FindDuplicateYamlKey("l:\n  - name: a\n    name: b\n"));
+}
+
 TEST(RequireFiniteInRange, RefusesNanInfinityAndOutOfRange) {
   EXPECT_EQ(RequireFiniteInRange(0.5, 0, 1, "--ratio"), 0.5);
   const double nan = std::numeric_limits<double>::quiet_NaN();
