@@ -137,5 +137,32 @@ TEST(RecordingSource, NamesTheFileWhenAFrameIsUnreadableOrTheVideoIsShort) {
   EXPECT_THROW(RecordingSource(LoadRecording(dir.path() / "vid"), bad), SourceError);
 }
 
+// Issue 17: frames.txt naming a file outside the recording was loaded and handed to COLMAP.
+TEST(LoadRecording, FramePathsOutsideTheFolderAreRefused) {
+  TempDir dir("outside");
+  MakeStillRecording(dir.path() / "rec", 2);
+  test::WriteImage(dir.path() / "other.png", 64, 48, 0);
+  fs::create_symlink(dir.path() / "other.png", dir.path() / "rec" / "frames" / "link.png");
+  for (const std::string bad : {"../../../../etc/passwd", "/etc/passwd", "../other.png", "frames/link.png"}) {
+    WriteFramesTxt(dir.path() / "rec", {{0.0, "frames/100.png"}, {1.0, bad}});
+    try {
+      LoadRecording(dir.path() / "rec");
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const RecordingError& e) {
+      EXPECT_NE(std::string(e.what()).find("points outside"), std::string::npos) << bad << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find("frames.txt"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Issue 17: a frames.txt that is a FIFO (or a link to /dev/zero) hung the reader.
+TEST(LoadRecording, AFramesTxtThatIsNotARegularFileIsRefusedAtOnce) {
+  TempDir dir("fifo");
+  MakeStillRecording(dir.path() / "rec", 2);
+  fs::remove(dir.path() / "rec" / "frames.txt");
+  fs::create_symlink("/dev/zero", dir.path() / "rec" / "frames.txt");
+  EXPECT_THROW(LoadRecording(dir.path() / "rec"), RecordingError);
+}
+
 }  // namespace
 }  // namespace arview::recordings

@@ -8,6 +8,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "base/input_guard.h"
+
 namespace arview::recordings {
 
 namespace fs = std::filesystem;
@@ -29,8 +31,13 @@ cv::Mat Recording::ReadImage(size_t index) const {
 }
 
 std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw RecordingError(file.string() + ": cannot open");
+  // A FIFO or a device (a link to /dev/zero) would never end: only a regular file of sane size.
+  std::istringstream in;
+  try {
+    in.str(ReadFileUpTo(file, kMaxTextFileBytes));
+  } catch (const InputError& e) {
+    throw RecordingError(e.what());
+  }
   std::vector<FrameEntry> frames;
   std::string line;
   int line_no = 0;
@@ -77,6 +84,13 @@ Recording LoadRecording(const fs::path& root) {
   std::set<std::string> checked;
   for (const FrameEntry& f : r.frames) {
     if (!checked.insert(f.path).second) continue;
+    // A frame path such as ../../../../etc/passwd (or a symlink out of the folder) is refused:
+    // a recording holds its own frames, and COLMAP would be handed whatever it names.
+    try {
+      ResolveInside(root, f.path, (root / "frames.txt").string());
+    } catch (const InputError& e) {
+      throw RecordingError(e.what());
+    }
     if (!fs::is_regular_file(root / f.path, ec)) {
       throw RecordingError((root / f.path).string() + ": listed in frames.txt but missing");
     }
