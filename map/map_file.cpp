@@ -191,6 +191,11 @@ Map ReadPayload(Reader& r) {
 
 }  // namespace
 
+namespace {
+constexpr double kMaxCoordinate = 1e6;  // map units: far beyond any mapped room or square
+constexpr float kMaxPixel = 1e6f;
+}  // namespace
+
 void ValidateMap(const Map& map, const std::string& source) {
   auto fail = [&](const std::string& problem) { throw MapError(source + ": " + problem); };
   try {
@@ -207,11 +212,15 @@ void ValidateMap(const Map& map, const std::string& source) {
   }
   for (std::size_t i = 0; i < map.keyframes.size(); ++i) {
     const Keyframe& k = map.keyframes[i];
-    if (!std::isfinite(k.pose.q_cw.norm()) || std::abs(k.pose.q_cw.norm() - 1.0) > 1e-6 || !k.pose.t_cw.allFinite()) {
+    // Values far beyond any real scene (a corrupted file with its checksum recomputed) are
+    // refused: the maths downstream would print nan or overflow.
+    if (!std::isfinite(k.pose.q_cw.norm()) || std::abs(k.pose.q_cw.norm() - 1.0) > 1e-6 || !k.pose.t_cw.allFinite() ||
+        k.pose.t_cw.cwiseAbs().maxCoeff() > kMaxCoordinate || !std::isfinite(k.timestamp)) {
       fail("keyframe " + std::to_string(i) + " ('" + k.name + "') has an invalid pose");
     }
     for (const KeyframeObservation& o : k.observations) {
-      if (o.point >= map.points.size() || o.descriptor >= rows || !o.pixel.allFinite()) {
+      if (o.point >= map.points.size() || o.descriptor >= rows || !o.pixel.allFinite() ||
+          o.pixel.cwiseAbs().maxCoeff() > kMaxPixel) {
         fail("keyframe " + std::to_string(i) + " has an observation with an index out of range");
       }
       if (map.descriptor_point[o.descriptor] != o.point || map.descriptor_keyframe[o.descriptor] != i) {
@@ -221,7 +230,12 @@ void ValidateMap(const Map& map, const std::string& source) {
   }
   for (std::size_t i = 0; i < map.points.size(); ++i) {
     const MapPoint& p = map.points[i];
-    if (!p.xyz.allFinite()) fail("point " + std::to_string(i) + " is not finite");
+    if (!p.xyz.allFinite() || p.xyz.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+      fail("point " + std::to_string(i) + " is not finite or lies beyond 1e6 map units");
+    }
+    if (!std::isfinite(p.reprojection_error) || p.reprojection_error < 0 || p.reprojection_error > kMaxPixel) {
+      fail("point " + std::to_string(i) + " has an invalid reprojection error");
+    }
     if (p.descriptor_count == 0 || p.first_descriptor > rows || p.descriptor_count > rows - p.first_descriptor) {
       fail("point " + std::to_string(i) + " has a descriptor range outside the descriptor rows");
     }
@@ -231,6 +245,12 @@ void ValidateMap(const Map& map, const std::string& source) {
   }
   for (std::size_t r = 0; r < rows; ++r) {
     if (map.descriptor_keyframe[r] >= map.keyframes.size()) fail("descriptor row " + std::to_string(r) + " names no keyframe");
+    // Every row lies in the range of the point it names (a row outside it was accepted before).
+    const std::uint32_t owner = map.descriptor_point[r];
+    if (owner >= map.points.size() || r < map.points[owner].first_descriptor ||
+        r - map.points[owner].first_descriptor >= map.points[owner].descriptor_count) {
+      fail("descriptor row " + std::to_string(r) + " lies outside the descriptor range of its point");
+    }
   }
 }
 

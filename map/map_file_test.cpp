@@ -1,6 +1,8 @@
 #include "map/map_file.h"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 #include <unistd.h>
 
 #include <fstream>
@@ -153,6 +155,38 @@ TEST_F(MapFileTest, InconsistentMapsAreRefused) {
   map.keyframes[0].observations[0].descriptor = 1;  // a row of keyframe 1
   EXPECT_THROW(ValidateMap(map, "test"), MapError);
   EXPECT_FALSE(fs::exists(dir_ / "bad.arvmap"));
+}
+
+// Issue 17's reproducers: loaded without complaint before (the checksum was recomputed).
+TEST_F(MapFileTest, ADescriptorRowOutsideItsPointsRangeIsRefused) {
+  Map map = SmallMap();
+  map.points[0].descriptor_count = 2;  // row 2 still names point 0
+  try {
+    ValidateMap(map, "test");
+    FAIL();
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("outside the descriptor range of its point"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(MapFileTest, HugeAndNonFiniteValuesAreRefused) {
+  const auto refused = [](void (*mutate)(Map&)) {
+    Map map = SmallMap();
+    mutate(map);
+    try {
+      ValidateMap(map, "test");
+    } catch (const MapError&) {
+      return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused([](Map& m) { m.points[3].xyz.x() = 1e30; }));
+  EXPECT_TRUE(refused([](Map& m) { m.points[3].xyz.y() = -1e30; }));
+  EXPECT_TRUE(refused([](Map& m) { m.points[3].reprojection_error = std::nan(""); }));
+  EXPECT_TRUE(refused([](Map& m) { m.keyframes[1].pose.t_cw.z() = 1e30; }));
+  EXPECT_TRUE(refused([](Map& m) { m.keyframes[1].timestamp = INFINITY; }));
+  EXPECT_TRUE(refused([](Map& m) { m.keyframes[1].observations[0].pixel.x() = 1e30f; }));
+  EXPECT_FALSE(refused([](Map&) {}));
 }
 
 }  // namespace
