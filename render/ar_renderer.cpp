@@ -29,7 +29,7 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
 
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
   characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
-                         std::make_unique<CastShadow>(context_->gl())});
+                         std::make_unique<CastShadow>(context_->gl()), LightView{}, 0});
   if (options_.lighting == LightingMode::kShShadowed) {
     const CharacterTransfer transfer = ComputeShadowedTransfer(character, options_.prt);
     characters_.back().renderer->SetTransfer(transfer);
@@ -43,6 +43,7 @@ void ArRenderer::SetRoomLight(const RoomLight& light) {
   has_room_light_ = true;
   current_sh_ = light.sh;
   follower_ = std::make_unique<ExposureFollower>(light.thumbnails, light.scene_triangles, camera_, options_.exposure_smoothing);
+  frames_since_exposure_ = 0;
   SetOccluders(light.occluder_triangles);
 }
 
@@ -60,7 +61,10 @@ void ArRenderer::FollowExposure(const cv::Mat& background, const calib::Pose& po
     throw RenderError("lighting '" + LightingModeName(options_.lighting) +
                       "' needs the room's light (a .light.yml from 'arview place --recording')");
   }
-  const Eigen::Vector3d gain = background.empty() ? follower_->gain() : follower_->Update(background, pose);
+  // The exposure is followed every kExposureEvery-th frame (its cost, ~1 ms of CPU for the
+  // thumbnail and its rays, is then spread; cameras change exposure over several frames).
+  const bool due = frames_since_exposure_++ % kExposureEvery == 0;
+  const Eigen::Vector3d gain = background.empty() || !due ? follower_->gain() : follower_->Update(background, pose);
   current_sh_ = Scaled(room_light_.sh, gain);
 }
 
@@ -84,7 +88,33 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& f
   }
   const Eigen::Vector3d normal = (spec.anchor.rotation.normalized() * spec.up).normalized();
   // Below 15 degrees of elevation the shadow would stretch across the room: none.
-  return MakeLightView(room_light_.dominant.direction, centre, radius, spec.anchor.position, normal, 15.0, view);
+  const Eigen::Vector3d d = room_light_.dominant.direction;
+  if (!MakeLightView(d, centre, radius, spec.anchor.position, normal, 15.0, view)) return false;
+  // The floor quad drawn (and read back) only where the shadow can fall: the joints' spheres
+  // projected along the light, bounded in the floor plane, plus the blur's reach.
+  Eigen::Vector3d e1 = d - d.dot(normal) * normal;
+  if (e1.norm() < 1e-9) e1 = normal.unitOrthogonal();
+  e1.normalize();
+  const Eigen::Vector3d e2 = normal.cross(e1);
+  const Eigen::Vector3d& o = spec.anchor.position;
+  Eigen::Vector2d lo2 = Eigen::Vector2d::Constant(1e300), hi2 = -lo2;
+  for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
+    if (radii[j] <= 0) continue;
+    const Eigen::Vector3d p = (model_to_map * frame.model[j].col(3)).head<3>();
+    const double r = 1.1 * radii[j] * scale;
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d q = p + r * Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+      const Eigen::Vector3d f = q - d * ((q - o).dot(normal) / d.dot(normal)) - o;
+      const Eigen::Vector2d f2(f.dot(e1), f.dot(e2));
+      lo2 = lo2.cwiseMin(f2), hi2 = hi2.cwiseMax(f2);
+    }
+  }
+  if (lo2.x() > hi2.x()) return false;
+  const double margin = 2.0 * options_.cast_shadow_softness * 2 * radius;
+  lo2 -= Eigen::Vector2d::Constant(margin), hi2 += Eigen::Vector2d::Constant(margin);
+  view->floor_corners = {o + lo2.x() * e1 + lo2.y() * e2, o + hi2.x() * e1 + lo2.y() * e2,
+                         o + hi2.x() * e1 + hi2.y() * e2, o + lo2.x() * e1 + hi2.y() * e2};
+  return true;
 }
 
 float ArRenderer::CastShadowStrength(const Placed& placed) const {
@@ -227,11 +257,21 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   std::vector<bool> casts(characters_.size(), false);
   for (size_t i = 0; i < characters_.size(); ++i) {
     Placed& placed = characters_[i];
-    if (!CastShadowView(placed, *frames[i], &light_views[i])) continue;
+    if (!CastShadowView(placed, *frames[i], &light_views[i])) {
+      placed.silhouette_frames = 0;
+      continue;
+    }
     casts[i] = true;
+    // The silhouette is redrawn every kSilhouetteEvery-th frame (a second pass over every
+    // triangle is the cast shadow's main cost); in between the last one is used with the view
+    // it was drawn in, so the shadow lags the pose by at most one frame.
+    if (placed.silhouette_frames++ % kSilhouetteEvery != 0) {
+      light_views[i].map_to_clip = placed.silhouette_view.map_to_clip;
+      continue;
+    }
+    placed.silhouette_view = light_views[i];
     CharacterDraw draw = character_draw(placed, *frames[i]);
-    draw.silhouette = true;
-    draw.cull_back_faces = false;
+    draw.silhouette = true;  // front faces seen from the light cover the whole silhouette of closed meshes
     placed.cast->BeginSilhouette();
     placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
     placed.cast->EndSilhouette();

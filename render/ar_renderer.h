@@ -55,7 +55,7 @@ struct ArOptions {
   bool occlusion = true;        // the room light's occluder triangles in the depth buffer first
   float cast_shadow_softness = 0.03f;  // blur radius, share of the character's bounding diameter
   float cast_shadow_max_strength = 0.8f;
-  double exposure_smoothing = 0.25;    // ExposureFollower's per-frame share
+  double exposure_smoothing = 0.5;     // ExposureFollower's share per update (every 4th frame)
   PrtOptions prt;
 };
 
@@ -101,7 +101,10 @@ class ArRenderer {
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
     std::unique_ptr<CastShadow> cast;
+    LightView silhouette_view;   // the light view the cast shadow's silhouette was drawn in
+    long silhouette_frames = 0;  // frames since the silhouette was last drawn (mod kSilhouetteEvery)
   };
+  static constexpr int kSilhouetteEvery = 2;
   struct ShadowEllipse {
     Eigen::Vector3d center, axis_u, axis_v;
   };
@@ -130,6 +133,8 @@ class ArRenderer {
   std::unique_ptr<ExposureFollower> follower_;
   std::unique_ptr<DepthProxy> occluders_;
   double prt_seconds_ = 0;
+  static constexpr int kExposureEvery = 4;
+  long frames_since_exposure_ = 0;
 };
 
 }  // namespace arview::render

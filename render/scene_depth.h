@@ -1,11 +1,11 @@
 #pragma once
 // Two things the room adds to the character layer (issue 14, items 3 and 4):
 //  - CastShadow: the character's soft shadow on its floor plane from the room's dominant light.
-//    The skinned character is drawn as a white silhouette into a 256 x 256 texture, seen along
+//    The skinned character is drawn as a white silhouette into a 128 x 128 texture, seen along
 //    the light (orthographic, around the character's bounding sphere); the floor's
 //    parallelogram under that view is then drawn into the layer, each pixel darkened by the
-//    silhouette coverage at its point projected along the light, averaged over a 12-tap disc
-//    from a blurred mip level (a soft, percentage-closer-style edge).
+//    silhouette coverage at its point projected along the light, averaged over 4 taps from a
+//    blurred mip level (a soft, percentage-closer-style edge).
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
@@ -33,7 +33,7 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
 
 class CastShadow {
  public:
-  explicit CastShadow(const GlApi& gl, int size = 256);
+  explicit CastShadow(const GlApi& gl, int size = 128);
   // Binds the silhouette target (cleared, viewport set): draw the character with
   // LightView::map_to_clip as projection, an identity view, and CharacterDraw::silhouette.
   void BeginSilhouette();
