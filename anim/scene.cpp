@@ -291,8 +291,11 @@ Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what)
   }
   std::string extra;
   if (in >> extra) throw Error(what + ": more than three numbers in \"" + text + "\"");
-  if (!(v.norm() > 1e-12)) throw Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
-  return v.normalized();
+  // Scaled by its largest component first: the norm of (1e308, 1e308, 1e308) overflows to
+  // infinity and normalizing by it gave (0, 0, 0).
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (!(largest > 1e-12)) throw Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
+  return (v / largest).normalized();
 }
 
 AnimatedCharacter::AnimatedCharacter(const CharacterSpec& spec)

@@ -107,6 +107,9 @@ TEST(Scene, ParseViewpoint) {
   EXPECT_LT((ParseViewpoint(" 1, 0 ,0") - Eigen::Vector3d::UnitX()).norm(), 1e-12);
   EXPECT_THROW(ParseViewpoint("1,2"), Error);
   EXPECT_THROW(ParseViewpoint("1,2,3,4"), Error);
+  // Issue 17: the norm of (1e308, 1e308, 1e308) overflowed and the direction became (0, 0, 0).
+  EXPECT_LT((ParseViewpoint("1e308,1e308,1e308") - Eigen::Vector3d::Ones().normalized()).norm(), 1e-12);
+  EXPECT_LT((ParseViewpoint("-1e308,0,0") + Eigen::Vector3d::UnitX()).norm(), 1e-12);
   EXPECT_THROW(ParseViewpoint("1,x,3"), Error);
   EXPECT_THROW(ParseViewpoint("1,nan,3"), Error);
   try {
