@@ -1,11 +1,79 @@
-# arview_module(<name> [DEPS <targets...>])
+# arview_discover_tests(<test target> [DATA <gtest filter>] [SLOW_DATA <gtest filter>]
+#                       [SLOW <gtest filter>] [ENVIRONMENT <VAR=value>])
+#
+# Registers a GoogleTest binary's tests with ctest, labelled so that `ctest -LE slow` is the
+# quick loop and `ctest -L data` runs what reads ../shared/data:
+#   DATA       tests that read ../shared/data             label `data`
+#   SLOW_DATA  tests that read it and run over 30 s        labels `data` and `slow`
+#   SLOW       tests over 30 s that read no shared data    label `slow`
+# Filters are gtest patterns joined by ':' (e.g. "TempleMapTest.*:Import.Fox"), disjoint; every
+# other test of the binary is registered without a label. Each group is one gtest_discover_tests
+# call with a TEST_FILTER, so a binary can mix quick and slow tests.
+function(arview_discover_tests target)
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;ENVIRONMENT" "" ${ARGN})
+  # One variable: gtest_discover_tests (CMake 3.25) would split a list of them.
+  set(environment "ARVIEW_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+  if(ARG_ENVIRONMENT)
+    set(environment "${ARG_ENVIRONMENT}")
+  endif()
+  set(labelled "")
+  foreach(group DATA SLOW_DATA SLOW)
+    if(ARG_${group})
+      list(APPEND labelled ${ARG_${group}})
+    endif()
+  endforeach()
+  list(JOIN labelled ":" labelled)
+  set(rest_filter "")
+  if(labelled)
+    set(rest_filter TEST_FILTER "-${labelled}")
+  endif()
+  gtest_discover_tests(${target} ${rest_filter}
+    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES ENVIRONMENT "${environment}"
+    DISCOVERY_TIMEOUT 60)
+  foreach(group DATA SLOW_DATA SLOW)
+    if(NOT ARG_${group})
+      continue()
+    endif()
+    set(label data)
+    if(NOT group STREQUAL "DATA")
+      set(label slow)
+    endif()
+    gtest_discover_tests(${target} TEST_FILTER "${ARG_${group}}"
+      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+      PROPERTIES ENVIRONMENT "${environment}" LABELS ${label}
+      DISCOVERY_TIMEOUT 60)
+    if(group STREQUAL "SLOW_DATA")
+      # gtest_discover_tests (CMake 3.25) splits a list-valued property, so a second label is set
+      # by a ctest script that runs after the discovered tests are added.
+      get_property(counter TARGET ${target} PROPERTY CTEST_DISCOVERED_TEST_COUNTER)
+      set(tests_file "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_tests.cmake")
+      set(labels_script "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_labels.cmake")
+      file(WRITE "${labels_script}" "
+if(EXISTS \"${tests_file}\")
+  file(STRINGS \"${tests_file}\" lines REGEX \"^add_test\\\\(\")
+  foreach(line IN LISTS lines)
+    if(line MATCHES \"^add_test\\\\(\\\\[=\\\\[([^]]*)\\\\]=\\\\]\")
+      set_tests_properties(\"\${CMAKE_MATCH_1}\" PROPERTIES LABELS \"data;slow\")
+    endif()
+  endforeach()
+endif()
+")
+      set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_script}")
+    endif()
+  endforeach()
+endfunction()
+
+# arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>]
+#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>])
 #
 # One library per top-level folder: every *.cpp in the folder except *_test.cpp and
 # bench_*.cpp goes into the library `arview_<name>` (alias arview::<name>).
-# *_test.cpp files form one GoogleTest binary `<name>_tests`, run by ctest.
+# *_test.cpp files form one GoogleTest binary `<name>_tests`, run by ctest (DATA, SLOW_DATA,
+# SLOW: see arview_discover_tests).
 # bench_*.cpp files form the Google Benchmark binary `bench_<name>`.
 function(arview_module name)
-  cmake_parse_arguments(ARG "" "" "DEPS;TEST_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW" "DEPS;TEST_DEPS" ${ARGN})
   file(GLOB all_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(lib_sources "")
   set(test_sources "")
@@ -36,10 +104,7 @@ function(arview_module name)
   if(ARVIEW_BUILD_TESTS AND test_sources)
     add_executable(${name}_tests ${test_sources})
     target_link_libraries(${name}_tests PRIVATE arview_${name} arview_testing ${ARG_TEST_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
-    gtest_discover_tests(${name}_tests
-      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-      PROPERTIES ENVIRONMENT "ARVIEW_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
-      DISCOVERY_TIMEOUT 60)
+    arview_discover_tests(${name}_tests DATA "${ARG_DATA}" SLOW_DATA "${ARG_SLOW_DATA}" SLOW "${ARG_SLOW}")
   endif()
 
   if(ARVIEW_BUILD_BENCHMARKS AND bench_sources)

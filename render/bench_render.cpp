@@ -296,14 +296,29 @@ int main(int argc, char** argv) {
     if (std::strncmp(argv[i], "--gl_threads=", 13) == 0) {
       arview::render::g_gl.threads = std::atoi(argv[i] + 13);
     } else if (std::strncmp(argv[i], "--gl=", 5) == 0) {
-      arview::render::g_gl.backend = arview::render::ParseGlBackend(argv[i] + 5);
+      try {
+        arview::render::g_gl.backend = arview::render::ParseGlBackend(argv[i] + 5);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_render: --gl: %s\n", e.what());
+        return 2;
+      }
     } else {
       rest.push_back(argv[i]);
     }
   }
   int rest_count = static_cast<int>(rest.size());
   benchmark::Initialize(&rest_count, rest.data());
-  std::printf("%s\n", arview::render::Context().Description().c_str());
+  // The renderer goes into the report's context (console header and the JSON "context" object)
+  // and to stderr: stdout carries only the report, so that --benchmark_format=json is pure JSON.
+  std::string renderer;
+  try {
+    renderer = arview::render::Context().Description();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_render: %s\n", e.what());
+    return 1;
+  }
+  benchmark::AddCustomContext("renderer", renderer);
+  std::fprintf(stderr, "renderer: %s\n", renderer.c_str());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
