@@ -20,6 +20,7 @@ struct CompositorOptions {
   bool hmd = false;   // side-by-side stereo
   double ipd_m = 0.064;
   std::optional<render::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
+  bool hud = false;   // the view-sphere overlay (render/hud.h) over localized frames
 };
 
 class ArCompositor : public FrameCompositor {
@@ -42,6 +43,8 @@ class ArCompositor : public FrameCompositor {
   std::vector<anim::FrameOutput> outputs_;
   std::vector<const anim::FrameOutput*> output_ptrs_;
   std::string description_;
+  std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
+  void DrawHud(cv::Mat& frame, const FrameToCompose& input) const;
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
 };
 

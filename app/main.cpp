@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   AddAnimCommand(app);
   AddPlaceCommand(app);
   AddRenderCommand(app);
+  AddViewCommand(app);
   AddReplayCommand(app);
   AddRunCommand(app);
   AddDemoCommand(app);

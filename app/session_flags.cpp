@@ -13,6 +13,7 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--hud", f.hud, "Draw the view-sphere overlay: key viewpoints coloured by weight, the current viewpoint");
   cmd->add_option("--gl", f.gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
   cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
       ->capture_default_str()
@@ -37,6 +38,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.compositor.gl.threads = f.gl_threads;
   o.compositor.hmd = f.hmd;
   o.compositor.ipd_m = f.ipd;
+  o.compositor.hud = f.hud;
   o.fade = {f.hold, f.fade};
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
   o.compositor.ar.lighting = lighting.mode;

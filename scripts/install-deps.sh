@@ -16,6 +16,9 @@ PACKAGES=(
   libcli11-dev
   ffmpeg
   libyaml-cpp-dev nlohmann-json3-dev
+  libx11-dev libxext-dev
+  xvfb
+  xdotool
 )
 
 missing=()

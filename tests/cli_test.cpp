@@ -15,7 +15,7 @@ using testing::LineCount;
 using testing::RunArview;
 
 const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "map", "track", "eval",
-                              "anim", "place", "render", "replay", "run", "demo"};
+                              "anim", "place", "render", "view", "replay", "run", "demo"};
 
 TEST(Cli, HelpListsEverySubcommand) {
   const auto r = RunArview({"--help"});
