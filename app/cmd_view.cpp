@@ -4,6 +4,7 @@
 // save key viewpoints. With --orbit and --out, a scripted orbit is rendered without a window.
 
 #include <nlohmann/json.hpp>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -44,11 +45,22 @@ cv::Size ParseSize(const std::string& text) {
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-nlohmann::json StatsJson(const StageStats& stats, size_t frames, double wall_seconds) {
+// CPU time of the whole process (every thread, llvmpipe's included), seconds. On a machine
+// shared with other work the wall-clock frame rate says how busy the machine was; the CPU time
+// per frame says what a frame costs.
+double ProcessCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  auto s = [](const timeval& t) { return t.tv_sec + t.tv_usec * 1e-6; };
+  return s(u.ru_utime) + s(u.ru_stime);
+}
+
+nlohmann::json StatsJson(const StageStats& stats, size_t frames, double wall_seconds, double cpu_seconds) {
   nlohmann::json j;
   j["frames"] = frames;
   j["wall_seconds"] = wall_seconds;
   j["fps"] = wall_seconds > 0 ? frames / wall_seconds : 0;
+  j["cpu_ms_per_frame"] = frames > 0 ? 1000 * cpu_seconds / frames : 0;
   for (const auto& [stage, t] : stats.Summaries()) {
     j["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}, {"mean_ms", t.mean_ms}, {"count", t.count}};
   }
@@ -95,6 +107,7 @@ void RunOrbit(const ViewArgs& a) {
   InterruptFlag interrupt;
   StageStats stats;
   const Clock::time_point start = Clock::now();
+  const double cpu0 = ProcessCpuSeconds();
   for (int i = 0; i < frames; ++i) {
     if (interrupt.raised()) throw CommandError("interrupted: " + a.out + " not written", 130);
     const double u = frames > 1 ? static_cast<double>(i) / (frames - 1) : 0.0;
@@ -109,7 +122,7 @@ void RunOrbit(const ViewArgs& a) {
   const double wall = Seconds(start);
   std::printf("wrote %s: %d frames (%.1f s at %g fps), rendered at %.1f frames/s\n%srenderer: %s\n", a.out.c_str(),
               frames, frames / a.fps, a.fps, frames / wall, StatsText(stats).c_str(), session.renderer().c_str());
-  WriteStats(a, StatsJson(stats, frames, wall));
+  WriteStats(a, StatsJson(stats, frames, wall, ProcessCpuSeconds() - cpu0));
 }
 
 void RunWindow(const ViewArgs& a) {
@@ -120,6 +133,7 @@ void RunWindow(const ViewArgs& a) {
   InterruptFlag interrupt;
   StageStats stats;
   const Clock::time_point start = Clock::now();
+  const double cpu0 = ProcessCpuSeconds();
   Clock::time_point next = start, last_frame = start, fps_since = start;
   size_t frames = 0, fps_frames = 0;
   const auto period = a.fps_limit > 0 ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1 / a.fps_limit))
@@ -148,10 +162,11 @@ void RunWindow(const ViewArgs& a) {
     }
   }
   const double wall = Seconds(start);
+  const double cpu = ProcessCpuSeconds() - cpu0;
   if (session.dirty()) {
     std::fprintf(stderr, "view: quit with unsaved key changes (%s not written; s saves)\n", a.scene.c_str());
   }
-  nlohmann::json stats_json = StatsJson(stats, frames, wall);
+  nlohmann::json stats_json = StatsJson(stats, frames, wall, cpu);
   stats_json["present"] = window->PresentMethod();
   stats_json["renderer"] = session.renderer();
   stats_json["size"] = a.size;
@@ -161,8 +176,9 @@ void RunWindow(const ViewArgs& a) {
     j["stats"] = stats_json;
     std::printf("%s\n", j.dump().c_str());
   } else {
-    std::printf("%zu frames in %.1f s: %.1f frames/s (%s, %s)\n%srenderer: %s\n", frames, wall, frames / wall,
-                a.size.c_str(), window->PresentMethod().c_str(), StatsText(stats).c_str(), session.renderer().c_str());
+    std::printf("%zu frames in %.1f s: %.1f frames/s (%s, %s), %.2f ms of CPU per frame\n%srenderer: %s\n", frames, wall,
+                frames / wall, a.size.c_str(), window->PresentMethod().c_str(), frames ? 1000 * cpu / frames : 0.0,
+                StatsText(stats).c_str(), session.renderer().c_str());
   }
 }
 
