@@ -12,12 +12,12 @@
 #include <thread>
 
 #include "app/commands.h"
-#include "app/interrupt.h"
 #include "app/output_file.h"
 #include "app/stage_stats.h"
 #include "app/view_orbit.h"
 #include "app/view_session.h"
 #include "app/view_window.h"
+#include "base/cancellation.h"
 #include "render/sinks.h"
 
 namespace arview::app {
@@ -104,12 +104,12 @@ void RunOrbit(const ViewArgs& a) {
   PendingOutput pending(a.out);
   const bool file = std::filesystem::path(a.out).has_extension();
   std::unique_ptr<render::FrameSink> sink = render::OpenSink(file ? pending.partial().string() : a.out, o.size, a.fps);
-  InterruptFlag interrupt;
+  const ScopedSignalCancellation signals;
   StageStats stats;
   const Clock::time_point start = Clock::now();
   const double cpu0 = ProcessCpuSeconds();
   for (int i = 0; i < frames; ++i) {
-    if (interrupt.raised()) throw CommandError("interrupted: " + a.out + " not written", 130);
+    signals.token().ThrowIfCancelled(a.out + " not written");
     const double u = frames > 1 ? static_cast<double>(i) / (frames - 1) : 0.0;
     session.camera().Set(OrbitAt(spec, home, u));
     const cv::Mat frame = session.Render(i / a.fps, &stats);
@@ -130,7 +130,7 @@ void RunWindow(const ViewArgs& a) {
   // The display first: without one, say so before loading anything.
   std::unique_ptr<ViewWindow> window = ViewWindow::Open("arview view: " + a.scene, o.size);
   ViewSession session(a.scene, o);
-  InterruptFlag interrupt;
+  const ScopedSignalCancellation signals;
   StageStats stats;
   const Clock::time_point start = Clock::now();
   const double cpu0 = ProcessCpuSeconds();
@@ -138,7 +138,7 @@ void RunWindow(const ViewArgs& a) {
   size_t frames = 0, fps_frames = 0;
   const auto period = a.fps_limit > 0 ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1 / a.fps_limit))
                                       : Clock::duration::zero();
-  while (!session.quit_requested() && !interrupt.raised()) {
+  while (!session.quit_requested() && !signals.token().IsCancelled()) {
     const double t = Seconds(start);
     if (a.seconds > 0 && t >= a.seconds) break;
     for (const InputEvent& e : window->Poll()) session.Handle(e, t);
