@@ -45,6 +45,8 @@
 // Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
 
 #include "anim/character.h"
+#include "base/enum_table.h"
+#include "base/geometry.h"
 #include "anim/lookat.h"
 #include "anim/pose.h"
 #include "anim/view_adaptive.h"
@@ -58,14 +60,19 @@
 
 namespace arview::anim {
 
-struct Anchor {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
-  double scale = 1.0;
-};
+// The scene file's anchor is the one arview::Anchor (base/geometry.h): the rotation a unit
+// quaternion, as the placement that writes it.
+using Anchor = arview::Anchor;
 
 struct KeySpec {
   enum class Source { kClip, kLookAt, kRestPose, kStaticPose };
+  // Names for messages and `arview anim weights` (base/enum_table.h), found by argument lookup.
+  friend constexpr auto EnumNames(Source) {
+    return EnumTable<Source, 4>{{{Source::kClip, "clip"},
+                                 {Source::kLookAt, "lookat"},
+                                 {Source::kRestPose, "rest"},
+                                 {Source::kStaticPose, "pose"}}};
+  }
   Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // unit, character frame
   Source source = Source::kClip;
   std::string clip;        // kClip, kStaticPose
