@@ -1,10 +1,12 @@
 #include "app/ar_session.h"
 
+#include "base/stats.h"
+
 #include <cstdio>
 #include <algorithm>
 #include <memory>
 
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 #include "app/pipeline_report.h"
 #include "app/progress.h"
 #include "render/sinks.h"
@@ -16,8 +18,7 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
   std::vector<double> dt;
   for (size_t i = 1; i < frames.size(); ++i) dt.push_back(frames[i].timestamp - frames[i - 1].timestamp);
   if (dt.empty()) return 30;
-  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-  const double median = dt[dt.size() / 2];
+  const double median = Median(dt);
   // Still-photo datasets are stamped one second apart; a 1 fps video of them would be a slide show.
   if (median >= 0.5) return 10;
   return median > 0 ? 1.0 / median : 30;
@@ -76,7 +77,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
-  if (!o.stats_out.empty()) WriteTextFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer));
+  if (!o.stats_out.empty()) WriteFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer));
   return result;
 }
 

@@ -7,10 +7,11 @@
 #include <iostream>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "anim/lookat.h"
 #include "anim/scene.h"
 #include "app/commands.h"
-#include "app/json_writer.h"
 
 namespace arview::app {
 
@@ -61,29 +62,26 @@ void RunInfo(const AnimArgs& args) {
   const anim::Skeleton& sk = c.skeleton;
   const std::vector<std::string> chain = anim::DefaultLookAtChain(sk);
   if (args.json) {
-    JsonWriter j;
-    j.BeginObject().Value("asset", c.source);
-    j.BeginArray("joints");
-    for (int i = 0; i < sk.size(); ++i)
-      j.BeginObject().Value("index", i).Value("name", sk.names[i]).Value("parent", sk.parents[i]).EndObject();
-    j.EndArray();
-    j.BeginArray("clips");
+    nlohmann::ordered_json j = {{"asset", c.source}};
+    nlohmann::ordered_json& joints = j["joints"] = nlohmann::ordered_json::array();
+    for (int i = 0; i < sk.size(); ++i) joints.push_back({{"index", i}, {"name", sk.names[i]}, {"parent", sk.parents[i]}});
+    nlohmann::ordered_json& clips = j["clips"] = nlohmann::ordered_json::array();
     for (const anim::Clip& clip : c.clips)
-      j.BeginObject().Value("name", clip.name).Value("duration_s", clip.duration).Value("ticks_per_second", clip.ticks_per_second).EndObject();
-    j.EndArray();
-    j.BeginArray("meshes");
+      clips.push_back({{"name", clip.name}, {"duration_s", clip.duration}, {"ticks_per_second", clip.ticks_per_second}});
+    nlohmann::ordered_json& meshes = j["meshes"] = nlohmann::ordered_json::array();
     for (const anim::Mesh& m : c.meshes) {
-      j.BeginObject().Value("name", m.name).Value("vertices", m.positions.size()).Value("triangles", m.indices.size() / 3);
-      j.Value("bones", BonesUsed(m, sk.size())).Value("uvs", !m.uvs.empty()).Value("material", m.material);
-      if (m.material >= 0) j.Value("texture", TextureText(c, c.materials[m.material].texture));
-      j.EndObject();
+      nlohmann::ordered_json mesh = {{"name", m.name},
+                                     {"vertices", m.positions.size()},
+                                     {"triangles", m.indices.size() / 3},
+                                     {"bones", BonesUsed(m, sk.size())},
+                                     {"uvs", !m.uvs.empty()},
+                                     {"material", m.material}};
+      if (m.material >= 0) mesh["texture"] = TextureText(c, c.materials[m.material].texture);
+      meshes.push_back(std::move(mesh));
     }
-    j.EndArray();
-    j.BeginArray("default_lookat_chain");
-    for (const std::string& n : chain) j.BeginObject().Value("joint", n).EndObject();
-    j.EndArray();
-    j.EndObject();
-    std::cout << j.str() << "\n";
+    nlohmann::ordered_json& chain_json = j["default_lookat_chain"] = nlohmann::ordered_json::array();
+    for (const std::string& n : chain) chain_json.push_back({{"joint", n}});
+    std::cout << j.dump(2) << "\n";
     return;
   }
   std::cout << c.source << "\n";
@@ -114,16 +112,6 @@ void RunInfo(const AnimArgs& args) {
   std::cout << "\n";
 }
 
-const char* SourceName(anim::KeySpec::Source s) {
-  switch (s) {
-    case anim::KeySpec::Source::kClip: return "clip";
-    case anim::KeySpec::Source::kLookAt: return "lookat";
-    case anim::KeySpec::Source::kRestPose: return "rest";
-    case anim::KeySpec::Source::kStaticPose: return "pose";
-  }
-  return "?";
-}
-
 void RunWeights(const AnimArgs& args) {
   const Eigen::Vector3d v = anim::ParseViewpoint(args.viewpoint, "--viewpoint");
   if (!std::isfinite(args.time)) throw CommandError("--time must be a finite number of seconds");
@@ -145,23 +133,26 @@ void RunWeights(const AnimArgs& args) {
   }
   const bool dib = spec->blend == anim::BlendMethod::kDib;
   if (args.json) {
-    JsonWriter j;
-    j.BeginObject().Value("scene", args.scene).Value("character", spec->name);
-    j.BeginArray("viewpoint").Element(v.x()).Element(v.y()).Element(v.z()).EndArray();
-    j.Value("time_s", args.time);
-    j.BeginArray("keys");
+    nlohmann::ordered_json j = {{"scene", args.scene},
+                                {"character", spec->name},
+                                {"viewpoint", {v.x(), v.y(), v.z()}},
+                                {"time_s", args.time}};
+    nlohmann::ordered_json& keys = j["keys"] = nlohmann::ordered_json::array();
     for (std::size_t k = 0; k < spec->keys.size(); ++k) {
       const anim::KeySpec& key = spec->keys[k];
-      j.BeginObject().Value("index", k).Value("source", SourceName(key.source)).Value("clip", ch.key_clip(int(k)).name);
-      j.BeginArray("viewpoint").Element(key.viewpoint.x()).Element(key.viewpoint.y()).Element(key.viewpoint.z()).EndArray();
-      j.Value("weight", out.weights[k]).EndObject();
+      keys.push_back({{"index", k},
+                      {"source", ToString(key.source)},
+                      {"clip", ch.key_clip(int(k)).name},
+                      {"viewpoint", {key.viewpoint.x(), key.viewpoint.y(), key.viewpoint.z()}},
+                      {"weight", out.weights[k]}});
     }
-    j.EndArray();
-    j.Value("blend", dib ? "dib" : "dlb");
-    if (dib) j.Value("dib_converged", out.converged).Value("dib_max_iterations", out.max_iterations);
-    if (lookat) j.Value("head_to_viewpoint_deg", head_deg);
-    j.EndObject();
-    std::cout << j.str() << "\n";
+    j["blend"] = dib ? "dib" : "dlb";
+    if (dib) {
+      j["dib_converged"] = out.converged;
+      j["dib_max_iterations"] = out.max_iterations;
+    }
+    if (lookat) j["head_to_viewpoint_deg"] = head_deg;
+    std::cout << j.dump(2) << "\n";
     return;
   }
   std::cout << "character " << spec->name << ", viewpoint (" << Fixed(v.x()) << ", " << Fixed(v.y()) << ", "
@@ -169,7 +160,7 @@ void RunWeights(const AnimArgs& args) {
   for (std::size_t k = 0; k < spec->keys.size(); ++k) {
     const anim::KeySpec& key = spec->keys[k];
     std::cout << "  key " << k << "  (" << Fixed(key.viewpoint.x()) << ", " << Fixed(key.viewpoint.y()) << ", "
-              << Fixed(key.viewpoint.z()) << ")  " << SourceName(key.source) << " " << ch.key_clip(int(k)).name
+              << Fixed(key.viewpoint.z()) << ")  " << ToString(key.source) << " " << ch.key_clip(int(k)).name
               << "  weight " << Fixed(out.weights[k], 4) << "\n";
   }
   if (dib)

@@ -1,5 +1,7 @@
 // arview calibrate: camera intrinsics from photos of a chessboard or ChArUco board.
 
+#include "base/image_file.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -107,9 +109,7 @@ void AddCalibrateCommand(CLI::App& app) {
     calib::SaveCamera(result.camera, args->out);
     std::printf("wrote %s\n", args->out.c_str());
     if (!args->report.empty()) {
-      if (!cv::imwrite(args->report, calib::DrawCalibrationReport(result))) {
-        throw CommandError("--report " + args->report + ": could not write the PNG");
-      }
+      WriteImageAtomically(args->report, calib::DrawCalibrationReport(result));
       std::printf("wrote %s\n", args->report.c_str());
     }
   });

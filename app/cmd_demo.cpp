@@ -11,7 +11,7 @@
 
 #include "app/ar_session.h"
 #include "app/commands.h"
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 #include "app/pipeline_report.h"
 #include "app/place_character.h"
 #include "app/progress.h"
@@ -181,7 +181,7 @@ void AddDemoCommand(CLI::App& app) {
     std::printf("  camera centre error: median %.1f mm, RMSE %.1f mm, max %.1f mm; rotation median %.2f deg\n",
                 1000 * report.ate.median, 1000 * report.ate.rmse, 1000 * report.ate.max, report.rotation_deg.median);
     std::printf("  throughput %.1f frames per second, end-to-end latency median %.1f ms\n", result.report.fps,
-                result.report.stages.count("latency") ? result.report.stages.at("latency").median_ms : 0.0);
+                result.report.stages.count("latency") ? result.report.stages.at("latency").median : 0.0);
     std::printf("\nwrote %s\n      %s (plot), %s, %s, %s\n", out.c_str(), (work / "trajectory.png").c_str(),
                 (work / "trajectory.txt").c_str(), (work / "stats.json").c_str(), scene.c_str());
   });

@@ -52,9 +52,10 @@ void AddPlaceCommand(CLI::App& app) {
     placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
     WriteSceneFile(placed, a->out);
     const Anchor& anchor = placed.anchor;
+    const Eigen::Vector3d up = anchor.rotation * Eigen::Vector3d::UnitY();
     std::printf("placed %s at (%.4f, %.4f, %.4f), up (%.3f, %.3f, %.3f), scale %.5g (rest height %.4g units)\n",
                 placed.name.c_str(), anchor.position.x(), anchor.position.y(), anchor.position.z(),
-                anchor.rotation(0, 1), anchor.rotation(1, 1), anchor.rotation(2, 1), anchor.scale, placed.rest_height);
+                up.x(), up.y(), up.z(), anchor.scale, placed.rest_height);
     std::printf("wrote %s with %d look-at keys at %.1f deg elevation\n", a->out.c_str(), placed.key_count,
                 placed.key_elevation_deg);
     if (!a->no_light) WritePlacedLight(map, a->map_dir, a->recording, placed, a->out);

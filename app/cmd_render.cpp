@@ -1,4 +1,6 @@
 // arview render --scene scene.yaml --camera camera.yaml --pose "tx ty tz qx qy qz qw"
+
+#include "base/image_file.h"
 //               [--background image.png] [--time s] [--hmd --ipd m] --out out.png
 
 #include <opencv2/imgcodecs.hpp>
@@ -100,7 +102,7 @@ void RunRender(const RenderArgs& args) {
     }
     const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
                                    : renderer.Render(background, pose, frames);
-    if (!cv::imwrite(args.out, image)) throw CommandError(args.out + ": cannot write the image");
+    WriteImageAtomically(args.out, image);
     std::cout << "wrote " << args.out << " (" << image.cols << "x" << image.rows << ", "
               << characters.size() << " character" << (characters.size() == 1 ? "" : "s")
               << (camera.HasDistortion() ? ", undistorted view" : "")

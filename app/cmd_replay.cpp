@@ -6,7 +6,7 @@
 
 #include "app/ar_session.h"
 #include "app/commands.h"
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 #include "app/session_flags.h"
 #include "base/cancellation.h"
 #include "app/pipeline_report.h"

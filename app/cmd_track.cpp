@@ -4,19 +4,19 @@
 // recording's timestamps, lost frames omitted), optional per-frame statistics as JSON, and a
 // summary on stdout (frames localised, median and 95th percentile time per status).
 
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
 #include <sstream>
 
 #include "app/commands.h"
-#include "app/json_writer.h"
 #include "app/progress.h"
 #include "app/stage_stats.h"
 #include "base/cancellation.h"
+#include "base/atomic_file.h"
 #include "map/map_file.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
@@ -54,7 +54,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   tracker::TrackerOptions o;
   try {
     o.relocalization.pose.solver = tracker::ParseMinimalSolver(a.solver);
-  } catch (const std::invalid_argument& e) {
+  } catch (const Error& e) {
     throw CommandError(std::string("--solver: ") + e.what());
   }
   o.relocalization.features.max_features = a.max_features;
@@ -81,36 +81,26 @@ struct FrameRecord {
   tracker::FrameResult result;
 };
 
-void WriteFrameJson(JsonWriter& w, const FrameRecord& f) {
+nlohmann::ordered_json FrameJson(const FrameRecord& f) {
   const auto& r = f.result;
-  w.BeginObject()
-      .Value("index", f.index)
-      .Value("timestamp", f.timestamp)
-      .Value("status", tracker::TrackStatusName(r.status))
-      .Value("inliers", r.inliers)
-      .Value("rms_px", r.rms_px)
-      .Value("flow_tracks", r.flow_tracks)
-      .Value("guided_matches", r.guided_matches)
-      .Value("keypoints", r.keypoints)
-      .Value("matches", r.matches)
-      .Value("reason", r.reason);
-  w.BeginObject("ms")
-      .Value("flow", r.times.flow_ms)
-      .Value("extract", r.times.extract_ms)
-      .Value("match", r.times.match_ms)
-      .Value("ransac", r.times.ransac_ms)
-      .Value("refine", r.times.refine_ms)
-      .Value("total", r.times.total_ms)
-      .Value("cpu", r.times.cpu_ms)
-      .EndObject();
+  nlohmann::ordered_json j = {{"index", f.index},
+                              {"timestamp", f.timestamp},
+                              {"status", ToString(r.status)},
+                              {"inliers", r.inliers},
+                              {"rms_px", r.rms_px},
+                              {"flow_tracks", r.flow_tracks},
+                              {"guided_matches", r.guided_matches},
+                              {"keypoints", r.keypoints},
+                              {"matches", r.matches},
+                              {"reason", r.reason}};
+  j["ms"] = {{"flow", r.times.flow_ms},       {"extract", r.times.extract_ms}, {"match", r.times.match_ms},
+             {"ransac", r.times.ransac_ms},   {"refine", r.times.refine_ms},   {"total", r.times.total_ms},
+             {"cpu", r.times.cpu_ms}};
   if (r.status != tracker::TrackStatus::kLost) {
-    w.BeginArray("center");
-    for (int i = 0; i < 3; ++i) w.Element(r.center[i]);
-    w.EndArray().BeginArray("smoothed_center");
-    for (int i = 0; i < 3; ++i) w.Element(r.smoothed_center[i]);
-    w.EndArray();
+    j["center"] = {r.center[0], r.center[1], r.center[2]};
+    j["smoothed_center"] = {r.smoothed_center[0], r.smoothed_center[1], r.smoothed_center[2]};
   }
-  w.EndObject();
+  return j;
 }
 
 // Per status (and "all"): wall time and thread CPU time of Track().
@@ -123,38 +113,29 @@ using StatusSummaries = std::map<std::string, StatusSummary>;
 StatusSummaries SummarizeByStatus(const std::vector<FrameRecord>& frames) {
   std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> samples;
   for (const auto& f : frames) {
-    for (const char* key : {tracker::TrackStatusName(f.result.status), "all"}) {
+    for (const std::string& key : {ToString(f.result.status), std::string("all")}) {
       samples[key].first.push_back(f.result.times.total_ms);
       samples[key].second.push_back(f.result.times.cpu_ms);
     }
   }
   StatusSummaries out;
-  for (auto& [status, ms] : samples) out[status] = {Summarize(std::move(ms.first)), Summarize(std::move(ms.second))};
+  for (auto& [status, ms] : samples) out[status] = {Summarize(ms.first), Summarize(ms.second)};
   return out;
 }
 
 void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
                     const std::vector<FrameRecord>& frames, const StatusSummaries& summaries) {
-  JsonWriter w;
-  w.BeginObject().Value("recording", args.recording).Value("map", args.map).Value("threads", args.threads);
-  w.BeginObject("summary");
+  nlohmann::ordered_json j = {{"recording", args.recording}, {"map", args.map}, {"threads", args.threads}};
+  nlohmann::ordered_json& summary = j["summary"] = nlohmann::ordered_json::object();
   for (const auto& [status, s] : summaries) {
-    w.BeginObject(status)
-        .Value("frames", s.wall.count)
-        .Value("median_ms", s.wall.median_ms)
-        .Value("p95_ms", s.wall.p95_ms)
-        .Value("mean_ms", s.wall.mean_ms)
-        .Value("max_ms", s.wall.max_ms)
-        .Value("cpu_median_ms", s.cpu.median_ms)
-        .Value("cpu_p95_ms", s.cpu.p95_ms)
-        .EndObject();
+    summary[status] = {{"frames", s.wall.count},     {"median_ms", s.wall.median},
+                       {"p95_ms", s.wall.p95},       {"mean_ms", s.wall.mean},
+                       {"max_ms", s.wall.max},       {"cpu_median_ms", s.cpu.median},
+                       {"cpu_p95_ms", s.cpu.p95}};
   }
-  w.EndObject().BeginArray("frames");
-  for (const auto& f : frames) WriteFrameJson(w, f);
-  w.EndArray().EndObject();
-  std::ofstream out(path);
-  out << w.str() << "\n";
-  if (!out) throw CommandError("cannot write " + path.string());
+  nlohmann::ordered_json& list = j["frames"] = nlohmann::ordered_json::array();
+  for (const auto& f : frames) list.push_back(FrameJson(f));
+  WriteFileAtomically(path, j.dump(2) + "\n");
 }
 
 void RunTrack(const TrackArgs& args) {
@@ -206,7 +187,7 @@ void RunTrack(const TrackArgs& args) {
         trajectory.push_back({record.timestamp, record.result.pose});
       frames.push_back(std::move(record));
       if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
-                      tracker::TrackStatusName(frames.back().result.status));
+                      ToString(frames.back().result.status));
     }
   } catch (const recordings::RecordingError& e) {
     throw CommandError(e.what());
@@ -234,9 +215,9 @@ void RunTrack(const TrackArgs& args) {
   }
   std::cout << ")\n" << std::fixed << std::setprecision(2);
   for (const auto& [status, s] : summaries)
-    std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.wall.median_ms
-              << " ms, p95 " << s.wall.p95_ms << " ms wall; median " << s.cpu.median_ms << " ms, p95 "
-              << s.cpu.p95_ms << " ms CPU (" << s.wall.count << " frames)\n";
+    std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.wall.median
+              << " ms, p95 " << s.wall.p95 << " ms wall; median " << s.cpu.median << " ms, p95 "
+              << s.cpu.p95 << " ms CPU (" << s.wall.count << " frames)\n";
   for (const auto& f : frames)
     if (f.result.status == tracker::TrackStatus::kLost)
       std::cout << "  lost frame " << f.index << ": " << f.result.reason << "\n";

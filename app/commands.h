@@ -8,12 +8,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/error.h"
+
 namespace arview::app {
 
 // Thrown by a command to exit with a specific code after its message.
-struct CommandError : std::runtime_error {
-  explicit CommandError(const std::string& message, int exit_code = 1)
-      : std::runtime_error(message), code(exit_code) {}
+struct CommandError : Error {
+  explicit CommandError(const std::string& message, int exit_code = 1) : Error(message), code(exit_code) {}
   int code;
 };
 

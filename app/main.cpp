@@ -83,7 +83,10 @@ int main(int argc, char** argv) {
   } catch (const CommandError& e) {
     std::cerr << "arview: " << OneLine(e.what()) << "\n";
     return e.code;
-  } catch (const std::exception& e) {
+  } catch (const arview::Error& e) {  // every module's errors: a bad file, device or value
+    std::cerr << "arview: " << OneLine(e.what()) << "\n";
+    return 1;
+  } catch (const std::exception& e) {  // not ours (out of memory, a library's own exception)
     std::cerr << "arview: " << OneLine(e.what()) << "\n";
     return 1;
   }

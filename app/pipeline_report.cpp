@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "app/json_writer.h"
+#include <nlohmann/json.hpp>
 
 namespace arview::app {
 
@@ -15,28 +15,26 @@ GazeSummary SummarizeGaze(const PipelineReport& report) {
   GazeSummary g;
   g.frames = errors.size();
   if (errors.empty()) return g;
-  const TimingSummary s = Summarize(errors);
-  g.median_deg = s.median_ms;
-  g.max_deg = s.max_ms;
+  const Summary s = Summarize(errors);
+  g.median_deg = s.median;
+  g.max_deg = s.max;
   g.within_20_deg = std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 20.0; });
   return g;
 }
 
 namespace {
 
-void WriteSummary(JsonWriter& w, const std::string& key, const TimingSummary& s) {
-  w.BeginObject(key)
-      .Value("count", s.count)
-      .Value("median_ms", s.median_ms)
-      .Value("p95_ms", s.p95_ms)
-      .Value("mean_ms", s.mean_ms)
-      .Value("max_ms", s.max_ms)
-      .EndObject();
+}  // namespace
+
+nlohmann::ordered_json TimingJson(const TimingSummary& s) {
+  return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"mean_ms", s.mean}, {"max_ms", s.max}};
 }
+
+namespace {
 
 std::map<std::string, TimingSummary> TrackTimesByStatus(const PipelineReport& report) {
   std::map<std::string, std::vector<double>> samples;
-  for (const FrameLog& f : report.frames) samples[tracker::TrackStatusName(f.track.status)].push_back(f.track.times.total_ms);
+  for (const FrameLog& f : report.frames) samples[ToString(f.track.status)].push_back(f.track.times.total_ms);
   std::map<std::string, TimingSummary> out;
   for (auto& [status, v] : samples) out[status] = Summarize(v);
   return out;
@@ -45,45 +43,37 @@ std::map<std::string, TimingSummary> TrackTimesByStatus(const PipelineReport& re
 }  // namespace
 
 std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_description) {
-  JsonWriter w;
-  w.BeginObject();
-  w.Value("frames_read", r.frames_read)
-      .Value("frames_processed", r.frames_processed)
-      .Value("frames_dropped", r.frames_dropped)
-      .Value("frames_localized", r.frames_localized)
-      .Value("wall_seconds", r.wall_seconds)
-      .Value("frames_per_second", r.fps)
-      .Value("renderer", gl_description);
-  w.BeginObject("stages");
-  for (const auto& [stage, s] : r.stages) WriteSummary(w, stage, s);
-  w.EndObject();
-  w.BeginObject("tracker_time_by_status");
-  for (const auto& [status, s] : TrackTimesByStatus(r)) WriteSummary(w, status, s);
-  w.EndObject();
+  nlohmann::ordered_json j;
+  j["frames_read"] = r.frames_read;
+  j["frames_processed"] = r.frames_processed;
+  j["frames_dropped"] = r.frames_dropped;
+  j["frames_localized"] = r.frames_localized;
+  j["wall_seconds"] = r.wall_seconds;
+  j["frames_per_second"] = r.fps;
+  j["renderer"] = gl_description;
+  nlohmann::ordered_json& stages = j["stages"] = nlohmann::ordered_json::object();
+  for (const auto& [stage, s] : r.stages) stages[stage] = TimingJson(s);
+  nlohmann::ordered_json& by_status = j["tracker_time_by_status"] = nlohmann::ordered_json::object();
+  for (const auto& [status, s] : TrackTimesByStatus(r)) by_status[status] = TimingJson(s);
   const GazeSummary g = SummarizeGaze(r);
-  w.BeginObject("gaze")
-      .Value("frames", g.frames)
-      .Value("median_error_deg", g.median_deg)
-      .Value("max_error_deg", g.max_deg)
-      .Value("frames_within_20_deg", g.within_20_deg)
-      .EndObject();
-  w.BeginArray("frames");
+  j["gaze"] = {{"frames", g.frames},
+               {"median_error_deg", g.median_deg},
+               {"max_error_deg", g.max_deg},
+               {"frames_within_20_deg", g.within_20_deg}};
+  nlohmann::ordered_json& frames = j["frames"] = nlohmann::ordered_json::array();
   for (const FrameLog& f : r.frames) {
-    w.BeginObject()
-        .Value("index", static_cast<long long>(f.index))
-        .Value("timestamp", f.timestamp)
-        .Value("status", tracker::TrackStatusName(f.track.status))
-        .Value("inliers", f.track.inliers)
-        .Value("rms_px", f.track.rms_px)
-        .Value("track_ms", f.track.times.total_ms)
-        .Value("idle_weight", f.idle_weight);
-    if (f.gaze_error_deg) w.Value("gaze_error_deg", *f.gaze_error_deg);
-    if (!f.track.reason.empty()) w.Value("reason", f.track.reason);
-    w.EndObject();
+    nlohmann::ordered_json frame = {{"index", f.index},
+                                    {"timestamp", f.timestamp},
+                                    {"status", ToString(f.track.status)},
+                                    {"inliers", f.track.inliers},
+                                    {"rms_px", f.track.rms_px},
+                                    {"track_ms", f.track.times.total_ms},
+                                    {"idle_weight", f.idle_weight}};
+    if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
+    if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
+    frames.push_back(std::move(frame));
   }
-  w.EndArray();
-  w.EndObject();
-  return w.str() + "\n";
+  return j.dump(2) + "\n";
 }
 
 std::string PipelineReportText(const PipelineReport& r) {
@@ -97,12 +87,12 @@ std::string PipelineReportText(const PipelineReport& r) {
   out += line;
   out += "stage          median ms   p95 ms\n";
   for (const auto& [stage, s] : r.stages) {
-    std::snprintf(line, sizeof(line), "%-14s %9.2f %8.2f\n", stage.c_str(), s.median_ms, s.p95_ms);
+    std::snprintf(line, sizeof(line), "%-14s %9.2f %8.2f\n", stage.c_str(), s.median, s.p95);
     out += line;
   }
   for (const auto& [status, s] : TrackTimesByStatus(r)) {
     std::snprintf(line, sizeof(line), "tracker, %-12s %5zu frames, median %.2f ms, p95 %.2f ms\n", status.c_str(), s.count,
-                  s.median_ms, s.p95_ms);
+                  s.median, s.p95);
     out += line;
   }
   const GazeSummary g = SummarizeGaze(r);

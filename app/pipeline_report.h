@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "app/ar_pipeline.h"
 
 namespace arview::app {
@@ -15,6 +17,8 @@ struct GazeSummary {
 };
 
 GazeSummary SummarizeGaze(const PipelineReport& report);
+// The timing object of stats.json: {count, median_ms, p95_ms, mean_ms, max_ms}.
+nlohmann::ordered_json TimingJson(const TimingSummary& summary);
 std::string PipelineReportJson(const PipelineReport& report, const std::string& gl_description);
 std::string PipelineReportText(const PipelineReport& report);
 

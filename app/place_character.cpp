@@ -5,6 +5,7 @@
 
 #include "anim/character.h"
 #include "app/character_bounds.h"
+#include "base/stats.h"
 
 namespace arview::app {
 
@@ -40,15 +41,14 @@ PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path&
   // seen from the character's eyes (a character on a table is looked at from above; a tall one
   // looks down at cameras held lower than its head). Eyes: 93% of the rest height.
   std::vector<double> elevations;
-  const Eigen::Vector3d up = placed.anchor.rotation.col(1);
+  const Eigen::Vector3d up = placed.anchor.rotation * Eigen::Vector3d::UnitY();
   const Eigen::Vector3d eyes = placed.anchor.position + 0.93 * height * placed.anchor.scale * up;
   for (const auto& c : centres) {
     const Eigen::Vector3d d = c - eyes;
     if (d.norm() > 0) elevations.push_back(std::asin(std::clamp(up.dot(d.normalized()), -1.0, 1.0)) * 180 / M_PI);
   }
   if (!elevations.empty() && o.key_elevation_deg.has_value() == false) {
-    std::nth_element(elevations.begin(), elevations.begin() + elevations.size() / 2, elevations.end());
-    placed.key_elevation_deg = std::clamp(elevations[elevations.size() / 2], -60.0, 60.0);
+    placed.key_elevation_deg = std::clamp(Median(elevations), -60.0, 60.0);
   } else {
     placed.key_elevation_deg = o.key_elevation_deg.value_or(0.0);
   }

@@ -6,42 +6,19 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include <cstdint>
-#include <optional>
-#include <stdexcept>
 #include <vector>
+
+#include "base/error.h"
+#include "base/geometry.h"
+#include "base/plane_fit.h"
 
 namespace arview::app {
 
-struct PlacementError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct PlacementError : Error {
+  using Error::Error;
 };
 
-struct Plane {
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit
-  double offset = 0;                                   // normal·x + offset = 0
-  int inliers = 0;
-  double Distance(const Eigen::Vector3d& x) const { return normal.dot(x) + offset; }
-};
-
-struct PlaneFitOptions {
-  double inlier_distance = 0;   // 0: 1% of the scene's robust extent
-  double middle_fraction = 0.5; // use the points within this fraction of the extent around the median
-  int iterations = 500;
-  std::uint64_t seed = 1;
-  // When set, only planes whose normal lies within max_tilt_deg of this direction are floors.
-  std::optional<Eigen::Vector3d> up_prior;
-  double max_tilt_deg = 30;
-};
-
-// Throws PlacementError when there are fewer than 3 points or no plane holds enough of them.
-Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& options);
-
-struct Anchor {
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // character frame → map frame
-  double scale = 1;
-};
+// The plane fit (FitDominantPlane, Plane, PlaneFitOptions) and the Anchor are base/'s.
 
 struct PlacementOptions {
   PlaneFitOptions plane;

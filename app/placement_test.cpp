@@ -66,10 +66,10 @@ TEST(Placement, TheCamerasRingTellsTheFloorFromAWall) {
 }
 
 TEST(Placement, DegenerateInputsAreClearErrors) {
-  EXPECT_THROW(FitDominantPlane({Eigen::Vector3d::Zero()}, {}), PlacementError);
+  EXPECT_THROW(FitDominantPlane({Eigen::Vector3d::Zero()}, {}), arview::Error);
   std::vector<Eigen::Vector3d> line;
   for (int i = 0; i < 50; ++i) line.emplace_back(i, 0, 0);
-  EXPECT_THROW(FitDominantPlane(line, {}), PlacementError);
+  EXPECT_THROW(FitDominantPlane(line, {}), arview::Error);
   EXPECT_THROW(PlaceOnDominantPlane(MakeScene(false).points, {}, {}, 1.0, {}), PlacementError);
 }
 

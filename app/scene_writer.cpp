@@ -5,7 +5,7 @@
 #include <yaml-cpp/emittermanip.h>
 
 #include "anim/scene.h"
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 
 namespace arview::app {
 
@@ -71,7 +71,7 @@ std::string SceneYaml(const PlacedCharacter& c) {
 void WriteSceneFile(const PlacedCharacter& c, const std::filesystem::path& file) {
   const std::string text = SceneYaml(c);
   anim::ParseScene(text, file);  // throws anim::Error when the text would not load
-  WriteTextFileAtomically(file, text);
+  WriteFileAtomically(file, text);
 }
 
 }  // namespace arview::app

@@ -1,6 +1,7 @@
 #pragma once
 // Per-stage timings of the real-time pipeline: each stage records how long it took for each
-// frame; the summary gives the median and 95th percentile that stats.json and the console show.
+// frame; the summary (base/stats.h) gives the median and 95th percentile that stats.json and the
+// console show.
 
 #include <chrono>
 #include <map>
@@ -8,17 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "base/stats.h"
+
 namespace arview::app {
 
-struct TimingSummary {
-  size_t count = 0;
-  double median_ms = 0;
-  double p95_ms = 0;
-  double mean_ms = 0;
-  double max_ms = 0;
-};
-
-TimingSummary Summarize(std::vector<double> samples_ms);
+// Milliseconds, summarised by base/stats.h (median, p95, mean, max, count, ...).
+using TimingSummary = Summary;
 
 // Thread-safe: stages running on different threads record into one object.
 class StageStats {

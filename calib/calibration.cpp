@@ -1,5 +1,7 @@
 #include "calib/calibration.h"
 
+#include "base/stats.h"
+
 #include <glob.h>
 
 #include <algorithm>
@@ -113,12 +115,6 @@ PassResult CalibratePass(const std::vector<const Detection*>& views, cv::Size im
   r.rms = cv::calibrateCamera(object, image, image_size, r.K, r.dist, rvecs, tvecs);
   for (size_t i = 0; i < views.size(); ++i) r.view_rms.push_back(ViewRms(*views[i], r.K, r.dist, rvecs[i], tvecs[i]));
   return r;
-}
-
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 }  // namespace

@@ -13,8 +13,8 @@
 
 namespace arview::calib {
 
-struct CalibrationError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct CalibrationError : Error {
+  using Error::Error;
 };
 
 enum class BoardKind { kChessboard, kCharuco };

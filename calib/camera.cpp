@@ -9,6 +9,8 @@
 
 #include "base/input_guard.h"
 
+#include "base/atomic_file.h"
+
 namespace arview::calib {
 
 Camera Camera::Pinhole(int width, int height, double fx, double fy, double cx, double cy) {
@@ -281,25 +283,13 @@ Camera LoadCamera(const std::filesystem::path& path) {
 
 void SaveCamera(const Camera& camera, const std::filesystem::path& path) {
   camera.Validate("camera to save as " + path.string());
-  // Write to a sibling file and rename, so that a failure never leaves a half-written camera.
-  const std::filesystem::path tmp = path.string() + ".tmp.yaml";
-  {
-    std::ofstream probe(tmp);
-    if (!probe) throw CameraError(path.string() + ": cannot write here (directory missing or not writable)");
-  }
-  cv::FileStorage fs(tmp.string(), cv::FileStorage::WRITE);
-  if (!fs.isOpened()) throw CameraError(path.string() + ": cannot write here");
+  // Encoded in memory (FileStorage's YAML, as a file would be), then written atomically.
+  cv::FileStorage fs(".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
   fs << "image_width" << camera.width;
   fs << "image_height" << camera.height;
   fs << "camera_matrix" << cv::Mat(camera.K());
   fs << "distortion_coefficients" << camera.DistCoeffs();
-  fs.release();
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw CameraError(path.string() + ": cannot write here (" + ec.message() + ")");
-  }
+  WriteFileAtomically(path, fs.releaseAndGetString());
 }
 
 }  // namespace arview::calib

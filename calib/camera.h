@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "base/error.h"
+
 #include <array>
 #include <filesystem>
 #include <stdexcept>
@@ -13,8 +15,8 @@
 namespace arview::calib {
 
 // A camera file or camera value that cannot be used; the message names the file and field.
-struct CameraError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct CameraError : Error {
+  using Error::Error;
 };
 
 // Applies OpenCV's radial-tangential distortion to normalised image coordinates (x, y).

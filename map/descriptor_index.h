@@ -13,10 +13,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "base/error.h"
+
 namespace arview::map {
 
-struct DescriptorIndexError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct DescriptorIndexError : Error {
+  using Error::Error;
 };
 
 enum class IndexKind {

@@ -15,10 +15,12 @@
 #include "calib/camera.h"
 #include "calib/pose.h"
 
+#include "base/error.h"
+
 namespace arview::map {
 
-struct MapError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct MapError : Error {
+  using Error::Error;
 };
 
 struct MapPoint {

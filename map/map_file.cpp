@@ -1,5 +1,8 @@
 #include "map/map_file.h"
 
+#include "base/atomic_file.h"
+#include "base/stats.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -266,17 +269,9 @@ void SaveMap(const Map& map, const fs::path& file) {
   header.Put<std::uint64_t>(body.size());
   header.Put<std::uint64_t>(Checksum(body.data(), body.size()));
 
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw MapError(file.string() + ": cannot write here (directory missing or not writable)");
-    out.write(header.buffer().data(), static_cast<std::streamsize>(header.buffer().size()));
-    out.write(body.data(), static_cast<std::streamsize>(body.size()));
-    if (!out.flush()) throw MapError(file.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) throw MapError(file.string() + ": cannot move the written map into place: " + ec.message());
+  std::string bytes(header.buffer().begin(), header.buffer().end());
+  bytes.append(body.data(), body.size());
+  WriteFileAtomically(file, bytes);
 }
 
 Map LoadMap(const fs::path& path) {
@@ -337,14 +332,8 @@ MapStats ComputeStats(const Map& map) {
     s.mean_track_length = tracks / static_cast<double>(map.points.size());
     s.mean_colmap_point_error = colmap_error / static_cast<double>(map.points.size());
   }
-  if (!errors.empty()) {
-    double sum = 0;
-    for (double e : errors) sum += e;
-    s.mean_reprojection_error = sum / static_cast<double>(errors.size());
-    auto mid = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
-    std::nth_element(errors.begin(), mid, errors.end());
-    s.median_reprojection_error = *mid;
-  }
+  s.mean_reprojection_error = Mean(errors);
+  s.median_reprojection_error = Median(errors);
   return s;
 }
 

@@ -1,5 +1,7 @@
 #include "mapping/colmap_pipeline.h"
 
+#include "base/image_file.h"
+
 #include <sqlite3.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -20,19 +22,7 @@ namespace arview::mapping {
 namespace fs = std::filesystem;
 
 MatcherKind ParseMatcherKind(const std::string& text) {
-  if (text == "auto") return MatcherKind::kAuto;
-  if (text == "sequential") return MatcherKind::kSequential;
-  if (text == "exhaustive") return MatcherKind::kExhaustive;
-  throw map::MapError("--matcher must be auto, sequential or exhaustive (got '" + text + "')");
-}
-
-std::string ToString(MatcherKind kind) {
-  switch (kind) {
-    case MatcherKind::kAuto: return "auto";
-    case MatcherKind::kSequential: return "sequential";
-    case MatcherKind::kExhaustive: return "exhaustive";
-  }
-  return "?";
+  return ParseEnum<MatcherKind, map::MapError>(text, "--matcher");
 }
 
 namespace {
@@ -198,7 +188,7 @@ ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& ou
       if (i != (*selected)[next]) continue;
       options.cancel.ThrowIfCancelled("stopped writing the selected frames; nothing of this stage kept");
       const fs::path png = set.root / FrameName(i);
-      if (!cv::imwrite(png.string(), frame)) throw map::MapError(png.string() + ": cannot write");
+      WriteImageAtomically(png, frame);
       ++next;
     }
     std::ofstream out(list);

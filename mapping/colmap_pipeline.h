@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "base/cancellation.h"
+#include "base/enum_table.h"
 #include "map/map.h"
 #include "mapping/frame_selection.h"
 #include "recordings/recording.h"
@@ -22,8 +23,12 @@
 namespace arview::mapping {
 
 enum class MatcherKind { kAuto, kSequential, kExhaustive };
-MatcherKind ParseMatcherKind(const std::string& text);  // throws MapError
-std::string ToString(MatcherKind kind);
+constexpr auto EnumNames(MatcherKind) {
+  return EnumTable<MatcherKind, 3>{{{MatcherKind::kAuto, "auto"},
+                                    {MatcherKind::kSequential, "sequential"},
+                                    {MatcherKind::kExhaustive, "exhaustive"}}};
+}
+MatcherKind ParseMatcherKind(const std::string& text);  // throws MapError; back: arview::ToString
 
 struct MapBuildOptions {
   std::string frames_spec;  // recordings::ParseFrameSpec syntax; empty: every frame

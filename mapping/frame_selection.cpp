@@ -1,5 +1,7 @@
 #include "mapping/frame_selection.h"
 
+#include "base/stats.h"
+
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -32,13 +34,6 @@ FrameQuality MeasureFrame(const cv::Mat& image) {
 }
 
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 double MeanAbsDifference(const cv::Mat& a, const cv::Mat& b) {
   cv::Mat diff;

@@ -1,5 +1,9 @@
 // map.png: the map seen from "above", i.e. along the normal of the plane the cameras move in.
 
+#include "base/image_file.h"
+
+#include "base/stats.h"
+
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -38,13 +42,6 @@ Eigen::Matrix3d ViewAxes(const map::Map& map) {
   axes.row(1) = b.transpose();
   axes.row(2) = normal.transpose();
   return axes;
-}
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  auto it = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), it, v.end());
-  return *it;
 }
 
 }  // namespace
@@ -93,13 +90,7 @@ void WriteTopView(const map::Map& map, const std::filesystem::path& png, int siz
   const std::string caption = std::to_string(map.keyframes.size()) + " keyframes, " +
                               std::to_string(map.points.size()) + " points (top view; green: first keyframe)";
   cv::putText(image, caption, cv::Point(10, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(png.string(), image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw map::MapError(png.string() + ": cannot write the top view");
+  WriteImageAtomically(png, image);
 }
 
 }  // namespace arview::mapping

@@ -7,79 +7,24 @@
 #include <set>
 #include <sstream>
 
-#include <Eigen/SVD>
+#include <nlohmann/json.hpp>
 
 namespace arview::recordings {
 
-calib::Pose Sim3::Apply(const calib::Pose& pose) const {
-  const Eigen::Quaterniond q_wc(R * pose.CameraToWorldRotation().toRotationMatrix());
-  return calib::Pose::FromCameraToWorld(q_wc, (*this)(pose.Center()));
+calib::Pose Transform(const Sim3& transform, const calib::Pose& pose) {
+  return calib::Pose::FromRigid(transform.TransformPose(pose.ToRigid()));
 }
 
-Sim3 Sim3::Inverse() const {
-  Sim3 inv;
-  inv.scale = 1.0 / scale;
-  inv.R = R.transpose();
-  inv.t = -(inv.scale * (inv.R * t));
-  return inv;
-}
-
-Eigen::Matrix4d Sim3::Matrix() const {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.topLeftCorner<3, 3>() = scale * R;
-  m.topRightCorner<3, 1>() = t;
-  return m;
-}
-
-AlignMode ParseAlignMode(const std::string& text) {
-  if (text == "none") return AlignMode::kNone;
-  if (text == "se3") return AlignMode::kSE3;
-  if (text == "sim3") return AlignMode::kSim3;
-  throw RecordingError("alignment '" + text + "' is not one of none, se3, sim3");
-}
-
-std::string ToString(AlignMode mode) {
-  switch (mode) {
-    case AlignMode::kNone: return "none";
-    case AlignMode::kSE3: return "se3";
-    case AlignMode::kSim3: return "sim3";
-  }
-  return "?";
-}
+AlignMode ParseAlignMode(const std::string& text) { return ParseEnum<AlignMode, RecordingError>(text, "alignment"); }
 
 Sim3 Umeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, bool with_scale) {
-  if (src.size() != dst.size()) throw RecordingError("alignment: point lists differ in length");
-  const size_t n = src.size();
-  if (n < 3) throw RecordingError("alignment: needs at least 3 corresponding positions, has " + std::to_string(n));
-  Eigen::Vector3d mu_s = Eigen::Vector3d::Zero(), mu_d = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < n; ++i) {
-    mu_s += src[i];
-    mu_d += dst[i];
+  try {
+    return EstimateSim3(src, dst, with_scale, "alignment");
+  } catch (const RecordingError&) {
+    throw;
+  } catch (const Error& e) {
+    throw RecordingError(e.what());
   }
-  mu_s /= static_cast<double>(n);
-  mu_d /= static_cast<double>(n);
-  Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
-  double var_s = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d s = src[i] - mu_s;
-    sigma += (dst[i] - mu_d) * s.transpose();
-    var_s += s.squaredNorm();
-  }
-  sigma /= static_cast<double>(n);
-  var_s /= static_cast<double>(n);
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(sigma, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d d = svd.singularValues();
-  // A rotation is determined only when the points span at least a plane in both sets.
-  if (!(var_s > 0) || !(d(1) > 1e-12 * std::max(d(0), 1e-300))) {
-    throw RecordingError("alignment: the positions are degenerate (all on one line or one point); cannot fit a rotation");
-  }
-  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) S(2, 2) = -1;
-  Sim3 out;
-  out.R = svd.matrixU() * S * svd.matrixV().transpose();
-  out.scale = with_scale ? (d.asDiagonal() * S).trace() / var_s : 1.0;
-  out.t = mu_d - out.scale * (out.R * mu_s);
-  return out;
 }
 
 std::vector<std::pair<size_t, size_t>> AssociateByTimestamp(const Trajectory& a, const Trajectory& b, double max_dt) {
@@ -143,28 +88,8 @@ Sim3 FitAlignment(const Trajectory& from, const Trajectory& to, AlignMode mode, 
 Trajectory TransformTrajectory(const Trajectory& trajectory, const Sim3& transform) {
   Trajectory out;
   out.reserve(trajectory.size());
-  for (const StampedPose& p : trajectory) out.push_back({p.timestamp, transform.Apply(p.pose)});
+  for (const StampedPose& p : trajectory) out.push_back({p.timestamp, Transform(transform, p.pose)});
   return out;
-}
-
-ErrorStats ComputeStats(const std::vector<double>& values) {
-  ErrorStats s;
-  s.count = static_cast<int>(values.size());
-  if (values.empty()) return s;
-  double sum = 0, sum2 = 0;
-  for (double v : values) {
-    sum += v;
-    sum2 += v * v;
-    s.max = std::max(s.max, v);
-  }
-  const double n = static_cast<double>(values.size());
-  s.mean = sum / n;
-  s.rmse = std::sqrt(sum2 / n);
-  std::vector<double> sorted = values;
-  std::sort(sorted.begin(), sorted.end());
-  const size_t mid = sorted.size() / 2;
-  s.median = sorted.size() % 2 ? sorted[mid] : 0.5 * (sorted[mid - 1] + sorted[mid]);
-  return s;
 }
 
 double RotationErrorDeg(const calib::Pose& a, const calib::Pose& b) {
@@ -216,8 +141,8 @@ AccuracyReport EvaluateTrajectory(const Trajectory& estimate, const Trajectory& 
     r.position_errors.push_back((e.Center() - g.Center()).norm());
     r.rotation_errors_deg.push_back(RotationErrorDeg(e, g));
   }
-  r.ate = ComputeStats(r.position_errors);
-  r.rotation_deg = ComputeStats(r.rotation_errors_deg);
+  r.ate = Summarize(r.position_errors);
+  r.rotation_deg = Summarize(r.rotation_errors_deg);
   std::vector<double> rpe_t, rpe_r;
   const size_t delta = static_cast<size_t>(options.rpe_delta);
   for (size_t k = 0; k + delta < r.pairs.size(); ++k) {
@@ -229,48 +154,40 @@ AccuracyReport EvaluateTrajectory(const Trajectory& estimate, const Trajectory& 
     rpe_t.push_back((m_gt.q.conjugate() * (m_est.t - m_gt.t)).norm());
     rpe_r.push_back(m_gt.q.angularDistance(m_est.q) * 180.0 / M_PI);
   }
-  r.rpe_translation = ComputeStats(rpe_t);
-  r.rpe_rotation_deg = ComputeStats(rpe_r);
+  r.rpe_translation = Summarize(rpe_t);
+  r.rpe_rotation_deg = Summarize(rpe_r);
   return r;
 }
 
 namespace {
 
-std::string Num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.9g", v);
-  return buf;
-}
-
-std::string StatsJson(const ErrorStats& s) {
-  return "{\"rmse\": " + Num(s.rmse) + ", \"mean\": " + Num(s.mean) + ", \"median\": " + Num(s.median) +
-         ", \"max\": " + Num(s.max) + ", \"count\": " + std::to_string(s.count) + "}";
+nlohmann::ordered_json StatsJson(const ErrorStats& s) {
+  return {{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"max", s.max}, {"count", s.count}};
 }
 
 }  // namespace
 
 std::string ReportToJson(const AccuracyReport& r) {
-  std::ostringstream o;
-  o << "{\n";
-  o << "  \"align\": \"" << ToString(r.align) << "\",\n";
-  o << "  \"aligned_with_other_trajectory\": " << (r.aligned_with_other ? "true" : "false") << ",\n";
-  o << "  \"alignment_pairs\": " << r.alignment_pairs << ",\n";
-  o << "  \"alignment\": {\"scale\": " << Num(r.alignment.scale) << ", \"R\": [";
-  for (int i = 0; i < 9; ++i) o << (i ? ", " : "") << Num(r.alignment.R(i / 3, i % 3));
-  o << "], \"t\": [" << Num(r.alignment.t.x()) << ", " << Num(r.alignment.t.y()) << ", " << Num(r.alignment.t.z())
-    << "]},\n";
-  o << "  \"estimate_poses\": " << r.estimate_poses << ",\n";
-  o << "  \"groundtruth_poses\": " << r.groundtruth_poses << ",\n";
-  o << "  \"associated\": " << r.associated << ",\n";
-  o << "  \"coverage\": " << Num(r.coverage) << ",\n";
-  o << "  \"ate\": " << StatsJson(r.ate) << ",\n";
-  o << "  \"rotation_deg\": " << StatsJson(r.rotation_deg) << ",\n";
-  o << "  \"rpe_delta\": " << r.rpe_delta << ",\n";
-  o << "  \"rpe_translation\": " << StatsJson(r.rpe_translation) << ",\n";
-  o << "  \"rpe_rotation_deg\": " << StatsJson(r.rpe_rotation_deg) << "\n";
-  o << "}\n";
-  return o.str();
+  // Keys in the order people read them (ordered_json keeps insertion order).
+  nlohmann::ordered_json j;
+  j["align"] = ToString(r.align);
+  j["aligned_with_other_trajectory"] = r.aligned_with_other;
+  j["alignment_pairs"] = r.alignment_pairs;
+  std::vector<double> rotation;
+  for (int i = 0; i < 9; ++i) rotation.push_back(r.alignment.R(i / 3, i % 3));
+  j["alignment"] = {{"scale", r.alignment.scale},
+                    {"R", rotation},
+                    {"t", {r.alignment.t.x(), r.alignment.t.y(), r.alignment.t.z()}}};
+  j["estimate_poses"] = r.estimate_poses;
+  j["groundtruth_poses"] = r.groundtruth_poses;
+  j["associated"] = r.associated;
+  j["coverage"] = r.coverage;
+  j["ate"] = StatsJson(r.ate);
+  j["rotation_deg"] = StatsJson(r.rotation_deg);
+  j["rpe_delta"] = r.rpe_delta;
+  j["rpe_translation"] = StatsJson(r.rpe_translation);
+  j["rpe_rotation_deg"] = StatsJson(r.rpe_rotation_deg);
+  return j.dump(2) + "\n";
 }
 
 std::string ReportToText(const AccuracyReport& r) {

@@ -21,30 +21,28 @@
 
 #include <Eigen/Core>
 
+#include "base/enum_table.h"
+#include "base/geometry.h"
+#include "base/stats.h"
 #include "recordings/trajectory.h"
 
 namespace arview::recordings {
 
-// x ↦ scale · R · x + t. Maps positions of one trajectory's world into another's.
-struct Sim3 {
-  double scale = 1;
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-
-  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const { return scale * (R * x) + t; }
-  // The same camera expressed in the target world: centre mapped, orientation rotated by R.
-  calib::Pose Apply(const calib::Pose& pose) const;
-  Sim3 Inverse() const;
-  Eigen::Matrix4d Matrix() const;
-};
+// x ↦ scale · R · x + t, maps positions of one trajectory's world into another's: base/'s.
+using Sim3 = arview::Sim3;
+// The same camera expressed in the target world: centre mapped, orientation rotated by R.
+calib::Pose Transform(const Sim3& transform, const calib::Pose& pose);
 
 enum class AlignMode { kNone, kSE3, kSim3 };
-// "none" | "se3" | "sim3" (RecordingError otherwise) and back.
+constexpr auto EnumNames(AlignMode) {
+  return EnumTable<AlignMode, 3>{{{AlignMode::kNone, "none"}, {AlignMode::kSE3, "se3"}, {AlignMode::kSim3, "sim3"}}};
+}
+// "none" | "se3" | "sim3"; RecordingError otherwise. (Back: arview::ToString.)
 AlignMode ParseAlignMode(const std::string& text);
-std::string ToString(AlignMode mode);
 
-// Least-squares similarity (with_scale) or rigid motion mapping src[i] onto dst[i] (Umeyama
-// 1991). Needs at least 3 points not all on one line.
+// Least-squares similarity (with_scale) or rigid motion mapping src[i] onto dst[i]
+// (arview::EstimateSim3, i.e. Eigen::umeyama). Needs at least 3 points not all on one line;
+// throws RecordingError otherwise.
 Sim3 Umeyama(const std::vector<Eigen::Vector3d>& src, const std::vector<Eigen::Vector3d>& dst, bool with_scale);
 
 // Pairs (index into a, index into b) whose timestamps differ by at most max_dt seconds; each
@@ -59,11 +57,8 @@ Sim3 FitAlignment(const Trajectory& from, const Trajectory& to, AlignMode mode, 
 
 Trajectory TransformTrajectory(const Trajectory& trajectory, const Sim3& transform);
 
-struct ErrorStats {
-  double rmse = 0, mean = 0, median = 0, max = 0;
-  int count = 0;
-};
-ErrorStats ComputeStats(const std::vector<double>& values);  // all zero when empty
+// rmse, mean, median, max, count (and percentiles) by base/stats.h's one definition.
+using ErrorStats = arview::Summary;
 
 struct AccuracyOptions {
   AlignMode align = AlignMode::kSim3;
@@ -106,7 +101,8 @@ std::string ReportToText(const AccuracyReport& report);
 
 // A PNG with a top view and a side view (the ground-truth path's principal plane and a plane
 // across it) of the ground truth (grey) and the aligned estimate, each estimate position
-// coloured by its error (colour bar in the image). Throws RecordingError if it cannot write.
+// coloured by its error (colour bar in the image). Throws arview::Error naming the file if it
+// cannot write it.
 void PlotTrajectories(const AccuracyReport& report, const Trajectory& groundtruth,
                       const std::filesystem::path& png, int width = 1200, int height = 600);
 

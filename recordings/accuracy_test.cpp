@@ -74,7 +74,7 @@ TEST(Sim3, InverseAndApplyAgree) {
   std::mt19937 rng(3);
   const Sim3 s = RandomSim3(rng, 0.3);
   const calib::Pose p = Orbit(10)[3].pose;
-  const calib::Pose back = s.Inverse().Apply(s.Apply(p));
+  const calib::Pose back = Transform(s.Inverse(), Transform(s, p));
   EXPECT_LT((back.Center() - p.Center()).norm(), 1e-12);
   EXPECT_LT(RotationErrorDeg(back, p), 1e-6);
   EXPECT_LT((s.Matrix() * s.Inverse().Matrix() - Eigen::Matrix4d::Identity()).norm(), 1e-12);
@@ -119,11 +119,11 @@ TEST(EvaluateTrajectory, AlignWithFitsOnTheOtherTrajectoryOnly) {
   Trajectory keyframes, queries;
   for (size_t i = 0; i < gt.size(); ++i) {
     if (i % 2 == 0) {
-      keyframes.push_back({gt[i].timestamp, moved.Apply(gt[i].pose)});
+      keyframes.push_back({gt[i].timestamp, Transform(moved, gt[i].pose)});
     } else {
       calib::Pose p = gt[i].pose;
       p = calib::Pose::FromCameraToWorld(p.CameraToWorldRotation(), p.Center() + Eigen::Vector3d(0.1, 0, 0));
-      queries.push_back({gt[i].timestamp, moved.Apply(p)});
+      queries.push_back({gt[i].timestamp, Transform(moved, p)});
     }
   }
   AccuracyOptions opt;
@@ -169,13 +169,13 @@ TEST(EvaluateTrajectory, RelativePoseErrorSeesOneDisplacedPose) {
   AccuracyOptions opt;
   opt.align = AlignMode::kNone;
   const AccuracyReport r = EvaluateTrajectory(est, gt, opt);
-  EXPECT_EQ(r.rpe_translation.count, 29);
+  EXPECT_EQ(r.rpe_translation.count, 29u);
   EXPECT_NEAR(r.rpe_translation.max, 0.05, 1e-12);
   EXPECT_NEAR(r.rpe_translation.median, 0.0, 1e-12);
   EXPECT_NEAR(r.ate.max, 0.05, 1e-12);
   EXPECT_NEAR(r.ate.rmse, 0.05 / std::sqrt(30.0), 1e-12);
   opt.rpe_delta = 5;
-  EXPECT_EQ(EvaluateTrajectory(est, gt, opt).rpe_translation.count, 25);
+  EXPECT_EQ(EvaluateTrajectory(est, gt, opt).rpe_translation.count, 25u);
 }
 
 TEST(EvaluateTrajectory, ReportsWhatItCannotJudge) {
@@ -230,7 +230,7 @@ TEST(PlotTrajectories, DrawsBothViewsWithErrorColours) {
     EXPECT_GT(red, 20);
     EXPECT_GT(blue, 20);
   }
-  EXPECT_THROW(PlotTrajectories(r, gt, "/nonexistent-folder/plot.png"), RecordingError);
+  EXPECT_THROW(PlotTrajectories(r, gt, "/nonexistent-folder/plot.png"), arview::Error);
 }
 
 TEST(Tum, WriteThenReadRoundTrips) {

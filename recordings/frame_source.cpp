@@ -1,5 +1,7 @@
 #include "recordings/frame_source.h"
 
+#include "base/stats.h"
+
 #include <algorithm>
 #include <numeric>
 #include <thread>
@@ -33,11 +35,7 @@ RecordingSource::RecordingSource(Recording recording, ReplayOptions options)
   for (size_t k = 1; k < order_.size(); ++k) {
     gaps.push_back(std::abs(recording_.frames[order_[k]].timestamp - recording_.frames[order_[k - 1]].timestamp));
   }
-  double median_gap = 1.0;
-  if (!gaps.empty()) {
-    std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-    median_gap = gaps[gaps.size() / 2];
-  }
+  const double median_gap = gaps.empty() ? 1.0 : Median(gaps);
   pass_length_ = recording_.frames[order_.back()].timestamp - recording_.frames[order_.front()].timestamp + median_gap;
   if (recording_.IsVideo()) {
     const std::string file = recording_.FramePath(0).string();

@@ -1,5 +1,7 @@
 #include "recordings/importers.h"
 
+#include "base/image_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -60,8 +62,8 @@ void StoreFrame(const fs::path& source, const cv::Mat& decoded, const fs::path& 
     std::error_code ec;
     fs::copy_file(source, dest, fs::copy_options::overwrite_existing, ec);
     if (ec) throw RecordingError(dest.string() + ": cannot copy " + source.string() + " (" + ec.message() + ")");
-  } else if (!cv::imwrite(dest.string(), decoded)) {
-    throw RecordingError(dest.string() + ": cannot write");
+  } else {
+    WriteImageAtomically(dest, decoded);
   }
   frames->push_back({timestamp, rel});
 }

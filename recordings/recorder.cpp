@@ -1,5 +1,7 @@
 #include "recordings/recorder.h"
 
+#include "base/image_file.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -74,17 +76,7 @@ void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.png", count_);
   const std::string rel = std::string("frames/") + name;
-  const fs::path tmp = root_ / "frames" / (std::string(".") + name);  // still a .png for imwrite
-  bool ok = false;
-  try {
-    ok = cv::imwrite(tmp.string(), image, {cv::IMWRITE_PNG_COMPRESSION, 1});  // speed over size
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw RecordingError((root_ / rel).string() + ": cannot write the frame");
-  std::error_code ec;
-  fs::rename(tmp, root_ / rel, ec);
-  if (ec) throw RecordingError((root_ / rel).string() + ": cannot write the frame (" + ec.message() + ")");
+  WriteImageAtomically(root_ / rel, image, {cv::IMWRITE_PNG_COMPRESSION, 1});  // speed over size
   char line[96];
   std::snprintf(line, sizeof(line), "%.9f %s\n", timestamp, rel.c_str());
   WriteAll(fd_, line, list);

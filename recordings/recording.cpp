@@ -1,5 +1,7 @@
 #include "recordings/recording.h"
 
+#include "base/atomic_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -127,22 +129,14 @@ void PrepareRecordingFolder(const fs::path& out_dir, bool overwrite) {
 
 void WriteFramesTxt(const fs::path& root, const std::vector<FrameEntry>& frames) {
   const fs::path file = root / "frames.txt";
-  const fs::path tmp = root / "frames.txt.tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw RecordingError(file.string() + ": cannot write");
+  WriteFileAtomically(file, [&](std::ostream& out) {
     out << "# timestamp path\n";
     char buf[64];
     for (const FrameEntry& f : frames) {
       std::snprintf(buf, sizeof(buf), "%.9f", f.timestamp);
       out << buf << ' ' << f.path << '\n';
     }
-    out.flush();
-    if (!out) throw RecordingError(file.string() + ": write failed");
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) throw RecordingError(file.string() + ": cannot write (" + ec.message() + ")");
+  });
 }
 
 namespace {

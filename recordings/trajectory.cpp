@@ -1,5 +1,7 @@
 #include "recordings/trajectory.h"
 
+#include "base/atomic_file.h"
+
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -42,10 +44,7 @@ Trajectory ReadTum(const std::filesystem::path& path) {
 
 void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
               const std::string& header_comment) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw RecordingError(path.string() + ": cannot write trajectory file here");
+  WriteFileAtomically(path, [&](std::ostream& out) {
     if (!header_comment.empty()) out << "# " << header_comment << "\n";
     out << "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
     out << std::setprecision(17);
@@ -56,11 +55,7 @@ void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
           << ' ' << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z()
           << ' ' << q.w() << '\n';
     }
-    if (!out) throw RecordingError(path.string() + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw RecordingError(path.string() + ": cannot write trajectory file (" + ec.message() + ")");
+  });
 }
 
 }  // namespace arview::recordings

@@ -6,12 +6,13 @@
 #include <string>
 #include <vector>
 
+#include "base/error.h"
 #include "calib/pose.h"
 
 namespace arview::recordings {
 
-struct RecordingError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct RecordingError : Error {
+  using Error::Error;
 };
 
 struct StampedPose {

@@ -1,5 +1,9 @@
 // PlotTrajectories (accuracy.h): two orthographic views drawn with OpenCV.
 
+#include "base/image_file.h"
+
+#include "base/stats.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -98,9 +102,7 @@ void PlotTrajectories(const AccuracyReport& report, const Trajectory& groundtrut
   for (size_t k = 1; k < gt_points.size(); ++k) steps.push_back((gt_points[k] - gt_points[k - 1]).norm());
   std::vector<bool> joined(gt_points.size(), false);
   if (!steps.empty()) {
-    std::vector<double> sorted = steps;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double limit = 3 * sorted[sorted.size() / 2];
+    const double limit = 3 * Median(steps);
     for (size_t k = 1; k < gt_points.size(); ++k) joined[k] = steps[k - 1] <= limit;
   }
 
@@ -151,13 +153,7 @@ void PlotTrajectories(const AccuracyReport& report, const Trajectory& groundtrut
   cv::putText(image, "estimate position error (grey: ground truth)", {bar_x + bar_w + 12, bar_y + bar_h - 2},
               cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1, cv::LINE_AA);
 
-  bool ok = false;
-  try {
-    ok = cv::imwrite(png.string(), image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) throw RecordingError(png.string() + ": cannot write the plot (folder missing, or not a .png name?)");
+  WriteImageAtomically(png, image);
 }
 
 }  // namespace arview::recordings

@@ -41,7 +41,7 @@ void SetThreadsOnce(GlBackend backend, int threads) {
   }
   if (auto it = fixed.find(backend); it != fixed.end()) {
     if (it->second != threads) {
-      throw RenderError(GlBackendName(backend) + ": llvmpipe already runs with " +
+      throw RenderError(ToString(backend) + ": llvmpipe already runs with " +
                         std::to_string(it->second) + " threads in this process; cannot switch to " +
                         std::to_string(threads));
     }
@@ -171,21 +171,7 @@ std::unique_ptr<OffscreenContext> CreateOne(GlBackend backend, int threads) {
 
 }  // namespace
 
-GlBackend ParseGlBackend(const std::string& name) {
-  if (name == "auto") return GlBackend::kAuto;
-  if (name == "osmesa") return GlBackend::kOsMesa;
-  if (name == "egl") return GlBackend::kEgl;
-  throw RenderError("unknown GL backend '" + name + "' (expected auto, osmesa or egl)");
-}
-
-std::string GlBackendName(GlBackend backend) {
-  switch (backend) {
-    case GlBackend::kAuto: return "auto";
-    case GlBackend::kOsMesa: return "osmesa";
-    case GlBackend::kEgl: return "egl";
-  }
-  return "?";
-}
+GlBackend ParseGlBackend(const std::string& name) { return ParseEnum<GlBackend, RenderError>(name, "GL backend"); }
 
 std::unique_ptr<OffscreenContext> OffscreenContext::Create(const OffscreenOptions& options) {
   if (options.backend != GlBackend::kAuto) {
@@ -200,21 +186,21 @@ std::unique_ptr<OffscreenContext> OffscreenContext::Create(const OffscreenOption
     try {
       return CreateOne(backend, options.threads);
     } catch (const RenderError& e) {
-      failures += (failures.empty() ? "" : "; ") + GlBackendName(backend) + ": " + e.what();
+      failures += (failures.empty() ? "" : "; ") + ToString(backend) + ": " + e.what();
     }
   }
   throw RenderError("no OpenGL 4.5 offscreen context (" + failures +
                     "); install Mesa's libosmesa6 or libegl-mesa0");
 }
 
-void OffscreenContext::LoadApi(const GlProcLoader& loader) { gl_ = LoadGlApi(loader, GlBackendName(backend_)); }
+void OffscreenContext::LoadApi(const GlProcLoader& loader) { gl_ = LoadGlApi(loader, ToString(backend_)); }
 
 std::string OffscreenContext::Description() const {
   auto text = [this](GLenum name) {
     const GLubyte* s = gl_.GetString(name);
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
   };
-  return GlBackendName(backend_) + ": " + text(GL_RENDERER) + ", OpenGL " + text(GL_VERSION) + ", " +
+  return ToString(backend_) + ": " + text(GL_RENDERER) + ", OpenGL " + text(GL_VERSION) + ", " +
          std::to_string(threads_) + " llvmpipe threads";
 }
 

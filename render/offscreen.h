@@ -11,20 +11,24 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/enum_table.h"
+#include "base/error.h"
 #include "render/gl_api.h"
 
 namespace arview::render {
 
 // Anything in render/ that cannot be done: no GL, a shader that does not compile, bad input.
-struct RenderError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct RenderError : Error {
+  using Error::Error;
 };
 
 enum class GlBackend { kAuto, kOsMesa, kEgl };
+constexpr auto EnumNames(GlBackend) {
+  return EnumTable<GlBackend, 3>{{{GlBackend::kAuto, "auto"}, {GlBackend::kOsMesa, "osmesa"}, {GlBackend::kEgl, "egl"}}};
+}
 
-// "auto" | "osmesa" | "egl"; throws RenderError naming the value otherwise.
+// "auto" | "osmesa" | "egl"; throws RenderError naming the value otherwise. (Back: arview::ToString.)
 GlBackend ParseGlBackend(const std::string& name);
-std::string GlBackendName(GlBackend backend);
 
 struct OffscreenOptions {
   GlBackend backend = GlBackend::kAuto;  // auto: OSMesa, then EGL if OSMesa is unavailable

@@ -27,7 +27,7 @@ void ExpectClearReadsBack(GlBackend backend) {
   try {
     context = OffscreenContext::Create({backend, 2});
   } catch (const RenderError& e) {
-    GTEST_SKIP() << GlBackendName(backend) << " unavailable here: " << e.what();
+    GTEST_SKIP() << ToString(backend) << " unavailable here: " << e.what();
   }
   EXPECT_EQ(context->backend(), backend);
   const GlApi& gl = context->gl();

@@ -1,5 +1,7 @@
 #include "render/sinks.h"
 
+#include "base/image_file.h"
+
 #include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -117,9 +119,7 @@ class PngSequenceSink final : public FrameSink {
     char name[32];
     std::snprintf(name, sizeof name, "%06d.png", index_++);
     const fs::path file = folder_ / name;
-    if (!cv::imwrite(file.string(), bgr, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-      throw RenderError(file.string() + ": cannot write the frame");
-    }
+    WriteImageAtomically(file, bgr, {cv::IMWRITE_PNG_COMPRESSION, 1});
   }
   void Close() override {}
   std::string Describe() const override { return folder_.string() + "/NNNNNN.png"; }

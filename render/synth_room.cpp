@@ -1,5 +1,7 @@
 #include "render/synth_room.h"
 
+#include "base/image_file.h"
+
 #include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -353,7 +355,12 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
     finish_write();
     pending_name = name;
     pending_write = std::async(std::launch::async, [file = (o.out / name).string(), image] {
-      return cv::imwrite(file, image, {cv::IMWRITE_PNG_COMPRESSION, 1});
+      try {
+        WriteImageAtomically(file, image, {cv::IMWRITE_PNG_COMPRESSION, 1});
+        return true;
+      } catch (const Error&) {
+        return false;
+      }
     });
     entries.push_back({t, name});
     groundtruth.push_back({t, path.At(t)});

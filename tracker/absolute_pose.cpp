@@ -57,19 +57,6 @@ std::vector<T> Gather(const std::vector<T>& values, const std::vector<int>& subs
 
 }  // namespace
 
-const char* PoseFailureName(PoseFailure failure) {
-  switch (failure) {
-    case PoseFailure::kNone: return "none";
-    case PoseFailure::kTooFewCorrespondences: return "too_few_correspondences";
-    case PoseFailure::kRansacFailed: return "ransac_failed";
-    case PoseFailure::kTooFewInliers: return "too_few_inliers";
-    case PoseFailure::kDegenerate: return "degenerate";
-    case PoseFailure::kRefinementFailed: return "refinement_failed";
-    case PoseFailure::kRmsTooHigh: return "rms_too_high";
-  }
-  return "?";
-}
-
 double CollinearityRatio(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& subset) {
   if (subset.size() < 2) return 0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -87,7 +74,7 @@ AbsolutePoseResult EstimateAbsolutePose(const calib::Camera& camera,
                                         const std::vector<Eigen::Vector3d>& points,
                                         const AbsolutePoseOptions& options) {
   if (pixels.size() != points.size())
-    throw std::invalid_argument("EstimateAbsolutePose: pixels and points differ in count");
+    throw Error("EstimateAbsolutePose: pixels and points differ in count");
   AbsolutePoseResult result;
   result.stats.correspondences = static_cast<int>(pixels.size());
   const int needed = std::max(options.min_inliers, MinimalSampleSize(options.solver));

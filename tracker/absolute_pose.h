@@ -48,7 +48,15 @@ enum class PoseFailure {
   kRefinementFailed,
   kRmsTooHigh,
 };
-const char* PoseFailureName(PoseFailure failure);
+constexpr auto EnumNames(PoseFailure) {
+  return EnumTable<PoseFailure, 7>{{{PoseFailure::kNone, "none"},
+                                    {PoseFailure::kTooFewCorrespondences, "too_few_correspondences"},
+                                    {PoseFailure::kRansacFailed, "ransac_failed"},
+                                    {PoseFailure::kTooFewInliers, "too_few_inliers"},
+                                    {PoseFailure::kDegenerate, "degenerate"},
+                                    {PoseFailure::kRefinementFailed, "refinement_failed"},
+                                    {PoseFailure::kRmsTooHigh, "rms_too_high"}}};
+}
 
 struct AbsolutePoseStats {
   int correspondences = 0;

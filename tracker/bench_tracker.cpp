@@ -25,6 +25,7 @@
 #include "map/map_file.h"
 #include "recordings/accuracy.h"
 #include "recordings/recording.h"
+#include "base/stats.h"
 #include "tracker/test_planar_scene.h"
 #include "tracker/test_scene.h"
 #include "tracker/tracker.h"
@@ -90,7 +91,7 @@ void BM_PoseSolver_OpenGV_Ceres(benchmark::State& state) {
   errors.Report(state);
   state.counters["ransac_ms"] = ransac_ms / state.iterations();
   state.counters["refine_ms"] = refine_ms / state.iterations();
-  state.SetLabel(MinimalSolverName(options.solver));
+  state.SetLabel(ToString(options.solver));
 }
 BENCHMARK(BM_PoseSolver_OpenGV_Ceres)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
@@ -334,9 +335,7 @@ struct RealErrors {
     if (truth) centre_mm.push_back(scale_to_mm * (pose.Center() - *truth).norm());
   }
   void Report(benchmark::State& state, size_t solves) const {
-    std::vector<double> sorted = centre_mm;
-    std::sort(sorted.begin(), sorted.end());
-    state.counters["median_centre_err_mm"] = sorted.empty() ? -1 : sorted[sorted.size() / 2];
+    state.counters["median_centre_err_mm"] = centre_mm.empty() ? -1 : Median(centre_mm);
     state.counters["failures"] = failures;
     state.counters["inliers"] = solves > static_cast<size_t>(failures) ? inliers / (solves - failures) : 0;
   }

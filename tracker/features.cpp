@@ -6,12 +6,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "base/error.h"
+
 namespace arview::tracker {
 
 cv::Mat ToColmapDescriptors(const cv::Mat& sift) {
   if (sift.empty()) return cv::Mat(0, 128, CV_8U);
   if (sift.type() != CV_32F || sift.cols != 128)
-    throw std::invalid_argument("ToColmapDescriptors: expected N x 128 CV_32F SIFT descriptors");
+    throw Error("ToColmapDescriptors: expected N x 128 CV_32F SIFT descriptors");
   cv::Mat out(sift.rows, 128, CV_8U);
   for (int r = 0; r < sift.rows; ++r) {
     const float* in = sift.ptr<float>(r);

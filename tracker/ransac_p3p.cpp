@@ -34,21 +34,7 @@ void Seed(Problem& problem, std::uint32_t seed) {
 
 }  // namespace
 
-MinimalSolver ParseMinimalSolver(const std::string& name) {
-  if (name == "kneip") return MinimalSolver::kKneip;
-  if (name == "gao") return MinimalSolver::kGao;
-  if (name == "epnp") return MinimalSolver::kEpnp;
-  throw std::invalid_argument("unknown minimal solver '" + name + "' (expected kneip, gao or epnp)");
-}
-
-const char* MinimalSolverName(MinimalSolver solver) {
-  switch (solver) {
-    case MinimalSolver::kKneip: return "kneip";
-    case MinimalSolver::kGao: return "gao";
-    case MinimalSolver::kEpnp: return "epnp";
-  }
-  return "?";
-}
+MinimalSolver ParseMinimalSolver(const std::string& name) { return ParseEnum<MinimalSolver>(name, "minimal solver"); }
 
 double PixelThresholdToOpenGV(double pixels, double focal_px) {
   return 1.0 - std::cos(std::atan(pixels / focal_px));
@@ -63,7 +49,7 @@ RansacResult RansacAbsolutePose(const std::vector<Eigen::Vector3d>& bearings,
                                 const std::vector<Eigen::Vector3d>& points,
                                 const RansacOptions& options) {
   if (bearings.size() != points.size())
-    throw std::invalid_argument("RansacAbsolutePose: bearings and points differ in count");
+    throw Error("RansacAbsolutePose: bearings and points differ in count");
   RansacResult result;
   if (static_cast<int>(bearings.size()) < MinimalSampleSize(options.solver)) return result;
 

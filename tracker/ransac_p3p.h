@@ -8,15 +8,20 @@
 #include <string>
 #include <vector>
 
+#include "base/enum_table.h"
 #include "calib/pose.h"
 
 namespace arview::tracker {
 
 enum class MinimalSolver { kKneip, kGao, kEpnp };
 
-// Parses "kneip" | "gao" | "epnp"; throws std::invalid_argument naming the value otherwise.
+constexpr auto EnumNames(MinimalSolver) {
+  return EnumTable<MinimalSolver, 3>{
+      {{MinimalSolver::kKneip, "kneip"}, {MinimalSolver::kGao, "gao"}, {MinimalSolver::kEpnp, "epnp"}}};
+}
+// Parses "kneip" | "gao" | "epnp"; throws arview::Error naming the value otherwise.
+// (Back: arview::ToString.)
 MinimalSolver ParseMinimalSolver(const std::string& name);
-const char* MinimalSolverName(MinimalSolver solver);
 
 struct RansacOptions {
   MinimalSolver solver = MinimalSolver::kKneip;

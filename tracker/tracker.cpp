@@ -15,15 +15,6 @@
 namespace arview::tracker {
 namespace {
 
-calib::Pose Compose(const calib::Pose& a, const calib::Pose& b) {  // x ↦ a(b(x))
-  return {(a.q_cw * b.q_cw).normalized(), a.q_cw * b.t_cw + a.t_cw};
-}
-
-calib::Pose Inverse(const calib::Pose& p) {
-  const Eigen::Quaterniond qi = p.q_cw.conjugate();
-  return {qi, -(qi * p.t_cw)};
-}
-
 int SquaredDistance(const std::uint8_t* a, const std::uint8_t* b) {
   int sum = 0;
   for (int i = 0; i < 128; ++i) {
@@ -42,21 +33,12 @@ void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
 
 }  // namespace
 
-const char* TrackStatusName(TrackStatus status) {
-  switch (status) {
-    case TrackStatus::kTracking: return "tracking";
-    case TrackStatus::kRelocalized: return "relocalized";
-    case TrackStatus::kLost: return "lost";
-  }
-  return "?";
-}
-
 calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity) {
-  return Compose(velocity, last);
+  return velocity * last;
 }
 
 calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last) {
-  return Compose(last, Inverse(previous));
+  return last * previous.Inverse();
 }
 
 Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size) {

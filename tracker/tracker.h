@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "base/enum_table.h"
+#include "base/error.h"
 #include "map/descriptor_index.h"
 #include "map/map.h"
 #include "tracker/one_euro.h"
@@ -20,12 +22,16 @@
 
 namespace arview::tracker {
 
-struct TrackerError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct TrackerError : Error {
+  using Error::Error;
 };
 
 enum class TrackStatus { kTracking, kRelocalized, kLost };
-const char* TrackStatusName(TrackStatus status);
+constexpr auto EnumNames(TrackStatus) {
+  return EnumTable<TrackStatus, 3>{{{TrackStatus::kTracking, "tracking"},
+                                    {TrackStatus::kRelocalized, "relocalized"},
+                                    {TrackStatus::kLost, "lost"}}};
+}
 
 struct TrackingOptions {
   int lk_window_px = 21;

@@ -20,8 +20,12 @@ inline std::filesystem::path SourceDir() {
 #endif
 }
 
-// ../shared/data/<relative> seen from the project root.
+// ../shared/data/<relative> seen from the project root, or <ARVIEW_DATA_DIR>/<relative> when that
+// is set (a checkout that is not beside shared/, e.g. a git worktree).
 inline std::filesystem::path SharedData(const std::string& relative) {
+  if (const char* env = std::getenv("ARVIEW_DATA_DIR"); env && *env) {
+    return (std::filesystem::path(env) / relative).lexically_normal();
+  }
   return (SourceDir() / ".." / "shared" / "data" / relative).lexically_normal();
 }
 
