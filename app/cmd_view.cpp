@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "app/commands.h"
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 #include "app/stage_stats.h"
 #include "app/view_orbit.h"
 #include "app/view_session.h"
@@ -78,7 +78,7 @@ std::string StatsText(const StageStats& stats) {
 }
 
 void WriteStats(const ViewArgs& a, const nlohmann::json& stats) {
-  if (!a.stats.empty()) WriteTextFileAtomically(a.stats, stats.dump(2) + "\n");
+  if (!a.stats.empty()) WriteFileAtomically(a.stats, stats.dump(2) + "\n");
 }
 
 ViewOptions Options(const ViewArgs& a) {

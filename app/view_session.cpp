@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/output_file.h"
+#include "base/atomic_file.h"
 #include "app/view_hud.h"
 #include "render/hud.h"
 
@@ -259,7 +259,7 @@ void ViewSession::Save() {
     }
     const std::string text = SpliceKeys(scene_text_, scene_, edited_, editor_.keys(), editor_.FileOrigins());
     anim::Scene reread = ValidateSceneText(text, scene_file_, edited_, editor_.keys());
-    WriteTextFileAtomically(scene_file_, text);
+    WriteFileAtomically(scene_file_, text);
     scene_text_ = text;
     scene_ = std::move(reread);
     editor_.MarkSaved();

@@ -74,22 +74,33 @@ void WriteFileAtomically(const fs::path& file, const std::function<void(std::ost
 }
 
 PendingOutput::PendingOutput(fs::path final_path) : final_(std::move(final_path)) {
+  if (final_.filename().empty()) final_ = final_.parent_path();  // "frames/" names the folder
+  folder_ = !final_.has_extension();
   partial_ = final_.parent_path() / (final_.stem().string() + ".partial" + final_.extension().string());
 }
 
 PendingOutput::~PendingOutput() {
   if (!committed_) {
     std::error_code ec;
-    fs::remove(partial_, ec);
+    fs::remove_all(partial_, ec);
   }
 }
 
 void PendingOutput::Commit() {
   std::error_code ec;
   if (!fs::exists(partial_, ec)) throw Error(final_.string() + ": cannot write (nothing was written)");
-  fs::rename(partial_, final_, ec);
+  if (folder_ && fs::is_directory(final_, ec)) {
+    for (const auto& entry : fs::directory_iterator(partial_, ec)) {
+      fs::rename(entry.path(), final_ / entry.path().filename(), ec);
+      if (ec) break;
+    }
+    if (!ec) fs::remove(partial_, ec);
+  } else {
+    fs::rename(partial_, final_, ec);
+  }
   if (ec) {
-    fs::remove(partial_, ec);
+    std::error_code ignored;
+    fs::remove_all(partial_, ignored);
     throw Error(final_.string() + ": cannot write (" + ec.message() + ")");
   }
   committed_ = true;

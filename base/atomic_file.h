@@ -27,7 +27,8 @@ void WriteFileAtomically(const std::filesystem::path& file, const std::function<
 class PendingOutput {
  public:
   // "out.mp4" is written as "out.partial.mp4": the extension is kept, as writers choose their
-  // format by it.
+  // format by it. A folder of frames "frames" (a path without extension, or ending in '/') is
+  // written as "frames.partial/": an interrupted run never leaves a folder that looks complete.
   explicit PendingOutput(std::filesystem::path final_path);
   ~PendingOutput();
   PendingOutput(const PendingOutput&) = delete;
@@ -36,12 +37,16 @@ class PendingOutput {
   const std::filesystem::path& partial() const { return partial_; }
   const std::filesystem::path& final_path() const { return final_; }
   bool committed() const { return committed_; }
-  // Renames the partial file over the final one; throws arview::Error naming the final file
+  // What to hand to a sink that chooses file or folder by the name: a folder ends with '/'.
+  std::string sink_target() const { return partial_.string() + (folder_ ? "/" : ""); }
+  // Renames the partial file over the final one (a partial folder's files into an existing final
+  // folder: a re-run replaces frames of the same name); throws arview::Error naming the final file
   // (and removes the partial) if the partial file is missing or the rename fails.
   void Commit();
 
  private:
   std::filesystem::path final_, partial_;
+  bool folder_ = false;
   bool committed_ = false;
 };
 

@@ -140,5 +140,33 @@ TEST_F(AtomicFileTest, PendingOutputCommitWithNothingWrittenThrows) {
   EXPECT_FALSE(fs::exists(dir_ / "video.mp4"));
 }
 
+TEST_F(AtomicFileTest, PendingFolderIsRenamedOnCommitAndMergedIntoAnExistingOne) {
+  {
+    PendingOutput out(dir_ / "frames/");
+    EXPECT_EQ(out.partial(), dir_ / "frames.partial");
+    EXPECT_EQ(out.sink_target(), (dir_ / "frames.partial").string() + "/");
+    fs::create_directories(out.partial());
+    std::ofstream(out.partial() / "000000.png") << "a";
+    out.Commit();
+  }
+  {
+    PendingOutput again(dir_ / "frames");
+    fs::create_directories(again.partial());
+    std::ofstream(again.partial() / "000000.png") << "b";
+    again.Commit();
+  }
+  EXPECT_EQ(Read(dir_ / "frames" / "000000.png"), "b");
+  EXPECT_FALSE(fs::exists(dir_ / "frames.partial"));
+}
+
+TEST_F(AtomicFileTest, PendingFolderNeverCommittedIsRemovedWithItsFiles) {
+  {
+    PendingOutput out(dir_ / "frames");
+    fs::create_directories(out.partial());
+    std::ofstream(out.partial() / "000000.png") << "half";
+  }
+  EXPECT_EQ(FilesInDir(), 0u);
+}
+
 }  // namespace
 }  // namespace arview
