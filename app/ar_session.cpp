@@ -27,7 +27,7 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& o) {
   if (source_size != map.camera.Size()) {
-    throw std::runtime_error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
+    throw Error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
                              std::to_string(source_size.height) + " but the map " + map_name +
                              " was built for a " + std::to_string(map.camera.width) + "x" +
                              std::to_string(map.camera.height) + " camera");

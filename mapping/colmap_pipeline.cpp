@@ -1,5 +1,6 @@
 #include "mapping/colmap_pipeline.h"
 
+#include "base/atomic_file.h"
 #include "base/image_file.h"
 
 #include <sqlite3.h>
@@ -51,9 +52,7 @@ class StageRecord {
   }
   void Save(const std::string& stage, const std::string& inputs) const {
     fs::create_directories(dir_);
-    std::ofstream out(dir_ / (stage + ".inputs"), std::ios::trunc);
-    out << inputs;
-    if (!out.flush()) throw map::MapError((dir_ / (stage + ".inputs")).string() + ": cannot write");
+    WriteFileAtomically(dir_ / (stage + ".inputs"), inputs);
   }
 
  private:
