@@ -13,6 +13,7 @@
 
 #include "app/commands.h"
 #include "base/atomic_file.h"
+#include "app/pipeline_report.h"
 #include "app/stage_stats.h"
 #include "app/view_orbit.h"
 #include "app/view_session.h"
@@ -55,14 +56,14 @@ double ProcessCpuSeconds() {
   return s(u.ru_utime) + s(u.ru_stime);
 }
 
-nlohmann::json StatsJson(const StageStats& stats, size_t frames, double wall_seconds, double cpu_seconds) {
-  nlohmann::json j;
+nlohmann::ordered_json StatsJson(const StageStats& stats, size_t frames, double wall_seconds, double cpu_seconds) {
+  nlohmann::ordered_json j;
   j["frames"] = frames;
   j["wall_seconds"] = wall_seconds;
   j["fps"] = wall_seconds > 0 ? frames / wall_seconds : 0;
   j["cpu_ms_per_frame"] = frames > 0 ? 1000 * cpu_seconds / frames : 0;
   for (const auto& [stage, t] : stats.Summaries()) {
-    j["stages"][stage] = {{"median_ms", t.median_ms}, {"p95_ms", t.p95_ms}, {"mean_ms", t.mean_ms}, {"count", t.count}};
+    j["stages"][stage] = TimingJson(t);
   }
   return j;
 }
@@ -71,13 +72,13 @@ std::string StatsText(const StageStats& stats) {
   std::string text;
   for (const auto& [stage, t] : stats.Summaries()) {
     char line[128];
-    std::snprintf(line, sizeof line, "  %-8s median %6.2f ms  p95 %6.2f ms\n", stage.c_str(), t.median_ms, t.p95_ms);
+    std::snprintf(line, sizeof line, "  %-8s median %6.2f ms  p95 %6.2f ms\n", stage.c_str(), t.median, t.p95);
     text += line;
   }
   return text;
 }
 
-void WriteStats(const ViewArgs& a, const nlohmann::json& stats) {
+void WriteStats(const ViewArgs& a, const nlohmann::ordered_json& stats) {
   if (!a.stats.empty()) WriteFileAtomically(a.stats, stats.dump(2) + "\n");
 }
 
@@ -166,13 +167,13 @@ void RunWindow(const ViewArgs& a) {
   if (session.dirty()) {
     std::fprintf(stderr, "view: quit with unsaved key changes (%s not written; s saves)\n", a.scene.c_str());
   }
-  nlohmann::json stats_json = StatsJson(stats, frames, wall, cpu);
+  nlohmann::ordered_json stats_json = StatsJson(stats, frames, wall, cpu);
   stats_json["present"] = window->PresentMethod();
   stats_json["renderer"] = session.renderer();
   stats_json["size"] = a.size;
   WriteStats(a, stats_json);
   if (a.json) {
-    nlohmann::json j = nlohmann::json::parse(session.StateJson());
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(session.StateJson());
     j["stats"] = stats_json;
     std::printf("%s\n", j.dump().c_str());
   } else {

@@ -56,7 +56,7 @@ std::optional<PlacedLightReport> EstimatePlacedLight(const map::Map& map, const 
   render::SceneProxy proxy = render::BuildPlaneProxy(points);
   const render::TriangleBvh scene(proxy.Triangles());
   const Anchor& anchor = placed.anchor;
-  const Eigen::Vector3d up = anchor.rotation.col(1).normalized();
+  const Eigen::Vector3d up = (anchor.rotation * Eigen::Vector3d::UnitY()).normalized();
   const double height = placed.rest_height * anchor.scale;
   // The floor the character stands on cannot hide it: out of the occluders (its inlier band
   // is a hundredth of the character's height, or of the plane proxy's own tolerance).

@@ -32,7 +32,7 @@ TEST(SceneWriter, WritesWhatTheSceneReaderReadsBack) {
   EXPECT_EQ(spec.name, "fox");
   EXPECT_EQ(spec.asset, std::filesystem::path(c.asset));
   EXPECT_LT((spec.anchor.position - c.anchor.position).norm(), 1e-9);
-  EXPECT_LT((spec.anchor.rotation.toRotationMatrix() - c.anchor.rotation).norm(), 1e-8);
+  EXPECT_LT(spec.anchor.rotation.angularDistance(c.anchor.rotation), 1e-8);
   EXPECT_NEAR(spec.anchor.scale, 0.0123, 1e-12);
   EXPECT_EQ(spec.lookat.base_clip, "Survey");
   ASSERT_EQ(spec.keys.size(), 6u);
