@@ -8,7 +8,7 @@
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
 #include "anim/pose.h"
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
 #include <benchmark/benchmark.h>

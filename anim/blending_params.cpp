@@ -135,14 +135,14 @@ int FirstJoint(const Skeleton& sk, std::initializer_list<const char*> words, Sid
   return -1;
 }
 
-int ArmRoot(const Skeleton& sk, Side side) {
+int ArmRootOf(const Skeleton& sk, Side side) {
   int j = FirstJoint(sk, {"clavicle", "collar"}, side);
   if (j < 0) j = FirstJoint(sk, {"shoulder"}, side);
   if (j < 0) j = FirstJoint(sk, {"upperarm", "humerus", "arm"}, side);
   return j;
 }
 
-int LegRoot(const Skeleton& sk, Side side) {
+int LegRootOf(const Skeleton& sk, Side side) {
   int j = FirstJoint(sk, {"hipjoint", "upleg", "thigh", "femur", "hip"}, side);
   if (j < 0) j = FirstJoint(sk, {"leg", "knee"}, side);
   return j;
@@ -156,6 +156,17 @@ std::vector<int> Join(std::vector<int> a, const std::vector<int>& b) {
 }
 
 }  // namespace
+
+int ArmRoot(const Skeleton& sk, bool left) { return ArmRootOf(sk, left ? Side::kLeft : Side::kRight); }
+int LegRoot(const Skeleton& sk, bool left) { return LegRootOf(sk, left ? Side::kLeft : Side::kRight); }
+int NeckJoint(const Skeleton& sk) {
+  const int j = FirstJoint(sk, {"neck"}, Side::kNone);
+  return j >= 0 ? j : FirstJoint(sk, {"head"}, Side::kNone);
+}
+int NameSide(const std::string& name) {
+  const Side s = SideOf(name);
+  return s == Side::kLeft ? 1 : s == Side::kRight ? -1 : 0;
+}
 
 const std::vector<std::string>& BuiltinScopes() {
   static const std::vector<std::string> names = {"all", "root", "torso", "legs", "left_leg", "right_leg",
@@ -183,17 +194,22 @@ std::vector<int> ResolveScope(const Skeleton& sk, const std::string& name, const
     return out;
   }
   if (name == "root") return {0};
-  if (name == "torso") return need(FirstJoint(sk, {"lowerback", "spine", "=ab", "abdomen", "chest", "back"}, Side::kNone), "spine");
-  if (name == "head") {
-    int j = FirstJoint(sk, {"neck"}, Side::kNone);
-    if (j < 0) j = FirstJoint(sk, {"head"}, Side::kNone);
-    return need(j, "neck or head");
+  if (name == "torso") {
+    int j = FirstJoint(sk, {"lowerback", "spine", "=ab", "abdomen", "chest", "back"}, Side::kNone);
+    if (j < 0) {
+      // Rigs that name no spine (CesiumMan: torso_joint_1 > _2 > _3 > neck): the neck's
+      // ancestor just below the root.
+      for (int k = NeckJoint(sk); k >= 0 && sk.parents[k] >= 0; k = sk.parents[k]) j = k;
+      if (j >= 0 && j == NeckJoint(sk)) j = -1;
+    }
+    return need(j, "spine");
   }
-  if (name == "left_arm") return need(ArmRoot(sk, Side::kLeft), "left shoulder/arm");
-  if (name == "right_arm") return need(ArmRoot(sk, Side::kRight), "right shoulder/arm");
-  if (name == "left_leg") return need(LegRoot(sk, Side::kLeft), "left hip/leg");
-  if (name == "right_leg") return need(LegRoot(sk, Side::kRight), "right hip/leg");
-  if (name == "legs") return Join(need(LegRoot(sk, Side::kLeft), "left hip/leg"), need(LegRoot(sk, Side::kRight), "right hip/leg"));
+  if (name == "head") return need(NeckJoint(sk), "neck or head");
+  if (name == "left_arm") return need(ArmRootOf(sk, Side::kLeft), "left shoulder/arm");
+  if (name == "right_arm") return need(ArmRootOf(sk, Side::kRight), "right shoulder/arm");
+  if (name == "left_leg") return need(LegRootOf(sk, Side::kLeft), "left hip/leg");
+  if (name == "right_leg") return need(LegRootOf(sk, Side::kRight), "right hip/leg");
+  if (name == "legs") return Join(need(LegRootOf(sk, Side::kLeft), "left hip/leg"), need(LegRootOf(sk, Side::kRight), "right hip/leg"));
   std::string known;
   for (const auto& s : BuiltinScopes()) known += (known.empty() ? "" : ", ") + s;
   for (const auto& [n, s] : custom) known += ", " + n;

@@ -87,6 +87,14 @@ using ScopeTable = std::map<std::string, ScopeSpec>;
 std::vector<int> ResolveScope(const Skeleton& skeleton, const std::string& name, const ScopeTable& custom = {});
 // The names of the built-in scopes.
 const std::vector<std::string>& BuiltinScopes();
+// The first joint of a side's arm (clavicle/collar, else shoulder, else upper arm) or leg
+// (hip joint/up-leg/thigh, else leg/knee) found by name, or −1; also used by the humanoid map.
+int ArmRoot(const Skeleton& skeleton, bool left);
+int LegRoot(const Skeleton& skeleton, bool left);
+// The first neck joint (else head), or −1.
+int NeckJoint(const Skeleton& skeleton);
+// Whether a joint name marks the left (+1), right (−1) or no (0) side.
+int NameSide(const std::string& name);
 // Descendants of `joint` including itself.
 std::vector<int> Subtree(const Skeleton& skeleton, int joint);
 

@@ -1,8 +1,9 @@
 #pragma once
-// A skinned, animated character loaded from a file through Assimp (glTF 2.0 .glb/.gltf, FBX,
-// Collada .dae, DirectX .X, BVH), in the asset's own units and axes ("model space").
+// A skinned, animated character (loaded from a file by anim_authoring/import.h: glTF 2.0
+// .glb/.gltf, FBX, Collada .dae, DirectX .X, BVH), in the asset's own units and axes ("model
+// space"). These are the runtime's data; nothing here reads files.
 //
-//   Character c = LoadCharacter("Fox.glb");          // throws anim::Error naming the file
+//   Character c = LoadCharacter("Fox.glb");          // anim_authoring/import.h
 //   c.skeleton.parents[j]      parent joint (−1 for a root); parents come before children
 //   c.skeleton.inverse_bind[j] model space → joint j's space at bind time
 //   c.meshes[i].positions / normals / uvs / indices (triangles) / joints / weights (≤ 4, sum 1)
@@ -125,9 +126,5 @@ struct Character {
   // nullptr when absent.
   const Clip* FindClip(const std::string& name) const;
 };
-
-// Loads a character. Throws Error (naming the file) when the file is missing or unreadable,
-// Assimp cannot parse it, or it has no skeleton (no bones and no animated nodes).
-Character LoadCharacter(const std::filesystem::path& path);
 
 }  // namespace arview::anim

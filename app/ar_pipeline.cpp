@@ -6,7 +6,7 @@
 #include <mutex>
 #include <thread>
 
-#include "anim/lookat.h"
+#include "anim_authoring/lookat.h"
 #include "app/bounded_queue.h"
 
 namespace arview::app {

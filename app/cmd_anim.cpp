@@ -9,8 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "anim/lookat.h"
-#include "anim/scene.h"
+#include "anim_authoring/lookat.h"
+#include "anim_authoring/import.h"
+#include "anim_authoring/scene.h"
 #include "app/commands.h"
 
 namespace arview::app {

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "app/commands.h"
 #include "app/scene_lighting.h"
 #include "calib/camera.h"

@@ -1,21 +1,25 @@
 #pragma once
-// The character's animation as the appliance drives it (PAPERS.md §2): the view-adaptive blend
-// (anim::AnimatedCharacter) runs over an idle layer, the base clip. While the tracker follows
-// the camera, the view-adaptive layer has full weight. When tracking is lost the character
-// holds its last viewpoint for `hold_seconds` (time keeps running: no freeze), then fades to
-// the idle layer over `fade_seconds`; when the tracker relocalizes it fades back. The fade mixes
-// model-space joint transforms (translation and scale linearly, rotation by slerp), so no joint
-// jumps from one frame to the next.
+// The character's animation as the appliance drives it (PAPERS.md §2), on anim/'s MIRAnim
+// engine (anim/animator.h): a schedule per character — by default the idle layer underneath
+// (the scene's idle synthesizer, or the base clip looped, or the rest pose) and the
+// view-adaptive action on top, or the scene's own `schedule:`. While the tracker follows the
+// camera the view-adaptive action has full weight. When tracking is lost the character holds its
+// last viewpoint for `hold_seconds` (time keeps running: no freeze), then the view-adaptive
+// action fades out (cosine, over `fade_seconds`) to the layers below it; when the tracker
+// relocalizes it fades back. The fade blends local joint transforms (dual quaternions), so bones
+// keep their lengths and no joint jumps. The viewer's distance to the character (map units)
+// drives the scene's distance triggers and weights.
 
 #include <Eigen/Core>
 
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
-#include "anim/pose.h"
-#include "anim/scene.h"
+#include "anim/animator.h"
+#include "anim_authoring/scene.h"
 
 namespace arview::app {
 
@@ -29,14 +33,15 @@ struct AnimatedFrame {
   std::span<const anim::DualQuatf> skinning_dual_quats;
   std::span<const Eigen::Matrix4d> model;
   std::span<const double> key_weights;  // of the view-adaptive layer
-  double idle_weight = 0;               // 0: fully view-adaptive, 1: fully the base clip
+  double idle_weight = 0;               // 0: fully view-adaptive, 1: fully the layers below it
   Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // the one used (character frame)
 };
 
 class LayeredAnimator {
  public:
-  // `character` must outlive the animator. The idle layer is `idle_clip` of the asset, or the
-  // scene's look-at base clip ("rest": the rest pose), or the asset's first clip, or the rest pose.
+  // `character` must outlive the animator. The default schedule's idle layer is `idle_clip` of
+  // the asset, or the scene's idle synthesizer, or its look-at base clip ("rest": the rest pose),
+  // or the asset's first clip, or the rest pose. `options` override the scene's tracking_loss.
   explicit LayeredAnimator(anim::AnimatedCharacter& character, const std::string& idle_clip = "",
                            const FadeOptions& options = {});
 
@@ -44,24 +49,15 @@ class LayeredAnimator {
   // tracker lost the frame. `time` is the video time in seconds (monotonic).
   const AnimatedFrame& Update(const std::optional<Eigen::Vector3d>& camera_center, double time);
 
+  // The clip of the default idle layer, or nullptr (rest pose, idle synthesizer, scene schedule).
   const anim::Clip* idle_clip() const { return idle_; }
   const anim::AnimatedCharacter& character() const { return character_; }
+  anim::Animator& animator() { return *animator_; }
 
  private:
-  void MixWithIdle(std::span<const Eigen::Matrix4d> adaptive, double idle_weight);
-
   anim::AnimatedCharacter& character_;
   const anim::Clip* idle_ = nullptr;
-  FadeOptions options_;
-  Eigen::Vector3d last_viewpoint_ = Eigen::Vector3d::UnitZ();
-  std::optional<double> lost_since_;
-  double idle_weight_ = 0;
-  std::optional<double> last_time_;
-
-  anim::LocalPose idle_pose_;
-  std::vector<Eigen::Matrix4d> idle_model_, mixed_model_;
-  std::vector<Eigen::Matrix4f> skin_;
-  std::vector<anim::DualQuatf> skin_dq_;
+  std::unique_ptr<anim::Animator> animator_;
   AnimatedFrame frame_;
 };
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "anim/character.h"
+#include "anim_authoring/import.h"
 #include "app/character_bounds.h"
 #include "base/stats.h"
 

@@ -4,7 +4,7 @@
 #include <yaml-cpp/emitter.h>
 #include <yaml-cpp/emittermanip.h>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "base/atomic_file.h"
 
 namespace arview::app {

@@ -4,7 +4,7 @@
 
 #include <Eigen/Geometry>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 
 namespace arview::app {
 namespace {

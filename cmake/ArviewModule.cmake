@@ -64,7 +64,7 @@ endif()
   endforeach()
 endfunction()
 
-# arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>]
+# arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>] [BENCH_DEPS <targets...>]
 #               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>])
 #
 # One library per top-level folder: every *.cpp in the folder except *_test.cpp and
@@ -72,8 +72,10 @@ endfunction()
 # *_test.cpp files form one GoogleTest binary `<name>_tests`, run by ctest (DATA, SLOW_DATA,
 # SLOW: see arview_discover_tests).
 # bench_*.cpp files form the Google Benchmark binary `bench_<name>`.
+# TEST_DEPS / BENCH_DEPS: what the tests / benchmarks link beyond the library (e.g. a runtime
+# library's tests loading assets through its authoring library).
 function(arview_module name)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW" "DEPS;TEST_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
   file(GLOB all_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(lib_sources "")
   set(test_sources "")
@@ -109,6 +111,6 @@ function(arview_module name)
 
   if(ARVIEW_BUILD_BENCHMARKS AND bench_sources)
     add_executable(bench_${name} ${bench_sources})
-    target_link_libraries(bench_${name} PRIVATE arview_${name} arview_testing benchmark::benchmark)
+    target_link_libraries(bench_${name} PRIVATE arview_${name} arview_testing ${ARG_BENCH_DEPS} benchmark::benchmark)
   endif()
 endfunction()

@@ -18,7 +18,7 @@
 #include <span>
 #include <vector>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "render/character_renderer.h"

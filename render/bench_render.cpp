@@ -25,7 +25,8 @@
 #include <cstring>
 #include <map>
 
-#include "anim/scene.h"
+#include "anim_authoring/import.h"
+#include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/synth_room.h"
 #include "tests/support/test_data.h"

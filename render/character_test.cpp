@@ -5,7 +5,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/test_scene.h"
 #include "tests/support/test_data.h"

@@ -1,7 +1,7 @@
 // The paper's claim, checked on real rigs: with key animations that look toward 8 viewpoints
 // around the horizon, the blended character's head points at viewpoints between the keys.
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
 #include <gtest/gtest.h>

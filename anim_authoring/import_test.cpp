@@ -1,4 +1,4 @@
-#include "anim/character.h"
+#include "anim_authoring/import.h"
 #include "anim/pose.h"
 #include "tests/support/test_data.h"
 

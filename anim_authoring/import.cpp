@@ -2,7 +2,7 @@
 // references (bone nodes and the nodes between them and their lowest common ancestor); a file
 // without a skin (BVH) uses its animated nodes instead.
 
-#include "anim/character.h"
+#include "anim_authoring/import.h"
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>

@@ -1,5 +1,5 @@
 #include "anim/character.h"
-#include "anim/yaml.h"
+#include "anim_authoring/yaml.h"
 
 #include <gtest/gtest.h>
 

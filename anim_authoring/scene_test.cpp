@@ -1,4 +1,4 @@
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
 #include <gtest/gtest.h>

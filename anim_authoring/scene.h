@@ -45,15 +45,22 @@
 // Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
 
 #include "anim/character.h"
+#include "anim_authoring/import.h"
+#include "anim_authoring/lookat.h"
 #include "base/enum_table.h"
 #include "base/geometry.h"
-#include "anim/lookat.h"
 #include "anim/pose.h"
+#include "anim/animator.h"
+#include "anim/blending_params.h"
+#include "anim/idle.h"
 #include "anim/view_adaptive.h"
 #include "anim/view_sphere.h"
 
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,6 +87,65 @@ struct KeySpec {
   int line = 0;            // where it was written, for messages
 };
 
+// The `schedule:` section (anim/schedule.h): actions on objects, with curves, masks, layers.
+struct ActionSpec;
+struct ObjectSpec {
+  enum class Kind { kClip, kPose, kViewAdaptive, kIdle, kSchedule };
+  Kind kind = Kind::kClip;
+  std::string clip;          // kClip, kPose (empty with kPose: the rest pose)
+  double pose_time = 0;      // kPose
+  std::vector<ActionSpec> actions;  // kSchedule (nested)
+  // Modifiers, applied in this order: window, stretch, loop, mirror, transform.
+  bool has_window = false;
+  double window_from = 0, window_to = 0;
+  double stretch = 0;        // seconds; 0: none
+  int loop = -1;             // −1: none, 0: forever, n: n times
+  bool mirror = false;
+  bool has_transform = false;
+  Anchor transform;          // position + rotation (scale ignored)
+  int line = 0;
+};
+struct MaskSpec {
+  double default_rotation = 1, default_translation = 1;
+  struct Scope {
+    std::string name;
+    double rotation = 1, translation = 1;
+  };
+  std::vector<Scope> scopes;  // applied in order over the default
+  int line = 0;
+};
+struct ActionSpec {
+  std::string name;
+  ObjectSpec object;
+  double start = 0;
+  bool keep_rendering = false;
+  int layer = 0;
+  double weight = 1;
+  std::vector<Curve> curves, scalings;
+  std::vector<MaskSpec> masks;
+  bool has_trigger = false;  // a distance trigger: added when the viewer comes within `near`
+  double trigger_near = 0, trigger_far = 0;
+  std::vector<std::pair<double, double>> distance_weight;  // (metres, weight)
+  int line = 0;
+};
+struct ScheduleSpec {
+  bool given = false;        // false: the default (idle underneath, view-adaptive on top)
+  std::vector<ActionSpec> actions;
+  double rest_threshold = 0.1;
+  double hold_seconds = 0.5, fade_seconds = 1.0;  // tracking loss
+  std::string view_action = "view";
+};
+// The idle synthesizer (anim/idle.h), learned at load from motion files and/or clips.
+struct IdleSpec {
+  bool given = false;
+  std::vector<std::filesystem::path> motion;  // BVH (or any asset) files, absolute
+  std::vector<std::string> clips;             // clips of the character itself
+  std::map<std::string, std::string> joint_map;  // data joint → character joint overrides
+  std::uint64_t seed = 1;
+  int components = 10;
+  int line = 0;
+};
+
 struct LookAtSpec {
   std::string base_clip;             // empty: the first clip, or the rest pose if none; "rest": the rest pose
   std::vector<std::string> chain;    // empty: DefaultLookAtChain()
@@ -102,6 +168,9 @@ struct CharacterSpec {
   bool has_lookat = false;
   LookAtSpec lookat;
   std::vector<KeySpec> keys;
+  ScopeTable scopes;       // `scopes:` added to the built-in ones
+  IdleSpec idle;           // `idle:`
+  ScheduleSpec schedule;   // `schedule:`
 
   // model space → map: translate(position) · rotation · uniform scale (anchor.scale · scale).
   Eigen::Matrix4d ModelToMap() const;
@@ -172,5 +241,21 @@ class AnimatedCharacter {
   std::vector<DualQuatf> skin_dq_;
   FrameOutput out_;
 };
+
+// What the appliance may override in the scene's schedule.
+struct AnimatorOverrides {
+  std::string idle_clip;                  // the default schedule's idle layer: this clip (looped)
+  std::optional<double> hold_seconds, fade_seconds;  // tracking loss
+};
+
+// The character's animator (anim/animator.h): its scene `schedule:` built (objects, modifiers,
+// curves, masks with scopes resolved on its skeleton, distance triggers and weights), or by
+// default the idle underneath (the `idle:` synthesizer if given, else the look-at base clip
+// looped, else the first clip, else the rest pose) and the view-adaptive action "view" on top.
+// `character` must outlive the animator. Throws Error "scene:line: why".
+std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {});
+
+// The idle synthesizer of the character's `idle:` section (learned here), with what was learned.
+std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& character, std::string* summary = nullptr);
 
 }  // namespace arview::anim

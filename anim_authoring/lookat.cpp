@@ -1,4 +1,4 @@
-#include "anim/lookat.h"
+#include "anim_authoring/lookat.h"
 
 #include "anim/pose.h"
 

@@ -1,4 +1,4 @@
-#include "anim/yaml.h"
+#include "anim_authoring/yaml.h"
 
 #include "anim/character.h"  // Error
 

@@ -1,0 +1,102 @@
+#pragma once
+// A character's animation as the appliance (and `arview view`) drives it: one schedule per
+// character (idle underneath, the view-adaptive action on top, scene actions), plus what the
+// world decides each frame:
+//   - tracking: when the viewer is lost the view-adaptive action holds its last viewpoint for
+//     `hold_seconds`, then fades out (cosine, `fade_seconds`) to what is below it (the idle);
+//     on relocalization it fades back in. Time keeps running: the character never freezes.
+//   - distance: actions triggered when the viewer comes within `near` metres (re-armed beyond
+//     `far`: hysteresis), and action weights as piecewise-linear functions of the distance.
+// Then local-to-model and skinning, once.
+//
+//   Animator animator(skeleton, schedule, options);     // anim_authoring builds these from a scene
+//   FrameInputs in{viewpoint, distance_m, tracking_ok};
+//   const AnimatorFrame& f = animator.Update(time_s, in);   // per frame, no allocation
+//   f.skinning_matrices / f.skinning_dual_quats → the renderer
+//
+// Update allocates only when a distance trigger fires (it adds an action to the schedule).
+
+#include "anim/schedule.h"
+#include "anim/view_adaptive.h"
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace arview::anim {
+
+struct DistanceTrigger {
+  double near = 1.5;  // fires when the distance drops to this (metres) while armed
+  double far = 2.0;   // re-arms when it rises above this (far > near)
+  Action action;      // added to the schedule when it fires; action.start is relative to then
+};
+
+struct DistanceWeight {
+  std::string action;                          // by name
+  std::vector<std::pair<double, double>> points;  // (distance m, weight), distances increasing
+  double At(double distance) const;            // clamped at the ends
+};
+
+struct AnimatorOptions {
+  std::string view_action = "view";  // the action faded on tracking loss ("" or absent: none)
+  double hold_seconds = 0.5;
+  double fade_seconds = 1.0;
+  std::vector<DistanceTrigger> triggers;
+  std::vector<DistanceWeight> distance_weights;
+};
+
+struct AnimatorFrame {
+  std::span<const Eigen::Matrix4f> skinning_matrices;
+  std::span<const DualQuatf> skinning_dual_quats;
+  std::span<const Eigen::Matrix4d> model;
+  std::span<const LocalPose> local;           // one element: the blended local pose
+  std::span<const double> key_weights;        // of the view-adaptive blend (empty without one)
+  double view_gain = 0;                       // the view-adaptive action's gain now (0..1)
+  Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // the one used (held while lost)
+  bool converged = true;                      // DIB converged on every joint
+  int triggered = 0;                          // distance triggers fired this frame
+};
+
+class Animator {
+ public:
+  // `view` is the view-adaptive blend the schedule's view action plays (for its key weights), or
+  // nullptr. Throws Error when a distance weight names an action the schedule lacks, or a
+  // trigger's far is not beyond its near.
+  Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Schedule> schedule, AnimatorOptions options = {},
+           std::shared_ptr<const ViewAdaptiveBlend> view = nullptr);
+
+  // `time` in seconds, monotonic (a jump backwards restarts the tracking-loss state).
+  const AnimatorFrame& Update(double time, const FrameInputs& inputs);
+
+  Schedule& schedule() { return *schedule_; }
+  const Skeleton& skeleton() const { return *skeleton_; }
+  int view_action_id() const { return view_id_; }
+
+ private:
+  void Track(double time, bool tracking);
+  void Distance(double time, double distance);
+
+  std::shared_ptr<const Skeleton> skeleton_;
+  std::shared_ptr<Schedule> schedule_;
+  AnimatorOptions options_;
+  std::shared_ptr<const ViewAdaptiveBlend> view_;
+  int view_id_ = -1;
+  std::vector<int> weight_ids_;      // per distance weight
+  std::vector<bool> armed_;          // per trigger
+  std::vector<int> fired_ids_;       // actions added by triggers, removed once they end
+  std::optional<double> last_time_;
+  std::optional<double> lost_since_;
+  bool fading_out_ = false;
+  Eigen::Vector3d viewpoint_ = Eigen::Vector3d::UnitZ();
+  FrameInputs inputs_;
+  std::vector<LocalPose> pose_;      // one
+  std::vector<Eigen::Matrix4d> model_;
+  std::vector<Eigen::Matrix4f> skin_;
+  std::vector<DualQuatf> skin_dq_;
+  AnimatorFrame frame_;
+};
+
+}  // namespace arview::anim

@@ -1,0 +1,136 @@
+#include "anim/idle.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace arview::anim {
+namespace {
+
+// Exponential map: a rotation vector (axis · angle) → quaternion.
+Eigen::Quaterniond ExpMap(const Eigen::Vector3d& v) {
+  const double angle = v.norm();
+  if (angle < 1e-12) return Eigen::Quaterniond::Identity();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, v / angle));
+}
+
+// A draw in [0, 1) from the walk's generator, the same on every platform (no distribution
+// objects, whose algorithms the standard leaves open).
+double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0); }
+
+int Draw(std::mt19937_64& rng, const std::vector<double>& weights) {
+  double total = 0;
+  for (double w : weights) total += w;
+  double x = Uniform(rng) * total;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    if (x < weights[i]) return static_cast<int>(i);
+    x -= weights[i];
+  }
+  return static_cast<int>(weights.size()) - 1;
+}
+
+}  // namespace
+
+void IdleModel::Check(int skeleton_joints) const {
+  const int d = 3 * static_cast<int>(joints.size()) + 3;
+  if (mean.size() != d || min.size() != d || max.size() != d || components.rows() != d ||
+      components.cols() != eigenvalues.size() || static_cast<int>(chains.size()) != eigenvalues.size())
+    throw Error("idle model: sizes disagree");
+  for (int j : joints)
+    if (j < 0 || j >= skeleton_joints) throw Error("idle model: joint index out of range");
+  if (root < 0 || root >= skeleton_joints) throw Error("idle model: root out of range");
+  for (const ComponentChain& c : chains) {
+    if (c.clusters.empty() || c.transitions.size() != c.clusters.size() || c.frequency.size() != c.clusters.size())
+      throw Error("idle model: a component has no extrema");
+    for (const auto& members : c.clusters)
+      if (members.empty()) throw Error("idle model: an empty cluster");
+  }
+}
+
+IdleSynthesizer::IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<const IdleModel> model,
+                                 std::uint64_t seed)
+    : skeleton_(std::move(skeleton)), model_(std::move(model)), seed_(seed) {
+  if (!skeleton_ || !model_) throw Error("idle synthesizer: no skeleton or model");
+  model_->Check(skeleton_->size());
+  walks_.resize(model_->component_count());
+  coefficients_ = Eigen::VectorXd::Zero(model_->component_count());
+  posture_ = model_->mean;
+  Restart();
+}
+
+void IdleSynthesizer::Restart() {
+  for (int i = 0; i < model_->component_count(); ++i) {
+    Walk& w = walks_[i];
+    w.rng.seed(seed_ * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i) * 0xBF58476D1CE4E5B9ull + 1);
+    const IdleModel::ComponentChain& chain = model_->chains[i];
+    w.cluster = Draw(w.rng, chain.frequency);
+    const auto& members = chain.clusters[w.cluster];
+    const IdleModel::Extremum& e = members[static_cast<std::size_t>(Uniform(w.rng) * members.size())];
+    // Start inside the first segment at a seeded phase, so streams of different seeds differ.
+    w.t1 = 0;
+    w.v1 = e.value;
+    Step(i);
+    const double phase = Uniform(w.rng) * (w.t1 - w.t0);
+    w.t0 -= phase;
+    w.t1 -= phase;
+  }
+}
+
+void IdleSynthesizer::Step(int i) {
+  Walk& w = walks_[i];
+  const IdleModel::ComponentChain& chain = model_->chains[i];
+  const auto& row = chain.transitions[w.cluster];
+  double outgoing = 0;
+  for (double c : row) outgoing += c;
+  w.cluster = Draw(w.rng, outgoing > 0 ? row : chain.frequency);
+  const auto& members = chain.clusters[w.cluster];
+  const IdleModel::Extremum& e = members[std::min(members.size() - 1, static_cast<std::size_t>(Uniform(w.rng) * members.size()))];
+  w.t0 = w.t1;
+  w.v0 = w.v1;
+  w.t1 = w.t0 + std::max(e.dt, 1e-3);
+  w.v1 = e.value;
+}
+
+void IdleSynthesizer::Advance(int i, double t) {
+  if (t < walks_[i].t0) Restart();  // backwards: replay from the seed
+  while (t > walks_[i].t1) Step(i);
+}
+
+const Eigen::VectorXd& IdleSynthesizer::Coefficients(double t) {
+  if (!std::isfinite(t)) t = 0;
+  for (int i = 0; i < model_->component_count(); ++i) {
+    Advance(i, t);
+    const Walk& w = walks_[i];
+    const double x = (t - w.t0) / (w.t1 - w.t0);
+    coefficients_[i] = w.v0 + (w.v1 - w.v0) * 0.5 * (1 - std::cos(M_PI * std::clamp(x, 0.0, 1.0)));
+  }
+  return coefficients_;
+}
+
+const Eigen::VectorXd& IdleSynthesizer::Posture(double t) {
+  const Eigen::VectorXd& c = Coefficients(t);
+  posture_.noalias() = model_->components * c;
+  posture_ += model_->mean;
+  posture_ = posture_.cwiseMax(model_->min).cwiseMin(model_->max);
+  return posture_;
+}
+
+bool IdleSynthesizer::Sample(double t, const FrameInputs&, LocalPose& out) {
+  const Skeleton& sk = *skeleton_;
+  if (out.size() != sk.size()) return false;
+  const Eigen::VectorXd& p = Posture(t);
+  for (int j = 0; j < sk.size(); ++j) {
+    out.rigid[j] = sk.rest[j].Rigid();
+    out.scale[j] = sk.rest[j].scale;
+  }
+  const int m = static_cast<int>(model_->joints.size());
+  for (int k = 0; k < m; ++k) {
+    const int j = model_->joints[k];
+    const Eigen::Quaterniond r = sk.rest[j].rotation * ExpMap(p.segment<3>(3 * k));
+    out.rigid[j] = DualQuatd::FromRotationTranslation(r, out.rigid[j].Translation());
+  }
+  const int root = model_->root;
+  out.rigid[root] = DualQuatd::FromRotationTranslation(out.rigid[root].Rotation(), sk.rest[root].translation + p.segment<3>(3 * m));
+  return true;
+}
+
+}  // namespace arview::anim

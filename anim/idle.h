@@ -1,0 +1,89 @@
+#pragma once
+// Idle motion (thesis chapter 3, PAPERS.md §3): small posture variations synthesised on the
+// principal components of standing postures, so that joints vary together as in the data.
+//
+// A posture is a vector: per animated joint the exponential map of its rotation relative to the
+// character's rest rotation (3 values), then the root's translation offset (3 values). The
+// model (learned by anim_authoring/idle_learning.h from motion capture mapped onto the
+// character, or from its own clips) holds the mean posture, the first principal components
+// and their eigenvalues, and per component the extrema of the training signal — (time since
+// the previous extremum, value) pairs — clustered with k-means, with the transition counts
+// between clusters of consecutive extrema. Synthesis walks each component's cluster chain
+// (seeded), draws each next extremum from the recorded members of the chosen cluster (no
+// invented values), and joins consecutive extrema with cosine segments (zero velocity at
+// every extremum, as the signal has there). The posture is the mean plus the components, each
+// value clamped to the training data's range.
+//
+//   IdleSynthesizer idle(skeleton, model, /*seed=*/7);
+//   if (!idle.Sample(t, {}, pose)) ...                 // unbounded, deterministic in (seed, t)
+
+#include "anim/blendable.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <vector>
+
+namespace arview::anim {
+
+struct IdleModel {
+  std::vector<int> joints;            // character joints whose rotations vary
+  int root = 0;                       // the joint whose translation varies
+  Eigen::VectorXd mean;               // 3·joints.size() + 3
+  Eigen::MatrixXd components;         // dims × m, orthonormal columns
+  Eigen::VectorXd eigenvalues;        // m, decreasing
+  Eigen::VectorXd min, max;           // per dimension, over the training postures
+  struct Extremum {
+    double dt = 0;     // seconds since the previous extremum
+    double value = 0;  // the component's value there
+  };
+  struct ComponentChain {
+    std::vector<std::vector<Extremum>> clusters;  // recorded extrema, by k-means cluster
+    std::vector<std::vector<double>> transitions; // counts, cluster → next cluster
+    std::vector<double> frequency;                // cluster sizes (for rows without transitions)
+  };
+  std::vector<ComponentChain> chains;  // one per component
+  double training_seconds = 0;
+  int training_frames = 0;
+
+  int dims() const { return static_cast<int>(mean.size()); }
+  int component_count() const { return static_cast<int>(eigenvalues.size()); }
+  // Throws Error when sizes disagree or a chain is empty.
+  void Check(int skeleton_joints) const;
+};
+
+class IdleSynthesizer : public Blendable {
+ public:
+  IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<const IdleModel> model, std::uint64_t seed);
+
+  double Duration() const override { return kUnbounded; }
+  // Time runs forward: sampling earlier than the chains' window restarts them from the seed
+  // and walks forward again (so the stream is a function of (seed, t)).
+  bool Sample(double t, const FrameInputs& inputs, LocalPose& out) override;
+  int joint_count() const override { return skeleton_->size(); }
+
+  // The component values at t (after Sample or Coefficients(t)).
+  const Eigen::VectorXd& Coefficients(double t);
+  const Eigen::VectorXd& Posture(double t);  // clamped posture vector at t
+  const IdleModel& model() const { return *model_; }
+
+ private:
+  struct Walk {
+    std::mt19937_64 rng;
+    int cluster = 0;
+    double t0 = 0, v0 = 0, t1 = 0, v1 = 0;  // the segment [t0, t1] between two extrema
+  };
+  void Restart();
+  void Advance(int component, double t);
+  void Step(int component);
+
+  std::shared_ptr<const Skeleton> skeleton_;
+  std::shared_ptr<const IdleModel> model_;
+  std::uint64_t seed_;
+  std::vector<Walk> walks_;
+  Eigen::VectorXd coefficients_, posture_;
+};
+
+}  // namespace arview::anim
