@@ -14,7 +14,7 @@
 #include <map>
 #include <random>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/prt.h"
 #include "render/room_light.h"
