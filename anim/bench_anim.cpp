@@ -4,10 +4,12 @@
 //   BM_SampleNlerpBlend/...      the same with nlerp sampling (SamplingJob::nlerp)
 //   BM_Skinning/<method>         CPU skinning of 25 000 vertices, 4 influences, 27 joints
 //   BM_FoxUpdate/<method>        AnimatedCharacter::Update on the Fox with 8 look-at keys
+//   BM_ScheduleUpdate/<dib>      Animator::Update, BCN_Epileptic (54 joints), a four-action schedule
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
 #include "anim/pose.h"
+#include "anim/animator.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
@@ -189,6 +191,57 @@ void BM_FoxUpdate(benchmark::State& state) {
   state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + (state.range(1) ? " nlerp" : " slerp"));
 }
 BENCHMARK(BM_FoxUpdate)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->ArgNames({"method", "nlerp"});
+
+// One Animator::Update of the 54-joint BCN_Epileptic with a four-action schedule: the idle
+// synthesizer (learned from its own clip) underneath, the 8-key view-adaptive blend (look-at
+// keys) on top, a gesture fading in and out (cosine, re-timed as it ends) and a clip masked to
+// the left arm; local-to-model and skinning matrices included.
+void BM_ScheduleUpdate(benchmark::State& state) {
+  const std::string bcn = "/usr/share/assimp/models/X/BCN_Epileptic.X";
+  if (!std::filesystem::exists(bcn)) {
+    state.SkipWithError(("needs " + bcn + " (Debian package assimp-testmodels)").c_str());
+    return;
+  }
+  std::string text = "characters:\n  - asset: " + bcn + "\n    blend: {method: " + (state.range(0) ? "dib" : "dlb") +
+                     "}\n    idle: {clips: [Epileptisch], seed: 1}\n    keys:\n";
+  for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
+  text += R"(    schedule:
+      actions:
+        - name: idle
+          object: {idle: true}
+          keep_rendering: true
+        - name: view
+          object: {view_adaptive: true}
+          keep_rendering: true
+          layer: 1
+        - name: gesture
+          object: {clip: Epileptisch, mirror: true}
+          layer: 2
+          curve: {shape: cosine-fade, in: 0.3, out: 0.3}
+          mask: {default: 0, torso: 1}
+        - name: arm
+          object: {clip: Epileptisch, loop: true}
+          layer: 2
+          weight: 0.5
+          mask: {default: 0, left_arm: 1}
+)";
+  AnimatedCharacter ch(ParseScene(text, "bench.yaml").characters[0]);
+  auto animator = BuildAnimator(ch);
+  Schedule& schedule = animator->schedule();
+  const int gesture = schedule.FindByName("gesture");
+  const double gesture_length = ch.character().FindClip("Epileptisch")->duration;
+  double t = 0;
+  FrameInputs in;
+  for (auto _ : state) {
+    t += 1.0 / 60;
+    if (t > schedule.Find(gesture)->start + gesture_length) schedule.Retime(gesture, t);
+    in.viewpoint = DirectionFromAzimuthElevation(100 * t, 5);
+    const AnimatorFrame& f = animator->Update(t, in);
+    benchmark::DoNotOptimize(f.skinning_matrices.data());
+  }
+  state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + ", 54 joints, 4 actions");
+}
+BENCHMARK(BM_ScheduleUpdate)->Arg(0)->Arg(1)->ArgName("dib");
 
 }  // namespace
 }  // namespace arview::anim
