@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "app/layered_animator.h"
 
 namespace arview::app {

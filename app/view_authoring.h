@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "anim/character.h"
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 
 namespace arview::app {
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "app/view_authoring.h"
 
 namespace arview::app {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "render/hud.h"
 
 namespace arview::app {

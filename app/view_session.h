@@ -12,7 +12,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "anim/scene.h"
+#include "anim_authoring/scene.h"
 #include "app/stage_stats.h"
 #include "app/view_animation.h"
 #include "app/view_authoring.h"
