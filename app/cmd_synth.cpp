@@ -1,6 +1,7 @@
 // arview synth room --out <recording> [--frames N] [--seed S] [--motion-blur N] [--noise sigma] ...
 
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 
 #include "app/commands.h"
@@ -15,6 +16,7 @@ struct SynthArgs {
   std::string out;
   std::string data_dir = render::kOpenCvDocData;
   std::string backend = "auto";
+  std::string size = "640x480";
   bool quiet = false;
 };
 
@@ -22,6 +24,9 @@ void RunSynthRoom(SynthArgs& args) {
   render::SynthRoomOptions& o = args.options;
   o.out = args.out;
   o.data_dir = args.data_dir;
+  char tail = 0;
+  if (std::sscanf(args.size.c_str(), "%dx%d%c", &o.width, &o.height, &tail) != 2)
+    throw CommandError("--size must be WxH, e.g. 1920x1080 (got '" + args.size + "')", 2);
   const auto start = std::chrono::steady_clock::now();
   try {
     o.gl.backend = render::ParseGlBackend(args.backend);
@@ -30,7 +35,7 @@ void RunSynthRoom(SynthArgs& args) {
     });
     if (!args.quiet) std::cerr << "\n";
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "wrote " << report.frames << " frames (640x480, " << o.fps << " fps, seed " << o.seed
+    std::cout << "wrote " << report.frames << " frames (" << o.width << "x" << o.height << ", " << o.fps << " fps, seed " << o.seed
               << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
   } catch (const std::exception& e) {
     throw CommandError(e.what());
@@ -55,6 +60,17 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--exposure", o.exposure_s, "Exposure time spanned by motion blur, seconds")->default_val(o.exposure_s);
   room->add_option("--noise", o.noise_sigma, "Gaussian sensor noise, standard deviation in grey levels (0 = off)")
       ->default_val(o.noise_sigma);
+  room->add_option("--size", args->size, "Frame size WxH, e.g. 1280x720 or 1920x1080 (field of view kept)")
+      ->default_val(args->size);
+  room->add_option("--jpeg", o.jpeg_quality, "Write frames as JPEG at this quality, 1..100 (0 = PNG)")
+      ->default_val(o.jpeg_quality)
+      ->check(CLI::Range(0, 100));
+  room->add_option("--gain-drift", o.gain_drift,
+                   "Exposure/gain change over time: brightness x (1 + A sin(2 pi t / 7 s)), A in [0, 1) (0 = off)")
+      ->default_val(o.gain_drift);
+  room->add_option("--rolling-shutter", o.rolling_shutter_s,
+                   "Rolling-shutter readout time top to bottom, seconds (0 = global shutter)")
+      ->default_val(o.rolling_shutter_s);
   room->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
       ->default_val(args->backend)
       ->check(CLI::IsMember({"auto", "osmesa", "egl"}));

@@ -48,6 +48,7 @@ struct TrackArgs {
   int threads = 1;
   double smoothing_min_cutoff = 1.0;
   double smoothing_beta = 0.5;
+  int working_size = tracker::TrackerOptions{}.working_long_side;
 };
 
 tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
@@ -72,6 +73,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.smoothing.beta = a.smoothing_beta;
   o.index.seed = a.seed;
   o.index.checks = a.index_checks;
+  o.working_long_side = a.working_size;
   return o;
 }
 
@@ -88,6 +90,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"status", ToString(r.status)},
                               {"inliers", r.inliers},
                               {"rms_px", r.rms_px},
+                              {"rms_gate_px", r.rms_gate_px},
                               {"flow_tracks", r.flow_tracks},
                               {"guided_matches", r.guided_matches},
                               {"keypoints", r.keypoints},
@@ -139,6 +142,9 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
 }
 
 void RunTrack(const TrackArgs& args) {
+  if (args.working_size != 0 && args.working_size < 64)
+    throw CommandError("--working-size must be 0 (full resolution) or at least 64 (got " +
+                       std::to_string(args.working_size) + ")", 2);
   const ScopedSignalCancellation signals;
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
@@ -255,6 +261,10 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
   cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
+  cmd->add_option("--working-size", a->working_size,
+                  "Longest side of the image the tracker works on (frames larger are reduced; pixel "
+                  "options are at this size); 0: full resolution")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
   cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")
       ->capture_default_str()->check(CLI::Range(1, 256));

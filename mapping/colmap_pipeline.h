@@ -38,25 +38,28 @@ struct MapBuildOptions {
   FrameSelectionOptions selection;  // video recordings only (its max_frames is ignored)
   bool refine_intrinsics = false;   // let COLMAP's bundle adjustment refine the camera
   int threads = 2;                  // COLMAP's threads per stage (-1: all cores)
-  // Speed settings, chosen on templeRing (docs/mapping.md, "Mapping time"); COLMAP's own
-  // defaults in brackets. COLMAP 3.8 matches on the CPU by building a FLANN kd-tree per image
-  // and pair, so matching time grows with the number of descriptors per image.
-  int max_num_features = 850;        // SiftExtraction.max_num_features [8192]
-  int max_num_orientations = 1;      // SiftExtraction.max_num_orientations [2]
-  double ba_global_ratio = 1.3;      // Mapper.ba_global_images_ratio and _points_ratio [1.1]
-  int ba_global_max_iterations = 25; // Mapper.ba_global_max_num_iterations [50]
-  int ba_local_max_iterations = 15;  // Mapper.ba_local_max_num_iterations [25]
+  // Feature and bundle-adjustment settings. The defaults are COLMAP's own (the "quality" preset:
+  // templeRing's odd frames then localise at about 0.9 mm, as COLMAP registers them); the "fast"
+  // preset trades accuracy for time (docs/mapping.md, "Presets"). COLMAP 3.8 matches on the CPU
+  // by building a FLANN kd-tree per image and pair, so matching time grows with the number of
+  // descriptors per image.
+  int max_num_features = 8192;       // SiftExtraction.max_num_features
+  int max_num_orientations = 2;      // SiftExtraction.max_num_orientations
+  double ba_global_ratio = 1.1;      // Mapper.ba_global_images_ratio and _points_ratio
+  int ba_global_max_iterations = 50; // Mapper.ba_global_max_num_iterations
+  int ba_local_max_iterations = 25;  // Mapper.ba_local_max_num_iterations
   int sequential_overlap = 10;       // SequentialMatching.overlap
   bool quadratic_overlap = true;     // SequentialMatching.quadratic_overlap: loop-like long links
   std::vector<std::string> extra_mapper_args;  // appended to the mapper's command line
 
-  // COLMAP's defaults for the speed settings above (for comparison: `arview map --colmap-defaults`).
-  void UseColmapDefaults() {
-    max_num_features = 8192;
-    max_num_orientations = 2;
-    ba_global_ratio = 1.1;
-    ba_global_max_iterations = 50;
-    ba_local_max_iterations = 25;
+  // `arview map --preset fast`: 850 features and one orientation per keypoint, fewer bundle
+  // adjustments (chosen on templeRing: a third less CPU, about twice the tracking error).
+  void UseFastPreset() {
+    max_num_features = 850;
+    max_num_orientations = 1;
+    ba_global_ratio = 1.3;
+    ba_global_max_iterations = 25;
+    ba_local_max_iterations = 15;
   }
   std::string colmap = "colmap";    // the COLMAP executable (found on PATH)
   // Cancelled (Ctrl-C, SIGTERM): the running COLMAP stage is stopped, BuildMap throws

@@ -216,7 +216,14 @@ RoomScene MakeRoomScene(const fs::path& data_dir) {
   return builder.Finish();
 }
 
-calib::Camera RoomCamera() { return calib::Camera::Pinhole(640, 480, 525.0, 525.0, 321.5, 238.5); }
+calib::Camera RoomCamera(int width, int height) {
+  const double s = width / 640.0;
+  // The 640x480 camera's principal point offset from the image centre, scaled (pixel centres:
+  // the image centre is at (W − 1) / 2).
+  const double cx = (width - 1) / 2.0 + (321.5 - 319.5) * s;
+  const double cy = (height - 1) / 2.0 + (238.5 - 239.5) * s;
+  return calib::Camera::Pinhole(width, height, 525.0 * s, 525.0 * s, cx, cy);
+}
 
 RoomPath::RoomPath(double duration, uint64_t seed) : duration_(duration) {
   std::mt19937_64 engine(seed);
@@ -283,6 +290,12 @@ void ValidateOptions(const SynthRoomOptions& o) {
   if (o.motion_blur_samples < 0 || o.motion_blur_samples > 64) fail("--motion-blur must be in 0..64 samples");
   if (!(o.exposure_s >= 0 && o.exposure_s <= 1.0 / o.fps)) fail("--exposure must be in [0, 1/fps] seconds");
   if (!(o.noise_sigma >= 0 && o.noise_sigma <= 64)) fail("--noise must be in [0, 64] grey levels");
+  if (o.width < 64 || o.height < 48 || o.width > 7680 || o.height > 4320)
+    fail("--size must be between 64x48 and 7680x4320, got " + std::to_string(o.width) + "x" + std::to_string(o.height));
+  if (o.jpeg_quality < 0 || o.jpeg_quality > 100) fail("--jpeg must be in 0..100 (0: PNG)");
+  if (!(o.gain_drift >= 0 && o.gain_drift < 1)) fail("--gain-drift must be in [0, 1)");
+  if (!(o.rolling_shutter_s >= 0 && o.rolling_shutter_s <= 1.0 / o.fps))
+    fail("--rolling-shutter must be in [0, 1/fps] seconds");
 }
 
 void PrepareFolder(const SynthRoomOptions& o) {
@@ -300,7 +313,7 @@ void PrepareFolder(const SynthRoomOptions& o) {
   if (ec) throw RenderError(o.out.string() + ": cannot create the recording folder (" + ec.message() + ")");
 }
 
-cv::Mat RenderExposure(RoomRenderer& renderer, const RoomPath& path, double t, const SynthRoomOptions& o) {
+cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const RoomPath& path, double t, const SynthRoomOptions& o) {
   if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path.At(t));
   cv::Mat sum;
   for (int k = 0; k < o.motion_blur_samples; ++k) {
@@ -313,6 +326,25 @@ cv::Mat RenderExposure(RoomRenderer& renderer, const RoomPath& path, double t, c
   cv::Mat out;
   sum.convertTo(out, CV_8UC3, 1.0 / o.motion_blur_samples);
   return out;
+}
+
+// A rolling shutter reads row y at t + (y / H − 1/2)·readout: 16 horizontal bands, each rendered
+// (with its motion blur) at its middle row's time.
+cv::Mat RenderExposure(RoomRenderer& renderer, const RoomPath& path, double t, const SynthRoomOptions& o) {
+  if (o.rolling_shutter_s <= 0) return RenderGlobalExposure(renderer, path, t, o);
+  constexpr int kBands = 16;
+  cv::Mat out(o.height, o.width, CV_8UC3);
+  for (int b = 0; b < kBands; ++b) {
+    const int y0 = o.height * b / kBands, y1 = o.height * (b + 1) / kBands;
+    const double row_time = t + ((y0 + y1) / 2.0 / o.height - 0.5) * o.rolling_shutter_s;
+    RenderGlobalExposure(renderer, path, row_time, o).rowRange(y0, y1).copyTo(out.rowRange(y0, y1));
+  }
+  return out;
+}
+
+void ApplyGain(cv::Mat& image, double drift, double t) {
+  if (drift <= 0) return;
+  image.convertTo(image, CV_8UC3, 1.0 + drift * std::sin(2 * M_PI * t / 7.0));  // saturating
 }
 
 void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
@@ -332,7 +364,7 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   const RoomScene scene = MakeRoomScene(o.data_dir);
   std::unique_ptr<OffscreenContext> context = OffscreenContext::Create(o.gl);
   PrepareFolder(o);
-  const calib::Camera camera = RoomCamera();
+  const calib::Camera camera = RoomCamera(o.width, o.height);
   RoomRenderer renderer(*context, scene, camera, o.samples);
   const RoomPath path(o.frames / o.fps, o.seed);
 
@@ -349,14 +381,17 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   for (int i = 0; i < o.frames; ++i) {
     const double t = i / o.fps;
     cv::Mat image = RenderExposure(renderer, path, t, o);
+    ApplyGain(image, o.gain_drift, t);
     AddNoise(image, o.noise_sigma, o.seed, i);
     char name[32];
-    std::snprintf(name, sizeof name, "frames/%06d.png", i);
+    std::snprintf(name, sizeof name, "frames/%06d.%s", i, o.jpeg_quality > 0 ? "jpg" : "png");
     finish_write();
     pending_name = name;
-    pending_write = std::async(std::launch::async, [file = (o.out / name).string(), image] {
+    const std::vector<int> params = o.jpeg_quality > 0 ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality}
+                                                       : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
+    pending_write = std::async(std::launch::async, [file = (o.out / name).string(), image, params] {
       try {
-        WriteImageAtomically(file, image, {cv::IMWRITE_PNG_COMPRESSION, 1});
+        WriteImageAtomically(file, image, params);
         return true;
       } catch (const Error&) {
         return false;

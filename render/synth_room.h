@@ -43,7 +43,9 @@ struct RoomScene {
 RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData);
 
 // The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
-calib::Camera RoomCamera();
+// Other sizes keep the horizontal field of view (f and the principal point offset scale with
+// width / 640, pixel centres in OpenCV's convention); a wider aspect crops top and bottom.
+calib::Camera RoomCamera(int width = 640, int height = 480);
 
 // The hand-held path: camera pose (world → camera) at time t (seconds) for a sequence of
 // `duration` seconds; deterministic for a seed. The fast turn (90° in 0.6 s) starts at 55% of
@@ -67,6 +69,14 @@ struct SynthRoomOptions {
   int motion_blur_samples = 0;   // 0 or 1: none; N > 1: average N renders over the exposure
   double exposure_s = 1.0 / 60;  // shutter time spanned by motion blur
   double noise_sigma = 0.0;      // additive Gaussian sensor noise, grey levels (8-bit)
+  int width = 640, height = 480; // frame size (e.g. 1280x720, 1920x1080)
+  int jpeg_quality = 0;          // 0: frames as PNG; 1..100: JPEG at this quality
+  // Exposure/gain change over time: brightness multiplied by 1 + gain_drift·sin(2πt / 7 s)
+  // (auto-exposure hunting); 0: off.
+  double gain_drift = 0.0;
+  // Rolling shutter: rows are read out over this time, top to bottom (each of 16 bands is
+  // rendered at its own time); 0: global shutter.
+  double rolling_shutter_s = 0.0;
   int samples = 4;               // MSAA samples
   bool overwrite = false;        // replace an existing recording in `out`
   std::filesystem::path data_dir = kOpenCvDocData;
@@ -78,8 +88,9 @@ struct SynthRoomReport {
   int frames = 0;
 };
 
-// Renders and writes the recording: frames/NNNNNN.png, frames.txt, camera.yaml and
-// groundtruth.txt (TUM, camera-to-world, pose at the middle of each exposure).
+// Renders and writes the recording: frames/NNNNNN.png (or .jpg), frames.txt, camera.yaml and
+// groundtruth.txt (TUM, camera-to-world, pose at the middle of each exposure; with a rolling
+// shutter, of the middle row's exposure).
 // `progress(done, total)` is called after every frame when given.
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options,
                                const std::function<void(int, int)>& progress = nullptr);

@@ -200,6 +200,39 @@ TEST(SynthRoom, WritesALoadableDeterministicRecording) {
   EXPECT_NE(Bytes(a.path / "frames/000003.png"), Bytes(c.path / "frames/000003.png"));
 }
 
+// The realistic-footage flags: a 1280x720 camera with the same field of view, JPEG frames, a
+// gain change and a rolling shutter, each changing the image and none the ground truth.
+TEST(SynthRoom, RealisticFootageFlags) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  const calib::Camera hd = RoomCamera(1280, 720);
+  EXPECT_DOUBLE_EQ(hd.fx, 2 * RoomCamera().fx);
+  EXPECT_DOUBLE_EQ(hd.cx, 643.5);  // (640 − 1)/2 + 2 at 640 wide, scaled in pixel centres
+  TempDir plain, real;
+  SynthRoomOptions options;
+  options.frames = 2;
+  options.width = 1280;
+  options.height = 720;
+  options.gl = {GlBackend::kAuto, 2};
+  options.out = plain.path;
+  SynthesizeRoom(options);
+  options.out = real.path;
+  options.jpeg_quality = 80;
+  options.gain_drift = 0.3;
+  options.rolling_shutter_s = 0.02;
+  SynthesizeRoom(options);
+  const recordings::Recording a = recordings::LoadRecording(plain.path);
+  const recordings::Recording b = recordings::LoadRecording(real.path);
+  EXPECT_EQ(a.camera.Size(), cv::Size(1280, 720));
+  EXPECT_EQ(b.ReadImage(1).size(), cv::Size(1280, 720));
+  EXPECT_TRUE(fs::exists(real.path / "frames/000001.jpg"));
+  EXPECT_LT(((*a.groundtruth)[1].pose.Center() - (*b.groundtruth)[1].pose.Center()).norm(), 1e-12);
+  cv::Mat diff;
+  cv::absdiff(a.ReadImage(1), b.ReadImage(1), diff);
+  EXPECT_GT(cv::mean(diff)[0], 1.0) << "gain, JPEG and rolling shutter should change the frame";
+  options.jpeg_quality = 101;
+  EXPECT_THROW(SynthesizeRoom(options), RenderError);
+}
+
 TEST(SynthRoom, RefusesANonEmptyFolderAndBadOptions) {
   TempDir dir;
   fs::create_directories(dir.path);

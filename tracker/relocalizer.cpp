@@ -53,9 +53,9 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
   }
 }
 
-Relocalizer::Relocalizer(const map::Map& map, const map::DescriptorIndex& index,
-                         const RelocalizerOptions& options)
-    : map_(map), index_(index), options_(options), extractor_(options.features) {}
+Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
+                         const map::DescriptorIndex& index, const RelocalizerOptions& options)
+    : map_(map), camera_(camera), index_(index), options_(options), extractor_(options.features) {}
 
 RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
   const auto start = std::chrono::steady_clock::now();
@@ -76,7 +76,7 @@ RelocalizationResult Relocalizer::Relocalize(const Features& features) const {
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> points;
   GatherCorrespondences(features, map_, matches, &pixels, &points);
-  result.pose = EstimateAbsolutePose(map_.camera, pixels, points, options_.pose);
+  result.pose = EstimateAbsolutePose(camera_, pixels, points, options_.pose);
   if (result.pose.ok) {
     for (int i : result.pose.inliers) {
       result.inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());

@@ -56,8 +56,9 @@ struct RelocalizationResult {
 
 class Relocalizer {
  public:
-  // `map` and `index` must outlive the relocalizer.
-  Relocalizer(const map::Map& map, const map::DescriptorIndex& index,
+  // `map` and `index` must outlive the relocalizer. `camera`: the camera of the images it is
+  // given (the map camera, or the map camera scaled to the tracker's working resolution).
+  Relocalizer(const map::Map& map, const calib::Camera& camera, const map::DescriptorIndex& index,
               const RelocalizerOptions& options);
   RelocalizationResult Relocalize(const cv::Mat& gray) const;
   // Features already extracted (e.g. by guided matching of the same frame).
@@ -67,6 +68,7 @@ class Relocalizer {
 
  private:
   const map::Map& map_;
+  calib::Camera camera_;
   const map::DescriptorIndex& index_;
   RelocalizerOptions options_;
   SiftExtractor extractor_;

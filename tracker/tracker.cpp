@@ -41,6 +41,12 @@ calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last)
   return last * previous.Inverse();
 }
 
+calib::Pose ScaleMotion(const calib::Pose& motion, double ratio) {
+  Eigen::AngleAxisd rotation(motion.q_cw);
+  rotation.angle() *= ratio;
+  return {Eigen::Quaterniond(rotation).normalized(), ratio * motion.t_cw};
+}
+
 Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size) {
   if (static_cast<int>(tracks.pixels.size()) <= max_count) return tracks;
   const int gw = size.width / cell + 1, gh = size.height / cell + 1;
@@ -81,10 +87,14 @@ void ValidateMap(const map::Map& map, int min_points) {
 }
 
 Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
-    : map_(map), options_(options), smoother_(options.smoothing) {
+    : map_(map),
+      options_(options),
+      resolution_(map.camera, options.working_long_side),
+      rms_gate_(options.tracking.rms_gate),
+      smoother_(options.smoothing) {
   ValidateMap(map, options.min_map_points);
   index_ = map::DescriptorIndex(map.descriptors, options.index);
-  relocalizer_ = std::make_unique<Relocalizer>(map_, index_, options.relocalization);
+  relocalizer_ = std::make_unique<Relocalizer>(map_, resolution_.work(), index_, options.relocalization);
   FeatureOptions guided_features = options.relocalization.features;
   guided_features.max_features = options.tracking.guided_max_features;
   guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
@@ -198,12 +208,20 @@ struct Tracker::Guided {
   }
 };
 
-bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
-                             std::optional<Features>* extracted) {
+calib::Pose Tracker::Predict(double timestamp) const {
+  if (!has_velocity_) return last_pose_;
+  const double dt = timestamp - last_timestamp_;
+  double ratio = 1;
+  if (std::isfinite(dt) && dt > 0 && velocity_dt_ > 0)
+    ratio = std::min(dt / velocity_dt_, options_.tracking.max_prediction_ratio);
+  return PredictConstantVelocity(last_pose_, ScaleMotion(velocity_, ratio));
+}
+
+bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,
+                             std::optional<Features>* extracted, Track2D3D* tracked_inliers) {
   const TrackingOptions& opt = options_.tracking;
-  const calib::Camera& camera = map_.camera;
-  const calib::Pose predicted =
-      has_velocity_ ? PredictConstantVelocity(last_pose_, velocity_) : last_pose_;
+  const calib::Camera& camera = resolution_.work();
+  const calib::Pose predicted = Predict(timestamp);
 
   // 1. Pyramidal LK from last frame's inliers, started where the prediction puts them.
   const auto flow_start = std::chrono::steady_clock::now();
@@ -242,8 +260,28 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
   result->flow_tracks = static_cast<int>(pixels.size());
   result->times.flow_ms = MillisecondsSince(flow_start);
 
-  // 2. Guided matching when the flow tracks have thinned out.
+  AbsolutePoseOptions pose_options = options_.relocalization.pose;
+  pose_options.ransac_max_iterations = opt.ransac_max_iterations;
+  pose_options.min_inliers = opt.min_inliers;
+  pose_options.max_rms_px = rms_gate_.Gate();
+  pose_options.seed += frame_counter_;
+  pose_options.prior = predicted;
+  result->rms_gate_px = rms_gate_.Gate();
+
+  // 2. Guided matching when the flow tracks have thinned out: map points projected with the
+  // pose the surviving tracks give (closer than the prediction after a large or sudden
+  // motion), or with the prediction and a wider radius when too few tracks survive.
   if (result->flow_tracks < opt.replenish_below) {
+    calib::Pose projecting = predicted;
+    double radius = opt.guided_radius_predicted_px;
+    if (result->flow_tracks >= opt.min_inliers) {
+      const AbsolutePoseResult from_flow = EstimateAbsolutePose(camera, pixels, points, pose_options);
+      result->times.refine_ms += from_flow.stats.refine_ms;
+      if (from_flow.ok) {
+        projecting = from_flow.pose;
+        radius = opt.guided_radius_px;
+      }
+    }
     const auto extract_start = std::chrono::steady_clock::now();
     const Features& features = extracted->emplace(guided_extractor_->Extract(gray));
     result->keypoints = static_cast<int>(features.keypoints.size());
@@ -251,19 +289,18 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
     const auto match_start = std::chrono::steady_clock::now();
     std::vector<Guided::Candidate> candidates;
     const std::vector<int> keyframes =
-        point_ids.empty() ? NearestKeyframes(predicted) : CovisibleKeyframes(point_ids);
+        point_ids.empty() ? NearestKeyframes(projecting) : CovisibleKeyframes(point_ids);
     for (int k : keyframes) {
       for (const auto& obs : map_.keyframes[k].observations) {
         if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
         point_stamp_[obs.point] = frame_counter_;
-        const Eigen::Vector3d pc = predicted.ToCamera(map_.points[obs.point].xyz);
+        const Eigen::Vector3d pc = projecting.ToCamera(map_.points[obs.point].xyz);
         if (pc.z() <= 0) continue;
         const Eigen::Vector2d px = camera.Project(pc);
         if (camera.InImage(px)) candidates.push_back({px, obs.point});
       }
     }
-    const auto guided = Guided::Match(features, candidates, map_, opt.guided_radius_px,
-                                      opt.guided_ratio, gray.size());
+    const auto guided = Guided::Match(features, candidates, map_, radius, opt.guided_ratio, gray.size());
     for (const auto& m : guided) {
       const cv::Point2f& p = features.keypoints[m.keypoint].pt;
       pixels.emplace_back(p.x, p.y);
@@ -276,12 +313,6 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short
   // RANSAC, whose pose must stay near the prediction.
-  AbsolutePoseOptions pose_options = options_.relocalization.pose;
-  pose_options.ransac_max_iterations = opt.ransac_max_iterations;
-  pose_options.min_inliers = opt.min_inliers;
-  pose_options.max_rms_px = opt.max_rms_px;
-  pose_options.seed += frame_counter_;
-  pose_options.prior = predicted;
   AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
   CopyStats(pose, result);
   last_pyramid_ = std::move(pyramid);
@@ -304,36 +335,56 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, FrameResult* result,
     return false;
   }
   result->pose = pose.pose;
-  Track2D3D inliers;
+  Track2D3D& inliers = *tracked_inliers;
   for (int i : pose.inliers) {
     inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
     inliers.points.push_back(point_ids[i]);
   }
-  last_inliers_ = SpreadTracks(inliers, opt.max_flow_tracks, 40, gray.size());
   return true;
 }
 
-void Tracker::Remember(const FrameResult& result, const Track2D3D& inliers) {
+void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const {
+  if (!resolution_.reduced() || !options_.refine_on_full_camera || inliers.pixels.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  pixels.reserve(inliers.pixels.size());
+  points.reserve(inliers.pixels.size());
+  for (size_t i = 0; i < inliers.pixels.size(); ++i) {
+    pixels.push_back(resolution_.ToFull({inliers.pixels[i].x, inliers.pixels[i].y}));
+    points.push_back(map_.points[inliers.points[i]].xyz);
+  }
+  RefineOptions refine = options_.relocalization.pose.refinement;
+  refine.loss_scale_px *= resolution_.full_per_work();  // the same loss, in full-resolution pixels
+  const RefineResult refined = RefinePose(resolution_.full(), pixels, points, result->pose, refine);
+  if (refined.ok) result->pose = refined.pose;
+  result->times.refine_ms += MillisecondsSince(start);
+}
+
+void Tracker::Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers) {
   if (has_pose_ && result.status == TrackStatus::kTracking) {
     velocity_ = RelativeMotion(last_pose_, result.pose);
+    velocity_dt_ = timestamp - last_timestamp_;
     has_velocity_ = true;
   } else {
     has_velocity_ = false;
   }
+  if (result.status == TrackStatus::kTracking) rms_gate_.Observe(result.rms_px);
   last_pose_ = result.pose;
+  last_timestamp_ = timestamp;
   has_pose_ = true;
-  if (result.status == TrackStatus::kRelocalized)
-    last_inliers_ = SpreadTracks(inliers, options_.tracking.max_flow_tracks, 40, map_.camera.Size());
+  const TrackingOptions& opt = options_.tracking;
+  last_inliers_ = SpreadTracks(inliers, opt.max_flow_tracks, opt.flow_grid_cell_px, resolution_.work().Size());
 }
 
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMilliseconds();
   FrameResult result;
-  const cv::Mat gray = image.empty() ? cv::Mat() : ToGray8(image);
-  if (gray.empty() || gray.size() != map_.camera.Size()) {
+  const cv::Mat full_gray = image.empty() ? cv::Mat() : ToGray8(image);
+  if (full_gray.empty() || full_gray.size() != map_.camera.Size()) {
     std::ostringstream msg;
-    msg << "frame is " << gray.cols << "x" << gray.rows << ", the map camera is "
+    msg << "frame is " << full_gray.cols << "x" << full_gray.rows << ", the map camera is "
         << map_.camera.width << "x" << map_.camera.height;
     result.reason = msg.str();
     Reset();
@@ -342,14 +393,15 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     return result;
   }
 
+  const cv::Mat gray = resolution_.Reduce(full_gray);
   bool tracked = false;
   std::string tracking_reason;
   std::optional<Features> features;
+  Track2D3D inliers;
   if (has_pose_) {
-    tracked = TrackWithPrior(gray, &result, &features);
+    tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     tracking_reason = result.reason;
   }
-  Track2D3D reloc_inliers;
   if (tracked) {
     result.status = TrackStatus::kTracking;
     result.reason.clear();
@@ -365,7 +417,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
       result.status = TrackStatus::kRelocalized;
       result.pose = reloc.pose.pose;
       result.reason = tracking_reason;
-      reloc_inliers = reloc.inliers;
+      inliers = reloc.inliers;
       if (last_pyramid_.empty() || !has_pose_)
         cv::buildOpticalFlowPyramid(gray, last_pyramid_,
                                     cv::Size(options_.tracking.lk_window_px, options_.tracking.lk_window_px),
@@ -381,7 +433,8 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   if (result.status == TrackStatus::kLost) {
     Reset();
   } else {
-    Remember(result, reloc_inliers);
+    RefineOnFullCamera(inliers, &result);
+    Remember(result, timestamp, inliers);
     result.center = result.pose.Center();
     result.smoothed_center = smoother_.Filter(result.center, timestamp);
   }

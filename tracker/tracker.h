@@ -19,6 +19,8 @@
 #include "map/map.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
+#include "tracker/residual_gate.h"
+#include "tracker/working_resolution.h"
 
 namespace arview::tracker {
 
@@ -33,20 +35,27 @@ constexpr auto EnumNames(TrackStatus) {
                                     {TrackStatus::kLost, "lost"}}};
 }
 
+// Every pixel quantity below is in working-resolution pixels (TrackerOptions::working_long_side).
 struct TrackingOptions {
   int lk_window_px = 21;
-  int lk_pyramid_levels = 3;
+  // 4 levels follow ~80 px of unpredicted motion at the working resolution (frames 2-4 video
+  // frames apart, or the first frame after a relocalization, which has no velocity yet).
+  int lk_pyramid_levels = 4;
   int lk_max_iterations = 20;
   // At most this many inliers are followed into the next frame, spread over the image (LK and
   // refinement time grow with the count; a few hundred well-spread points pin the pose).
   int max_flow_tracks = 300;
-  // Guided matching (SIFT on the frame, matched only against map points projected within
-  // guided_radius_px) runs when fewer flow tracks than this survive.
+  int flow_grid_cell_px = 40;  // cell of the grid the followed inliers are spread over
+  // Guided matching (SIFT on the frame, matched only against map points projected within a
+  // radius) runs when fewer flow tracks than this survive.
   int replenish_below = 150;
   // Keyframes whose observations are projected: those seeing most of the flow tracks
   // (covisibility), or without tracks the nearest looking the same way.
   int guided_keyframes = 4;
+  // Radius around the projection with the pose refined on the flow tracks; with only the
+  // motion prediction to project with (too few flow tracks), the wider radius.
   double guided_radius_px = 10;
+  double guided_radius_predicted_px = 25;
   double guided_ratio = 0.85;
   // SIFT keypoints for guided matching: more than relocalization uses, since matching them
   // costs little and the tracked pose needs points spread over the whole view.
@@ -59,11 +68,14 @@ struct TrackingOptions {
   // mirrored on a nearly planar patch explains the points almost as well as the true one).
   double max_rotation_from_prediction_deg = 20;
   int min_inliers = 30;            // below this, fall back to relocalization
-  // Tracked poses fit at about 1 px; a worse fit means drifted flow tracks or wrong guided
-  // matches (seen in fast turns), so the frame is relocalised instead.
-  double max_rms_px = 1.5;
+  // The largest accepted inlier RMS follows the residual scale of recent tracked frames
+  // (tracker/residual_gate.h): drifted flow tracks or wrong guided matches (seen in fast turns)
+  // fit worse than the camera's genuine poses, and the frame is relocalised instead.
+  ResidualGateOptions rms_gate;
+  // Constant-velocity prediction scaled by the time since the last frame over the time the
+  // velocity was measured on, within these bounds (a dropped frame doubles the motion).
+  double max_prediction_ratio = 4;
 };
-
 // FLANN's default 64 leaves per query, halved: on templeRing and the synthetic room the same
 // frames localise with the same accuracy, and global matching is ~1.5x faster.
 inline map::IndexParams DefaultIndexParams() {
@@ -78,6 +90,11 @@ struct TrackerOptions {
   OneEuroOptions smoothing;
   map::IndexParams index = DefaultIndexParams();
   int min_map_points = 30;  // a map with fewer points is refused at construction
+  // Longest side of the image every per-frame step works on (0: the camera's full size); the
+  // frames stay at the map camera's resolution (tracker/working_resolution.h).
+  int working_long_side = 960;
+  // The final refinement on the full camera model (pixels mapped back to full resolution).
+  bool refine_on_full_camera = true;
 };
 
 struct StageTimes {
@@ -96,7 +113,8 @@ struct FrameResult {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();           // C = −Rᵀt
   Eigen::Vector3d smoothed_center = Eigen::Vector3d::Zero();  // One Euro filtered C
   int inliers = 0;
-  double rms_px = 0;
+  double rms_px = 0;       // inlier RMS, working pixels
+  double rms_gate_px = 0;  // the largest RMS a tracked pose could have had (tracking only)
   int flow_tracks = 0;     // LK tracks that survived into this frame
   int guided_matches = 0;  // added by guided matching
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
@@ -117,18 +135,25 @@ class Tracker {
   // Forgets the prior: the next frame is relocalised.
   void Reset();
   const TrackerOptions& options() const { return options_; }
+  // The camera every per-frame step uses (the map camera scaled to the working resolution).
+  const calib::Camera& working_camera() const { return resolution_.work(); }
 
  private:
   struct Guided;
   // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
   // to relocalization does not extract it again.
-  bool TrackWithPrior(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features);
-  void Remember(const FrameResult& result, const Track2D3D& inliers);
+  bool TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,
+                      std::optional<Features>* features, Track2D3D* inliers);
+  calib::Pose Predict(double timestamp) const;
+  void RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const;
+  void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
   std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
   std::vector<int> CovisibleKeyframes(const std::vector<std::uint32_t>& points) const;
 
   const map::Map& map_;
   TrackerOptions options_;
+  WorkingResolution resolution_;
+  ResidualGate rms_gate_;
   map::DescriptorIndex index_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<SiftExtractor> guided_extractor_;
@@ -139,6 +164,8 @@ class Tracker {
   bool has_velocity_ = false;
   calib::Pose last_pose_;
   calib::Pose velocity_;  // last_pose ∘ previous⁻¹
+  double last_timestamp_ = 0;
+  double velocity_dt_ = 0;  // the time velocity_ spans
   std::vector<cv::Mat> last_pyramid_;
   Track2D3D last_inliers_;
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
@@ -155,6 +182,9 @@ void ValidateMap(const map::Map& map, int min_points);
 
 // Constant-velocity prediction: apply the last inter-frame motion once more.
 calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity);
+// `motion` scaled by `ratio` (rotation angle and translation multiplied): the motion over
+// ratio times the interval it was measured on.
+calib::Pose ScaleMotion(const calib::Pose& motion, double ratio);
 // velocity such that PredictConstantVelocity(previous, velocity) == last.
 calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last);
 
