@@ -9,6 +9,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -378,8 +379,21 @@ class Importer {
 
 }  // namespace
 
+namespace {
+std::atomic<BuiltinCharacterProvider> builtin_provider{nullptr};
+}  // namespace
+
+bool IsBuiltinAsset(const fs::path& asset) { return asset.native().rfind(kBuiltinAssetPrefix, 0) == 0; }
+
+void SetBuiltinCharacterProvider(BuiltinCharacterProvider provider) { builtin_provider = provider; }
+
 Character LoadCharacter(const fs::path& path) {
   const std::string file = path.string();
+  if (IsBuiltinAsset(path)) {
+    const BuiltinCharacterProvider provider = builtin_provider.load();
+    if (!provider) throw Error(file + ": built-in characters are not available in this program");
+    return provider(file.substr(std::string(kBuiltinAssetPrefix).size()));
+  }
   std::error_code ec;
   if (!fs::exists(path, ec)) throw Error(file + ": no such file");
   if (!fs::is_regular_file(path, ec)) throw Error(file + ": not a regular file");

@@ -91,8 +91,13 @@ class SceneReader {
     const Node* asset = n.Find("asset");
     if (!asset) Fail(n, "a character needs 'asset: <file>'");
     fs::path a = String(*asset, "asset");
-    if (a.is_relative()) a = base_dir / a;
-    c.asset = fs::absolute(a).lexically_normal();
+    if (IsBuiltinAsset(a)) {  // generated in code, not a file: no path to resolve
+      c.asset = a;
+      if (c.name.empty()) c.name = a.string().substr(std::string(kBuiltinAssetPrefix).size());
+    } else {
+      if (a.is_relative()) a = base_dir / a;
+      c.asset = fs::absolute(a).lexically_normal();
+    }
     if (c.name.empty()) c.name = c.asset.stem().string();
     if (const Node* x = n.Find("scale")) {
       c.scale = Number(*x, "scale");

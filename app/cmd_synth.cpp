@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 
 #include "app/commands.h"
 #include "render/synth_room.h"
@@ -79,6 +80,12 @@ void AddSynthCommand(CLI::App& app) {
       ->check(CLI::Range(0, 32));
   o.gl.threads = 2;
   room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
+  room->add_option("--path", o.walk,
+                   "Camera walk: room (round the room's centre, looking at the walls) or orbit (two laps round the "
+                   "demo's character spot: the first looking across the room, the second at the character)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, render::RoomWalk>{{"room", render::RoomWalk::kRoom},
+                                                                                   {"orbit", render::RoomWalk::kOrbit}}))
+      ->default_str("room");
   room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
   room->add_flag("--quiet", args->quiet, "No progress on stderr");
   room->callback([args] { RunSynthRoom(*args); });

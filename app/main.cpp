@@ -7,6 +7,7 @@
 #include "app/commands.h"
 #include "app/numeric_flags.h"
 #include "base/cancellation.h"
+#include "figure/humanoid.h"
 
 namespace arview::app {
 
@@ -31,6 +32,7 @@ std::string OneLine(std::string text) {
 
 int main(int argc, char** argv) {
   using namespace arview::app;
+  arview::figure::RegisterBuiltinCharacters();  // "builtin:figure" wherever an asset is named
   CLI::App app{"arview: marker-less augmented reality with view-adaptive characters", "arview"};
   app.require_subcommand(1);
   app.fallthrough(false);

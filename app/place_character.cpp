@@ -11,7 +11,9 @@ namespace arview::app {
 
 PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path& asset_path,
                                const PlaceCharacterOptions& o) {
-  const std::filesystem::path asset = std::filesystem::absolute(asset_path);
+  // A built-in asset ("builtin:figure") is a name, not a file.
+  const std::filesystem::path asset =
+      anim::IsBuiltinAsset(asset_path) ? asset_path : std::filesystem::absolute(asset_path);
   const anim::Character character = anim::LoadCharacter(asset);
   const double height = RestHeight(character, Eigen::Vector3d::UnitY());
 
@@ -33,9 +35,10 @@ PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path&
   options.plane.seed = o.seed;
 
   PlacedCharacter placed;
-  placed.name = asset.stem().string();
+  placed.name = anim::IsBuiltinAsset(asset) ? asset.string().substr(std::string(anim::kBuiltinAssetPrefix).size())
+                                            : asset.stem().string();
   placed.asset = asset;
-  placed.anchor = PlaceOnDominantPlane(points, centres, up_axes, height, options);
+  placed.anchor = o.anchor ? *o.anchor : PlaceOnDominantPlane(points, centres, up_axes, height, options);
   placed.rest_height = height;
   // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
   // seen from the character's eyes (a character on a table is looked at from above; a tall one

@@ -18,6 +18,10 @@ struct PlaceCharacterOptions {
   std::string base_clip;         // empty: the asset's first clip; "rest": the rest pose
   std::optional<double> key_elevation_deg;  // empty: the median elevation of the map's cameras
   std::uint64_t seed = 1;
+  // Given: the character stands here (position, rotation and scale in map units) instead of on
+  // the dominant plane, e.g. where the demo's walk circles; the keys are still fitted to the
+  // map's cameras.
+  std::optional<Anchor> anchor;
 };
 
 PlacedCharacter PlaceCharacter(const map::Map& map, const std::filesystem::path& asset,

@@ -1,5 +1,5 @@
 #pragma once
-// Writes the scene file (the format of anim/scene.h) for a character placed by `arview place`:
+// Writes the scene file (the format of anim_authoring/scene.h) for a character placed by `arview place`:
 // the anchor, and K look-at keys evenly spaced on the horizon around the character.
 
 #include <filesystem>

@@ -313,13 +313,15 @@ void PrepareFolder(const SynthRoomOptions& o) {
   if (ec) throw RenderError(o.out.string() + ": cannot create the recording folder (" + ec.message() + ")");
 }
 
-cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const RoomPath& path, double t, const SynthRoomOptions& o) {
-  if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path.At(t));
+using PoseAt = std::function<calib::Pose(double)>;
+
+cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const PoseAt& path, double t, const SynthRoomOptions& o) {
+  if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path(t));
   cv::Mat sum;
   for (int k = 0; k < o.motion_blur_samples; ++k) {
     const double offset = o.exposure_s * (static_cast<double>(k) / (o.motion_blur_samples - 1) - 0.5);
     cv::Mat frame;
-    renderer.Render(path.At(t + offset)).convertTo(frame, CV_32FC3);
+    renderer.Render(path(t + offset)).convertTo(frame, CV_32FC3);
     if (sum.empty()) sum = frame;
     else sum += frame;
   }
@@ -330,7 +332,7 @@ cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const RoomPath& path, doubl
 
 // A rolling shutter reads row y at t + (y / H − 1/2)·readout: 16 horizontal bands, each rendered
 // (with its motion blur) at its middle row's time.
-cv::Mat RenderExposure(RoomRenderer& renderer, const RoomPath& path, double t, const SynthRoomOptions& o) {
+cv::Mat RenderExposure(RoomRenderer& renderer, const PoseAt& path, double t, const SynthRoomOptions& o) {
   if (o.rolling_shutter_s <= 0) return RenderGlobalExposure(renderer, path, t, o);
   constexpr int kBands = 16;
   cv::Mat out(o.height, o.width, CV_8UC3);
@@ -366,7 +368,9 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   PrepareFolder(o);
   const calib::Camera camera = RoomCamera(o.width, o.height);
   RoomRenderer renderer(*context, scene, camera, o.samples);
-  const RoomPath path(o.frames / o.fps, o.seed);
+  const RoomPath room_path(o.frames / o.fps, o.seed);
+  const OrbitWalk orbit_walk(o.frames / o.fps, o.seed, o.orbit);
+  const PoseAt path = [&](double t) { return o.walk == RoomWalk::kOrbit ? orbit_walk.At(t) : room_path.At(t); };
 
   std::vector<recordings::FrameEntry> entries;
   recordings::Trajectory groundtruth;
@@ -398,7 +402,7 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
       }
     });
     entries.push_back({t, name});
-    groundtruth.push_back({t, path.At(t)});
+    groundtruth.push_back({t, path(t)});
     if (progress) progress(i + 1, o.frames);
   }
   finish_write();

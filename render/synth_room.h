@@ -19,6 +19,7 @@
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "render/offscreen.h"
+#include "render/orbit_walk.h"
 #include "render/textured_scene.h"
 
 namespace arview::render {
@@ -61,8 +62,14 @@ class RoomPath {
   double shake_phase_[6];
 };
 
+// The camera's walk: RoomPath (round the room's centre, looking at the walls), or OrbitWalk
+// (two laps round a spot where a character stands, for `arview demo`).
+enum class RoomWalk { kRoom, kOrbit };
+
 struct SynthRoomOptions {
   std::filesystem::path out;
+  RoomWalk walk = RoomWalk::kRoom;
+  OrbitWalkOptions orbit;        // for RoomWalk::kOrbit
   int frames = 300;
   uint64_t seed = 1;
   double fps = 30.0;

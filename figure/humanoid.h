@@ -1,0 +1,50 @@
+#pragma once
+// figure/: the project's own character, generated in code — a rigged, coloured humanoid with
+// authored key animations — so that the demo and the tests have a lifelike character on a
+// fresh machine with no downloads and no asset file in the repository.
+//
+//   figure::RegisterBuiltinCharacters();              // once, at program start
+//   anim::Character c = anim::LoadCharacter("builtin:figure");   // like any imported asset
+//
+// The figure ("builtin:figure"): 1.72 m tall, in metres, +Y up, facing +Z (its left is +X),
+// standing on y = 0; the bind pose is the rest pose (arms 15° from the body).
+// - Skeleton: 33 joints with Mixamo's names without the "mixamorig:" prefix (Hips, Spine,
+//   Spine1, Spine2, Neck, Head, HeadTop_End, Left/RightShoulder, Arm, ForeArm, Hand,
+//   HandIndex1, HandThumb1, Left/RightUpLeg, Leg, Foot, ToeBase, Toe_End), which CMU's BVH
+//   names share (Hips, Spine, Spine1, Neck, Head, LeftArm, LeftForeArm, LeftUpLeg, ...), so
+//   look-at chains, arm chains and humanoid masks find head, neck, spine, arms and legs by
+//   name. Every rest rotation is the identity: joint frames are parallel to the model frame.
+// - Skin: smooth tubes along the limbs and the torso (elliptic cross-sections, rounded ends),
+//   an ellipsoid head with eyes, brows, nose, mouth and hair, mitten hands with thumbs, shoes;
+//   about 9 000 triangles in 18 meshes, each with its material's colour (skin, shirt,
+//   trousers, shoes, hair, eyes, lips). Vertices near a joint blend the two bones on either
+//   side of it (smoothstep over a band as wide as the limb), so bends stay smooth under
+//   linear and dual-quaternion skinning.
+// - Clips (30 keys per second): Idle (4 s loop: breathing, relaxed arms, small head motion),
+//   WeightShift (6 s loop: the weight moves from leg to leg, the free knee bends, the feet
+//   stay planted), Wave (3.2 s: the right arm rises, the hand waves three times, lowers),
+//   Point (3 s: the right arm points straight ahead at shoulder height, holds, lowers),
+//   Nod (2 s: a greeting nod). All start from, and the one-shots end in, Idle's posture, so
+//   they blend and cross-fade without a jump.
+
+#include <string>
+#include <vector>
+
+#include "anim/character.h"
+
+namespace arview::figure {
+
+// The humanoid above. Deterministic: the same character every call.
+anim::Character MakeHumanoid();
+
+// Names accepted after "builtin:" (today: "figure").
+std::vector<std::string> BuiltinCharacterNames();
+
+// The built-in character `name` (without the "builtin:" prefix); throws anim::Error naming
+// the asset and listing the known names when there is no such character.
+anim::Character MakeBuiltinCharacter(const std::string& name);
+
+// Makes anim::LoadCharacter("builtin:<name>") return MakeBuiltinCharacter(name).
+void RegisterBuiltinCharacters();
+
+}  // namespace arview::figure
