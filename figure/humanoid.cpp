@@ -1,5 +1,7 @@
 #include "figure/humanoid.h"
 
+#include "anim_authoring/import.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
