@@ -49,6 +49,7 @@ struct TrackArgs {
   double smoothing_min_cutoff = 1.0;
   double smoothing_beta = 0.5;
   int working_size = tracker::TrackerOptions{}.working_long_side;
+  int sift_size = tracker::RelocalizerOptions{}.sift_long_side;
 };
 
 tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
@@ -74,6 +75,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.index.seed = a.seed;
   o.index.checks = a.index_checks;
   o.working_long_side = a.working_size;
+  o.relocalization.sift_long_side = a.sift_size;
   return o;
 }
 
@@ -145,6 +147,9 @@ void RunTrack(const TrackArgs& args) {
   if (args.working_size != 0 && args.working_size < 64)
     throw CommandError("--working-size must be 0 (full resolution) or at least 64 (got " +
                        std::to_string(args.working_size) + ")", 2);
+  if (args.sift_size != 0 && args.sift_size < 64)
+    throw CommandError("--sift-size must be 0 (the working resolution) or at least 64 (got " +
+                       std::to_string(args.sift_size) + ")", 2);
   const ScopedSignalCancellation signals;
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
@@ -264,6 +269,10 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--working-size", a->working_size,
                   "Longest side of the image the tracker works on (frames larger are reduced; pixel "
                   "options are at this size); 0: full resolution")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--sift-size", a->sift_size,
+                  "Longest side of the image SIFT runs on (relocalization, guided matching; smaller "
+                  "working frames are kept as they are); 0: the working resolution")
       ->capture_default_str()->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
   cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")

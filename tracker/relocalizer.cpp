@@ -55,11 +55,30 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
 
 Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
                          const map::DescriptorIndex& index, const RelocalizerOptions& options)
-    : map_(map), camera_(camera), index_(index), options_(options), extractor_(options.features) {}
+    : map_(map),
+      camera_(camera),
+      index_(index),
+      options_(options),
+      extractor_(options.features),
+      sift_resolution_(camera, options.sift_long_side) {}
+
+Features Relocalizer::Extract(const cv::Mat& gray, const SiftExtractor& extractor) const {
+  // The reduction is defined for the camera's size only.
+  const bool reduce = sift_resolution_.reduced() && gray.size() == camera_.Size();
+  Features features = extractor.Extract(reduce ? sift_resolution_.Reduce(ToGray8(gray)) : gray);
+  if (!reduce) return features;
+  const auto size_scale = static_cast<float>(sift_resolution_.full_per_work());
+  for (cv::KeyPoint& kp : features.keypoints) {
+    const Eigen::Vector2d p = sift_resolution_.ToFull({kp.pt.x, kp.pt.y});
+    kp.pt = cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
+    kp.size *= size_scale;
+  }
+  return features;
+}
 
 RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
   const auto start = std::chrono::steady_clock::now();
-  const Features features = extractor_.Extract(gray);
+  const Features features = Extract(gray, extractor_);
   const double extract_ms = MillisecondsSince(start);
   RelocalizationResult result = Relocalize(features);
   result.extract_ms = extract_ms;

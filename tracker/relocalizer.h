@@ -11,6 +11,7 @@
 #include "map/map.h"
 #include "tracker/absolute_pose.h"
 #include "tracker/features.h"
+#include "tracker/working_resolution.h"
 
 namespace arview::tracker {
 
@@ -41,6 +42,12 @@ struct Track2D3D {
 
 struct RelocalizerOptions {
   FeatureOptions features;
+  // SIFT (relocalization and the tracker's guided matching) runs on the image reduced to this
+  // longest side (0: the image given, i.e. the tracker's working resolution); keypoints come
+  // back in the given image's pixels. OpenCV's SIFT doubles its input first, so its cost grows
+  // with the pixel count: at 640 a 540x960 working frame costs ~0.45x, while the map's SIFT
+  // (COLMAP, full resolution, doubled too) still holds the coarser scales the smaller image sees.
+  int sift_long_side = 640;
   MatchOptions matching;
   AbsolutePoseOptions pose;
 };
@@ -61,6 +68,9 @@ class Relocalizer {
   Relocalizer(const map::Map& map, const calib::Camera& camera, const map::DescriptorIndex& index,
               const RelocalizerOptions& options);
   RelocalizationResult Relocalize(const cv::Mat& gray) const;
+  // SIFT of `gray` (the camera's size) by `extractor` on the image reduced to sift_long_side,
+  // keypoints in `gray`'s pixels. Another size is given to SIFT as it is.
+  Features Extract(const cv::Mat& gray, const SiftExtractor& extractor) const;
   // Features already extracted (e.g. by guided matching of the same frame).
   RelocalizationResult Relocalize(const Features& features) const;
   const RelocalizerOptions& options() const { return options_; }
@@ -72,6 +82,7 @@ class Relocalizer {
   const map::DescriptorIndex& index_;
   RelocalizerOptions options_;
   SiftExtractor extractor_;
+  WorkingResolution sift_resolution_;  // the given image → the image SIFT runs on
 };
 
 // Pixels and world points of `matches`, in order, for the pose solver.

@@ -21,7 +21,9 @@ void ResidualGate::Observe(double rms_px) {
     recent_[next_] = rms_px;
     next_ = (next_ + 1) % recent_.size();
   }
+  ++observed_;
   scale_ = Median(recent_);
+  if (observed_ < options_.min_observations) scale_ = std::max(scale_, options_.initial_scale_px);
   gate_ = std::clamp(options_.factor * scale_, options_.min_px, options_.max_px);
 }
 

@@ -17,6 +17,10 @@ struct ResidualGateOptions {
   double max_px = 2.5;
   double initial_scale_px = 0.75;  // before any tracked frame: gate = 1.5 px
   int window = 30;
+  // Until this many frames were observed the scale is not set below initial_scale_px: the
+  // median of three clean frames is no robust scale, and a gate closed by it refused the fourth
+  // frame of a phone clip whose residuals grew from 0.6 to 1.2 px as it turned.
+  int min_observations = 10;
 };
 
 class ResidualGate {
@@ -33,6 +37,7 @@ class ResidualGate {
   ResidualGateOptions options_;
   std::vector<double> recent_;  // ring buffer of the last `window` RMS values
   std::size_t next_ = 0;
+  int observed_ = 0;  // accepted frames so far
   double scale_ = 0;
   double gate_ = 0;
 };

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "map/map_file.h"
+#include "tracker/refine_pose.h"
 #include "tracker/timing.h"
 
 namespace arview::tracker {
@@ -283,7 +284,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       }
     }
     const auto extract_start = std::chrono::steady_clock::now();
-    const Features& features = extracted->emplace(guided_extractor_->Extract(gray));
+    const Features& features = extracted->emplace(relocalizer_->Extract(gray, *guided_extractor_));
     result->keypoints = static_cast<int>(features.keypoints.size());
     result->times.extract_ms = MillisecondsSince(extract_start);
     const auto match_start = std::chrono::steady_clock::now();
@@ -361,6 +362,18 @@ void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) 
   result->times.refine_ms += MillisecondsSince(start);
 }
 
+Track2D3D Tracker::DropDriftedTracks(const Track2D3D& inliers, const calib::Pose& pose) const {
+  const double bound = options_.tracking.max_track_residual_scales * rms_gate_.Scale();
+  Track2D3D kept;
+  for (size_t i = 0; i < inliers.pixels.size(); ++i) {
+    const Eigen::Vector2d pixel(inliers.pixels[i].x, inliers.pixels[i].y);
+    if (ReprojectionError(resolution_.work(), pose, pixel, map_.points[inliers.points[i]].xyz) > bound) continue;
+    kept.pixels.push_back(inliers.pixels[i]);
+    kept.points.push_back(inliers.points[i]);
+  }
+  return kept;
+}
+
 void Tracker::Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers) {
   if (has_pose_ && result.status == TrackStatus::kTracking) {
     velocity_ = RelativeMotion(last_pose_, result.pose);
@@ -374,7 +387,7 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
   last_timestamp_ = timestamp;
   has_pose_ = true;
   const TrackingOptions& opt = options_.tracking;
-  last_inliers_ = SpreadTracks(inliers, opt.max_flow_tracks, opt.flow_grid_cell_px, resolution_.work().Size());
+  last_inliers_ = SpreadTracks(DropDriftedTracks(inliers, result.pose), opt.max_flow_tracks, opt.flow_grid_cell_px, resolution_.work().Size());
 }
 
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {

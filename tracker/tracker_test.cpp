@@ -71,6 +71,34 @@ TEST_F(PlanarTrackerTest, RelocalizesANovelView) {
   EXPECT_GT(r.matches, r.inliers / 2);
 }
 
+// A 1280x720 camera (the tracker works at 960x540): relocalization's SIFT on the frame reduced
+// to 640x360 finds the pose as accurately as on the working image (its keypoints mapped back to
+// working pixels; used as found they would miss the pose; the mapping's exactness is
+// WorkingResolution's tests).
+TEST(PlanarTrackerAtHd, RelocalizesWithSiftOnAReducedImage) {
+  const cv::Mat texture = cv::imread(std::string(kOpenCvData) + "graf1.png");
+  if (texture.empty()) GTEST_SKIP() << "graf1.png missing (Debian package opencv-doc)";
+  calib::Camera camera = calib::Camera::Pinhole(1280, 720, 1040, 1036, 645.5, 362);
+  camera.dist = TestCamera().dist;
+  const PlanarWorld world(texture, camera, 0.0015);
+  const map::Map map = world.MakeMap({LookAt({0, 0, -0.9}, {0, 0, 0}), LookAt({0.3, 0, -0.85}, {0.05, 0, 0}),
+                                      LookAt({-0.3, 0.1, -0.85}, {-0.05, 0, 0})},
+                                     SiftExtractor());
+  const calib::Pose truth = LookAt({0.12, 0.06, -0.75}, {0.03, 0.01, 0});
+  const cv::Mat frame = world.Render(truth);
+  for (int reloc_side : {640, 0}) {
+    TrackerOptions options;
+    options.relocalization.sift_long_side = reloc_side;
+    Tracker tracker(map, options);
+    const FrameResult r = tracker.Track(frame, 0.0);
+    ASSERT_EQ(r.status, TrackStatus::kRelocalized) << "reloc size " << reloc_side << ": " << r.reason;
+    EXPECT_LT((r.pose.Center() - truth.Center()).norm(), 0.003) << "reloc size " << reloc_side;
+    EXPECT_LT(RotationErrorDeg(r.pose, truth), 0.2) << "reloc size " << reloc_side;
+    EXPECT_LT(r.rms_px, 1.0) << "reloc size " << reloc_side;
+    EXPECT_GE(r.inliers, 50) << "reloc size " << reloc_side;
+  }
+}
+
 TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   Tracker tracker(*map_);
   int tracked = 0;

@@ -71,6 +71,22 @@ TEST(ResidualGate, FollowsTheObservedScaleWithinItsBounds) {
   EXPECT_DOUBLE_EQ(gate.Gate(), o.min_px);
 }
 
+// A few clean frames do not close the gate below its initial 1.5 px: their median is no robust
+// scale yet.
+TEST(ResidualGate, StaysAtItsInitialScaleUntilEnoughFramesWereSeen) {
+  ResidualGateOptions o;
+  ResidualGate gate(o);
+  for (int i = 1; i < o.min_observations; ++i) {
+    gate.Observe(0.4);
+    EXPECT_DOUBLE_EQ(gate.Gate(), 1.5) << i << " frames";
+  }
+  gate.Observe(0.4);
+  EXPECT_DOUBLE_EQ(gate.Gate(), o.min_px);
+  ResidualGate noisy(o);  // a noisier camera opens it at once
+  noisy.Observe(1.0);
+  EXPECT_DOUBLE_EQ(noisy.Gate(), 2.0);
+}
+
 // One outlier frame moves a median gate by nothing.
 TEST(ResidualGate, OneBadFrameDoesNotOpenTheGate) {
   ResidualGate gate;
