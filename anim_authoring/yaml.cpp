@@ -254,4 +254,11 @@ Node ParseFile(const std::filesystem::path& path) {
   return Parse(ss.str(), path.string());
 }
 
+Node::Node() = default;
+Node::Node(const Node&) = default;
+Node::Node(Node&&) noexcept = default;
+Node& Node::operator=(const Node&) = default;
+Node& Node::operator=(Node&&) noexcept = default;
+Node::~Node() = default;
+
 }  // namespace arview::anim::yaml

@@ -34,6 +34,15 @@ struct Node {
   std::vector<std::pair<std::string, Node>> entries;   // kMapping, in file order
   int line = 0;                                        // 1-based
 
+  // Defined in yaml.cpp, where Node is complete: `entries` holds pairs of Node, and libstdc++
+  // under clang refuses to instantiate their destructor inside Node's own definition.
+  Node();
+  Node(const Node&);
+  Node(Node&&) noexcept;
+  Node& operator=(const Node&);
+  Node& operator=(Node&&) noexcept;
+  ~Node();
+
   bool IsScalar() const { return kind == Kind::kScalar; }
   bool IsSequence() const { return kind == Kind::kSequence; }
   bool IsMapping() const { return kind == Kind::kMapping; }

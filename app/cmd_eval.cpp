@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "app/commands.h"
+#include "base/geometry.h"
 #include "recordings/accuracy.h"
 
 namespace arview::app {
@@ -21,6 +22,21 @@ struct EvalArgs {
   double max_dt = 0.02;
   int rpe_delta = 1;
 };
+
+// An alignment needs positions that span at least a plane (base/geometry.h EstimateSim3). Each
+// trajectory the alignment is fitted on is checked by itself first, so that the error names
+// the file whose camera centres are degenerate (all at one point, or on one line).
+void RequireAlignablePositions(const recordings::Trajectory& trajectory, const std::string& file) {
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(trajectory.size());
+  for (const auto& stamped : trajectory) centres.push_back(stamped.pose.Center());
+  if (centres.size() < 3) return;  // the association's own error says how many are needed
+  try {
+    (void)EstimateSim3(centres, centres, false, "alignment");
+  } catch (const Error& e) {
+    throw CommandError(file + ": " + e.what());
+  }
+}
 
 void RunEval(const EvalArgs& args) {
   try {
@@ -40,6 +56,10 @@ void RunEval(const EvalArgs& args) {
       align_with = recordings::ReadTum(args.align_with);
       options.align_with = &*align_with;
     }
+    if (options.align != recordings::AlignMode::kNone) {
+      RequireAlignablePositions(groundtruth, args.groundtruth);
+      RequireAlignablePositions(align_with ? *align_with : estimate, align_with ? args.align_with : args.estimate);
+    }
     const recordings::AccuracyReport report = recordings::EvaluateTrajectory(estimate, groundtruth, options);
     if (!args.plot.empty()) recordings::PlotTrajectories(report, groundtruth, args.plot);
     if (args.json) {
@@ -49,7 +69,12 @@ void RunEval(const EvalArgs& args) {
       if (!args.plot.empty()) std::cout << "plot        " << args.plot << "\n";
     }
   } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
+    // The alignment's and association's errors concern the pair: both files are named.
+    const std::string message = e.what();
+    if (message.rfind("alignment", 0) == 0 || message.rfind("evaluation", 0) == 0) {
+      throw CommandError(args.estimate + " against " + args.groundtruth + ": " + message);
+    }
+    throw CommandError(message);
   }
 }
 

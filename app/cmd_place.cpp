@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "anim_authoring/import.h"
 #include "app/commands.h"
 #include "app/place_character.h"
 #include "app/scene_lighting.h"
@@ -20,6 +21,20 @@ struct PlaceArgs {
   std::string recording;  // where still keyframe images are (video maps keep theirs in <map>/images)
   bool no_light = false;
 };
+
+// A --base-clip the asset lacks is refused before the map is read and before a scene naming it
+// is written (the scene would only fail when loaded, far from the command that made it).
+void RequireBaseClip(const std::string& asset, const std::string& clip) {
+  if (clip.empty() || clip == "rest") return;
+  const anim::Character character = anim::LoadCharacter(asset);
+  std::string names;
+  for (const auto& c : character.clips) {
+    if (c.name == clip) return;
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  throw CommandError("--base-clip: '" + clip + "' is not a clip of " + asset + " (clips: " +
+                     (names.empty() ? "none; use 'rest'" : names + ", or 'rest'") + ")");
+}
 
 }  // namespace
 
@@ -47,6 +62,7 @@ void AddPlaceCommand(CLI::App& app) {
   cmd->add_flag("--no-light", a->no_light, "Do not estimate the room's light (no <scene>.light.yml)");
   cmd->callback([a] {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
+    RequireBaseClip(a->character, a->options.base_clip);
     const map::Map map = map::LoadMap(a->map_dir);
     PlacedCharacter placed = PlaceCharacter(map, a->character, a->options);
     placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;

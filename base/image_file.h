@@ -16,4 +16,18 @@ namespace arview {
 // encoding or the write fails. `params` are cv::imwrite's (e.g. IMWRITE_PNG_COMPRESSION, 1).
 void WriteImageAtomically(const std::filesystem::path& file, const cv::Mat& image, const std::vector<int>& params = {});
 
+// Largest image a frame may be: a side of at most 32768 pixels, at most 2^28 pixels in all
+// (an 8K frame is 2^25). OpenCV's own limit (2^30) is enforced by an assertion whose text is
+// not a message for a user.
+inline constexpr long long kMaxImageSide = 32768;
+inline constexpr long long kMaxImagePixels = 1ll << 28;
+
+// Reads an image file as cv::imread(file, imread_flags) would, but with one clear error
+// (arview::Error naming the file) for every way it can fail: not a regular file or over
+// kMaxImageFileBytes; a PNG whose signature, IHDR header or size is wrong, or that is cut
+// short (no IEND chunk at its end: checked before libpng sees it, so that libpng prints
+// nothing of its own); an image OpenCV cannot decode or refuses (its exception text is kept
+// after ours). Never returns an empty image.
+cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags);
+
 }  // namespace arview

@@ -1,5 +1,6 @@
 #include "recordings/frame_source.h"
 
+#include "base/image_file.h"
 #include "base/stats.h"
 
 #include <algorithm>
@@ -70,8 +71,11 @@ cv::Mat RecordingSource::ReadFrame(int index) {
     image = ReadVideoFrame(index);
   } else {
     const std::string file = recording_.FramePath(index).string();
-    image = cv::imread(file, cv::IMREAD_COLOR);
-    if (image.empty()) throw SourceError(file + ": cannot be read as an image");
+    try {
+      image = ReadImageFile(file, cv::IMREAD_COLOR);
+    } catch (const Error& e) {
+      throw SourceError(e.what());
+    }
   }
   if (image.size() != recording_.camera.Size()) {
     throw SourceError(recording_.FramePath(index).string() + ": frame " + std::to_string(index) + " is " +

@@ -47,9 +47,11 @@ std::string FrameName(size_t index) {
 
 // Reads a source image (throws naming it) and returns its size.
 cv::Mat ReadSourceImage(const fs::path& file) {
-  cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw RecordingError(file.string() + ": cannot be read as an image");
-  return image;
+  try {
+    return ReadImageFile(file, cv::IMREAD_UNCHANGED);
+  } catch (const Error& e) {
+    throw RecordingError(e.what());
+  }
 }
 
 // Stores one source image as frames/<index>.png: PNG files are copied byte for byte (no

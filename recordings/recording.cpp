@@ -1,5 +1,6 @@
 #include "recordings/recording.h"
 
+#include "base/image_file.h"
 #include "base/atomic_file.h"
 
 #include <algorithm>
@@ -27,9 +28,11 @@ bool Recording::IsVideo() const {
 
 cv::Mat Recording::ReadImage(size_t index) const {
   const fs::path p = FramePath(index);
-  cv::Mat image = cv::imread(p.string(), cv::IMREAD_COLOR);
-  if (image.empty()) throw RecordingError(p.string() + ": cannot be read as an image");
-  return image;
+  try {
+    return ReadImageFile(p, cv::IMREAD_COLOR);
+  } catch (const Error& e) {
+    throw RecordingError(e.what());
+  }
 }
 
 std::vector<FrameEntry> ReadFrameList(const fs::path& file) {

@@ -1,0 +1,236 @@
+// Issue 17's faults and bad values met through the `arview` binary: a --base-clip the asset
+// lacks, degenerate ground truth in `eval`, and every writer on a full disk and in a folder it
+// cannot write to (one line naming the file, a non-zero exit, nothing left that looks written).
+
+#include <gtest/gtest.h>
+#include <sys/mount.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "calib/camera.h"
+#include "map/map_file.h"
+#include "tests/support/run_command.h"
+#include "tests/support/test_data.h"
+
+namespace arview {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CommandResult;
+using testing::LineCount;
+using testing::RunArview;
+using testing::ShellQuote;
+
+class Faults : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("arview_faults_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  void WriteText(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+
+  // A TUM trajectory of `n` poses 1/30 s apart; `moving` spreads the centres over a circle.
+  std::string Trajectory(int n, bool moving) {
+    std::string text;
+    for (int i = 0; i < n; ++i) {
+      const double a = 0.3 * i;
+      char line[160];
+      std::snprintf(line, sizeof line, "%.6f %.4f %.4f %.4f 0 0 0 1\n", i / 30.0, moving ? std::cos(a) : 1.5,
+                    moving ? std::sin(a) : -2.0, moving ? 0.1 * i : 0.25);
+      text += line;
+    }
+    return text;
+  }
+
+  // 200 random points seen by two keyframes: a valid map that places a character.
+  fs::path RandomMap() {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> coord(-1.0, 1.0);
+    map::Map map;
+    map.camera = calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5);
+    for (int k = 0; k < 2; ++k) {
+      map::Keyframe kf;
+      kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
+      kf.name = "frames/" + std::to_string(k) + ".png";
+      kf.frame_index = k;
+      kf.timestamp = k / 30.0;
+      kf.pose.t_cw = Eigen::Vector3d(0.2 * k, 0, 0);
+      map.keyframes.push_back(kf);
+    }
+    const int points = 200;
+    map.descriptors = cv::Mat(points, 128, CV_8U);
+    cv::randu(map.descriptors, 0, 255);
+    for (int i = 0; i < points; ++i) {
+      map::MapPoint p;
+      // A floor: y = 1 below the cameras, so the dominant plane is found.
+      p.xyz = Eigen::Vector3d(coord(rng), 1.0 + 0.001 * coord(rng), 3.0 + coord(rng));
+      p.first_descriptor = static_cast<std::uint32_t>(i);
+      p.descriptor_count = 1;
+      map.points.push_back(p);
+      map.descriptor_point.push_back(static_cast<std::uint32_t>(i));
+      const std::uint32_t k = static_cast<std::uint32_t>(i % 2);
+      map.descriptor_keyframe.push_back(k);
+      map::KeyframeObservation o;
+      o.point = static_cast<std::uint32_t>(i);
+      o.descriptor = static_cast<std::uint32_t>(i);
+      o.pixel = map.camera.Project(map.keyframes[k].pose.ToCamera(p.xyz)).cast<float>();
+      map.keyframes[k].observations.push_back(o);
+    }
+    const fs::path folder = dir_ / "map";
+    fs::create_directories(folder);
+    map::SaveMap(map, folder / map::kMapFileName);
+    return folder;
+  }
+
+  // Runs arview with a file-size limit of 0: every write() to a regular file fails with EFBIG,
+  // as on a full disk (SIGXFSZ is ignored, so that write() returns the error instead of the
+  // signal killing the process). stderr goes through a pipe to a process without the limit.
+  CommandResult RunOnFullDisk(const std::vector<std::string>& args) {
+    const char* bin = std::getenv("ARVIEW_BIN");
+    std::string inner = "trap '' XFSZ; ulimit -f 0; exec " + ShellQuote(bin ? bin : "arview");
+    for (const auto& a : args) inner += " " + ShellQuote(a);
+    const fs::path err = dir_ / "full_disk.err", code = dir_ / "full_disk.code";
+    const std::string cmd = "{ sh -c " + ShellQuote(inner) + "; echo $? >" + ShellQuote(code.string()) +
+                            "; } 2>&1 >/dev/null </dev/null | cat >" + ShellQuote(err.string());
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    CommandResult r;
+    r.exit_code = std::stoi(testing::ReadWholeFile(code.string()));
+    r.err = testing::ReadWholeFile(err.string());
+    fs::remove(err);
+    fs::remove(code);
+    return r;
+  }
+
+  // The files (not folders) under `folder`: a recording folder left with an empty frames/ and
+  // no frames.txt is not a recording; any file would be something left looking written.
+  static std::vector<std::string> FilesIn(const fs::path& folder) {
+    std::vector<std::string> names;
+    std::error_code ec;
+    for (const auto& e : fs::recursive_directory_iterator(folder, ec)) {
+      if (!e.is_directory()) names.push_back(e.path().string());
+    }
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+// Issue 17: `arview place --base-clip Nope` wrote a scene naming a clip the asset lacks.
+TEST_F(Faults, PlaceRefusesABaseClipTheAssetLacksNamingItsClips) {
+  const fs::path map = RandomMap();
+  const fs::path scene = dir_ / "scene.yaml";
+  const auto r = RunArview({"place", map.string(), "--character", "builtin:figure", "--base-clip", "Nope", "--out",
+                            scene.string(), "--no-light"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("'Nope'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("builtin:figure"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(clips: "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(scene));
+}
+
+// Issue 17: ground truth with every camera centre at one point made `eval` print numbers; then
+// the degenerate alignment's error did not name the file.
+TEST_F(Faults, EvalOnDegenerateGroundTruthIsOneErrorNamingTheFile) {
+  const fs::path estimate = dir_ / "estimate.txt", groundtruth = dir_ / "groundtruth.txt";
+  WriteText(estimate, Trajectory(30, true));
+  WriteText(groundtruth, Trajectory(30, false));
+  for (const char* align : {"sim3", "se3"}) {
+    const auto r = RunArview({"eval", estimate.string(), groundtruth.string(), "--align", align});
+    EXPECT_NE(r.exit_code, 0) << align;
+    EXPECT_EQ(r.out, "") << align;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(groundtruth.string() + ": "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("degenerate"), std::string::npos) << r.err;
+  }
+  // The estimate degenerate: it is the one named.
+  const auto r = RunArview({"eval", groundtruth.string(), estimate.string()});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.err.find(estimate.string() + ": "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(groundtruth.string() + ": "), std::string::npos) << r.err;
+  // Without an alignment nothing needs the spread: the figures are printed.
+  EXPECT_EQ(RunArview({"eval", estimate.string(), groundtruth.string(), "--align", "none"}).exit_code, 0);
+}
+
+// Every writer on a full disk: one line naming the file, non-zero exit, no file and no
+// temporary left. (Issue 17: `track --out` on a full disk exited 0 leaving a 0-byte file;
+// place, replay --stats and map left .tmp files.)
+TEST_F(Faults, EveryWriterOnAFullDiskFailsWithOneLineAndLeavesNothing) {
+  const fs::path map = RandomMap();
+  const fs::path estimate = dir_ / "estimate.txt", groundtruth = dir_ / "groundtruth.txt";
+  WriteText(estimate, Trajectory(30, true));
+  WriteText(groundtruth, Trajectory(30, true));
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  struct Writer {
+    std::vector<std::string> args;
+    std::string named;  // the file the line must name
+  };
+  const std::vector<Writer> writers = {
+      {{"place", map.string(), "--character", "builtin:figure", "--out", (out / "scene.yaml").string(), "--no-light"},
+       (out / "scene.yaml").string()},
+      {{"eval", estimate.string(), groundtruth.string(), "--plot", (out / "plot.png").string()},
+       (out / "plot.png").string()},
+      {{"synth", "room", "--out", (out / "room").string(), "--frames", "2", "--size", "160x120", "--quiet"},
+       (out / "room").string()},
+  };
+  for (const auto& w : writers) {
+    const auto r = RunOnFullDisk(w.args);
+    EXPECT_NE(r.exit_code, 0) << w.args[0] << ": " << r.err;
+    EXPECT_EQ(LineCount(r.err), 1) << w.args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(w.named), std::string::npos) << w.args[0] << ": " << r.err;
+    const auto left = FilesIn(out);
+    EXPECT_TRUE(left.empty()) << w.args[0] << " left " << left.front();
+    fs::remove_all(out);
+    fs::create_directories(out);
+  }
+}
+
+// The same writers into a folder that cannot be written: a read-only tmpfs (permission bits do
+// not stop root, who runs CI here; without the right to mount, a folder without write
+// permission when not root).
+TEST_F(Faults, EveryWriterIntoAnUnwritableFolderFailsWithOneLine) {
+  const fs::path map = RandomMap();
+  const fs::path estimate = dir_ / "estimate.txt", groundtruth = dir_ / "groundtruth.txt";
+  WriteText(estimate, Trajectory(30, true));
+  WriteText(groundtruth, Trajectory(30, true));
+  const fs::path out = dir_ / "readonly";
+  fs::create_directories(out);
+  bool mounted = ::mount("tmpfs", out.c_str(), "tmpfs", MS_RDONLY, "size=64k") == 0;
+  if (!mounted) {
+    if (::geteuid() == 0) GTEST_SKIP() << "running as root without the right to mount a read-only tmpfs";
+    fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec);
+  }
+  const std::vector<std::pair<std::vector<std::string>, std::string>> writers = {
+      {{"place", map.string(), "--character", "builtin:figure", "--out", (out / "scene.yaml").string(), "--no-light"},
+       (out / "scene.yaml").string()},
+      {{"eval", estimate.string(), groundtruth.string(), "--plot", (out / "plot.png").string()},
+       (out / "plot.png").string()},
+  };
+  for (const auto& [args, named] : writers) {
+    const auto r = RunArview(args);
+    EXPECT_NE(r.exit_code, 0) << args[0] << ": " << r.err;
+    EXPECT_EQ(LineCount(r.err), 1) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << args[0] << ": " << r.err;
+  }
+  if (mounted) {
+    ::umount(out.c_str());
+  } else {
+    fs::permissions(out, fs::perms::owner_all);
+  }
+}
+
+}  // namespace
+}  // namespace arview
