@@ -137,6 +137,36 @@ TEST(RecordingSource, NamesTheFileWhenAFrameIsUnreadableOrTheVideoIsShort) {
   EXPECT_THROW(RecordingSource(LoadRecording(dir.path() / "vid"), bad), SourceError);
 }
 
+// Issue 17: a frame deleted, or cut short (still being copied), after the recording was loaded
+// and before the replay reaches it. The replay stops at that frame with one SourceError naming
+// the file (the frames before it were delivered); libpng prints nothing of its own.
+TEST(RecordingSource, AFrameDeletedOrTruncatedMidReplayStopsItNamingTheFile) {
+  TempDir dir("replay_vanish");
+  const Recording rec = MakeStillRecording(dir.path() / "rec", 4);
+  for (const bool truncate : {false, true}) {
+    RecordingSource source(rec);
+    Frame f;
+    ASSERT_TRUE(source.Next(f));
+    const fs::path victim = rec.FramePath(1);
+    if (truncate) {
+      test::WriteImage(victim, 64, 48, 1);
+      const auto size = fs::file_size(victim);
+      fs::resize_file(victim, size / 2);
+    } else {
+      fs::remove(victim);
+    }
+    ::testing::internal::CaptureStderr();
+    std::string message;
+    try {
+      source.Next(f);
+    } catch (const SourceError& e) {
+      message = e.what();
+    }
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "") << truncate;
+    EXPECT_EQ(message.rfind(victim.string() + ": ", 0), 0u) << truncate << ": " << message;
+  }
+}
+
 // Issue 17: frames.txt naming a file outside the recording was loaded and handed to COLMAP.
 TEST(LoadRecording, FramePathsOutsideTheFolderAreRefused) {
   TempDir dir("outside");

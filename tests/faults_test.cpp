@@ -55,11 +55,11 @@ class Faults : public ::testing::Test {
   }
 
   // 200 random points seen by two keyframes: a valid map that places a character.
-  fs::path RandomMap() {
+  fs::path RandomMap(const calib::Camera& camera = calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5)) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> coord(-1.0, 1.0);
     map::Map map;
-    map.camera = calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5);
+    map.camera = camera;
     for (int k = 0; k < 2; ++k) {
       map::Keyframe kf;
       kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
@@ -196,6 +196,33 @@ TEST_F(Faults, EveryWriterOnAFullDiskFailsWithOneLineAndLeavesNothing) {
     fs::remove_all(out);
     fs::create_directories(out);
   }
+}
+
+// Issue 17's data loss: `track --out t.txt` on a full filesystem exited 0, printed
+// "trajectory: .../t.txt" and left a 0-byte file. A 3-frame rendered room and a random map
+// with its camera (every frame is relocalized and fails; the trajectory file is still written).
+TEST_F(Faults, TrackOnAFullDiskFailsAndLeavesNoTrajectoryOrStats) {
+  ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+  const fs::path room = dir_ / "room";
+  const auto rendered = RunArview({"synth", "room", "--out", room.string(), "--frames", "3", "--size", "160x120", "--quiet"});
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+  const fs::path map = RandomMap(calib::LoadCamera(room / "camera.yaml"));
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const std::vector<std::string> args = {"track", room.string(), "--map", map.string(), "--out",
+                                         (out / "t.txt").string(), "--stats", (out / "stats.json").string()};
+  ASSERT_EQ(RunArview(args).exit_code, 0) << "track must work with room to write";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const auto r = RunOnFullDisk(args);
+  EXPECT_NE(r.exit_code, 0) << r.err;
+  // The progress lines ("track: 3/3 (100%) lost") come first; then one error line.
+  const size_t last_line = r.err.rfind('\n', r.err.size() - 2);
+  const std::string error = r.err.substr(last_line == std::string::npos ? 0 : last_line + 1);
+  EXPECT_EQ(error.rfind("arview: " + out.string(), 0), 0u) << r.err;
+  EXPECT_EQ(r.err.find("arview: "), r.err.rfind("arview: ")) << r.err;
+  const auto left = FilesIn(out);
+  EXPECT_TRUE(left.empty()) << "left " << left.front();
 }
 
 // The same writers into a folder that cannot be written: a read-only tmpfs (permission bits do
