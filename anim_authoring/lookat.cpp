@@ -130,7 +130,8 @@ void RefreshBelow(const Skeleton& sk, int j, const LocalPose& pose, std::vector<
   }
 }
 
-// Rotates joint j by `delta` given in model space, about the joint's own origin.
+}  // namespace
+
 void RotateInModel(const Skeleton& sk, int j, const Eigen::Quaterniond& delta, LocalPose& pose,
                    std::vector<Eigen::Matrix4d>& model) {
   const int p = sk.parents[j];
@@ -140,6 +141,8 @@ void RotateInModel(const Skeleton& sk, int j, const Eigen::Quaterniond& delta, L
   pose.rigid[j] = DualQuatd::FromRotationTranslation((parent.conjugate() * delta * parent * local).normalized(), t);
   RefreshBelow(sk, j, pose, model);
 }
+
+namespace {
 
 // The yaw an upper joint takes for a total yaw `phi` (radians, in (−π, π]): an even share up to
 // its limit for viewpoints in front, tapering back to zero toward the back. Periodic and
@@ -152,8 +155,8 @@ double UpperYaw(double phi, double share, double limit) {
   return phi < 0 ? -y : y;
 }
 
-// Turns the chain of `pose` toward `target`; `model` holds the pose's model-space transforms and
-// is kept up to date.
+}  // namespace
+
 void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
                  std::vector<Eigen::Matrix4d>& model) {
   const std::size_t n = chain.joints.size();
@@ -182,8 +185,6 @@ void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vect
     RotateInModel(sk, chain.joints[i], Eigen::Quaterniond::Identity().slerp(share, full), pose, model);
   }
 }
-
-}  // namespace
 
 Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain& chain, const Eigen::Vector3d& viewpoint,
                         double sample_rate) {

@@ -17,6 +17,7 @@
 //   Eigen::Vector3d f = HeadForward(chain, model_pose);   // for checks
 
 #include "anim/character.h"
+#include "anim/pose.h"
 
 #include <span>
 #include <string>
@@ -52,6 +53,15 @@ LookAtChain MakeLookAtChain(const Skeleton& skeleton, const std::vector<std::str
 // `base` may be nullptr: the result is a static look from the rest pose.
 Clip GenerateLookAtClip(const Skeleton& skeleton, const Clip* base, const LookAtChain& chain,
                         const Eigen::Vector3d& viewpoint, double sample_rate = 30.0);
+
+// The steps GenerateLookAtClip takes per sample, for keys built on top of it (gesture.h).
+// `model` holds the model-space transforms of `pose` and is kept up to date.
+// Rotates joint j by `delta` (model space) about the joint's own origin.
+void RotateInModel(const Skeleton& skeleton, int j, const Eigen::Quaterniond& delta, LocalPose& pose,
+                   std::vector<Eigen::Matrix4d>& model);
+// Turns the chain toward `target` (unit, model space).
+void ApplyLookAt(const Skeleton& skeleton, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
+                 std::vector<Eigen::Matrix4d>& model);
 
 // The head's forward axis in model space for a pose given as model-space joint matrices.
 Eigen::Vector3d HeadForward(const LookAtChain& chain, std::span<const Eigen::Matrix4d> model);

@@ -82,8 +82,8 @@ class SceneReader {
   }
 
   CharacterSpec Character(const Node& n, const fs::path& base_dir) const {
-    OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "keys",
-                 "scopes", "idle", "schedule"},
+    OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "gesture",
+                 "keys", "scopes", "idle", "schedule"},
              "a character");
     CharacterSpec c;
     c.where = file_ + ":" + std::to_string(n.line);
@@ -153,6 +153,7 @@ class SceneReader {
           if (!(l > 0) || l > 180) Fail(*y, "lookat.limits: each limit must be in (0, 180] degrees");
       }
     }
+    if (const Node* x = n.Find("gesture")) c.gesture = GestureOf(*x);
     const Node* keys = n.Find("keys");
     if (!keys || !keys->IsSequence() || keys->items.empty()) Fail(n, "a character needs a non-empty 'keys:' list");
     for (const Node& k : keys->items) c.keys.push_back(Key(k, c));
@@ -435,8 +436,42 @@ class SceneReader {
     return a;
   }
 
+  GestureSpec GestureOf(const Node& n) const {
+    OnlyKeys(n, {"arm", "chain", "elbow", "shoulder_cone", "bend"}, "gesture");
+    GestureSpec g;
+    if (const Node* y = n.Find("arm"))
+      g.side = Choice<ArmSide>(*y, "gesture.arm", {{"right", ArmSide::kRight}, {"left", ArmSide::kLeft}});
+    if (const Node* y = n.Find("chain")) {
+      if (!y->IsSequence() || y->items.size() != 3)
+        Fail(*y, "gesture.chain: expected [upper arm, forearm, hand] joint names");
+      for (const Node& j : y->items) g.chain.push_back(String(j, "gesture.chain"));
+    }
+    if (const Node* y = n.Find("elbow")) {
+      const auto range = Numbers(*y, "gesture.elbow", 2);
+      if (!(range[0] >= 0 && range[0] <= range[1] && range[1] <= 180))
+        Fail(*y, "gesture.elbow: expected [min, max] bend with 0 <= min <= max <= 180 degrees");
+      g.limits.elbow_min_deg = range[0];
+      g.limits.elbow_max_deg = range[1];
+    }
+    if (const Node* y = n.Find("shoulder_cone")) {
+      g.limits.shoulder_cone_deg = Number(*y, "gesture.shoulder_cone");
+      if (!(g.limits.shoulder_cone_deg > 0 && g.limits.shoulder_cone_deg <= 180))
+        Fail(*y, "gesture.shoulder_cone must be in (0, 180] degrees");
+    }
+    if (const Node* y = n.Find("bend")) {
+      OnlyKeys(*y, {"point", "reach"}, "gesture.bend");
+      for (const char* which : {"point", "reach"})
+        if (const Node* z = y->Find(which)) {
+          const double b = Number(*z, std::string("gesture.bend.") + which);
+          if (!(b >= 0 && b <= 180)) Fail(*z, std::string("gesture.bend.") + which + " must be in [0, 180] degrees");
+          (std::string(which) == "point" ? g.limits.point_bend_deg : g.limits.reach_bend_deg) = b;
+        }
+    }
+    return g;
+  }
+
   KeySpec Key(const Node& n, const CharacterSpec& c) const {
-    OnlyKeys(n, {"viewpoint", "azimuth", "elevation", "clip", "generate", "pose"}, "a key");
+    OnlyKeys(n, {"viewpoint", "azimuth", "elevation", "clip", "generate", "gesture", "pose"}, "a key");
     KeySpec k;
     k.line = n.line;
     const Node* vp = n.Find("viewpoint");
@@ -455,14 +490,21 @@ class SceneReader {
     } else {
       Fail(n, "a key needs 'viewpoint: [x, y, z]' or 'azimuth: <deg>'");
     }
-    const int sources = (n.Find("clip") ? 1 : 0) + (n.Find("generate") ? 1 : 0) + (n.Find("pose") ? 1 : 0);
-    if (sources != 1) Fail(n, "a key needs exactly one of 'clip: <name>', 'generate: lookat', 'pose: rest|<clip>@<seconds>'");
+    // A gesture key is a generated look-at key with the arm on top: `generate: lookat` may go with it.
+    const bool generated = n.Find("generate") || n.Find("gesture");
+    const int sources = (n.Find("clip") ? 1 : 0) + (generated ? 1 : 0) + (n.Find("pose") ? 1 : 0);
+    if (sources != 1)
+      Fail(n, "a key needs exactly one of 'clip: <name>', 'generate: lookat', 'gesture: point|reach', "
+              "'pose: rest|<clip>@<seconds>'");
     if (const Node* x = n.Find("clip")) {
       k.source = KeySpec::Source::kClip;
       k.clip = String(*x, "clip");
-    } else if (const Node* x = n.Find("generate")) {
-      if (String(*x, "generate") != "lookat") Fail(*x, "generate: only 'lookat' is known");
+    } else if (generated) {
+      if (const Node* x = n.Find("generate"))
+        if (String(*x, "generate") != "lookat") Fail(*x, "generate: only 'lookat' is known (gestures: 'gesture: point|reach')");
       k.source = KeySpec::Source::kLookAt;
+      if (const Node* x = n.Find("gesture"))
+        k.gesture = Choice<Gesture>(*x, "gesture", {{"point", Gesture::kPoint}, {"reach", Gesture::kReach}});
     } else {
       const Node& p = *n.Find("pose");
       const std::string s = String(p, "pose");
@@ -617,6 +659,15 @@ std::vector<ViewAdaptiveKey> AnimatedCharacter::BuildKeys() {
       lookat_base = &c.clips.front();
     }
   }
+  const bool any_gesture = std::any_of(spec_.keys.begin(), spec_.keys.end(),
+                                       [](const KeySpec& k) { return k.gesture != Gesture::kNone; });
+  if (any_gesture) {
+    try {
+      arm_ = MakeArmChain(sk, spec_.gesture.chain, spec_.gesture.side, spec_.gesture.limits, spec_.forward, spec_.up);
+    } catch (const Error& e) {
+      throw Error(where + ": " + e.what());
+    }
+  }
   std::vector<std::shared_ptr<const Clip>> key_clips;
   for (const KeySpec& k : spec_.keys) {
     switch (k.source) {
@@ -625,7 +676,11 @@ std::vector<ViewAdaptiveKey> AnimatedCharacter::BuildKeys() {
         key_clips.push_back(std::shared_ptr<const Clip>(character_, &find_clip(k, k.clip)));
         break;
       case KeySpec::Source::kLookAt:
-        key_clips.push_back(std::make_shared<const Clip>(GenerateLookAtClip(sk, lookat_base, chain_, k.viewpoint)));
+        if (k.gesture != Gesture::kNone)
+          key_clips.push_back(
+              std::make_shared<const Clip>(GenerateGestureClip(sk, lookat_base, &chain_, arm_, k.gesture, k.viewpoint)));
+        else
+          key_clips.push_back(std::make_shared<const Clip>(GenerateLookAtClip(sk, lookat_base, chain_, k.viewpoint)));
         break;
       case KeySpec::Source::kRestPose: {
         Clip rest;

@@ -34,11 +34,19 @@
 //         base_clip: Survey
 //         chain: [b_Spine01_02, b_Spine02_03, b_Neck_04, b_Head_05]  # default: found by name
 //         limits: [45, 45, 50, 70]   # per joint, degrees (default 45 per spine joint, 50 neck, 70 head)
+//       gesture:                     # for keys with `gesture: point | reach` (see gesture.h)
+//         arm: right                 # or left
+//         chain: [RightArm, RightForeArm, RightHand]  # upper arm, forearm, hand; default: found by name
+//         elbow: [0, 150]            # elbow bend range, degrees (0 = straight)
+//         shoulder_cone: 100         # half-angle about front-and-out, degrees
+//         bend: {point: 10, reach: 40}  # elbow bend the gesture aims for, degrees
 //       keys:
 //         - viewpoint: [0, 0, 1]     # or azimuth: 0 with elevation: 0
 //           clip: Survey             # a clip of the asset ...
 //         - azimuth: 90
 //           generate: lookat         # ... or generated (see lookat.h) ...
+//         - azimuth: 30
+//           gesture: point           # ... or a look-at key with the arm pointing along the viewpoint ...
 //         - azimuth: 180
 //           pose: rest               # ... or a static pose: rest, or "<clip>@<seconds>"
 //
@@ -46,6 +54,7 @@
 
 #include "anim/character.h"
 #include "anim_authoring/import.h"
+#include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
 #include "base/enum_table.h"
 #include "base/geometry.h"
@@ -84,6 +93,7 @@ struct KeySpec {
   Source source = Source::kClip;
   std::string clip;        // kClip, kStaticPose
   double pose_time = 0;    // kStaticPose
+  Gesture gesture = Gesture::kNone;  // kLookAt: the arm on top points or reaches (gesture.h)
   int line = 0;            // where it was written, for messages
 };
 
@@ -152,6 +162,12 @@ struct LookAtSpec {
   std::vector<double> limits_deg;    // empty: defaults
 };
 
+struct GestureSpec {
+  ArmSide side = ArmSide::kRight;
+  std::vector<std::string> chain;    // upper arm, forearm, hand; empty: DefaultArmChain()
+  ArmLimits limits;
+};
+
 struct CharacterSpec {
   std::string where;  // "scene.yaml:3", for messages
   std::string name;
@@ -167,6 +183,7 @@ struct CharacterSpec {
   bool nlerp_sampling = false;  // `sampling: nlerp` (default slerp): see SamplingJob::nlerp
   bool has_lookat = false;
   LookAtSpec lookat;
+  GestureSpec gesture;     // `gesture:`, for keys with `gesture: point|reach`
   std::vector<KeySpec> keys;
   ScopeTable scopes;       // `scopes:` added to the built-in ones
   IdleSpec idle;           // `idle:`
@@ -220,6 +237,8 @@ class AnimatedCharacter {
   const Clip& key_clip(int key) const { return *blend_->key(key).clip; }
   // The look-at chain used for generated keys (empty joints if none).
   const LookAtChain& lookat_chain() const { return chain_; }
+  // The arm chain used for gesture keys (joints −1 if none).
+  const ArmChain& arm_chain() const { return arm_; }
   // The runtime blend, to schedule it as an action (anim/schedule.h).
   std::shared_ptr<ViewAdaptiveBlend> view_adaptive() const { return blend_; }
 
@@ -233,6 +252,7 @@ class AnimatedCharacter {
   std::shared_ptr<const Character> character_;
   CharacterSpec spec_;
   LookAtChain chain_;
+  ArmChain arm_;
   std::shared_ptr<ViewAdaptiveBlend> blend_;
   // Per-frame buffers.
   LocalPose blended_;

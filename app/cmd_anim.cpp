@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
@@ -82,6 +83,9 @@ void RunInfo(const AnimArgs& args) {
     }
     nlohmann::ordered_json& chain_json = j["default_lookat_chain"] = nlohmann::ordered_json::array();
     for (const std::string& n : chain) chain_json.push_back({{"joint", n}});
+    nlohmann::ordered_json& arms = j["default_arm_chains"] = nlohmann::ordered_json::object();
+    for (anim::ArmSide side : {anim::ArmSide::kRight, anim::ArmSide::kLeft})
+      arms[std::string(ToString(side))] = anim::DefaultArmChain(sk, side);
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -111,6 +115,20 @@ void RunInfo(const AnimArgs& args) {
   if (chain.empty()) std::cout << "none found (name the joints in the scene's lookat.chain)";
   for (std::size_t i = 0; i < chain.size(); ++i) std::cout << (i ? " > " : "") << chain[i];
   std::cout << "\n";
+  for (anim::ArmSide side : {anim::ArmSide::kRight, anim::ArmSide::kLeft}) {
+    const std::vector<std::string> arm = anim::DefaultArmChain(sk, side);
+    std::cout << "default " << ToString(side) << " arm chain (gesture keys): ";
+    if (arm.empty()) std::cout << "none found (name the joints in the scene's gesture.chain)";
+    for (std::size_t i = 0; i < arm.size(); ++i) std::cout << (i ? " > " : "") << arm[i];
+    std::cout << "\n";
+  }
+}
+
+// "lookat", or "lookat+point" for a gesture key.
+std::string SourceText(const anim::KeySpec& key) {
+  std::string s(ToString(key.source));
+  if (key.gesture != anim::Gesture::kNone) s += std::string("+") + std::string(ToString(key.gesture));
+  return s;
 }
 
 void RunWeights(const AnimArgs& args) {
@@ -132,6 +150,20 @@ void RunWeights(const AnimArgs& args) {
     const Eigen::Vector3d f = anim::HeadForward(ch.lookat_chain(), out.model);
     head_deg = std::atan2(f.cross(v).norm(), f.dot(v)) * 180 / M_PI;
   }
+  // Gesture keys: the arm's direction to the viewpoint, measured as the heaviest gesture key
+  // aims it (point: the forearm; reach: shoulder to hand).
+  const bool gesture = ch.arm_chain().upper >= 0;
+  anim::Gesture kind = anim::Gesture::kNone;
+  double heaviest = -1, arm_deg = 0;
+  for (std::size_t k = 0; k < spec->keys.size(); ++k)
+    if (spec->keys[k].gesture != anim::Gesture::kNone && out.weights[k] > heaviest) {
+      heaviest = out.weights[k];
+      kind = spec->keys[k].gesture;
+    }
+  if (gesture) {
+    const Eigen::Vector3d d = anim::GestureDirection(ch.arm_chain(), kind, out.model);
+    arm_deg = std::atan2(d.cross(v).norm(), d.dot(v)) * 180 / M_PI;
+  }
   const bool dib = spec->blend == anim::BlendMethod::kDib;
   if (args.json) {
     nlohmann::ordered_json j = {{"scene", args.scene},
@@ -142,7 +174,7 @@ void RunWeights(const AnimArgs& args) {
     for (std::size_t k = 0; k < spec->keys.size(); ++k) {
       const anim::KeySpec& key = spec->keys[k];
       keys.push_back({{"index", k},
-                      {"source", ToString(key.source)},
+                      {"source", SourceText(key)},
                       {"clip", ch.key_clip(int(k)).name},
                       {"viewpoint", {key.viewpoint.x(), key.viewpoint.y(), key.viewpoint.z()}},
                       {"weight", out.weights[k]}});
@@ -153,6 +185,11 @@ void RunWeights(const AnimArgs& args) {
       j["dib_max_iterations"] = out.max_iterations;
     }
     if (lookat) j["head_to_viewpoint_deg"] = head_deg;
+    if (gesture) {
+      j["gesture"] = ToString(kind);
+      j["arm_to_viewpoint_deg"] = arm_deg;
+      j["elbow_bend_deg"] = anim::ElbowBendDeg(ch.arm_chain(), out.model);
+    }
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -161,13 +198,16 @@ void RunWeights(const AnimArgs& args) {
   for (std::size_t k = 0; k < spec->keys.size(); ++k) {
     const anim::KeySpec& key = spec->keys[k];
     std::cout << "  key " << k << "  (" << Fixed(key.viewpoint.x()) << ", " << Fixed(key.viewpoint.y()) << ", "
-              << Fixed(key.viewpoint.z()) << ")  " << ToString(key.source) << " " << ch.key_clip(int(k)).name
+              << Fixed(key.viewpoint.z()) << ")  " << SourceText(key) << " " << ch.key_clip(int(k)).name
               << "  weight " << Fixed(out.weights[k], 4) << "\n";
   }
   if (dib)
     std::cout << "DIB: " << (out.converged ? "converged" : "NOT converged") << ", at most " << out.max_iterations
               << " iterations per joint\n";
   if (lookat) std::cout << "head forward to viewpoint: " << Fixed(head_deg, 2) << " deg\n";
+  if (gesture)
+    std::cout << ToString(spec->gesture.side) << " arm (" << ToString(kind) << ") to viewpoint: " << Fixed(arm_deg, 2)
+              << " deg, elbow bend " << Fixed(anim::ElbowBendDeg(ch.arm_chain(), out.model), 1) << " deg\n";
 }
 
 void Guard(const std::function<void()>& f) {
@@ -190,7 +230,7 @@ void AddAnimCommand(CLI::App& app) {
   info->add_flag("--json", args->json, "Print JSON instead of text");
   info->callback([args] { Guard([&] { RunInfo(*args); }); });
 
-  auto* weights = cmd->add_subcommand("weights", "Key weights (and the blended head's direction) for one viewpoint");
+  auto* weights = cmd->add_subcommand("weights", "Key weights (and the blended head's and gesturing arm's directions) for one viewpoint");
   weights->add_option("--scene", args->scene, "Scene file (YAML, see docs/anim.md)")->required();
   weights->add_option("--viewpoint", args->viewpoint, "Direction from the character to the viewer, x,y,z in the character's frame")
       ->required();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
 #include "anim/pose.h"
 #include "anim_authoring/scene.h"
@@ -195,6 +196,41 @@ TEST(Figure, LoadsAsABuiltinAssetInScenes) {
   const anim::FrameOutput& out = figure.Update(Eigen::Vector3d::UnitX(), 1.0);
   const Eigen::Vector3d forward = anim::HeadForward(figure.lookat_chain(), out.model);
   EXPECT_LT(AngleDeg(forward, Eigen::Vector3d::UnitX()), 20.0);
+}
+
+// Gesture keys on the figure (anim_authoring/gesture.h): over its Idle, at each key's viewpoint
+// in front, to the sides, above, below and behind, the right forearm points (or the hand
+// reaches) within 15° of the viewpoint, the elbow and shoulder within their limits.
+TEST(Figure, GestureKeysPointTheRightArmAtTheViewpoint) {
+  RegisterBuiltinCharacters();
+  EXPECT_EQ(anim::DefaultArmChain(Figure().skeleton, anim::ArmSide::kRight),
+            (std::vector<std::string>{"RightArm", "RightForeArm", "RightHand"}));
+  const anim::ArmLimits limits;
+  for (const char* gesture : {"point", "reach"}) {
+    double worst = 0;
+    for (const auto& [azimuth, elevation] : std::vector<std::pair<double, double>>{
+             {0, 0}, {35, 0}, {-35, 0}, {70, 0}, {-70, 0}, {100, 0}, {-100, 0}, {0, 30}, {40, 25}, {-40, -20}, {180, 0}}) {
+      const anim::Scene scene = anim::ParseScene(
+          "characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    keys:\n      - {azimuth: " +
+              std::to_string(azimuth) + ", elevation: " + std::to_string(elevation) + ", gesture: " + gesture +
+              "}\n      - {azimuth: " + std::to_string(azimuth + 90) + ", generate: lookat}\n",
+          "figure.yaml");
+      anim::AnimatedCharacter figure(scene.characters[0]);
+      const anim::KeySpec& key = scene.characters[0].keys[0];
+      for (double t : {0.0, 0.37, 1.5, 2.9}) {
+        const anim::FrameOutput& out = figure.Update(key.viewpoint, t);
+        const double deg = AngleDeg(anim::GestureDirection(figure.arm_chain(), key.gesture, out.model), key.viewpoint);
+        EXPECT_LE(deg, 15.0) << gesture << " azimuth " << azimuth << " elevation " << elevation << " t " << t;
+        const double elbow = anim::ElbowBendDeg(figure.arm_chain(), out.model);
+        EXPECT_GE(elbow, limits.elbow_min_deg - 0.5);
+        EXPECT_LE(elbow, limits.elbow_max_deg + 0.5);
+        EXPECT_LE(anim::ShoulderConeAngleDeg(figure.character().skeleton, figure.arm_chain(), out.model),
+                  limits.shoulder_cone_deg + 0.5);
+        worst = std::max(worst, deg);
+      }
+    }
+    std::printf("[gesture] builtin:figure %s: worst hand-to-viewpoint %.2f deg\n", gesture, worst);
+  }
 }
 
 }  // namespace
