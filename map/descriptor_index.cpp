@@ -1,6 +1,13 @@
 #include "map/descriptor_index.h"
 
-#include <flann/flann.hpp>
+// OpenCV's copy of FLANN (cvflann), not libflann: libflann 1.9.2 shuffles the points before
+// building each kd-tree with a std::random_device (flann/algorithms/kdtree_index.h), so its
+// index, and every global match, changed from run to run whatever seed was set; cvflann
+// shuffles with cv::theRNG(), which is seeded here.
+#include <opencv2/flann.hpp>
+
+#include <algorithm>
+#include <cstdlib>
 
 #include <cmath>
 #include <string>
@@ -10,7 +17,7 @@ namespace arview::map {
 namespace {
 
 constexpr int kDescriptorSize = 128;
-using FlannIndex = flann::Index<flann::L2<unsigned char>>;
+using FlannIndex = cvflann::Index<cvflann::L2<unsigned char>>;
 
 void CheckDescriptorMatrix(const cv::Mat& m, const char* what) {
   if (m.type() != CV_8UC1 || m.cols != kDescriptorSize) {
@@ -20,21 +27,22 @@ void CheckDescriptorMatrix(const cv::Mat& m, const char* what) {
   }
 }
 
-flann::IndexParams ToFlann(const IndexParams& p) {
+cvflann::IndexParams ToFlann(const IndexParams& p) {
   switch (p.kind) {
     case IndexKind::kLinear:
-      return flann::LinearIndexParams();
+      return cvflann::LinearIndexParams();
     case IndexKind::kKdTree:
-      return flann::KDTreeIndexParams(std::max(1, p.trees));
+      return cvflann::KDTreeIndexParams(std::max(1, p.trees));
     case IndexKind::kKMeans:
-      return flann::KMeansIndexParams(std::max(2, p.branching), std::max(1, p.iterations));
+      return cvflann::KMeansIndexParams(std::max(2, p.branching), std::max(1, p.iterations));
   }
   throw DescriptorIndexError("DescriptorIndex: unknown index kind");
 }
 
-flann::Matrix<unsigned char> View(const cv::Mat& m) {
-  return flann::Matrix<unsigned char>(const_cast<unsigned char*>(m.ptr<unsigned char>()),
-                                      static_cast<size_t>(m.rows), kDescriptorSize, m.step[0]);
+// cvflann's stride is in elements (bytes for uint8).
+cvflann::Matrix<unsigned char> View(const cv::Mat& m) {
+  return cvflann::Matrix<unsigned char>(const_cast<unsigned char*>(m.ptr<unsigned char>()),
+                                        static_cast<size_t>(m.rows), kDescriptorSize, m.step[0]);
 }
 
 }  // namespace
@@ -54,9 +62,14 @@ DescriptorIndex::DescriptorIndex(const cv::Mat& descriptors, const IndexParams& 
   CheckDescriptorMatrix(descriptors, "indexed descriptors");
   if (descriptors.rows == 0) throw DescriptorIndexError("DescriptorIndex: no descriptors to index");
   impl_->data = descriptors;
-  flann::seed_random(params.seed);
+  // The kd-trees' shuffles draw from the thread's cv::theRNG(), the split dimensions from
+  // std::rand(): both seeded, the thread's generator restored afterwards.
+  const cv::RNG caller_rng = cv::theRNG();
+  cvflann::seed_random(params.seed);
+  std::srand(params.seed);
   impl_->index = std::make_unique<FlannIndex>(View(impl_->data), ToFlann(params));
   impl_->index->buildIndex();
+  cv::theRNG() = caller_rng;
 }
 
 std::size_t DescriptorIndex::size() const { return impl_ ? static_cast<std::size_t>(impl_->data.rows) : 0; }
@@ -66,19 +79,21 @@ std::vector<std::vector<Neighbor>> DescriptorIndex::Knn(const cv::Mat& queries, 
   std::vector<std::vector<Neighbor>> result(static_cast<size_t>(queries.rows));
   if (empty() || k <= 0 || queries.rows == 0) return result;
   const size_t kk = std::min(static_cast<size_t>(k), size());
-  std::vector<std::vector<size_t>> indices;
-  std::vector<std::vector<float>> dists;
-  flann::SearchParams search(params_.kind == IndexKind::kLinear ? flann::FLANN_CHECKS_UNLIMITED
-                                                                 : std::max(1, params_.checks));
-  search.cores = std::max(1, params_.threads);
-  impl_->index->knnSearch(View(queries), indices, dists, kk, search);
+  std::vector<int> index_rows(result.size() * kk, -1);
+  std::vector<float> dist_rows(result.size() * kk, 0.f);
+  cvflann::Matrix<int> indices(index_rows.data(), result.size(), kk);
+  cvflann::Matrix<float> dists(dist_rows.data(), result.size(), kk);
+  const cvflann::SearchParams search(params_.kind == IndexKind::kLinear ? cvflann::FLANN_CHECKS_UNLIMITED
+                                                                         : std::max(1, params_.checks));
+  impl_->index->knnSearch(View(queries), indices, dists, static_cast<int>(kk), search);
   for (size_t q = 0; q < result.size(); ++q) {
     auto& out = result[q];
-    out.reserve(indices[q].size());
-    for (size_t j = 0; j < indices[q].size(); ++j) {
-      // FLANN pads with invalid indices when an approximate search found fewer than k.
-      if (indices[q][j] >= size()) break;
-      out.push_back({static_cast<std::uint32_t>(indices[q][j]), std::sqrt(std::max(0.f, dists[q][j]))});
+    out.reserve(kk);
+    for (size_t j = 0; j < kk; ++j) {
+      // Padded with invalid indices when an approximate search found fewer than k.
+      const int row = indices[q][j];
+      if (row < 0 || static_cast<size_t>(row) >= size()) break;
+      out.push_back({static_cast<std::uint32_t>(row), std::sqrt(std::max(0.f, dists[q][j]))});
     }
   }
   return result;

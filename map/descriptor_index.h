@@ -33,8 +33,8 @@ struct IndexParams {
   int branching = 32;   // k-means: branching factor
   int iterations = 11;  // k-means: iterations per level
   int checks = 64;      // leaves visited per query (accuracy vs time); ignored by kLinear
-  int threads = 1;      // threads for a batch of queries (FLANN's own, needs OpenMP)
-  unsigned seed = 0;    // FLANN picks split dimensions at random; seeded for repeatable results
+  int threads = 1;      // unused: OpenCV's FLANN searches a batch on the calling thread
+  unsigned seed = 0;    // the kd-trees' shuffles and split dimensions: same seed, same index
 };
 
 // One neighbour of a query: the row of Map::descriptors and the Euclidean (not squared)

@@ -48,6 +48,25 @@ TEST(DescriptorIndex, LinearIsExactAndSorted) {
   }
 }
 
+// Random queries (no true copy in the index) make an approximate search depend on the trees:
+// two indices built with the same seed answer the same, whatever the caller's cv::theRNG()
+// holds (libflann, which shuffled with a std::random_device, did not).
+TEST(DescriptorIndex, SameSeedSameNeighbours) {
+  const cv::Mat data = RandomDescriptors(3000, 5);
+  const cv::Mat queries = RandomDescriptors(300, 6);
+  for (IndexKind kind : {IndexKind::kKdTree, IndexKind::kKMeans}) {
+    const IndexParams params{.kind = kind, .checks = 16, .seed = 7};
+    const auto first = DescriptorIndex(data, params).Knn(queries, 4);
+    cv::theRNG() = cv::RNG(12345);
+    const auto second = DescriptorIndex(data, params).Knn(queries, 4);
+    for (size_t q = 0; q < first.size(); ++q) {
+      ASSERT_EQ(first[q].size(), second[q].size()) << "kind " << static_cast<int>(kind) << " query " << q;
+      for (size_t j = 0; j < first[q].size(); ++j)
+        ASSERT_EQ(first[q][j].row, second[q][j].row) << "kind " << static_cast<int>(kind) << " query " << q;
+    }
+  }
+}
+
 TEST(DescriptorIndex, KdTreeFindsPerturbedCopies) {
   const cv::Mat data = RandomDescriptors(5000, 3);
   std::mt19937 rng(4);
