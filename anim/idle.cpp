@@ -67,7 +67,7 @@ void IdleSynthesizer::Restart() {
     const IdleModel::Extremum& e = members[static_cast<std::size_t>(Uniform(w.rng) * members.size())];
     // Start inside the first segment at a seeded phase, so streams of different seeds differ.
     w.t1 = 0;
-    w.v1 = e.value;
+    w.v0 = w.v1 = e.value;  // no previous swing: the first may go either way
     Step(i);
     const double phase = Uniform(w.rng) * (w.t1 - w.t0);
     w.t0 -= phase;
@@ -82,12 +82,38 @@ void IdleSynthesizer::Step(int i) {
   double outgoing = 0;
   for (double c : row) outgoing += c;
   w.cluster = Draw(w.rng, outgoing > 0 ? row : chain.frequency);
-  const auto& members = chain.clusters[w.cluster];
-  const IdleModel::Extremum& e = members[std::min(members.size() - 1, static_cast<std::size_t>(Uniform(w.rng) * members.size()))];
+  // The next extremum lies on the other side of the current one (after a rise, a fall).
+  const double rising = w.v1 - w.v0;
+  auto opposite = [&](const IdleModel::Extremum& e) { return rising == 0 || (e.value - w.v1) * rising < 0; };
+  const IdleModel::Extremum* pick = nullptr;
+  for (int pass = 0; pass < 2 && !pick; ++pass) {
+    // First the chosen cluster's members; if none is on the other side, every cluster's.
+    std::size_t count = 0;
+    for (std::size_t c = 0; c < chain.clusters.size(); ++c)
+      if (pass == 1 || static_cast<int>(c) == w.cluster)
+        for (const auto& e : chain.clusters[c]) count += opposite(e);
+    if (count == 0) continue;
+    std::size_t k = std::min(count - 1, static_cast<std::size_t>(Uniform(w.rng) * count));
+    for (std::size_t c = 0; c < chain.clusters.size() && !pick; ++c)
+      if (pass == 1 || static_cast<int>(c) == w.cluster)
+        for (const auto& e : chain.clusters[c])
+          if (opposite(e) && k-- == 0) {
+            pick = &e;
+            break;
+          }
+  }
+  if (!pick) {  // no extremum on the other side at all: any member of the chosen cluster
+    const auto& members = chain.clusters[w.cluster];
+    pick = &members[std::min(members.size() - 1, static_cast<std::size_t>(Uniform(w.rng) * members.size()))];
+  }
+  // No faster than the recorded segment ending at the drawn extremum.
+  double dt = std::max(pick->dt, 1e-3);
+  const double recorded_speed = std::abs(pick->rise) / dt;
+  if (recorded_speed > 1e-12) dt = std::max(dt, std::abs(pick->value - w.v1) / recorded_speed);
   w.t0 = w.t1;
   w.v0 = w.v1;
-  w.t1 = w.t0 + std::max(e.dt, 1e-3);
-  w.v1 = e.value;
+  w.t1 = w.t0 + dt;
+  w.v1 = pick->value;
 }
 
 void IdleSynthesizer::Advance(int i, double t) {

@@ -10,9 +10,12 @@
 // the previous extremum, value) pairs — clustered with k-means, with the transition counts
 // between clusters of consecutive extrema. Synthesis walks each component's cluster chain
 // (seeded), draws each next extremum from the recorded members of the chosen cluster (no
-// invented values), and joins consecutive extrema with cosine segments (zero velocity at
-// every extremum, as the signal has there). The posture is the mean plus the components, each
-// value clamped to the training data's range.
+// invented values) that lie on the other side of the current one (maxima and minima
+// alternate, as in the signal: no plateau from drawing the same value twice), and joins
+// consecutive extrema with cosine segments (zero velocity at every extremum, as the signal has
+// there) no faster than the recorded segment ending at the drawn extremum (a large swing
+// joined in a short recorded interval would outrun the data). The posture is the mean plus the
+// components, each value clamped to the training data's range.
 //
 //   IdleSynthesizer idle(skeleton, model, /*seed=*/7);
 //   if (!idle.Sample(t, {}, pose)) ...                 // unbounded, deterministic in (seed, t)
@@ -38,6 +41,7 @@ struct IdleModel {
   struct Extremum {
     double dt = 0;     // seconds since the previous extremum
     double value = 0;  // the component's value there
+    double rise = 0;   // value − the previous extremum's value (its sign: a maximum or a minimum)
   };
   struct ComponentChain {
     std::vector<std::vector<Extremum>> clusters;  // recorded extrema, by k-means cluster

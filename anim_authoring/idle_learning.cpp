@@ -459,7 +459,7 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
       if (idx.back() != static_cast<int>(c.size()) - 1) idx.push_back(static_cast<int>(c.size()) - 1);
       for (std::size_t e = 1; e < idx.size(); ++e) {
         if (e > 1) links.emplace_back(static_cast<int>(ex.size()) - 1, static_cast<int>(ex.size()));
-        ex.push_back({(idx[e] - idx[e - 1]) / data.rate, c[idx[e]]});
+        ex.push_back({(idx[e] - idx[e - 1]) / data.rate, c[idx[e]], c[idx[e]] - c[idx[e - 1]]});
       }
     }
     IdleModel::ComponentChain chain;
