@@ -25,27 +25,50 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   description_ = context_->Description();
 }
 
+void ArCompositor::NoteFrameComposed() {
+  const auto now = std::chrono::steady_clock::now();
+  composed_at_.push_back(now);
+  while (composed_at_.size() > 2 && now - composed_at_.front() > std::chrono::seconds(1)) composed_at_.pop_front();
+}
+
+double ArCompositor::OutputRate() const {
+  if (composed_at_.size() < 2) return 0;
+  const double seconds = std::chrono::duration<double>(composed_at_.back() - composed_at_.front()).count();
+  return seconds > 0 ? (composed_at_.size() - 1) / seconds : 0;
+}
+
+std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) const {
+  char line[128];
+  std::snprintf(line, sizeof line, "frame %lld   %s   %.0f frames/s", static_cast<long long>(input.frame->index),
+                ToString(input.track->status).c_str(), OutputRate());
+  std::vector<std::string> status = {line};
+  if (input.track->status == tracker::TrackStatus::kLost) {
+    status.push_back("lost: the character is hidden until the camera is found again");
+  } else if (!input.animations.empty()) {
+    std::snprintf(line, sizeof line, "idle weight %.2f", input.animations.front()->idle_weight);
+    status.push_back(line);
+  }
+  return status;
+}
+
 void ArCompositor::DrawHud(cv::Mat& frame, const FrameToCompose& input) const {
   std::vector<render::HudSphere> spheres;
-  for (size_t i = 0; i < characters_.size() && i < input.animations.size(); ++i) {
+  const bool localized = input.track->status != tracker::TrackStatus::kLost;
+  for (size_t i = 0; localized && i < characters_.size() && i < input.animations.size(); ++i) {
     const AnimatedFrame& a = *input.animations[i];
     spheres.push_back(HudSphereFor(characters_[i]->spec(), a.key_weights, a.viewpoint, heights_[i]));
   }
   render::HudText text;
-  if (!input.animations.empty()) {
-    char line[96];
-    std::snprintf(line, sizeof line, "frame %lld   idle weight %.2f", static_cast<long long>(input.frame->index),
-                  input.animations.front()->idle_weight);
-    text.status.push_back(line);
-  }
+  text.status = HudStatus(input);
   const calib::Camera& k = renderer_->pinhole();
+  const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
   if (!options_.hmd) {
-    render::DrawHud(frame, k, input.track->pose, spheres, text);
+    render::DrawHud(frame, k, pose, spheres, text);
     return;
   }
   for (int eye = 0; eye < 2; ++eye) {
     cv::Mat half = frame(cv::Rect(eye * k.width, 0, k.width, k.height));
-    render::DrawHud(half, k, render::OffsetEye(input.track->pose, (eye == 0 ? -0.5 : 0.5) * options_.ipd_m), spheres, text);
+    render::DrawHud(half, k, render::OffsetEye(pose, (eye == 0 ? -0.5 : 0.5) * options_.ipd_m), spheres, text);
   }
 }
 
@@ -56,6 +79,7 @@ cv::Size ArCompositor::OutputSize() const {
 }
 
 cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
+  NoteFrameComposed();
   const bool localized = input.track->status != tracker::TrackStatus::kLost;
   outputs_.clear();
   output_ptrs_.clear();
@@ -75,7 +99,7 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
     const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
     cv::Mat frame = options_.hmd ? renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m)
                                  : renderer_->Render(input.frame->image, pose, output_ptrs_);
-    if (options_.hud && localized && !characters_.empty()) DrawHud(frame, input);
+    if (options_.hud && !characters_.empty()) DrawHud(frame, input);
     return frame;
   }
   // Lost: no pose to register the characters with, so the video is shown alone, undistorted
@@ -91,10 +115,11 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
     cv::remap(frame, undistorted, undistort_x_, undistort_y_, cv::INTER_LINEAR);
     frame = undistorted;
   }
-  if (!options_.hmd) return frame.clone();
-  cv::Mat both;
-  cv::hconcat(frame, frame, both);
-  return both;
+  cv::Mat out;
+  if (options_.hmd) cv::hconcat(frame, frame, out);
+  else out = frame.clone();
+  if (options_.hud && !characters_.empty()) DrawHud(out, input);  // the status says "lost"
+  return out;
 }
 
 }  // namespace arview::app

@@ -3,6 +3,8 @@
 // compositor and bound to the render thread (BindToThread); the characters are drawn where the tracker says the camera is, and
 // lost frames show the video alone.
 
+#include <chrono>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,7 +22,7 @@ struct CompositorOptions {
   bool hmd = false;   // side-by-side stereo
   double ipd_m = 0.064;
   std::optional<render::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
-  bool hud = false;   // the view-sphere overlay (render/hud.h) over localized frames
+  bool hud = false;   // the overlay (render/hud.h): view sphere, weights, tracking status, frame rate
 };
 
 class ArCompositor : public FrameCompositor {
@@ -35,6 +37,12 @@ class ArCompositor : public FrameCompositor {
   cv::Size OutputSize() const;
 
  private:
+  // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
+  std::vector<std::string> HudStatus(const FrameToCompose& input) const;
+  // Composed frames per second over the last second or so of output (wall clock).
+  void NoteFrameComposed();
+  double OutputRate() const;
+
   calib::Camera camera_;
   std::vector<const anim::AnimatedCharacter*> characters_;
   CompositorOptions options_;
@@ -46,6 +54,7 @@ class ArCompositor : public FrameCompositor {
   std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
   void DrawHud(cv::Mat& frame, const FrameToCompose& input) const;
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
+  std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
 };
 
 }  // namespace arview::app

@@ -143,6 +143,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
               compose.animations.push_back(&animator->Update(centre, item->frame.timestamp));
             }
             log.idle_weight = compose.animations.front()->idle_weight;
+            log.actions_triggered = compose.animations.front()->triggered;
             if (localized) {
               log.gaze_error_deg = GazeErrorDeg(animators.front()->character(), compose.animations.front()->model,
                                                 item->track.center);

@@ -52,6 +52,7 @@ struct FrameLog {
   tracker::FrameResult track;
   double idle_weight = 0;
   std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
+  int actions_triggered = 0;  // first character: distance-triggered actions started (a greeting)
 };
 
 struct PipelineReport {

@@ -48,6 +48,8 @@ struct DemoArgs {
   std::string gl = "auto";
   int gl_threads = 1;
   bool hmd = false;
+  bool no_hud = false;
+  double greet_within = 1.4;  // metres
 };
 
 constexpr int kSteps = 7;
@@ -113,6 +115,39 @@ Anchor AnchorInMap(const recordings::Sim3& to_room, const Eigen::Vector3d& spot,
   return a;
 }
 
+// What the character does in the demo, from the clips the asset has: the idle synthesizer
+// learned from its idle clips (the figure's Idle and WeightShift) under the view-adaptive
+// look-at, and its Wave clip on the right arm when the viewer comes within `greet_within_map`
+// (map units). An asset without such clips keeps the default schedule.
+PlacedBehaviour DemoBehaviour(const anim::Character& asset, double greet_within_map) {
+  PlacedBehaviour b;
+  for (const char* clip : {"Idle", "WeightShift"})
+    if (asset.FindClip(clip)) b.idle_clips.push_back(clip);
+  if (asset.FindClip("Wave") && greet_within_map > 0) {
+    b.greet_clip = "Wave";
+    b.greet_within = greet_within_map;
+  }
+  return b;
+}
+
+std::string BehaviourText(const PlacedBehaviour& b, double greet_within_m) {
+  if (b.empty()) return "behaviour: the scene's default (its base clip looped under the look-at keys)";
+  std::string text = "behaviour: ";
+  if (!b.idle_clips.empty()) {
+    text += "idles (synthesizer learned from";
+    for (const std::string& c : b.idle_clips) text += " " + c;
+    text += "), looks at the viewer with spine, neck and head";
+  } else {
+    text += "looks at the viewer";
+  }
+  if (!b.greet_clip.empty()) {
+    char line[96];
+    std::snprintf(line, sizeof line, ", greets (%s) when the viewer comes within %.2f m", b.greet_clip.c_str(), greet_within_m);
+    text += line;
+  }
+  return text + "; fades to idle while tracking is lost";
+}
+
 const char* Percent(std::size_t part, std::size_t whole, char* buffer, std::size_t size) {
   std::snprintf(buffer, size, "%zu/%zu (%.1f%%)", part, whole, 100.0 * part / std::max<std::size_t>(1, whole));
   return buffer;
@@ -140,6 +175,13 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--gl", a->gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
   cmd->add_option("--gl-threads", a->gl_threads, "llvmpipe rasterizer threads")->capture_default_str()->check(CLI::Range(0, 16));
   cmd->add_flag("--hmd", a->hmd, "Side-by-side stereo output");
+  cmd->add_flag("--no-hud", a->no_hud,
+                "No overlay (by default the video shows the view sphere with the keys and the current viewpoint, "
+                "the weights, the tracking status and the frame rate)");
+  cmd->add_option("--greet-within", a->greet_within,
+                  "The character greets (its Wave clip, once) when the viewer comes within this many metres; 0: never")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   cmd->callback([a] {
     const fs::path work = a->work;
     fs::create_directories(work);
@@ -206,6 +248,7 @@ void AddDemoCommand(CLI::App& app) {
     place_options.anchor = AnchorInMap(to_room, orbit.Subject(), orbit.CloseApproachAzimuth(), a->height, asset_height);
     PlacedCharacter placed = PlaceCharacter(built.map, a->character, place_options);
     placed.comment = "arview demo: " + placed.asset.filename().string() + " where the demo's walk circles";
+    placed.behaviour = DemoBehaviour(asset, a->greet_within * to_room.Inverse().scale);
     const fs::path scene = work / "scene.yaml";
     WriteSceneFile(placed, scene);
     // The room's light at the character, from the map's keyframe images (render/room_light):
@@ -215,6 +258,7 @@ void AddDemoCommand(CLI::App& app) {
                 "-> %s\n",
                 placed.name.c_str(), a->height, orbit.Subject().x(), orbit.Subject().y(),
                 placed.base_clip.empty() ? "its first clip" : placed.base_clip.c_str(), scene.c_str());
+    std::printf("  %s\n", BehaviourText(placed.behaviour, a->greet_within).c_str());
 
     Step(5, "Replaying the second lap: track, animate, render, composite");
     SessionOptions session;
@@ -226,6 +270,7 @@ void AddDemoCommand(CLI::App& app) {
     session.stats_out = work / "stats.json";
     session.compositor.gl = gl;
     session.compositor.hmd = a->hmd;
+    session.compositor.hud = !a->no_hud;
     const SceneLighting lighting = ResolveSceneLighting(scene, "auto", {});
     session.compositor.ar.lighting = lighting.mode;
     session.compositor.room_light = lighting.light;
@@ -275,6 +320,16 @@ void AddDemoCommand(CLI::App& app) {
       ++gaze_frames;
       gaze_within += *f.gaze_error_deg <= 20.0;
     }
+    std::vector<std::string> greetings;  // when the distance trigger fired, and how close
+    for (const FrameLog& f : result.report.frames) {
+      if (!f.actions_triggered) continue;
+      const auto it = std::find_if(second_lap.begin(), second_lap.end(),
+                                   [&](const recordings::StampedPose& g) { return std::abs(g.timestamp - f.timestamp) < 1e-3; });
+      char at[64];
+      std::snprintf(at, sizeof at, "frame %lld (%.2f m)", static_cast<long long>(f.index),
+                    it == second_lap.end() ? 0.0 : (it->pose.Center() - orbit.Subject()).head<2>().norm());
+      greetings.push_back(at);
+    }
     std::vector<double> distances;
     for (const auto& g : second_lap) distances.push_back((g.pose.Center() - orbit.Subject()).head<2>().norm());
     const fs::path sheet_file = out.parent_path() / "contact_sheet.png";
@@ -288,6 +343,12 @@ void AddDemoCommand(CLI::App& app) {
     std::printf("  head within 20 deg of the camera, frames in view: %s\n", Percent(gaze_within, gaze_frames, buffer, sizeof buffer));
     std::printf("  the viewer's distance to the character: median %.2f m, %.2f to %.2f m\n", Median(distances),
                 *std::min_element(distances.begin(), distances.end()), *std::max_element(distances.begin(), distances.end()));
+    if (!placed.behaviour.greet_clip.empty()) {
+      std::string when;
+      for (const std::string& g : greetings) when += (when.empty() ? " at " : ", ") + g;
+      std::printf("  greetings (%s when the viewer came within %.2f m): %zu%s\n", placed.behaviour.greet_clip.c_str(),
+                  a->greet_within, greetings.size(), when.c_str());
+    }
     std::printf("  tracking: %zu/%zu localized, centre error median %.1f mm, latency median %.1f ms\n",
                 result.report.frames_localized, result.report.frames_processed, 1000 * report.ate.median, latency);
     std::printf("  end to end: %.1f frames per second at %dx%d\n", result.report.fps, walk.camera.width, walk.camera.height);

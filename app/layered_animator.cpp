@@ -27,7 +27,11 @@ const AnimatedFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d
   inputs.tracking = camera_center.has_value();
   if (camera_center) {
     inputs.viewpoint = spec.ViewpointFromCamera(*camera_center);
-    inputs.distance = (*camera_center - spec.anchor.position).norm();
+    // Along the floor: "the viewer comes within 1.5 m" of a standing character means on the
+    // ground, not from the eyes to its feet (at eye height that would be never closer than ~1.6 m).
+    const Eigen::Vector3d up = (spec.anchor.rotation * spec.up).normalized();
+    const Eigen::Vector3d to_camera = *camera_center - spec.anchor.position;
+    inputs.distance = (to_camera - to_camera.dot(up) * up).norm();
   } else {
     inputs.viewpoint = Eigen::Vector3d::Zero();  // held by the animator
   }
@@ -37,6 +41,7 @@ const AnimatedFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d
   frame_.model = f.model;
   frame_.key_weights = f.key_weights;
   frame_.viewpoint = f.viewpoint;
+  frame_.triggered = f.triggered;
   frame_.idle_weight = animator_->view_action_id() >= 0 ? 1.0 - f.view_gain : 1.0;
   return frame_;
 }

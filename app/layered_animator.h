@@ -7,8 +7,9 @@
 // last viewpoint for `hold_seconds` (time keeps running: no freeze), then the view-adaptive
 // action fades out (cosine, over `fade_seconds`) to the layers below it; when the tracker
 // relocalizes it fades back. The fade blends local joint transforms (dual quaternions), so bones
-// keep their lengths and no joint jumps. The viewer's distance to the character (map units)
-// drives the scene's distance triggers and weights.
+// keep their lengths and no joint jumps. The viewer's distance to the character (map units,
+// along the character's floor: the camera's height above it does not count) drives the scene's
+// distance triggers and weights.
 
 #include <Eigen/Core>
 
@@ -35,6 +36,7 @@ struct AnimatedFrame {
   std::span<const double> key_weights;  // of the view-adaptive layer
   double idle_weight = 0;               // 0: fully view-adaptive, 1: fully the layers below it
   Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // the one used (character frame)
+  int triggered = 0;                    // distance-triggered actions started this frame
 };
 
 class LayeredAnimator {

@@ -70,6 +70,7 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
                                     {"track_ms", f.track.times.total_ms},
                                     {"idle_weight", f.idle_weight}};
     if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
+    if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
     if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
     frames.push_back(std::move(frame));
   }

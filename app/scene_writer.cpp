@@ -17,6 +17,60 @@ void EmitVector(YAML::Emitter& y, const char* key, std::initializer_list<double>
   y << YAML::EndSeq;
 }
 
+void EmitBehaviour(YAML::Emitter& y, const PlacedBehaviour& b) {
+  const bool idle = !b.idle_clips.empty();
+  if (idle) {
+    y << YAML::Key << "idle" << YAML::Value << YAML::BeginMap;
+    y << YAML::Key << "clips" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const std::string& clip : b.idle_clips) y << clip;
+    y << YAML::EndSeq;
+    y << YAML::Key << "seed" << YAML::Value << b.idle_seed;
+    y << YAML::EndMap;
+  }
+  y << YAML::Key << "schedule" << YAML::Value << YAML::BeginMap;
+  y << YAML::Key << "tracking_loss" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "hold" << YAML::Value
+    << b.loss_hold << YAML::Key << "fade" << YAML::Value << b.loss_fade << YAML::Key << "action" << YAML::Value << "view"
+    << YAML::EndMap;
+  y << YAML::Key << "actions" << YAML::Value << YAML::BeginSeq;
+  y << YAML::BeginMap << YAML::Key << "name" << YAML::Value << "idle";
+  if (idle) {
+    y << YAML::Key << "object" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "idle" << YAML::Value << true
+      << YAML::EndMap;
+  } else {
+    y << YAML::Key << "object" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "pose" << YAML::Value << "rest"
+      << YAML::EndMap;
+  }
+  y << YAML::Key << "keep_rendering" << YAML::Value << true << YAML::EndMap;
+
+  y << YAML::BeginMap << YAML::Key << "name" << YAML::Value << "view";
+  y << YAML::Key << "object" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "view_adaptive" << YAML::Value
+    << true << YAML::EndMap;
+  y << YAML::Key << "keep_rendering" << YAML::Value << true << YAML::Key << "layer" << YAML::Value << 1;
+  if (idle) {
+    // The look-at turns the spine, neck and head; arms and legs keep the idle's motion.
+    y << YAML::Key << "mask" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "default" << YAML::Value << 0
+      << YAML::Key << "torso" << YAML::Value << 1 << YAML::Key << "left_arm" << YAML::Value << 0 << YAML::Key
+      << "right_arm" << YAML::Value << 0 << YAML::EndMap;
+  }
+  y << YAML::EndMap;
+
+  if (!b.greet_clip.empty() && b.greet_within > 0) {
+    y << YAML::BeginMap << YAML::Key << "name" << YAML::Value << "greet";
+    y << YAML::Key << "object" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "clip" << YAML::Value
+      << b.greet_clip << YAML::EndMap;
+    y << YAML::Key << "layer" << YAML::Value << 2;
+    y << YAML::Key << "curve" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "shape" << YAML::Value
+      << "cosine-fade" << YAML::Key << "in" << YAML::Value << 0.15 << YAML::Key << "out" << YAML::Value << 0.15
+      << YAML::EndMap;
+    y << YAML::Key << "mask" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "default" << YAML::Value << 0
+      << YAML::Key << b.greet_scope << YAML::Value << 1 << YAML::EndMap;
+    y << YAML::Key << "trigger" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "near" << YAML::Value
+      << b.greet_within << YAML::Key << "far" << YAML::Value << 1.4 * b.greet_within << YAML::EndMap;
+    y << YAML::EndMap;
+  }
+  y << YAML::EndSeq << YAML::EndMap;
+}
+
 }  // namespace
 
 std::string SceneYaml(const PlacedCharacter& c) {
@@ -63,6 +117,7 @@ std::string SceneYaml(const PlacedCharacter& c) {
     y << YAML::EndMap;
   }
   y << YAML::EndSeq;
+  if (!c.behaviour.empty()) EmitBehaviour(y, c.behaviour);
   y << YAML::EndMap << YAML::EndSeq << YAML::EndMap;
   if (!y.good()) throw anim::Error("scene writer: " + y.GetLastError());
   return std::string(y.c_str()) + "\n";

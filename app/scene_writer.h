@@ -1,13 +1,36 @@
 #pragma once
 // Writes the scene file (the format of anim_authoring/scene.h) for a character placed by `arview place`:
-// the anchor, and K look-at keys evenly spaced on the horizon around the character.
+// the anchor, K look-at keys evenly spaced on the horizon around the character, and optionally
+// its behaviour (idle synthesizer, a greeting when the viewer comes close).
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "app/placement.h"
 
 namespace arview::app {
+
+// What the character does besides the view-adaptive look-at (the scene's `idle:` and
+// `schedule:` sections, docs/anim.md). Empty: the default schedule (the base clip looped under
+// the view-adaptive blend).
+struct PlacedBehaviour {
+  // The idle synthesizer learns from these clips of the asset; it runs underneath, and the
+  // view-adaptive blend then covers the spine, neck and head only (arms and legs idle).
+  std::vector<std::string> idle_clips;
+  std::uint64_t idle_seed = 1;
+  // A clip played once, on `greet_scope`, when the viewer comes within `greet_within` (map
+  // units; 0: no greeting), re-armed beyond 1.4 times that.
+  std::string greet_clip;
+  double greet_within = 0;
+  std::string greet_scope = "right_arm";
+  // Tracking loss: the view-adaptive blend holds for `loss_hold` s, then fades out (cosine)
+  // over `loss_fade` s, and back on relocalization.
+  double loss_hold = 0.5, loss_fade = 1.0;
+
+  bool empty() const { return idle_clips.empty() && greet_clip.empty(); }
+};
 
 struct PlacedCharacter {
   std::string name = "character";
@@ -18,6 +41,7 @@ struct PlacedCharacter {
   std::string base_clip;  // empty: the asset's first clip
   std::string comment;    // written at the top of the file
   double rest_height = 0; // the asset's rest-pose height, asset units (for messages)
+  PlacedBehaviour behaviour;
 };
 
 std::string SceneYaml(const PlacedCharacter& character);

@@ -44,5 +44,44 @@ TEST(SceneWriter, WritesWhatTheSceneReaderReadsBack) {
   EXPECT_EQ(text.rfind("# two lines\n", 0), 0u) << text;
 }
 
+TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
+  PlacedCharacter c = Placed();
+  c.behaviour.idle_clips = {"Survey", "Walk"};
+  c.behaviour.idle_seed = 7;
+  c.behaviour.greet_clip = "Run";
+  c.behaviour.greet_within = 1.5;
+  const anim::Scene s = anim::ParseScene(SceneYaml(c), "/tmp/placed.yaml");
+  const anim::CharacterSpec& spec = s.characters[0];
+  ASSERT_TRUE(spec.idle.given);
+  EXPECT_EQ(spec.idle.clips, (std::vector<std::string>{"Survey", "Walk"}));
+  EXPECT_EQ(spec.idle.seed, 7u);
+  ASSERT_TRUE(spec.schedule.given);
+  EXPECT_EQ(spec.schedule.view_action, "view");
+  EXPECT_DOUBLE_EQ(spec.schedule.hold_seconds, 0.5);
+  ASSERT_EQ(spec.schedule.actions.size(), 3u);
+  const anim::ActionSpec& idle = spec.schedule.actions[0];
+  EXPECT_EQ(idle.object.kind, anim::ObjectSpec::Kind::kIdle);
+  const anim::ActionSpec& view = spec.schedule.actions[1];
+  EXPECT_EQ(view.object.kind, anim::ObjectSpec::Kind::kViewAdaptive);
+  EXPECT_EQ(view.layer, 1);
+  ASSERT_EQ(view.masks.size(), 1u);
+  EXPECT_EQ(view.masks[0].default_rotation, 0);
+  ASSERT_EQ(view.masks[0].scopes.size(), 3u);
+  EXPECT_EQ(view.masks[0].scopes[0].name, "torso");
+  const anim::ActionSpec& greet = spec.schedule.actions[2];
+  EXPECT_EQ(greet.object.clip, "Run");
+  EXPECT_TRUE(greet.has_trigger);
+  EXPECT_DOUBLE_EQ(greet.trigger_near, 1.5);
+  EXPECT_DOUBLE_EQ(greet.trigger_far, 2.1);
+  ASSERT_EQ(greet.masks.size(), 1u);
+  EXPECT_EQ(greet.masks[0].scopes[0].name, "right_arm");
+}
+
+TEST(SceneWriter, NoBehaviourKeepsTheDefaultSchedule) {
+  const anim::Scene s = anim::ParseScene(SceneYaml(Placed()), "/tmp/placed.yaml");
+  EXPECT_FALSE(s.characters[0].idle.given);
+  EXPECT_FALSE(s.characters[0].schedule.given);
+}
+
 }  // namespace
 }  // namespace arview::app
