@@ -136,7 +136,7 @@ std::string BehaviourText(const PlacedBehaviour& b, double greet_within_m) {
   if (!b.idle_clips.empty()) {
     text += "idles (synthesizer learned from";
     for (const std::string& c : b.idle_clips) text += " " + c;
-    text += "), looks at the viewer with spine, neck and head";
+    text += "), turns its body, spine, neck and head to look at the viewer";
   } else {
     text += "looks at the viewer";
   }

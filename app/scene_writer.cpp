@@ -47,10 +47,12 @@ void EmitBehaviour(YAML::Emitter& y, const PlacedBehaviour& b) {
     << true << YAML::EndMap;
   y << YAML::Key << "keep_rendering" << YAML::Value << true << YAML::Key << "layer" << YAML::Value << 1;
   if (idle) {
-    // The look-at turns the spine, neck and head; arms and legs keep the idle's motion.
+    // The look-at turns the body (the root's rotation), the spine, neck and head; the root's
+    // translation (weight shifts), the legs and the arms keep the idle's motion.
     y << YAML::Key << "mask" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "default" << YAML::Value << 0
-      << YAML::Key << "torso" << YAML::Value << 1 << YAML::Key << "left_arm" << YAML::Value << 0 << YAML::Key
-      << "right_arm" << YAML::Value << 0 << YAML::EndMap;
+      << YAML::Key << "root" << YAML::Value << YAML::BeginMap << YAML::Key << "rotation" << YAML::Value << 1 << YAML::Key
+      << "translation" << YAML::Value << 0 << YAML::EndMap << YAML::Key << "torso" << YAML::Value << 1 << YAML::Key
+      << "left_arm" << YAML::Value << 0 << YAML::Key << "right_arm" << YAML::Value << 0 << YAML::EndMap;
   }
   y << YAML::EndMap;
 

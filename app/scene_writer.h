@@ -17,7 +17,8 @@ namespace arview::app {
 // the view-adaptive blend).
 struct PlacedBehaviour {
   // The idle synthesizer learns from these clips of the asset; it runs underneath, and the
-  // view-adaptive blend then covers the spine, neck and head only (arms and legs idle).
+  // view-adaptive blend then covers the body's turn (the root's rotation), the spine, neck and
+  // head only (the arms, the legs and the weight shifts idle).
   std::vector<std::string> idle_clips;
   std::uint64_t idle_seed = 1;
   // A clip played once, on `greet_scope`, when the viewer comes within `greet_within` (map

@@ -66,8 +66,11 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_EQ(view.layer, 1);
   ASSERT_EQ(view.masks.size(), 1u);
   EXPECT_EQ(view.masks[0].default_rotation, 0);
-  ASSERT_EQ(view.masks[0].scopes.size(), 3u);
-  EXPECT_EQ(view.masks[0].scopes[0].name, "torso");
+  ASSERT_EQ(view.masks[0].scopes.size(), 4u);
+  EXPECT_EQ(view.masks[0].scopes[0].name, "root");
+  EXPECT_EQ(view.masks[0].scopes[0].rotation, 1);
+  EXPECT_EQ(view.masks[0].scopes[0].translation, 0);
+  EXPECT_EQ(view.masks[0].scopes[1].name, "torso");
   const anim::ActionSpec& greet = spec.schedule.actions[2];
   EXPECT_EQ(greet.object.clip, "Run");
   EXPECT_TRUE(greet.has_trigger);
