@@ -123,6 +123,7 @@ PlacedBehaviour DemoBehaviour(const anim::Character& asset, double greet_within_
   PlacedBehaviour b;
   for (const char* clip : {"Idle", "WeightShift"})
     if (asset.FindClip(clip)) b.idle_clips.push_back(clip);
+  if (asset.FindClip("Idle")) b.front_gesture = "point";  // a humanoid with authored arm clips
   if (asset.FindClip("Wave") && greet_within_map > 0) {
     b.greet_clip = "Wave";
     b.greet_within = greet_within_map;
@@ -137,6 +138,7 @@ std::string BehaviourText(const PlacedBehaviour& b, double greet_within_m) {
     text += "idles (synthesizer learned from";
     for (const std::string& c : b.idle_clips) text += " " + c;
     text += "), turns its body, spine, neck and head to look at the viewer";
+    if (!b.front_gesture.empty()) text += ", points (" + b.front_gesture + " keys) at a viewer in front of it";
   } else {
     text += "looks at the viewer";
   }

@@ -4,6 +4,8 @@
 #include <yaml-cpp/emitter.h>
 #include <yaml-cpp/emittermanip.h>
 
+#include <algorithm>
+
 #include "anim_authoring/scene.h"
 #include "base/atomic_file.h"
 
@@ -52,7 +54,8 @@ void EmitBehaviour(YAML::Emitter& y, const PlacedBehaviour& b) {
     y << YAML::Key << "mask" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key << "default" << YAML::Value << 0
       << YAML::Key << "root" << YAML::Value << YAML::BeginMap << YAML::Key << "rotation" << YAML::Value << 1 << YAML::Key
       << "translation" << YAML::Value << 0 << YAML::EndMap << YAML::Key << "torso" << YAML::Value << 1 << YAML::Key
-      << "left_arm" << YAML::Value << 0 << YAML::Key << "right_arm" << YAML::Value << 0 << YAML::EndMap;
+      << "left_arm" << YAML::Value << 0 << YAML::Key << "right_arm" << YAML::Value << (b.front_gesture.empty() ? 0 : 1)
+      << YAML::EndMap;
   }
   y << YAML::EndMap;
 
@@ -112,10 +115,16 @@ std::string SceneYaml(const PlacedCharacter& c) {
   }
   y << YAML::Key << "keys" << YAML::Value << YAML::BeginSeq;
   for (int k = 0; k < c.key_count; ++k) {
+    const double azimuth = 360.0 * k / c.key_count;
+    const double off_front = std::min(azimuth, 360.0 - azimuth);
     y << YAML::BeginMap;
-    y << YAML::Key << "azimuth" << YAML::Value << 360.0 * k / c.key_count;
+    y << YAML::Key << "azimuth" << YAML::Value << azimuth;
     y << YAML::Key << "elevation" << YAML::Value << c.key_elevation_deg;
-    y << YAML::Key << "generate" << YAML::Value << "lookat";
+    if (!c.behaviour.front_gesture.empty() && off_front <= c.behaviour.gesture_within_deg + 1e-9) {
+      y << YAML::Key << "gesture" << YAML::Value << c.behaviour.front_gesture;
+    } else {
+      y << YAML::Key << "generate" << YAML::Value << "lookat";
+    }
     y << YAML::EndMap;
   }
   y << YAML::EndSeq;

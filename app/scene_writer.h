@@ -26,11 +26,16 @@ struct PlacedBehaviour {
   std::string greet_clip;
   double greet_within = 0;
   std::string greet_scope = "right_arm";
+  // Keys within `gesture_within_deg` of the character's front get this gesture (`point` or
+  // `reach`, anim_authoring/gesture.h): the right arm points at a viewer in front; the view
+  // layer then covers the right arm too. Empty: look-at keys only.
+  std::string front_gesture;
+  double gesture_within_deg = 50;
   // Tracking loss: the view-adaptive blend holds for `loss_hold` s, then fades out (cosine)
   // over `loss_fade` s, and back on relocalization.
   double loss_hold = 0.5, loss_fade = 1.0;
 
-  bool empty() const { return idle_clips.empty() && greet_clip.empty(); }
+  bool empty() const { return idle_clips.empty() && greet_clip.empty() && front_gesture.empty(); }
 };
 
 struct PlacedCharacter {

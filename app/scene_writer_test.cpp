@@ -50,6 +50,7 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   c.behaviour.idle_seed = 7;
   c.behaviour.greet_clip = "Run";
   c.behaviour.greet_within = 1.5;
+  c.behaviour.front_gesture = "point";  // keys at 0, 60 and 300 degrees (within 50 of the front)
   const anim::Scene s = anim::ParseScene(SceneYaml(c), "/tmp/placed.yaml");
   const anim::CharacterSpec& spec = s.characters[0];
   ASSERT_TRUE(spec.idle.given);
@@ -78,6 +79,11 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_DOUBLE_EQ(greet.trigger_far, 2.1);
   ASSERT_EQ(greet.masks.size(), 1u);
   EXPECT_EQ(greet.masks[0].scopes[0].name, "right_arm");
+  EXPECT_EQ(view.masks[0].scopes[3].name, "right_arm");
+  EXPECT_EQ(view.masks[0].scopes[3].rotation, 1);  // the gesture keys move it
+  int gestures = 0;
+  for (const anim::KeySpec& k : spec.keys) gestures += k.gesture != anim::Gesture::kNone;
+  EXPECT_EQ(gestures, 1);  // 6 keys, 60 degrees apart: only the front one is within 50 degrees
 }
 
 TEST(SceneWriter, NoBehaviourKeepsTheDefaultSchedule) {
