@@ -62,7 +62,11 @@ std::vector<std::string> KeyText(const anim::KeySpec& key, const anim::Character
   std::vector<std::string> out{pad + "- azimuth: " + Number(ae.x()), pad + "  elevation: " + Number(ae.y())};
   switch (key.source) {
     case anim::KeySpec::Source::kClip: out.push_back(pad + "  clip: \"" + key.clip + "\""); break;
-    case anim::KeySpec::Source::kLookAt: out.push_back(pad + "  generate: lookat"); break;
+    case anim::KeySpec::Source::kLookAt:
+      // A gesture key is a look-at key with the arm on top: saving must keep its gesture.
+      if (key.gesture != anim::Gesture::kNone) out.push_back(pad + "  gesture: " + ToString(key.gesture));
+      else out.push_back(pad + "  generate: lookat");
+      break;
     case anim::KeySpec::Source::kRestPose: out.push_back(pad + "  pose: rest"); break;
     case anim::KeySpec::Source::kStaticPose:
       out.push_back(pad + "  pose: \"" + key.clip + "@" + Number(key.pose_time) + "\"");

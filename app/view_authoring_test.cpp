@@ -85,6 +85,18 @@ TEST(SpliceKeys, KeepsEverythingButTheEditedKeys) {
   EXPECT_DOUBLE_EQ(reread.characters[0].keys[1].pose_time, 0.25);
 }
 
+TEST(SpliceKeys, AGestureKeyKeepsItsGesture) {
+  const anim::Scene scene = anim::ParseScene(kScene, "s.yaml");
+  std::vector<anim::KeySpec> keys = scene.characters[0].keys;
+  anim::KeySpec pointing = Key(30, anim::KeySpec::Source::kLookAt);
+  pointing.gesture = anim::Gesture::kPoint;
+  keys.push_back(pointing);  // an edit elsewhere must not turn it into a plain look-at key
+  const std::string text = SpliceKeys(kScene, scene, 0, keys, {0, 1, -1});
+  EXPECT_NE(text.find("        elevation: 0\n        gesture: point\n"), std::string::npos) << text;
+  const anim::Scene reread = ValidateSceneText(text, "s.yaml", 0, keys);
+  EXPECT_EQ(reread.characters[0].keys.back().gesture, anim::Gesture::kPoint);
+}
+
 TEST(SpliceKeys, SecondCharacterWithItemsAtTheKeysColumn) {
   const anim::Scene scene = anim::ParseScene(kScene, "s.yaml");
   std::vector<anim::KeySpec> keys = scene.characters[1].keys;
