@@ -226,14 +226,8 @@ Clip GenerateGestureClip(const Skeleton& sk, const Clip* base, const LookAtChain
   const Eigen::Vector3d target = viewpoint.normalized();
   Clip clip;
   clip.tracks.resize(sk.size());
-  std::vector<double> times = {0.0};
-  if (base) {
-    clip = *base;
-    const int samples = std::max(2, static_cast<int>(std::ceil(base->duration * sample_rate)) + 1);
-    times.clear();
-    for (int s = 0; s < samples; ++s) times.push_back(base->duration * s / (samples - 1));
-    if (base->duration <= 0) times = {0.0};
-  }
+  if (base) clip = *base;
+  const std::vector<double> times = KeySampleTimes(base, sample_rate);
   char where[96];
   std::snprintf(where, sizeof(where), "@%s(%.2f,%.2f,%.2f)", ToString(gesture).data(), target.x(), target.y(),
                 target.z());

@@ -186,6 +186,14 @@ void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vect
   }
 }
 
+std::vector<double> KeySampleTimes(const Clip* base, double sample_rate) {
+  if (!base || base->duration <= 0) return {0.0};
+  const int samples = std::max(2, static_cast<int>(std::ceil(base->duration * sample_rate)) + 1);
+  std::vector<double> times;
+  for (int s = 0; s < samples; ++s) times.push_back(base->duration * s / (samples - 1));
+  return times;
+}
+
 Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain& chain, const Eigen::Vector3d& viewpoint,
                         double sample_rate) {
   if (viewpoint.norm() < 1e-9) throw Error("look-at: the key viewpoint has zero length");
@@ -194,14 +202,8 @@ Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain&
   const Eigen::Vector3d target = viewpoint.normalized();
   Clip clip;
   clip.tracks.resize(sk.size());
-  std::vector<double> times = {0.0};
-  if (base) {
-    clip = *base;
-    const int samples = std::max(2, static_cast<int>(std::ceil(base->duration * sample_rate)) + 1);
-    times.clear();
-    for (int s = 0; s < samples; ++s) times.push_back(base->duration * s / (samples - 1));
-    if (base->duration <= 0) times = {0.0};
-  }
+  if (base) clip = *base;
+  const std::vector<double> times = KeySampleTimes(base, sample_rate);
   char where[96];
   std::snprintf(where, sizeof(where), "@lookat(%.2f,%.2f,%.2f)", target.x(), target.y(), target.z());
   clip.name = (base ? base->name : std::string("rest")) + where;

@@ -54,6 +54,10 @@ LookAtChain MakeLookAtChain(const Skeleton& skeleton, const std::vector<std::str
 Clip GenerateLookAtClip(const Skeleton& skeleton, const Clip* base, const LookAtChain& chain,
                         const Eigen::Vector3d& viewpoint, double sample_rate = 30.0);
 
+// The times a generated key samples: the base clip's duration at `sample_rate` Hz, both ends
+// included (at least two samples); {0} for no base clip or a zero-length one.
+std::vector<double> KeySampleTimes(const Clip* base, double sample_rate);
+
 // The steps GenerateLookAtClip takes per sample, for keys built on top of it (gesture.h).
 // `model` holds the model-space transforms of `pose` and is kept up to date.
 // Rotates joint j by `delta` (model space) about the joint's own origin.
