@@ -35,6 +35,16 @@ double GaussianIntegral(double tau, double mu, double sigma) {
 
 }  // namespace
 
+calib::Pose HandHeldCameraPose(const Eigen::Vector3d& centre, double yaw, double pitch, double roll) {
+  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d r_wc;
+  r_wc << right, down, forward;  // columns: the camera's x, y, z axes in the world
+  r_wc = r_wc * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), centre);
+}
+
 OrbitWalk::OrbitWalk(double duration, uint64_t seed, const OrbitWalkOptions& options) : duration_(duration), options_(options) {
   std::mt19937_64 engine(seed);
   pan_phase_ = kTwoPi * Unit(engine);
@@ -98,13 +108,7 @@ calib::Pose OrbitWalk::At(double t) const {
   const double pitch = std::atan2(look.z(), look.head<2>().norm()) + pitch_offset + shake(1, 0.002);
   const double roll = 0.03 * std::sin(kTwoPi * t / 4.1 + roll_phase_) + shake(2, 0.0015);
 
-  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
-  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d down = forward.cross(right);
-  Eigen::Matrix3d r_wc;
-  r_wc << right, down, forward;  // columns: the camera's x, y, z axes in the world
-  r_wc = r_wc * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), centre);
+  return HandHeldCameraPose(centre, yaw, pitch, roll);
 }
 
 }  // namespace arview::render

@@ -21,6 +21,10 @@
 
 namespace arview::render {
 
+// The pose of a camera at `centre` (world, z up) looking along yaw (about z, from +x) and pitch
+// (up from the horizon), rolled by `roll` about its optical axis; radians. Both walks use it.
+calib::Pose HandHeldCameraPose(const Eigen::Vector3d& centre, double yaw, double pitch, double roll);
+
 struct OrbitWalkOptions {
   Eigen::Vector2d subject{-0.2, 0.25};  // the spot the laps circle, on the floor
   double start_azimuth_deg = 90;        // where lap 1 starts, seen from the subject (0 = +x)

@@ -256,13 +256,7 @@ calib::Pose RoomPath::At(double t) const {
   const double pitch = -0.28 + 0.06 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
   const double roll = 0.03 * std::sin(kTwoPi * t / 4.1 + roll_phase_) + shake(2, 0.0015);
 
-  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
-  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-  const Eigen::Vector3d down = forward.cross(right);
-  Eigen::Matrix3d r_wc;
-  r_wc << right, down, forward;  // columns: the camera's x, y, z axes in the world
-  r_wc = r_wc * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), center);
+  return HandHeldCameraPose(center, yaw, pitch, roll);
 }
 
 RoomRenderer::RoomRenderer(OffscreenContext& context, const RoomScene& scene, const calib::Camera& camera, int samples)
