@@ -5,12 +5,14 @@
 //   BM_Skinning/<method>         CPU skinning of 25 000 vertices, 4 influences, 27 joints
 //   BM_FoxUpdate/<method>        AnimatedCharacter::Update on the Fox with 8 look-at keys
 //   BM_ScheduleUpdate/<dib>      Animator::Update, BCN_Epileptic (54 joints), a four-action schedule
+//   BM_ScheduleUpdateGesture/<dib>  the same with the gesture a generated point gesture (IK)
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
 #include "anim/pose.h"
 #include "anim/animator.h"
 #include "anim_authoring/scene.h"
+#include "tests/support/four_action_schedule.h"
 #include "tests/support/test_data.h"
 
 #include <benchmark/benchmark.h>
@@ -192,56 +194,30 @@ void BM_FoxUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_FoxUpdate)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->ArgNames({"method", "nlerp"});
 
-// One Animator::Update of the 54-joint BCN_Epileptic with a four-action schedule: the idle
-// synthesizer (learned from its own clip) underneath, the 8-key view-adaptive blend (look-at
-// keys) on top, a gesture fading in and out (cosine, re-timed as it ends) and a clip masked to
-// the left arm; local-to-model and skinning matrices included.
-void BM_ScheduleUpdate(benchmark::State& state) {
-  const std::string bcn = "/usr/share/assimp/models/X/BCN_Epileptic.X";
-  if (!std::filesystem::exists(bcn)) {
-    state.SkipWithError(("needs " + bcn + " (Debian package assimp-testmodels)").c_str());
+// One Animator::Update of the 54-joint BCN_Epileptic with issue 13's four-action schedule
+// (tests/support/four_action_schedule.h): the idle synthesizer learned from its own clip
+// underneath, the 8-key look-at view-adaptive blend on top, a torso-masked gesture fading in
+// and out (cosine, re-timed as it ends) and a clip masked to the left arm; weights, sampling,
+// the layered frame blender, local-to-model and skinning matrices included.
+//   BM_ScheduleUpdate         the gesture is the character's clip mirrored
+//   BM_ScheduleUpdateGesture  the gesture is a generated point gesture (two-bone IK)
+void ScheduleUpdate(benchmark::State& state, testing::FourActionSchedule::Gesture gesture) {
+  if (!std::filesystem::exists(testing::kBcnEpileptic)) {
+    state.SkipWithError((std::string("needs ") + testing::kBcnEpileptic + " (Debian package assimp-testmodels)").c_str());
     return;
   }
-  std::string text = "characters:\n  - asset: " + bcn + "\n    blend: {method: " + (state.range(0) ? "dib" : "dlb") +
-                     "}\n    idle: {clips: [Epileptisch], seed: 1}\n    keys:\n";
-  for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
-  text += R"(    schedule:
-      actions:
-        - name: idle
-          object: {idle: true}
-          keep_rendering: true
-        - name: view
-          object: {view_adaptive: true}
-          keep_rendering: true
-          layer: 1
-        - name: gesture
-          object: {clip: Epileptisch, mirror: true}
-          layer: 2
-          curve: {shape: cosine-fade, in: 0.3, out: 0.3}
-          mask: {default: 0, torso: 1}
-        - name: arm
-          object: {clip: Epileptisch, loop: true}
-          layer: 2
-          weight: 0.5
-          mask: {default: 0, left_arm: 1}
-)";
-  AnimatedCharacter ch(ParseScene(text, "bench.yaml").characters[0]);
-  auto animator = BuildAnimator(ch);
-  Schedule& schedule = animator->schedule();
-  const int gesture = schedule.FindByName("gesture");
-  const double gesture_length = ch.character().FindClip("Epileptisch")->duration;
-  double t = 0;
-  FrameInputs in;
+  testing::FourActionSchedule schedule(gesture, state.range(0) != 0);
   for (auto _ : state) {
-    t += 1.0 / 60;
-    if (t > schedule.Find(gesture)->start + gesture_length) schedule.Retime(gesture, t);
-    in.viewpoint = DirectionFromAzimuthElevation(100 * t, 5);
-    const AnimatorFrame& f = animator->Update(t, in);
+    const AnimatorFrame& f = schedule.Step(1.0 / 60);
     benchmark::DoNotOptimize(f.skinning_matrices.data());
   }
-  state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + ", 54 joints, 4 actions");
+  state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + ", 54 joints, 4 actions" +
+                 (gesture == testing::FourActionSchedule::Gesture::kPoint ? ", point gesture" : ""));
 }
+void BM_ScheduleUpdate(benchmark::State& state) { ScheduleUpdate(state, testing::FourActionSchedule::Gesture::kMirroredClip); }
+void BM_ScheduleUpdateGesture(benchmark::State& state) { ScheduleUpdate(state, testing::FourActionSchedule::Gesture::kPoint); }
 BENCHMARK(BM_ScheduleUpdate)->Arg(0)->Arg(1)->ArgName("dib");
+BENCHMARK(BM_ScheduleUpdateGesture)->Arg(0)->Arg(1)->ArgName("dib");
 
 }  // namespace
 }  // namespace arview::anim
