@@ -4,6 +4,8 @@
 
 #include "anim_authoring/import.h"
 
+#include "anim_authoring/gltf_check.h"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -401,6 +403,9 @@ Character LoadCharacter(const fs::path& path) {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw Error(file + ": cannot open for reading");
   }
+  // Assimp trusts a glTF's indices and byte ranges (and crashes on a skin without inverse bind
+  // matrices): the structure is checked first. Other formats go to Assimp as they are.
+  if (IsGltfAsset(path)) CheckGltfStructure(path);
   Assimp::Importer importer;
   // No stand-in "skeleton mesh" for files that have bones but no skin (BVH).
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);

@@ -281,7 +281,9 @@ TEST(ImportErrors, TruncatedGltf) {
     LoadCharacter(cut);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(cut.string() + ": cannot read"), std::string::npos) << e.what();
+    // Refused by the structure check before Assimp (anim_authoring/gltf_check.h).
+    EXPECT_NE(std::string(e.what()).find(cut.string() + ": the GLB header gives a length of"), std::string::npos)
+        << e.what();
   }
   fs::remove(cut);
 }

@@ -1,4 +1,5 @@
-// Asset loading through anim::LoadCharacter: Assimp's glTF/GLB importers, then our import of
+// Asset loading through anim::LoadCharacter: the glTF structure check (anim_authoring/gltf_check.h),
+// then Assimp's glTF/GLB importers, then our import of
 // skeleton, skin, materials and clips. Assimp is Debian's build (not instrumented): a crash
 // inside it still stops the fuzzer (SEGV, ASan on our side of the calls), but its coverage
 // is not seen; the coverage figure is our importer's.
