@@ -28,6 +28,16 @@ int Draw(std::mt19937_64& rng, const std::vector<double>& weights) {
   return static_cast<int>(weights.size()) - 1;
 }
 
+// The normalised shape of a segment at x in [0, 1]: the recorded one linearly interpolated
+// between its samples, or a cosine without one.
+double SegmentShape(const std::vector<double>* shape, double x) {
+  if (!shape || shape->size() < 2) return 0.5 * (1 - std::cos(M_PI * x));
+  const double at = x * static_cast<double>(shape->size() - 1);
+  const std::size_t i = std::min(shape->size() - 2, static_cast<std::size_t>(at));
+  const double f = at - static_cast<double>(i);
+  return (*shape)[i] + f * ((*shape)[i + 1] - (*shape)[i]);
+}
+
 }  // namespace
 
 void IdleModel::Check(int skeleton_joints) const {
@@ -114,6 +124,7 @@ void IdleSynthesizer::Step(int i) {
   w.v0 = w.v1;
   w.t1 = w.t0 + dt;
   w.v1 = pick->value;
+  w.shape = &pick->shape;
 }
 
 void IdleSynthesizer::Advance(int i, double t) {
@@ -127,7 +138,7 @@ const Eigen::VectorXd& IdleSynthesizer::Coefficients(double t) {
     Advance(i, t);
     const Walk& w = walks_[i];
     const double x = (t - w.t0) / (w.t1 - w.t0);
-    coefficients_[i] = w.v0 + (w.v1 - w.v0) * 0.5 * (1 - std::cos(M_PI * std::clamp(x, 0.0, 1.0)));
+    coefficients_[i] = w.v0 + (w.v1 - w.v0) * SegmentShape(w.shape, std::clamp(x, 0.0, 1.0));
   }
   return coefficients_;
 }

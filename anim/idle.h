@@ -12,10 +12,12 @@
 // (seeded), draws each next extremum from the recorded members of the chosen cluster (no
 // invented values) that lie on the other side of the current one (maxima and minima
 // alternate, as in the signal: no plateau from drawing the same value twice), and joins
-// consecutive extrema with cosine segments (zero velocity at every extremum, as the signal has
-// there) no faster than the recorded segment ending at the drawn extremum (a large swing
-// joined in a short recorded interval would outrun the data). The posture is the mean plus the
-// components, each value clamped to the training data's range.
+// consecutive extrema with the recorded segment that ended at the drawn extremum: its own
+// duration and its own shape (where it rose fast, where it dwelt), scaled from its recorded
+// swing to the new one, and stretched in time when the new swing is larger, so that it is never
+// faster than it was recorded. A cosine (zero velocity at both ends) is the fallback where no
+// shape was recorded. The posture is the mean plus the components, each value clamped to the
+// training data's range.
 //
 //   IdleSynthesizer idle(skeleton, model, /*seed=*/7);
 //   if (!idle.Sample(t, {}, pose)) ...                 // unbounded, deterministic in (seed, t)
@@ -42,6 +44,10 @@ struct IdleModel {
     double dt = 0;     // seconds since the previous extremum
     double value = 0;  // the component's value there
     double rise = 0;   // value − the previous extremum's value (its sign: a maximum or a minimum)
+    // The recorded segment from the previous extremum to this one, normalised: (x − previous) /
+    // rise at evenly spaced times, 0 first and 1 last. Synthesis joins two extrema with the
+    // shape of the segment that was recorded ending at the drawn one. Empty: a cosine.
+    std::vector<double> shape;
   };
   struct ComponentChain {
     std::vector<std::vector<Extremum>> clusters;  // recorded extrema, by k-means cluster
@@ -78,6 +84,7 @@ class IdleSynthesizer : public Blendable {
     std::mt19937_64 rng;
     int cluster = 0;
     double t0 = 0, v0 = 0, t1 = 0, v1 = 0;  // the segment [t0, t1] between two extrema
+    const std::vector<double>* shape = nullptr;  // its recorded shape (null or empty: cosine)
   };
   void Restart();
   void Advance(int component, double t);

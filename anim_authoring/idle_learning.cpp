@@ -319,6 +319,24 @@ std::vector<int> Extrema(const std::vector<double>& x, int window) {
   return out;
 }
 
+// The shape of the recorded segment c[from..to], normalised to run from 0 to 1: what synthesis
+// replays, scaled to the swing it joins. Empty (synthesis then uses a cosine) when the swing is
+// too small to carry a shape: the signal strays more than a quarter of the swing outside it
+// (a near-flat stretch between two barely different extrema).
+std::vector<double> SegmentShape(const std::vector<double>& c, int from, int to) {
+  const double rise = c[to] - c[from];
+  if (to - from < 2 || rise == 0) return {};
+  std::vector<double> shape;
+  for (int f = from; f <= to; ++f) {
+    const double x = (c[f] - c[from]) / rise;
+    if (x < -0.25 || x > 1.25) return {};
+    shape.push_back(x);
+  }
+  shape.front() = 0;
+  shape.back() = 1;
+  return shape;
+}
+
 }  // namespace
 
 std::vector<std::pair<int, int>> HumanoidJointPairs(const Skeleton& character, const Skeleton& data,
@@ -459,7 +477,8 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
       if (idx.back() != static_cast<int>(c.size()) - 1) idx.push_back(static_cast<int>(c.size()) - 1);
       for (std::size_t e = 1; e < idx.size(); ++e) {
         if (e > 1) links.emplace_back(static_cast<int>(ex.size()) - 1, static_cast<int>(ex.size()));
-        ex.push_back({(idx[e] - idx[e - 1]) / data.rate, c[idx[e]], c[idx[e]] - c[idx[e - 1]]});
+        ex.push_back({(idx[e] - idx[e - 1]) / data.rate, c[idx[e]], c[idx[e]] - c[idx[e - 1]],
+                      SegmentShape(c, idx[e - 1], idx[e])});
       }
     }
     IdleModel::ComponentChain chain;
