@@ -6,6 +6,8 @@
 #include <mutex>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include "anim_authoring/lookat.h"
 #include "app/bounded_queue.h"
 
@@ -19,6 +21,12 @@ struct InFlight {
   tracker::FrameResult track;
   cv::Mat output;
 };
+
+double ProcessCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -71,6 +79,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   PipelineReport report;
   std::mutex report_mutex;
   const Clock::time_point start = Clock::now();
+  const double cpu_start = ProcessCpuSeconds();
 
   // A stop request closes every queue, so that no stage stays blocked pushing to one that
   // stopped popping.
@@ -189,6 +198,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
   report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
   report.fps = report.wall_seconds > 0 ? report.frames_processed / report.wall_seconds : 0;
+  if (report.frames_processed > 0) report.cpu_ms_per_frame = 1e3 * (ProcessCpuSeconds() - cpu_start) / report.frames_processed;
   report.stages = stats.Summaries();
   return report;
 }

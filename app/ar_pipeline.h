@@ -62,6 +62,10 @@ struct PipelineReport {
   size_t frames_localized = 0;
   double wall_seconds = 0;
   double fps = 0;  // frames processed per wall-clock second
+  // CPU time of the whole process (every thread: the stages, llvmpipe's, the encoder's) per
+  // frame processed, over the run. On a shared machine this is steadier than the frame rate,
+  // and it bounds it: two cores give at most 2000 / cpu_ms_per_frame frames per second.
+  double cpu_ms_per_frame = 0;
   std::map<std::string, TimingSummary> stages;  // track, animate, render, sink, latency
   std::vector<FrameLog> frames;                 // in processing order
   recordings::Trajectory trajectory;            // raw poses of localized frames

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -50,6 +51,7 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
   j["frames_localized"] = r.frames_localized;
   j["wall_seconds"] = r.wall_seconds;
   j["frames_per_second"] = r.fps;
+  j["cpu_ms_per_frame"] = r.cpu_ms_per_frame;
   j["renderer"] = gl_description;
   nlohmann::ordered_json& stages = j["stages"] = nlohmann::ordered_json::object();
   for (const auto& [stage, s] : r.stages) stages[stage] = TimingJson(s);
@@ -85,6 +87,10 @@ std::string PipelineReportText(const PipelineReport& r) {
                 r.frames_processed ? 100.0 * r.frames_localized / r.frames_processed : 0.0);
   out += line;
   std::snprintf(line, sizeof(line), "throughput: %.1f frames per second (%.2f s wall clock)\n", r.fps, r.wall_seconds);
+  out += line;
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  std::snprintf(line, sizeof(line), "process CPU: %.1f ms per frame, all threads (%u cores: at most %.0f frames per second)\n",
+                r.cpu_ms_per_frame, cores, r.cpu_ms_per_frame > 0 ? 1000.0 * cores / r.cpu_ms_per_frame : 0.0);
   out += line;
   out += "stage          median ms   p95 ms\n";
   for (const auto& [stage, s] : r.stages) {

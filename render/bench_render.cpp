@@ -190,7 +190,11 @@ RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_po
   return light;
 }
 
-void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing, bool lit = false) {
+// What a lit frame leaves out, to break its cost down (BM_ArFrameLitWithout).
+enum class LitPart { kNothing, kCastShadow, kOcclusion, kPrt, kExposure };
+
+void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing, bool lit = false,
+                LitPart without = LitPart::kNothing) {
   Subject* subject = GetSubject(name);
   if (subject == nullptr) {
     state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
@@ -198,12 +202,16 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   }
   ArOptions options;
   options.antialiasing = antialiasing;
-  if (lit) options.lighting = LightingMode::kShShadowed;
+  if (lit) options.lighting = without == LitPart::kPrt ? LightingMode::kShUnshadowed : LightingMode::kShShadowed;
+  options.cast_shadow = without != LitPart::kCastShadow;
+  options.occlusion = without != LitPart::kOcclusion;
   ArRenderer renderer(Context(), BenchCamera(), options);
   renderer.AddCharacter(subject->animated->character(), subject->spec);
   const cv::Mat background = Background();
   if (lit) {
-    renderer.SetRoomLight(BenchRoomLight(background, subject->camera_pose));
+    RoomLight light = BenchRoomLight(background, subject->camera_pose);
+    if (without == LitPart::kExposure) light.thumbnails.clear();  // the follower then keeps gain 1
+    renderer.SetRoomLight(light);
     state.counters["prt_precompute_s"] = renderer.prt_seconds();
   }
   const Eigen::Vector3d viewpoint = subject->spec.ViewpointFromCamera(subject->camera_pose.Center());
@@ -239,6 +247,11 @@ void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(stat
 // shadow from the dominant light and a depth-only occluder proxy, on top of BM_ArFrame.
 void BM_ArFrameLit(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa, true); }
 void BM_ArFrameLitNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone, true); }
+
+// The lit frame without one of its parts: where its added cost goes.
+void BM_ArFrameLitWithout(benchmark::State& state, std::string name, LitPart part) {
+  RunArFrame(state, name, Antialiasing::kMsaa, true, part);
+}
 
 void BM_UndistortBackground(benchmark::State& state) {
   calib::Camera camera = BenchCamera();
@@ -284,6 +297,14 @@ BENCHMARK_CAPTURE(BM_ArFrameLit, tube25k, std::string("tube25k"))->Unit(benchmar
 BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, Fox, std::string("Fox"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, CesiumMan, std::string("CesiumMan"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameLitNoAa, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_cast_shadow, std::string("tube25k"), LitPart::kCastShadow)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_occlusion, std::string("tube25k"), LitPart::kOcclusion)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_prt, std::string("tube25k"), LitPart::kPrt)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_exposure, std::string("tube25k"), LitPart::kExposure)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "render/h264_writer.h"
 #include "render/offscreen.h"
 
 namespace arview::render {
@@ -72,7 +73,14 @@ class VideoSink final : public FrameSink {
     if (path.has_parent_path() && !fs::is_directory(path.parent_path())) {
       throw RenderError(path.string() + ": folder " + path.parent_path().string() + " does not exist");
     }
-    // H.264 when FFmpeg has an encoder for it, else MPEG-4 part 2, which every FFmpeg build has.
+    // H.264 through libx264 at a fast preset (render/h264_writer.h says why not OpenCV's writer);
+    // without libx264, OpenCV's writer: H.264 if its FFmpeg has another encoder for it, else
+    // MPEG-4 part 2, which every FFmpeg build has.
+    h264_ = H264Writer::Open(path, size, fps);
+    if (h264_) {
+      codec_ = "H.264, libx264 " + H264Options{}.preset;
+      return;
+    }
     for (const char* codec : {"avc1", "mp4v"}) {
       writer_.open(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps,
                    size, true);
@@ -83,12 +91,17 @@ class VideoSink final : public FrameSink {
     }
     if (!writer_.isOpened()) throw RenderError(path.string() + ": OpenCV's FFmpeg writer cannot open this file");
   }
-  ~VideoSink() override { writer_.release(); }
+  ~VideoSink() override {
+    h264_.reset();
+    writer_.release();
+  }
   void Write(const cv::Mat& bgr) override {
     CheckFrame(bgr, size_, path_.string());
-    writer_.write(bgr);
+    if (h264_) h264_->Write(bgr);
+    else writer_.write(bgr);
   }
   void Close() override {
+    if (h264_) h264_->Close();
     writer_.release();
     std::error_code ec;
     if (!closed_ && (!fs::exists(path_, ec) || fs::file_size(path_, ec) == 0)) {
@@ -102,6 +115,7 @@ class VideoSink final : public FrameSink {
  private:
   fs::path path_;
   cv::Size size_;
+  std::unique_ptr<H264Writer> h264_;
   cv::VideoWriter writer_;
   std::string codec_;
   bool closed_ = false;

@@ -4,6 +4,8 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "render/offscreen.h"
 #include "render/sinks.h"
@@ -41,6 +43,40 @@ TEST(Sinks, Mp4FileReadsBackWithEveryFrame) {
     ++frames;
   }
   EXPECT_EQ(frames, 10);
+  fs::remove_all(file.parent_path());
+}
+
+// The H.264 file (libx264 at its superfast preset, render/h264_writer.h): every frame comes back
+// where it was, close to what was written, and the stream says which x264 settings made it.
+TEST(Sinks, Mp4IsH264AtTheFastPresetAndKeepsThePicture) {
+  const fs::path file = Scratch("fast.mp4");
+  {
+    auto sink = OpenSink(file.string(), {160, 120}, 30);
+    EXPECT_NE(sink->Describe().find("libx264 superfast"), std::string::npos) << sink->Describe();
+    for (int i = 0; i < 10; ++i) sink->Write(Frame(i));
+    sink->Close();
+    sink->Close();  // twice is safe
+  }
+  cv::VideoCapture in(file.string(), cv::CAP_FFMPEG);
+  ASSERT_TRUE(in.isOpened());
+  EXPECT_NEAR(in.get(cv::CAP_PROP_FPS), 30.0, 1e-6);
+  int frames = 0;
+  cv::Mat m;
+  while (in.read(m)) {
+    // Mean absolute difference per channel: the disc moved by 10 px a frame, so a frame out of
+    // order or a lost one differs by far more than compression does.
+    cv::Mat diff;
+    cv::absdiff(m, Frame(frames), diff);
+    EXPECT_LT(cv::mean(diff)[0] + cv::mean(diff)[1] + cv::mean(diff)[2], 3 * 4.0) << "frame " << frames;
+    ++frames;
+  }
+  EXPECT_EQ(frames, 10);
+  // x264 writes its settings into the stream (an SEI message): the preset's, not medium's.
+  std::ifstream bytes(file, std::ios::binary);
+  const std::string content((std::istreambuf_iterator<char>(bytes)), {});
+  EXPECT_NE(content.find("x264 - core"), std::string::npos);
+  EXPECT_NE(content.find("subme=1 "), std::string::npos);  // superfast; medium is subme=7
+  EXPECT_NE(content.find("trellis=0"), std::string::npos);
   fs::remove_all(file.parent_path());
 }
 

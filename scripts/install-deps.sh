@@ -15,6 +15,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
   ffmpeg
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libyaml-cpp-dev nlohmann-json3-dev
   libx11-dev libxext-dev
   xvfb
