@@ -111,6 +111,36 @@ TEST(Sh, DominantLightOfADirectionalLightPlusAmbientIsExact) {
   EXPECT_NEAR((light.ambient - Eigen::Vector3d(0.1, 0.2, 0.3)).norm(), 0, 1e-9);
 }
 
+// The light arview demo estimated for its rendered room (scene.light.yml, map frame): brightest
+// towards +y, but lit from all round, so that band 2 is negative along that direction. The
+// bands 1 and 2 fit gave colour (0, 0, 0) — no cast shadow. The dominant light must carry what
+// band 1 sees, and with the ambient give back band 0.
+TEST(Sh, DominantLightOfARoomLitFromAllRoundIsNotBlack) {
+  const double rgb[9][3] = {{1.6414857760780706, 1.652338215481351, 1.4482548458347677},
+                            {0.21822534374020436, 0.2389546364735854, 0.17817935459308162},
+                            {-0.03801621195578381, 0.013176150017499846, 0.06711257937737013},
+                            {-0.04883622541381752, -0.028597595449231124, -0.12376249191495506},
+                            {0.06721728987501706, 0.11037497396336908, 0.08012514872968768},
+                            {-0.05270684202253553, -0.02581382118900257, -0.09844617950480637},
+                            {0.09186431880316566, 0.10793654791366537, 0.03227409092381579},
+                            {0.016524819727105677, 0.01291912675785907, 0.03823936880432086},
+                            {0.1746332286786995, 0.15662831053277795, 0.1845902375893085}};
+  ShRgb sh;
+  for (int k = 0; k < 9; ++k) sh[k] = Eigen::Vector3d(rgb[k][0], rgb[k][1], rgb[k][2]);
+  const DominantLight light = ExtractDominantLight(sh);
+  EXPECT_GT(light.direction.y(), 0.95);
+  // Band 1 of the light alone, c·Y_1m(d), equals the estimate's band 1 along d.
+  const Sh9 y = ShBasis(light.direction);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(light.color[c], 0.3) << c;
+    double along = 0;
+    for (int k = 1; k < 4; ++k) along += sh[k][c] * y[k];
+    EXPECT_NEAR(light.color[c] * (y[1] * y[1] + y[2] * y[2] + y[3] * y[3]), along, 1e-9) << c;
+    // Band 0: the light's share plus the ambient's.
+    EXPECT_NEAR(light.color[c] * y[0] + light.ambient[c] * 4 * M_PI * y[0], sh[0][c], 1e-9) << c;
+  }
+}
+
 // ---------------------------------------------------------------- analytic environment
 
 // One directional light (a 4-degree cap) plus ambient, "painted" on the walls of a 6 x 5 x 3 m

@@ -111,10 +111,13 @@ DominantLight ExtractDominantLight(const ShRgb& sh) {
   }
   light.direction = linear.normalized();
   const Sh9 y = ShBasis(light.direction);
-  // Σ_{m} Y_lm(d)² = (2l + 1) / 4π: 8 / 4π over bands 1 and 2.
+  // Band 1 only: Σ_m Y_1m(d)² = 3 / 4π. Band 2 is left out because a room is not one light: lit
+  // all round its horizon (walls, windows), its band 2 is negative along its brightest
+  // direction, and a fit over bands 1 and 2 then came out black (arview demo's rendered room:
+  // colour (0, 0, 0), so no cast shadow). Both fits are exact for one directional light.
   Eigen::Vector3d projected = Eigen::Vector3d::Zero();
-  for (int k = 1; k < 9; ++k) projected += sh[k] * y[k];
-  light.color = (projected / (8 / (4 * M_PI))).cwiseMax(0.0);
+  for (int k = 1; k < 4; ++k) projected += sh[k] * y[k];
+  light.color = (projected / (3 / (4 * M_PI))).cwiseMax(0.0);
   light.ambient = ((sh[0] - light.color * kY0) / (4 * M_PI * kY0)).cwiseMax(0.0);
   return light;
 }

@@ -39,10 +39,10 @@ Eigen::Vector3d EvaluateSh(const ShRgb& sh, const Eigen::Vector3d& unit_directio
 // Hanrahan 2001). A Lambertian surface of albedo ρ then has radiance ρ·E/π.
 Eigen::Vector3d IrradianceSh(const ShRgb& sh, const Eigen::Vector3d& unit_normal);
 
-// A directional light plus a constant ambient that has the same bands 1 and 2 as `sh` in the
-// least-squares sense: direction from band 1 (luminance weights), colour c from
-// L_lm ≈ c·Y_lm(d) over bands 1 and 2, ambient from what band 0 has left. Exact for one
-// directional light plus constant ambient.
+// A directional light plus a constant ambient: direction from band 1 (luminance weights),
+// colour c from L_1m = c·Y_1m(d) (band 1 in the least-squares sense), ambient from what band 0
+// has left. Exact for one directional light plus constant ambient; band 2 is not fitted, since
+// a real room's band 2 need not look like one light's (sh.cpp).
 struct DominantLight {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // unit, towards the light
   Eigen::Vector3d color = Eigen::Vector3d::Zero();       // irradiance at normal incidence, RGB
