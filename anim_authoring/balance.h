@@ -1,0 +1,75 @@
+#pragma once
+// What a recording holds for balance shifts (thesis §3.3, PAPERS.md §3): the thesis learns
+// resting-posture categories (weight on the left foot, on the right foot, on both), the
+// recorded transitions between them, transition probabilities and dwell times, from a person
+// standing. Before any of that can be learned the data must hold such standing: this measures,
+// per clip, how much of it does.
+//
+// Per frame (resampled at `rate`), in the data's model space:
+//   - planted: both feet (ankle joints, found by name) move slower than `max_foot_speed`;
+//   - support: where the pelvis (the legs' common parent) lies between the feet along the
+//     line joining them, 0 over the left foot, 1 over the right; its category is left (below
+//     `one_foot`), right (above 1 − `one_foot`) or both;
+//   - resting: planted, and the pelvis slower than `max_rest_speed` (horizontal).
+// A rest is a run of resting frames of one category lasting `min_rest_seconds` or more; a
+// transition is the stretch between two consecutive rests of different categories during which
+// both feet stay planted (a step or a jump in between is not a balance shift). Speeds are in
+// body heights (the median over the frames of the joints' extent along `up`) per second.
+//
+//   BalanceAnalysis a = AnalyseBalance(cmu.skeleton, cmu.clips[0], {});
+//   a.Summary();   // seconds planted (per support category), resting, rests, transitions
+
+#include "anim/character.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace arview::anim {
+
+enum class Support { kLeft = 0, kBoth = 1, kRight = 2 };
+
+struct BalanceOptions {
+  double rate = 30;
+  double max_foot_speed = 0.1;     // body heights per second
+  double max_rest_speed = 0.05;    // body heights per second, the pelvis along the floor
+  double one_foot = 1.0 / 3;       // support below this (or above 1 − this): weight on one foot
+  double min_rest_seconds = 0.5;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  // Joints by name instead of the ones found (e.g. marker data: LANK, RANK, and the four waist
+  // markers, whose mean is the pelvis). Empty: found by name.
+  std::string left_foot, right_foot;
+  std::vector<std::string> pelvis;
+};
+
+struct BalanceAnalysis {
+  struct Rest {
+    Support support = Support::kBoth;
+    double from = 0, to = 0;  // seconds
+  };
+  struct Transition {
+    Support from_support = Support::kBoth, to_support = Support::kBoth;
+    double from = 0, to = 0;  // seconds: the end of one rest to the start of the next
+  };
+  std::string source;              // "file clip"
+  double seconds = 0;
+  int frames = 0;
+  double height = 0;               // body height used for the speeds (data units; median extent along up)
+  double planted_seconds = 0;      // both feet planted
+  double resting_seconds = 0;      // planted and the pelvis still
+  std::array<double, 3> planted_by_support{};  // planted seconds per support category
+  double longest_planted_seconds = 0;          // the longest run of planted frames
+  double min_rest_seconds = 0;                 // the options' (for the summary)
+  std::vector<Rest> rests;
+  std::vector<Transition> transitions;
+
+  // Category pairs (from, to) with at least one transition.
+  int TransitionPairs() const;
+  std::string Summary() const;
+};
+
+// Throws Error when the skeleton has no left and right leg with a foot found by name.
+BalanceAnalysis AnalyseBalance(const Skeleton& skeleton, const Clip& clip, const BalanceOptions& options,
+                               const std::string& source = "");
+
+}  // namespace arview::anim
