@@ -60,7 +60,7 @@ TEST(NoAllocation, TheCounterCountsAVector) {
 }
 #endif
 
-void ExpectUpdatesAllocateNothing(testing::FourActionSchedule::Gesture gesture, bool dib) {
+void ExpectUpdatesAllocateNothing([[maybe_unused]] testing::FourActionSchedule::Gesture gesture, [[maybe_unused]] bool dib) {
 #ifndef ARVIEW_COUNTS_ALLOCATIONS
   GTEST_SKIP() << "allocations are not counted in sanitizer builds (they replace malloc)";
 #else
