@@ -61,8 +61,8 @@ int BalanceAnalysis::TransitionPairs() const {
 std::string BalanceAnalysis::Summary() const {
   char buf[1024];
   std::snprintf(buf, sizeof(buf),
-                "%s: %.1f s, %d frames, body height %.3g; both feet planted %.2f s (longest run %.2f s; pelvis over the left foot %.2f s, "
-                "between %.2f s, over the right %.2f s), resting %.2f s; %zu rests of %.2g s or more, %zu transitions "
+                "%s: %.1f s, %d frames, body height %.3g; both feet planted %.2f s (longest run %.2f s; "
+                "pelvis over the left foot %.2f s, between %.2f s, over the right %.2f s), resting %.2f s; %zu rests of %.2g s or more, %zu transitions "
                 "(%d category pairs)",
                 source.c_str(), seconds, frames, height, planted_seconds, longest_planted_seconds, planted_by_support[0],
                 planted_by_support[1], planted_by_support[2], resting_seconds, rests.size(), min_rest_seconds, transitions.size(),
