@@ -99,6 +99,36 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
   return recordings::LoadRecording(dir);
 }
 
+// The replayed lap read from uncompressed frames, as a camera delivers them: each PNG of the
+// walk from `first` on converted once to BMP in `dir` (again when its PNG is newer). Decoding a
+// 640x480 PNG took ~10 ms of CPU, a BMP 0.6 ms (docs/app.md): on two cores shared by
+// tracking, rendering and encoding, the PNG decoder alone cost the replay a quarter of its
+// frame rate. Same pixels, so the same tracking.
+recordings::Recording WithUncompressedFrames(const recordings::Recording& walk, int first, const fs::path& dir,
+                                             const CancellationToken& cancel) {
+  recordings::Recording out = walk;
+  fs::create_directories(dir);
+  Progress progress("  uncompressed frames");
+  const int total = static_cast<int>(walk.frames.size()) - first;
+  int converted = 0;
+  for (int i = first; i < static_cast<int>(walk.frames.size()); ++i) {
+    const fs::path png = walk.FramePath(i);
+    const fs::path bmp = fs::absolute(dir / png.filename().replace_extension(".bmp"));
+    std::error_code ec;
+    if (!fs::exists(bmp, ec) || fs::last_write_time(bmp, ec) < fs::last_write_time(png)) {
+      cancel.ThrowIfCancelled("stopped converting the replayed frames; a re-run converts the rest");
+      WriteImageAtomically(bmp, walk.ReadImage(i));
+      ++converted;
+    }
+    out.frames[i].path = bmp.string();  // absolute: root / path is then the path itself
+    progress.Update(i - first + 1, total);
+  }
+  progress.Finish();
+  std::printf("  frames %d-%zu read uncompressed from %s (%d converted now)\n", first, walk.frames.size() - 1,
+              dir.c_str(), converted);
+  return out;
+}
+
 // The character's anchor in the map: standing on the walk's spot (room coordinates), upright,
 // facing `facing_azimuth` (radians, room frame), `height` metres tall; `to_room` maps the map
 // into the room.
@@ -281,7 +311,8 @@ void AddDemoCommand(CLI::App& app) {
     session.output_name = out.string();
     recordings::ReplayOptions replay;
     for (int i = half; i < a->frames; ++i) replay.frames.push_back(i);
-    recordings::RecordingSource source(walk, replay);
+    const recordings::Recording replayed = WithUncompressedFrames(walk, half, work / "replay-frames", signals.token());
+    recordings::RecordingSource source(replayed, replay);
     const SessionResult result = RunSession(source, walk.camera.Size(), built.map, (work / "map").string(), session);
     video.Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
