@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -15,10 +16,13 @@
 #include "base/process.h"
 #include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
+#include "mapping/map_check.h"
 
 namespace arview::app {
 
 namespace {
+
+namespace fs = std::filesystem;
 
 struct MapArgs {
   std::string recording;
@@ -100,6 +104,10 @@ void RunMap(const MapArgs& args) {
     bar.Finish();
     std::cerr << "note: " << message << "\n";
   };
+  callbacks.warning = [&](const std::string& message) {
+    bar.Finish();
+    std::cerr << "warning: the map " << message << "\n";
+  };
   try {
     options.matcher = mapping::ParseMatcherKind(args.matcher);
     const recordings::Recording recording = recordings::LoadRecording(args.recording);
@@ -116,7 +124,8 @@ void RunMap(const MapArgs& args) {
       total += t.seconds;
     }
     std::cout << " (total " << Fixed(total, 1) << " s)\n";
-    std::cout << "wrote " << args.out << "/{" << map::kMapFileName
+    std::cout << "check: " << mapping::DescribeMapCheck(result.check) << "\n";
+    std::cout << "wrote " << args.out << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
               << ", keyframes.txt, map.png, database.db}, COLMAP model " << result.model_dir.string() << "\n";
   } catch (const mapping::ColmapStageError& e) {
     bar.Finish();
@@ -160,6 +169,15 @@ void RunInfo(const std::string& dir) {
               << "descriptors:         " << s.descriptors << " (128 x uint8, "
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
+    const fs::path folder = fs::is_directory(dir) ? fs::path(dir) : fs::path(dir).parent_path();
+    if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
+      std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
+      for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
+      if (!check->flagged()) std::cout << "                     (nothing flagged)\n";
+    } else {
+      std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
+                << " is written by arview map since issue 17)\n";
+    }
   } catch (const map::MapError& e) {
     throw CommandError(e.what());
   }

@@ -194,10 +194,6 @@ Map ReadPayload(Reader& r) {
 
 }  // namespace
 
-namespace {
-constexpr double kMaxCoordinate = 1e6;  // map units: far beyond any mapped room or square
-constexpr float kMaxPixel = 1e6f;
-}  // namespace
 
 void ValidateMap(const Map& map, const std::string& source) {
   auto fail = [&](const std::string& problem) { throw MapError(source + ": " + problem); };

@@ -28,6 +28,11 @@ Map LoadMap(const std::filesystem::path& path);
 // throws MapError prefixed with `source`.
 void ValidateMap(const Map& map, const std::string& source);
 
+// The value limits ValidateMap applies (mapping/ checks COLMAP's model against the same ones, so
+// that a value out of range is reported against the COLMAP file that holds it).
+inline constexpr double kMaxCoordinate = 1e6;  // map units: far beyond any mapped room or square
+inline constexpr float kMaxPixel = 1e6f;
+
 struct MapStats {
   std::size_t keyframes = 0;
   std::size_t points = 0;

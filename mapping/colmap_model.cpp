@@ -6,12 +6,15 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <sstream>
 #include <unordered_map>
 
 #include "base/input_guard.h"
+#include "map/map_file.h"
 
 namespace arview::mapping {
 
@@ -324,7 +327,8 @@ std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
 }
 
 map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
-                  const CancellationToken& cancel) {
+                  const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
+                  bool check_values) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
   const fs::path images_file = sparse_dir / "images.bin";
   const fs::path points_file = sparse_dir / "points3D.bin";
@@ -459,7 +463,50 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
       kf.observations.push_back({pi->second, px.cast<float>(), ri->second});
     }
   }
+  if (keypoints) {
+    keypoints->clear();
+    for (const auto& im : images) {
+      std::vector<Eigen::Vector2f>& all = keypoints->emplace_back();
+      all.reserve(im.xy.size());
+      for (const Eigen::Vector2d& xy : im.xy) all.push_back((xy - Eigen::Vector2d(0.5, 0.5)).cast<float>());
+    }
+  }
+  if (check_values) RequireModelValuesInRange(map, sparse_dir);
   return map;
+}
+
+void RequireModelValuesInRange(const map::Map& map, const fs::path& sparse_dir) {
+  const fs::path images_file = sparse_dir / "images.bin";
+  const fs::path points_file = sparse_dir / "points3D.bin";
+  auto big = [](double v) {
+    std::ostringstream s;
+    s << std::setprecision(3) << v;
+    return s;
+  };
+  for (const map::Keyframe& k : map.keyframes) {
+    const double t = k.pose.t_cw.cwiseAbs().maxCoeff();
+    if (t > map::kMaxCoordinate)
+      throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + k.name +
+                          "') has a translation of " + big(t).str() + ", beyond " + big(map::kMaxCoordinate).str() +
+                          " (a degenerate registration in COLMAP's model)");
+    for (const map::KeyframeObservation& o : k.observations)
+      if (o.pixel.cwiseAbs().maxCoeff() > map::kMaxPixel)
+        throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + k.name +
+                            "') has a 2D point at (" + big(o.pixel.x()).str() + ", " + big(o.pixel.y()).str() +
+                            "), beyond " + big(map::kMaxPixel).str() + " pixels");
+  }
+  for (std::size_t i = 0; i < map.points.size(); ++i) {
+    const map::MapPoint& p = map.points[i];
+    const double c = p.xyz.cwiseAbs().maxCoeff();
+    if (c > map::kMaxCoordinate)
+      throw map::MapError(points_file.string() + ": 3D point " + std::to_string(i + 1) + " of " +
+                          std::to_string(map.points.size()) + " lies at a coordinate of " + big(c).str() + ", beyond " +
+                          big(map::kMaxCoordinate).str() + " (a degenerate triangulation in COLMAP's model)");
+    if (p.reprojection_error < 0 || p.reprojection_error > map::kMaxPixel)
+      throw map::MapError(points_file.string() + ": 3D point " + std::to_string(i + 1) + " of " +
+                          std::to_string(map.points.size()) + " has a reprojection error of " +
+                          big(p.reprojection_error).str() + " pixels");
+  }
 }
 
 }  // namespace arview::mapping

@@ -7,6 +7,9 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "base/cancellation.h"
 #include "map/map.h"
@@ -28,8 +31,18 @@ std::uint64_t CountRegisteredImages(const std::filesystem::path& sparse_dir);
 // image must appear in `frames` (unless `frames` is empty: then frame_index = -1, timestamp 0).
 // Keyframes are ordered by frame index (then name), points by COLMAP's point id.
 // Only regular files are read (a link to a device or FIFO is refused), in chunks that look at
-// `cancel` (CancelledError).
+// `cancel` (CancelledError). With `keypoints`, it also receives every keypoint of each keyframe
+// (OpenCV pixels, in keyframe order), observations of map points or not (for mapping/map_check.h).
+// Values beyond what a map may hold (map::kMaxCoordinate, kMaxPixel: a degenerate registration
+// far away, a point at 1e11) are refused naming images.bin or points3D.bin, unless
+// `check_values` is false: then the caller runs RequireModelValuesInRange itself (arview map
+// first looks at the whole map, mapping/map_check.h, so that it can say why).
 map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::filesystem::path& database,
-                  const FrameLookup& frames = {}, const CancellationToken& cancel = {});
+                  const FrameLookup& frames = {}, const CancellationToken& cancel = {},
+                  std::vector<std::vector<Eigen::Vector2f>>* keypoints = nullptr, bool check_values = true);
+
+// Throws MapError naming the file of `sparse_dir` (images.bin, points3D.bin) that holds the first
+// value a map may not hold.
+void RequireModelValuesInRange(const map::Map& map, const std::filesystem::path& sparse_dir);
 
 }  // namespace arview::mapping

@@ -414,7 +414,14 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                            "map", colmap.log(), {});
   }
   options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-  result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel);
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
+  // The whole map looked at first, so that a degenerate model is refused with the reason too.
+  result.check = CheckMap(result.map, keypoints);
+  WriteMapCheck(result.check, out_dir / kMapCheckFileName);
+  if (cb.warning)
+    for (const std::string& w : result.check.warnings) cb.warning(w);
+  RequireModelValuesInRange(result.map, result.model_dir);
   options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
   WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
   map::SaveMap(result.map, out_dir / map::kMapFileName);

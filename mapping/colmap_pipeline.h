@@ -18,6 +18,7 @@
 #include "base/enum_table.h"
 #include "map/map.h"
 #include "mapping/frame_selection.h"
+#include "mapping/map_check.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -83,6 +84,9 @@ struct MapBuildCallbacks {
   std::function<void(const std::string& stage, int done, int total)> progress;
   // Things the user should know (a skipped stage, several models, dropped frames).
   std::function<void(const std::string& message)> note;
+  // What the map's self-check found wrong (mapping/map_check.h), one sentence each, before the
+  // map is written (or refused for a value out of range).
+  std::function<void(const std::string& message)> warning;
 };
 
 struct StageTiming {
@@ -97,6 +101,7 @@ struct MapBuildResult {
   std::vector<StageTiming> timings;
   int models = 0;                    // models COLMAP produced
   std::filesystem::path model_dir;   // the one kept (the largest)
+  MapCheck check;                    // what the map looks like as a whole (also in <out>/check.json)
 };
 
 // Runs everything and writes the map directory. Throws MapError (or ColmapStageError,

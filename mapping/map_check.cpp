@@ -1,0 +1,217 @@
+// The map's self-check (see map_check.h for what and why).
+
+#include "mapping/map_check.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <unordered_map>
+
+#include "base/atomic_file.h"
+#include "base/input_guard.h"
+#include "base/stats.h"
+
+namespace arview::mapping {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+std::string Percent(double fraction) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(fraction < 0.1 ? 1 : 0) << 100 * fraction << "%";
+  return s.str();
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+// Keypoints of one image in a grid of `radius`-sized cells, for "is one within radius of p".
+class KeypointGrid {
+ public:
+  KeypointGrid(const std::vector<Eigen::Vector2f>& points, double radius) : points_(points), radius_(radius) {
+    for (std::size_t i = 0; i < points.size(); ++i) cells_[Key(Cell(points[i].x()), Cell(points[i].y()))].push_back(i);
+  }
+  bool AnyWithin(const Eigen::Vector2f& p) const {
+    const long cx = Cell(p.x()), cy = Cell(p.y());
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy) {
+        const auto it = cells_.find(Key(cx + dx, cy + dy));
+        if (it == cells_.end()) continue;
+        for (std::size_t i : it->second)
+          if ((points_[i] - p).norm() <= radius_) return true;
+      }
+    return false;
+  }
+
+ private:
+  long Cell(float v) const { return static_cast<long>(std::floor(v / radius_)); }
+  static std::uint64_t Key(long x, long y) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
+  }
+  const std::vector<Eigen::Vector2f>& points_;
+  double radius_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+};
+
+// Median pixel motion of the map points seen by both keyframes (nothing when none is shared).
+std::optional<double> PointMotion(const map::Keyframe& a, const map::Keyframe& b) {
+  std::unordered_map<std::uint32_t, Eigen::Vector2f> in_a;
+  for (const auto& o : a.observations) in_a.emplace(o.point, o.pixel);
+  std::vector<double> motion;
+  for (const auto& o : b.observations)
+    if (const auto it = in_a.find(o.point); it != in_a.end()) motion.push_back((o.pixel - it->second).norm());
+  if (motion.empty()) return std::nullopt;
+  return Median(motion);
+}
+
+double StillFraction(const std::vector<Eigen::Vector2f>& a, const std::vector<Eigen::Vector2f>& b, double radius) {
+  if (a.empty()) return 0;
+  const KeypointGrid grid(b, radius);
+  const auto still = std::count_if(a.begin(), a.end(), [&](const Eigen::Vector2f& p) { return grid.AnyWithin(p); });
+  return static_cast<double>(still) / static_cast<double>(a.size());
+}
+
+// Per point, the widest angle between two of the rays from the keyframes that see it.
+double MedianTriangulationDeg(const map::Map& map, const std::vector<Eigen::Vector3d>& centres) {
+  std::vector<double> angles;
+  angles.reserve(map.points.size());
+  std::vector<Eigen::Vector3d> rays;
+  for (const map::MapPoint& p : map.points) {
+    rays.clear();
+    for (std::uint32_t r = p.first_descriptor; r < p.first_descriptor + p.descriptor_count; ++r) {
+      if (r >= map.descriptor_keyframe.size()) break;
+      const Eigen::Vector3d ray = p.xyz - centres[map.descriptor_keyframe[r]];
+      if (ray.norm() > 0) rays.push_back(ray.normalized());
+    }
+    double min_cos = 1;  // of the widest pair
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      for (std::size_t j = i + 1; j < rays.size(); ++j) min_cos = std::min(min_cos, rays[i].dot(rays[j]));
+    angles.push_back(std::acos(std::clamp(min_cos, -1.0, 1.0)) * 180.0 / M_PI);
+  }
+  return Median(angles);
+}
+
+// The median depth (along the optical axis) of the points each keyframe sees; median of those.
+double SceneDepth(const map::Map& map) {
+  std::vector<double> per_keyframe;
+  for (const map::Keyframe& k : map.keyframes) {
+    std::vector<double> depths;
+    for (const auto& o : k.observations) {
+      if (o.point >= map.points.size()) continue;
+      const double z = k.pose.ToCamera(map.points[o.point].xyz).z();
+      if (z > 0) depths.push_back(z);
+    }
+    if (!depths.empty()) per_keyframe.push_back(Median(depths));
+  }
+  return Median(per_keyframe);
+}
+
+void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
+  if (c.moving_pairs > 0 && c.still_fraction > limits.max_still_fraction)
+    c.warnings.push_back(
+        "looks like a still camera filming a moving object: " + Percent(c.still_fraction) +
+        " of each frame's features stay in place (within " + Fixed(limits.still_radius_px, 1) +
+        " px) while the map's points move between the frames, so the camera path is the object's motion, not the "
+        "camera's. Record again moving the camera through a still scene, with moving things out of view");
+  if (c.extent_ratio < limits.min_extent_ratio)
+    c.warnings.push_back("the camera path spans " + Percent(c.extent_ratio) +
+                         " of the scene's depth: looks like a still camera, or one that only turned, and the map's "
+                         "depth is guessed. Record again moving the camera sideways by a tenth of its distance to "
+                         "the scene or more");
+  if (c.median_triangulation_deg < limits.min_triangulation_deg)
+    c.warnings.push_back("the map's points are triangulated from rays a median " + Fixed(c.median_triangulation_deg, 2) +
+                         " degrees apart: their depth is poorly determined. Move the camera further between the "
+                         "frames (or give COLMAP more widely spaced frames with --frames)");
+  if (c.explained_fraction < limits.min_explained_fraction)
+    c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
+                         " of the frames' features: the scene changed while it was filmed, or most of what was "
+                         "filmed moved. Record a still scene");
+}
+
+}  // namespace
+
+MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
+                  const MapCheckLimits& limits) {
+  MapCheck c;
+  c.keyframes = static_cast<int>(map.keyframes.size());
+  std::vector<Eigen::Vector3d> centres;
+  for (const map::Keyframe& k : map.keyframes) centres.push_back(k.pose.Center());
+
+  std::vector<double> explained;
+  for (std::size_t k = 0; k < map.keyframes.size() && k < keypoints.size(); ++k)
+    if (!keypoints[k].empty())
+      explained.push_back(static_cast<double>(map.keyframes[k].observations.size()) /
+                          static_cast<double>(keypoints[k].size()));
+  c.explained_fraction = Median(explained);
+
+  for (std::size_t i = 0; i < centres.size(); ++i)
+    for (std::size_t j = i + 1; j < centres.size(); ++j)
+      c.path_extent = std::max(c.path_extent, (centres[i] - centres[j]).norm());
+  c.scene_depth = SceneDepth(map);
+  c.extent_ratio = c.scene_depth > 0 ? c.path_extent / c.scene_depth : 0;
+  c.median_triangulation_deg = MedianTriangulationDeg(map, centres);
+
+  std::vector<double> still;
+  for (std::size_t k = 0; k + 1 < map.keyframes.size() && k + 1 < keypoints.size(); ++k) {
+    const auto motion = PointMotion(map.keyframes[k], map.keyframes[k + 1]);
+    if (!motion || *motion < limits.moving_pair_px) continue;
+    still.push_back(StillFraction(keypoints[k], keypoints[k + 1], limits.still_radius_px));
+  }
+  c.moving_pairs = static_cast<int>(still.size());
+  c.still_fraction = Median(still);
+  AddWarnings(c, limits);
+  return c;
+}
+
+std::string DescribeMapCheck(const MapCheck& c) {
+  return "explains " + Percent(c.explained_fraction) + " of the frames' features (median per keyframe); camera path " +
+         Fixed(c.extent_ratio, 2) + " x the scene depth; triangulation angle median " +
+         Fixed(c.median_triangulation_deg, 1) + " deg; features staying still " + Percent(c.still_fraction) +
+         " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)";
+}
+
+void WriteMapCheck(const MapCheck& c, const fs::path& file) {
+  const json j = {{"keyframes", c.keyframes},
+                  {"explained_fraction", c.explained_fraction},
+                  {"path_extent", c.path_extent},
+                  {"scene_depth", c.scene_depth},
+                  {"extent_ratio", c.extent_ratio},
+                  {"median_triangulation_deg", c.median_triangulation_deg},
+                  {"moving_pairs", c.moving_pairs},
+                  {"still_fraction", c.still_fraction},
+                  {"flagged", c.flagged()},
+                  {"warnings", c.warnings}};
+  WriteFileAtomically(file, j.dump(2) + "\n");
+}
+
+std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) return std::nullopt;
+  try {
+    const json j = json::parse(ReadFileUpTo(file, 1 << 20));
+    MapCheck c;
+    c.keyframes = j.at("keyframes").get<int>();
+    c.explained_fraction = j.at("explained_fraction").get<double>();
+    c.path_extent = j.at("path_extent").get<double>();
+    c.scene_depth = j.at("scene_depth").get<double>();
+    c.extent_ratio = j.at("extent_ratio").get<double>();
+    c.median_triangulation_deg = j.at("median_triangulation_deg").get<double>();
+    c.moving_pairs = j.at("moving_pairs").get<int>();
+    c.still_fraction = j.at("still_fraction").get<double>();
+    c.warnings = j.at("warnings").get<std::vector<std::string>>();
+    return c;
+  } catch (const json::exception& e) {
+    throw map::MapError(file.string() + ": not a map check file (" + e.what() + ")");
+  } catch (const InputError& e) {
+    throw map::MapError(e.what());
+  }
+}
+
+}  // namespace arview::mapping

@@ -1,0 +1,136 @@
+// The map's self-check on maps built in the test: a camera moving through a still scene passes;
+// a still camera filming a moving object, and a camera that never moved, are flagged.
+#include "mapping/map_check.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <random>
+
+namespace arview::mapping {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Keyframes at `centres` looking down +z at a cloud of points 4-6 units away; every point seen by
+// every keyframe, observed at its projection. Keypoints: the observations, plus `clutter`
+// features that are not map points, at new random places in each frame.
+struct Scene {
+  map::Map map;
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+};
+
+Scene MovingCameraScene(const std::vector<Eigen::Vector3d>& centres, int points, int clutter, std::uint32_t seed = 5) {
+  Scene s;
+  s.map.camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    map::Keyframe kf;
+    kf.frame_index = static_cast<int>(k);
+    kf.pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond::Identity(), centres[k]);
+    s.map.keyframes.push_back(kf);
+  }
+  s.keypoints.resize(centres.size());
+  std::uint32_t row = 0;
+  for (int i = 0; i < points; ++i) {
+    map::MapPoint p;
+    p.xyz = Eigen::Vector3d(2 * u(rng), 1.5 * u(rng), 5 + u(rng));
+    p.first_descriptor = row;
+    p.descriptor_count = static_cast<std::uint32_t>(centres.size());
+    s.map.points.push_back(p);
+    for (std::uint32_t k = 0; k < centres.size(); ++k, ++row) {
+      s.map.descriptor_point.push_back(static_cast<std::uint32_t>(i));
+      s.map.descriptor_keyframe.push_back(k);
+      const Eigen::Vector2f px = s.map.camera.Project(s.map.keyframes[k].pose.ToCamera(p.xyz)).cast<float>();
+      s.map.keyframes[k].observations.push_back({static_cast<std::uint32_t>(i), px, row});
+      s.keypoints[k].push_back(px);
+    }
+  }
+  std::uniform_real_distribution<float> x(0, 640), y(0, 480);
+  for (auto& frame : s.keypoints)
+    for (int c = 0; c < clutter; ++c) frame.emplace_back(x(rng), y(rng));
+  return s;
+}
+
+std::vector<Eigen::Vector3d> SidewaysPath(int keyframes, double length) {
+  std::vector<Eigen::Vector3d> centres;
+  for (int k = 0; k < keyframes; ++k) centres.emplace_back(length * k / (keyframes - 1) - length / 2, 0, 0);
+  return centres;
+}
+
+bool HasWarning(const MapCheck& c, const std::string& text) {
+  for (const auto& w : c.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(MapCheck, ACameraMovingThroughAStillSceneIsNotFlagged) {
+  // 1.5 units of sideways travel at 5 units' depth; 400 map points and 1,200 clutter features a frame.
+  const Scene s = MovingCameraScene(SidewaysPath(12, 1.5), 400, 1200);
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  EXPECT_FALSE(c.flagged()) << DescribeMapCheck(c) << "\n" << (c.warnings.empty() ? "" : c.warnings[0]);
+  EXPECT_NEAR(c.explained_fraction, 0.25, 1e-9);
+  EXPECT_NEAR(c.path_extent, 1.5, 1e-9);
+  EXPECT_NEAR(c.extent_ratio, 1.5 / c.scene_depth, 1e-9);
+  EXPECT_GT(c.scene_depth, 4.5);
+  EXPECT_LT(c.scene_depth, 5.5);
+  EXPECT_GT(c.median_triangulation_deg, 10);
+  EXPECT_EQ(c.moving_pairs, 11);
+  EXPECT_LT(c.still_fraction, 0.05);  // chance coincidences within 0.5 px
+}
+
+// Issue 17's case: the camera never moves, an object is moved in front of it. COLMAP's map is the
+// object, with a camera path that is the object's motion; the background's features stay put.
+TEST(MapCheck, AStillCameraFilmingAMovingObjectIsFlagged) {
+  Scene s = MovingCameraScene(SidewaysPath(12, 1.5), 400, 200);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> x(0, 640), y(0, 480);
+  std::normal_distribution<float> jitter(0, 0.05f);  // SIFT positions under sensor noise
+  std::vector<Eigen::Vector2f> background(600);
+  for (auto& b : background) b = {x(rng), y(rng)};
+  for (auto& frame : s.keypoints)
+    for (const auto& b : background) frame.push_back(b + Eigen::Vector2f(jitter(rng), jitter(rng)));
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  ASSERT_TRUE(c.flagged()) << DescribeMapCheck(c);
+  EXPECT_TRUE(HasWarning(c, "looks like a still camera filming a moving object")) << c.warnings[0];
+  EXPECT_GT(c.still_fraction, 0.4);
+  EXPECT_EQ(c.warnings.size(), 1u) << "the geometry itself looks fine";
+}
+
+TEST(MapCheck, ACameraThatNeverMovedIsFlagged) {
+  // 2 mm of travel at 5 units' depth (COLMAP's model of a tripod shot fits noise).
+  const Scene s = MovingCameraScene(SidewaysPath(12, 0.002), 400, 400);
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  EXPECT_TRUE(HasWarning(c, "the camera path spans")) << DescribeMapCheck(c);
+  EXPECT_TRUE(HasWarning(c, "triangulated from rays a median")) << DescribeMapCheck(c);
+  EXPECT_LT(c.extent_ratio, 0.001);
+  EXPECT_EQ(c.moving_pairs, 0) << "no pair moves its points by 2 px";
+}
+
+TEST(MapCheck, AMapThatExplainsLittleOfTheFramesIsFlagged) {
+  const Scene s = MovingCameraScene(SidewaysPath(12, 1.5), 50, 2000);
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  EXPECT_TRUE(HasWarning(c, "the map explains only 2.4% of the frames' features")) << DescribeMapCheck(c);
+}
+
+TEST(MapCheck, TheCheckFileRoundTripsAndAnAbsentOneIsNothing) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_map_check_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Scene s = MovingCameraScene(SidewaysPath(12, 0.002), 100, 100);
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  WriteMapCheck(c, dir / kMapCheckFileName);
+  const auto back = ReadMapCheck(dir / kMapCheckFileName);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->warnings, c.warnings);
+  EXPECT_DOUBLE_EQ(back->extent_ratio, c.extent_ratio);
+  EXPECT_EQ(DescribeMapCheck(*back), DescribeMapCheck(c));
+  EXPECT_FALSE(ReadMapCheck(dir / "absent.json"));
+  std::ofstream(dir / "bad.json") << "{\"keyframes\": 3}";
+  EXPECT_THROW(ReadMapCheck(dir / "bad.json"), map::MapError);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview::mapping
