@@ -48,6 +48,8 @@ void IdleModel::Check(int skeleton_joints) const {
   for (int j : joints)
     if (j < 0 || j >= skeleton_joints) throw Error("idle model: joint index out of range");
   if (root < 0 || root >= skeleton_joints) throw Error("idle model: root out of range");
+  if (!(speed_limit >= 0) || (speed_limit > 0 && !(speed_step > 0 && speed_step < 1)))
+    throw Error("idle model: speed limit or its step out of range");
   for (const ComponentChain& c : chains) {
     if (c.clusters.empty() || c.transitions.size() != c.clusters.size() || c.frequency.size() != c.clusters.size())
       throw Error("idle model: a component has no extrema");
@@ -64,6 +66,9 @@ IdleSynthesizer::IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::
   walks_.resize(model_->component_count());
   coefficients_ = Eigen::VectorXd::Zero(model_->component_count());
   posture_ = model_->mean;
+  check_coefficients_ = coefficients_;
+  check_posture_ = posture_;
+  for (auto& r : check_rotations_) r.resize(model_->joints.size());
   Restart();
 }
 
@@ -78,14 +83,14 @@ void IdleSynthesizer::Restart() {
     // Start inside the first segment at a seeded phase, so streams of different seeds differ.
     w.t1 = 0;
     w.v0 = w.v1 = e.value;  // no previous swing: the first may go either way
-    Step(i);
+    Step(i, false);  // the other walks are not placed yet
     const double phase = Uniform(w.rng) * (w.t1 - w.t0);
     w.t0 -= phase;
     w.t1 -= phase;
   }
 }
 
-void IdleSynthesizer::Step(int i) {
+void IdleSynthesizer::Step(int i, bool limit_speed) {
   Walk& w = walks_[i];
   const IdleModel::ComponentChain& chain = model_->chains[i];
   const auto& row = chain.transitions[w.cluster];
@@ -125,21 +130,74 @@ void IdleSynthesizer::Step(int i) {
   w.t1 = w.t0 + dt;
   w.v1 = pick->value;
   w.shape = &pick->shape;
+  if (limit_speed && model_->speed_limit > 0) KeepWithinDataSpeed(i);
 }
 
-void IdleSynthesizer::Advance(int i, double t) {
-  if (t < walks_[i].t0) Restart();  // backwards: replay from the seed
-  while (t > walks_[i].t1) Step(i);
+double IdleSynthesizer::Value(const Walk& w, double t) {
+  const double x = (t - w.t0) / (w.t1 - w.t0);
+  return w.v0 + (w.v1 - w.v0) * SegmentShape(w.shape, std::clamp(x, 0.0, 1.0));
+}
+
+void IdleSynthesizer::PostureFromWalks(double t, Eigen::VectorXd& posture) {
+  for (int i = 0; i < model_->component_count(); ++i) check_coefficients_[i] = Value(walks_[i], t);
+  posture.noalias() = model_->components * check_coefficients_;
+  posture += model_->mean;
+  posture = posture.cwiseMax(model_->min).cwiseMin(model_->max);
+}
+
+double IdleSynthesizer::FastestJointSpeed(double from, double to, double limit) {
+  const double step = model_->speed_step, half = 0.5 * step;
+  const int joints = static_cast<int>(model_->joints.size());
+  double fastest = 0;
+  // Grid points every half step; chord n joins grid points n and n + 2 (one step apart).
+  for (int n = 0;; ++n) {
+    const double t = from - half + n * half;
+    PostureFromWalks(t, check_posture_);
+    std::vector<Eigen::Quaterniond>& now = check_rotations_[n % 3];
+    for (int k = 0; k < joints; ++k) now[k] = ExpMap(check_posture_.segment<3>(3 * k));
+    if (n >= 2) {
+      const std::vector<Eigen::Quaterniond>& before = check_rotations_[(n - 2) % 3];
+      for (int k = 0; k < joints; ++k) fastest = std::max(fastest, before[k].angularDistance(now[k]) / step);
+      if (fastest > limit || t >= to + half) return fastest;
+    }
+  }
+}
+
+// Stretch the segment just drawn for component i (its shape kept, its duration longer) until
+// the posture of all components together stays within the data's speed over it. Bounded: past
+// kMaxStretch the speed is the other components' (they are checked when they step).
+void IdleSynthesizer::KeepWithinDataSpeed(int i) {
+  constexpr double kMaxStretch = 8, kFactor = 1.25;
+  Walk& w = walks_[i];
+  const double duration = w.t1 - w.t0;
+  for (double stretch = 1;; stretch *= kFactor) {
+    w.t1 = w.t0 + duration * stretch;
+    if (stretch * kFactor > kMaxStretch || FastestJointSpeed(w.t0, w.t1, model_->speed_limit) <= model_->speed_limit) return;
+  }
+}
+
+// All walks up to t, in time order: always the one whose segment ends first steps, so the
+// others' segments covering that moment are known to its speed check. The order depends only on
+// the seed, not on the times sampled.
+void IdleSynthesizer::Advance(double t) {
+  for (const Walk& w : walks_)
+    if (t < w.t0) {
+      Restart();  // backwards: replay from the seed
+      break;
+    }
+  for (;;) {
+    int first = -1;
+    for (int i = 0; i < model_->component_count(); ++i)
+      if (t > walks_[i].t1 && (first < 0 || walks_[i].t1 < walks_[first].t1)) first = i;
+    if (first < 0) return;
+    Step(first, true);
+  }
 }
 
 const Eigen::VectorXd& IdleSynthesizer::Coefficients(double t) {
   if (!std::isfinite(t)) t = 0;
-  for (int i = 0; i < model_->component_count(); ++i) {
-    Advance(i, t);
-    const Walk& w = walks_[i];
-    const double x = (t - w.t0) / (w.t1 - w.t0);
-    coefficients_[i] = w.v0 + (w.v1 - w.v0) * SegmentShape(w.shape, std::clamp(x, 0.0, 1.0));
-  }
+  Advance(t);
+  for (int i = 0; i < model_->component_count(); ++i) coefficients_[i] = Value(walks_[i], t);
   return coefficients_;
 }
 

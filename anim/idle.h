@@ -19,12 +19,23 @@
 // shape was recorded. The posture is the mean plus the components, each value clamped to the
 // training data's range.
 //
+// The components are walked independently, as the thesis does, so at moments their speeds add
+// up where the data's dependent ones did not. Each new segment is therefore also stretched in
+// time until the posture it produces together with the other components' current segments
+// (all of them, reconstructed and clamped as rendered) turns no joint faster than the data's
+// own 99th percentile of per-frame fastest-joint speed (IdleModel::speed_limit, measured on the
+// training postures at its frame step). The walks step in time order (always the component
+// whose segment ends first), so when one steps every other's segment covering that moment is
+// known; a component beyond its drawn segment is taken as holding its end extremum (speed 0
+// there, as at every extremum), and is checked in turn when it steps.
+//
 //   IdleSynthesizer idle(skeleton, model, /*seed=*/7);
 //   if (!idle.Sample(t, {}, pose)) ...                 // unbounded, deterministic in (seed, t)
 
 #include "anim/blendable.h"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstdint>
 #include <memory>
@@ -57,6 +68,10 @@ struct IdleModel {
   std::vector<ComponentChain> chains;  // one per component
   double training_seconds = 0;
   int training_frames = 0;
+  // The training postures' fastest joint per frame step (rad/s), its 99th percentile, and the
+  // step it was measured at (s). No limit when 0.
+  double speed_limit = 0;
+  double speed_step = 1.0 / 30;
 
   int dims() const { return static_cast<int>(mean.size()); }
   int component_count() const { return static_cast<int>(eigenvalues.size()); }
@@ -86,15 +101,25 @@ class IdleSynthesizer : public Blendable {
     double t0 = 0, v0 = 0, t1 = 0, v1 = 0;  // the segment [t0, t1] between two extrema
     const std::vector<double>* shape = nullptr;  // its recorded shape (null or empty: cosine)
   };
+  static double Value(const Walk& w, double t);  // the walk's component value at t
   void Restart();
-  void Advance(int component, double t);
-  void Step(int component);
+  void Advance(double t);
+  void Step(int component, bool limit_speed);
+  void KeepWithinDataSpeed(int component);
+  // The fastest joint's angular speed (rad/s) over chords of one speed_step starting every half
+  // step from `from` − half a step to `to` − half a step, at the walks' current segments; stops
+  // at the first chord above `limit`.
+  double FastestJointSpeed(double from, double to, double limit);
+  void PostureFromWalks(double t, Eigen::VectorXd& posture);
 
   std::shared_ptr<const Skeleton> skeleton_;
   std::shared_ptr<const IdleModel> model_;
   std::uint64_t seed_;
   std::vector<Walk> walks_;
   Eigen::VectorXd coefficients_, posture_;
+  // Scratch for the speed check (sized once: no allocation per frame).
+  Eigen::VectorXd check_coefficients_, check_posture_;
+  std::vector<Eigen::Quaterniond> check_rotations_[3];  // per joint, the last three grid points
 };
 
 }  // namespace arview::anim

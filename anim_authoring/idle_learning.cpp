@@ -2,6 +2,7 @@
 
 #include "anim/blending_params.h"
 #include "anim/pose.h"
+#include "base/stats.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -20,6 +21,26 @@ std::string Lower(std::string s) {
 }
 
 Eigen::Matrix3d RootParentLinear(const Skeleton& sk) { return sk.root_parent.block<3, 3>(0, 0); }
+
+// The fastest joint's angular speed (rad/s) per frame step of each training sequence, the
+// postures read as the synthesizer reads them (exponential maps of the first `joints` triples).
+std::vector<double> FastestJointSpeeds(const PostureSequences& data) {
+  auto rotation = [](const Eigen::VectorXd& v, int k) {
+    const Eigen::Vector3d r = v.segment<3>(3 * k);
+    const double a = r.norm();
+    return a < 1e-12 ? Eigen::Quaterniond::Identity() : Eigen::Quaterniond(Eigen::AngleAxisd(a, r / a));
+  };
+  std::vector<double> speeds;
+  const int joints = static_cast<int>(data.joints.size());
+  for (const auto& seq : data.segments)
+    for (std::size_t f = 1; f < seq.size(); ++f) {
+      double fastest = 0;
+      for (int k = 0; k < joints; ++k)
+        fastest = std::max(fastest, rotation(seq[f - 1], k).angularDistance(rotation(seq[f], k)) * data.rate);
+      speeds.push_back(fastest);
+    }
+  return speeds;
+}
 
 Eigen::Quaterniond RootParentRotation(const Skeleton& sk) {
   Eigen::Matrix3d r = RootParentLinear(sk);
@@ -511,6 +532,8 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
     rep.clusters.push_back(used);
   }
   m.training_frames = frames;
+  m.speed_limit = arview::Percentile(FastestJointSpeeds(data), 0.99);
+  m.speed_step = 1 / data.rate;
   m.training_seconds = frames / data.rate;
   rep.frames = frames;
   rep.seconds = m.training_seconds;

@@ -118,14 +118,15 @@ TEST(Idle, TenMinuteStreamMatchesTheData) {
   Speeds(stream, static_cast<int>(m.joints.size()), rate, stream_speed);
   const double data_p99 = arview::Percentile(data_speed, 0.99), stream_max = *std::max_element(stream_speed.begin(), stream_speed.end());
   const double stream_p99 = arview::Percentile(stream_speed, 0.99);
-  std::printf("[idle] fastest joint per frame: data p99 %.3f rad/s; stream p99 %.3f, max %.3f rad/s; worst variance ratio %.2f\n",
-              data_p99, stream_p99, stream_max, worst_ratio);
-  // Issue 13 asks for the stream below the data's p99. Not met on this data (docs/anim.md): the
-  // components are synthesized independently, as the thesis does, and in the recorded clip PC 1
-  // alone reaches p99 1.54 rad/s, PCs 1–2 1.64 and all ten 1.62 (PC 3 cancels part of PC 2 at
-  // the fastest moments; a stream with independent phases does not). Held here within 5% of it,
-  // where it is (before segments replayed their recorded shapes it was 21% over, with cosines).
-  EXPECT_LE(stream_p99, 1.05 * data_p99);
+  std::printf("[idle] fastest joint per frame: data p99 %.3f rad/s (model limit %.3f); stream p99 %.3f, max %.3f rad/s; median data %.3f, "
+              "stream %.3f rad/s; worst variance ratio %.2f\n",
+              data_p99, m.speed_limit, stream_p99, stream_max, arview::Percentile(data_speed, 0.5), arview::Percentile(stream_speed, 0.5),
+              worst_ratio);
+  // Issue 13: the stream below the data's p99. The components are walked independently (as the
+  // thesis does) and each new segment is stretched until all components together stay within
+  // the data's p99 (anim/idle.h); without that the p99 was 1.650 against 1.621 on this clip.
+  EXPECT_NEAR(m.speed_limit, data_p99, 1e-9);
+  EXPECT_LT(stream_p99, data_p99);
   // Same seed, same stream; another seed, another.
   IdleSynthesizer again(skeleton, model, 7), other(skeleton, model, 8);
   for (int f = 0; f < 300; f += 7) {
