@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <limits>
 
 namespace arview::render {
 
@@ -172,13 +173,16 @@ bool ArRenderer::Shadow(const Placed& placed, const anim::FrameOutput& frame, Sh
   return true;
 }
 
-cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) const {
+cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+                                  double* farthest) const {
   const cv::Rect full(0, 0, camera_.width, camera_.height);
+  *farthest = std::numeric_limits<double>::infinity();
   if (options_.full_frame) return full;
-  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300, far_z = 0;
   bool behind = false;
   auto add = [&](const Eigen::Vector3d& world) {
     const Eigen::Vector3d c = eye.ToCamera(world);
+    far_z = std::max(far_z, c.z());
     if (c.z() <= options_.clip.near_m) {
       behind = true;
       return;
@@ -212,6 +216,7 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     if (behind) return full;
   }
   if (u0 > u1) return {};
+  if (std::isfinite(far_z)) *farthest = far_z;
   // A pose or camera far outside the scene projects to huge or non-finite bounds: converting
   // those to int is undefined behaviour. Clamp to a margin around the image first.
   if (!std::isfinite(u0) || !std::isfinite(u1) || !std::isfinite(v0) || !std::isfinite(v1)) return full;
@@ -232,7 +237,8 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
                       std::to_string(frames.size()) + " animation frames");
   }
   used_linear_fallback_ = false;
-  const cv::Rect rect = ScreenBounds(eye, frames);
+  double farthest = 0;
+  const cv::Rect rect = ScreenBounds(eye, frames, &farthest);
   if (rect.empty()) return;  // nothing in view: the video frame as it is
 
   const GlApi& gl = context_->gl();
@@ -284,7 +290,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
   const Eigen::Matrix4d view = ViewMatrix(eye);
   // Real things in front of the characters: depth only, before anything is drawn.
-  if (options_.occlusion && occluders_) occluders_->Draw(projection, view);
+  if (options_.occlusion && occluders_) occluders_->Draw(projection, view, farthest);
   for (size_t i = 0; i < characters_.size(); ++i) {
     Placed& placed = characters_[i];
     const anim::FrameOutput& out = *frames[i];

@@ -116,8 +116,10 @@ class ArRenderer {
   bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const;
   float CastShadowStrength(const Placed& placed) const;
   void FollowExposure(const cv::Mat& background, const calib::Pose& pose);
-  // The screen rectangle that contains everything drawn (empty when nothing is in view).
-  cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) const;
+  // The screen rectangle that contains everything drawn (empty when nothing is in view), and
+  // the farthest distance along the view axis of what is drawn (bounding boxes; infinity when
+  // not known): occluders wholly behind it are not drawn.
+  cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames, double* farthest) const;
 
   OffscreenContext* context_;
   calib::Camera camera_, pinhole_;

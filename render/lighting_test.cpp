@@ -501,6 +501,35 @@ TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
   ASSERT_LT(cv::countNonZero(masks[2]), 0.8 * cv::countNonZero(masks[0]));  // the pillar really hides part of it
   ASSERT_GT(cv::countNonZero(masks[2]), 0.2 * cv::countNonZero(masks[0]));
   EXPECT_GE(iou, 0.9);
+
+  // Occluders wholly behind the character are not drawn (DepthProxy::Draw's `farthest`); the
+  // full-frame render draws them all: the same mask.
+  ArOptions full;
+  full.shadow = false;
+  full.full_frame = true;
+  ArRenderer all_drawn(SharedContext(), camera, full);
+  all_drawn.AddCharacter(fox.character(), fox.spec());
+  all_drawn.SetOccluders(proxy_triangles);
+  cv::Mat differ;
+  cv::bitwise_xor(CoveredMask(all_drawn, pose, out, camera.Size()), masks[1], differ);
+  EXPECT_EQ(cv::countNonZero(differ), 0);
+}
+
+// The depth proxy draws only triangles with a corner nearer than the farthest thing drawn: the
+// walls behind the character go, the pillar in front of it stays.
+TEST(Occlusion, ProxyTrianglesBehindEverythingDrawnAreSkipped) {
+  const calib::Pose pose = LookAt({2.4, -0.6, 1.1}, {0, 0, 0.35});
+  std::vector<Eigen::Vector3f> triangles = BoxTriangles({-2.5, -0.3, 0}, {-2.2, 0.3, 2.6});  // a cabinet behind
+  const size_t behind = triangles.size() / 3;
+  const Eigen::Vector3d pillar_centre(1.1, -0.05, 0);
+  for (const auto& t : BoxTriangles(pillar_centre + Eigen::Vector3d(-0.15, -0.15, 0), pillar_centre + Eigen::Vector3d(0.15, 0.15, 2.4)))
+    triangles.push_back(t);
+  DepthProxy proxy(SharedContext().gl(), triangles);
+  const double character_far = (pose.ToCamera({-0.4, 0, 0})).z();  // the character's far side
+  proxy.Draw(Eigen::Matrix4d::Identity(), ViewMatrix(pose), character_far);
+  EXPECT_EQ(proxy.drawn_triangles(), static_cast<int>(triangles.size() / 3 - behind));
+  proxy.Draw(Eigen::Matrix4d::Identity(), ViewMatrix(pose));
+  EXPECT_EQ(proxy.drawn_triangles(), static_cast<int>(triangles.size() / 3));
 }
 
 // ---------------------------------------------------------------- the rendered room

@@ -143,18 +143,34 @@ void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Ma
 DepthProxy::DepthProxy(const GlApi& gl, const std::vector<Eigen::Vector3f>& triangles) : gl_(&gl) {
   program_ = MakeProgram(gl, "depth proxy", kDepthVertex, kDepthFragment);
   mvp_ = Uniform(gl, program_.get(), "mvp");
+  count_ = static_cast<GLsizei>(triangles.size() / 3 * 3);
+  triangles_.assign(triangles.begin(), triangles.begin() + count_);
   vao_ = MakeVertexArray(gl);
   gl.BindVertexArray(vao_.get());
-  count_ = static_cast<GLsizei>(triangles.size() / 3 * 3);
   vbo_ = MakeBuffer(gl, GL_ARRAY_BUFFER, triangles.data(), std::max<size_t>(1, count_) * sizeof(Eigen::Vector3f));
+  const std::uint32_t none = 0;
+  ibo_ = MakeBuffer(gl, GL_ELEMENT_ARRAY_BUFFER, &none, sizeof none);
   gl.EnableVertexAttribArray(0);
   gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector3f), nullptr);
   gl.BindVertexArray(0);
   CheckGl(gl, "depth proxy upload");
 }
 
-void DepthProxy::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view) const {
+void DepthProxy::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, double farthest) {
+  drawn_ = 0;
   if (count_ == 0) return;
+  // OpenGL's camera looks down −z: the distance along the view axis is −z.
+  const Eigen::RowVector4f depth_row = -view.row(2).cast<float>();
+  const float limit = static_cast<float>(std::min(farthest, 1e30));
+  indices_.clear();
+  for (GLsizei i = 0; i < count_; i += 3) {
+    bool nearer = false;
+    for (int k = 0; k < 3; ++k) nearer = nearer || depth_row.dot(triangles_[i + k].homogeneous()) < limit;
+    if (!nearer) continue;
+    for (int k = 0; k < 3; ++k) indices_.push_back(static_cast<std::uint32_t>(i + k));
+  }
+  drawn_ = static_cast<GLsizei>(indices_.size());
+  if (drawn_ == 0) return;
   const GlApi& gl = *gl_;
   const Eigen::Matrix4f mvp = (projection * view).cast<float>();
   gl.Enable(GL_DEPTH_TEST);
@@ -166,7 +182,10 @@ void DepthProxy::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& 
   gl.UseProgram(program_.get());
   gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
   gl.BindVertexArray(vao_.get());
-  gl.DrawArrays(GL_TRIANGLES, 0, count_);
+  gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo_.get());
+  gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices_.size() * sizeof(std::uint32_t)), indices_.data(),
+                GL_STREAM_DRAW);
+  gl.DrawElements(GL_TRIANGLES, drawn_, GL_UNSIGNED_INT, nullptr);
   gl.BindVertexArray(0);
   gl.ColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }

@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "render/gl_objects.h"
@@ -55,13 +57,22 @@ class DepthProxy {
  public:
   DepthProxy(const GlApi& gl, const std::vector<Eigen::Vector3f>& triangles);
   int triangle_count() const { return count_ / 3; }
-  // Depth only (colour writes off), depth test on.
-  void Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view) const;
+  // Depth only (colour writes off), depth test on. Only the triangles with a corner nearer to
+  // the camera than `farthest` (distance along the view axis, map units) are drawn: one
+  // wholly behind everything drawn after it can hide nothing, and the walls behind a character
+  // cover its whole rectangle at every sample (the pass's main cost, measured in
+  // docs/render.md). Infinity draws them all.
+  void Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view,
+            double farthest = std::numeric_limits<double>::infinity());
+  // Triangles the last Draw drew.
+  int drawn_triangles() const { return drawn_ / 3; }
 
  private:
   const GlApi* gl_;
-  GlName program_, vao_, vbo_;
-  GLsizei count_ = 0;
+  std::vector<Eigen::Vector3f> triangles_;
+  std::vector<std::uint32_t> indices_;  // this frame's triangles
+  GlName program_, vao_, vbo_, ibo_;
+  GLsizei count_ = 0, drawn_ = 0;
   GLint mvp_ = -1;
 };
 
