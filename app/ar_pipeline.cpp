@@ -166,9 +166,12 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
             std::lock_guard lock(report_mutex);
             if (localized) {
               ++report.frames_localized;
-              report.trajectory.push_back({item->frame.timestamp, item->track.pose});
+              if (options.keep_trajectory) report.trajectory.push_back({item->frame.timestamp, item->track.pose});
             }
-            report.frames.push_back(std::move(log));
+            report.briefs.push_back({static_cast<float>(log.track.times.total_ms),
+                                     log.gaze_error_deg ? static_cast<float>(*log.gaze_error_deg) : -1.0f,
+                                     log.track.status});
+            if (options.keep_frame_logs) report.frames.push_back(std::move(log));
           }
           if (!to_sink.Push(std::move(*item))) break;
         }

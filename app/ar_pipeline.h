@@ -44,6 +44,19 @@ struct PipelineOptions {
   // Live sources: a slower stage makes the oldest waiting frame drop. Replays: every frame.
   bool drop_frames = false;
   size_t queue_capacity = 2;
+  // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for --stats and the
+  // demo's figures) and `trajectory` (80 bytes a localized frame). A long run that writes
+  // neither turns them off, so that its memory stays flat (the soak test, docs/reliability.md);
+  // `briefs` (12 bytes a frame, for the text summary) are always kept.
+  bool keep_frame_logs = true;
+  bool keep_trajectory = true;
+};
+
+// What the text summary needs of each frame.
+struct FrameBrief {
+  float track_ms = 0;
+  float gaze_error_deg = -1;  // < 0: none
+  tracker::TrackStatus status = tracker::TrackStatus::kLost;
 };
 
 struct FrameLog {
@@ -67,7 +80,8 @@ struct PipelineReport {
   // and it bounds it: two cores give at most 2000 / cpu_ms_per_frame frames per second.
   double cpu_ms_per_frame = 0;
   std::map<std::string, TimingSummary> stages;  // track, animate, render, sink, latency
-  std::vector<FrameLog> frames;                 // in processing order
+  std::vector<FrameLog> frames;                 // in processing order (PipelineOptions::keep_frame_logs)
+  std::vector<FrameBrief> briefs;               // in processing order, always
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 

@@ -52,12 +52,20 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::unique_ptr<render::FrameSink> sink = render::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
 
   Progress progress("augmenting frames");
+  double rss_mib = -1;
+  std::size_t rss_read_at = 0;
   PipelineReport report = RunPipeline(
       source, tracker, animator_ptrs, compositor, *sink, o.pipeline,
       [&](const PipelineReport& r) {
         if (o.quiet || o.cancel.IsCancelled()) return;  // after a Ctrl-C: only the one line
-        char detail[96];
-        std::snprintf(detail, sizeof(detail), "%zu localized, %zu dropped", r.frames_localized, r.frames_dropped);
+        // Resident memory, read every 100 frames (a soak test follows it on these lines).
+        if (r.frames_processed >= rss_read_at + 100 || rss_mib < 0) {
+          rss_mib = ResidentMemoryMiB();
+          rss_read_at = r.frames_processed;
+        }
+        char detail[128];
+        std::snprintf(detail, sizeof(detail), "%zu localized, %zu dropped, resident %.1f MiB", r.frames_localized,
+                      r.frames_dropped, rss_mib);
         progress.Update(static_cast<long>(r.frames_processed), o.expected_frames > 0 ? o.expected_frames
                                                                                       : static_cast<long>(r.frames_processed),
                         detail);

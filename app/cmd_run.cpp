@@ -33,6 +33,9 @@ void AddRunCommand(CLI::App& app) {
   cmd->callback([a] {
     SessionOptions o;
     ApplySessionFlags(a->session, o);
+    // Per-frame records only for the files that need them: a long run's memory stays flat.
+    o.pipeline.keep_frame_logs = !o.stats_out.empty();
+    o.pipeline.keep_trajectory = !o.trajectory_out.empty();
     o.sink = a->out;
     o.pipeline.drop_frames = true;  // live: never fall behind the camera
     const ScopedSignalCancellation signals;

@@ -9,10 +9,14 @@
 namespace arview::app {
 
 GazeSummary SummarizeGaze(const PipelineReport& report) {
+  // From the full per-frame logs when they were kept (exact), else from the briefs.
   std::vector<double> errors;
   for (const FrameLog& f : report.frames) {
     if (f.gaze_error_deg) errors.push_back(*f.gaze_error_deg);
   }
+  if (report.frames.empty())
+    for (const FrameBrief& f : report.briefs)
+      if (f.gaze_error_deg >= 0) errors.push_back(f.gaze_error_deg);
   GazeSummary g;
   g.frames = errors.size();
   if (errors.empty()) return g;
@@ -36,6 +40,8 @@ namespace {
 std::map<std::string, TimingSummary> TrackTimesByStatus(const PipelineReport& report) {
   std::map<std::string, std::vector<double>> samples;
   for (const FrameLog& f : report.frames) samples[ToString(f.track.status)].push_back(f.track.times.total_ms);
+  if (report.frames.empty())
+    for (const FrameBrief& f : report.briefs) samples[ToString(f.status)].push_back(f.track_ms);
   std::map<std::string, TimingSummary> out;
   for (auto& [status, v] : samples) out[status] = Summarize(v);
   return out;

@@ -99,8 +99,9 @@ void RecordingSource::WaitUntilDue(double timestamp) {
 
 bool RecordingSource::Next(Frame& frame) {
   if (cursor_ == order_.size()) {
-    if (!options_.loop) return false;
+    if (!options_.loop || (options_.passes > 0 && pass_ >= options_.passes)) return false;
     cursor_ = 0;
+    ++pass_;
     loop_offset_ += pass_length_;
   }
   const int index = order_[cursor_++];

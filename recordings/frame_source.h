@@ -43,6 +43,8 @@ struct ReplayOptions {
   // Start again after the last frame, forever. Timestamps keep increasing across passes (each
   // pass is shifted by the recording's duration plus one median frame interval).
   bool loop = false;
+  // With loop: stop after this many passes over the frames (0: never). `arview replay --loop N`.
+  long passes = 0;
   // 0-based indices into frames.txt to deliver, in this order (ParseFrameSpec); empty = all.
   std::vector<int> frames;
 };
@@ -66,6 +68,7 @@ class RecordingSource : public FrameSource {
   std::vector<int> order_;
   size_t cursor_ = 0;
   double loop_offset_ = 0;
+  long pass_ = 1;  // the pass being delivered, from 1
   double pass_length_ = 0;
   cv::VideoCapture video_;
   int video_next_ = 0;  // index of the frame the next video read returns

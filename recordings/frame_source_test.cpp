@@ -63,6 +63,21 @@ TEST(RecordingSource, LoopsWithIncreasingTimestampsAndSelectsFrames) {
   for (size_t k = 1; k < stamps.size(); ++k) EXPECT_GT(stamps[k], stamps[k - 1]);
 }
 
+// `arview replay --loop N`: N passes over the selection, then the end of the stream.
+TEST(RecordingSource, StopsAfterTheGivenNumberOfPasses) {
+  TempDir dir("replay_passes");
+  ReplayOptions options;
+  options.loop = true;
+  options.passes = 3;
+  options.frames = {0, 2};
+  RecordingSource source(MakeStillRecording(dir.path() / "rec", 4), options);
+  Frame f;
+  std::vector<int64_t> indices;
+  while (source.Next(f)) indices.push_back(f.index);
+  EXPECT_EQ(indices, (std::vector<int64_t>{0, 2, 0, 2, 0, 2}));
+  EXPECT_FALSE(source.Next(f));
+}
+
 TEST(RecordingSource, PacedReplayWaitsForTheRecordedTimes) {
   TempDir dir("replay_paced");
   ReplayOptions options;

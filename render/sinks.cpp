@@ -144,6 +144,22 @@ class PngSequenceSink final : public FrameSink {
   int index_ = 0;
 };
 
+// Counts the frames and keeps none (`--out null`: soak runs and timing without an encoder).
+class NullSink final : public FrameSink {
+ public:
+  explicit NullSink(cv::Size size) : size_(size) {}
+  void Write(const cv::Mat& bgr) override {
+    CheckFrame(bgr, size_, "null");
+    ++frames_;
+  }
+  void Close() override {}
+  std::string Describe() const override { return "null (" + std::to_string(frames_) + " frames discarded)"; }
+
+ private:
+  cv::Size size_;
+  long frames_ = 0;
+};
+
 }  // namespace
 
 bool HasDisplay() {
@@ -159,6 +175,7 @@ std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_si
   if (target == "window" || target.rfind("window:", 0) == 0) {
     return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size);
   }
+  if (target == "null") return std::make_unique<NullSink>(frame_size);
   if (target.empty()) throw RenderError("sink: no output given");
   const fs::path path(target);
   std::string ext = path.extension().string();
@@ -167,7 +184,7 @@ std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_si
   if (target.back() == '/' || ext.empty() || fs::is_directory(path)) {
     return std::make_unique<PngSequenceSink>(path, frame_size);
   }
-  throw RenderError(target + ": unknown output (expected window, a .mp4/.avi/.mkv file, or a folder for PNGs)");
+  throw RenderError(target + ": unknown output (expected window, null, a .mp4/.avi/.mkv file, or a folder for PNGs)");
 }
 
 }  // namespace arview::render

@@ -2,6 +2,7 @@
 // Where augmented frames go: a window (OpenCV highgui), an MP4 file (OpenCV's FFmpeg writer),
 // or a folder of PNGs. OpenSink picks by the target's form:
 //   "window" or "window:<title>"  → a highgui window (no display → RenderError saying so)
+//   "null"                         → frames counted and discarded (soak runs, timing)
 //   "<file>.mp4" | ".avi" | ".mkv" → a video file at the given frame rate
 //   "<folder>/" or an existing folder or a name without extension → <folder>/000000.png, ...
 
