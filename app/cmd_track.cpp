@@ -95,6 +95,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"rms_gate_px", r.rms_gate_px},
                               {"flow_tracks", r.flow_tracks},
                               {"guided_matches", r.guided_matches},
+                              {"wide_matches", r.wide_matches},
                               {"keypoints", r.keypoints},
                               {"matches", r.matches},
                               {"reason", r.reason}};

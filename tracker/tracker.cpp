@@ -344,6 +344,77 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   return true;
 }
 
+bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
+                        std::optional<Features>* extracted, Track2D3D* tracked_inliers) {
+  const TrackingOptions& opt = options_.tracking;
+  if (opt.wide_radius_fraction <= 0) return false;
+  const calib::Camera& camera = resolution_.work();
+  const calib::Pose predicted = Predict(timestamp);
+  if (!*extracted) {
+    const auto extract_start = std::chrono::steady_clock::now();
+    // The relocalizer's own features, so that a fallback to it matches exactly what it would
+    // have extracted itself.
+    extracted->emplace(relocalizer_->Extract(gray, relocalizer_->extractor()));
+    result->keypoints = static_cast<int>((*extracted)->keypoints.size());
+    result->times.extract_ms += MillisecondsSince(extract_start);
+  }
+  const Features& features = **extracted;
+  const auto match_start = std::chrono::steady_clock::now();
+  const double radius = opt.wide_radius_fraction * std::max(camera.width, camera.height);
+  // Keyframes near the last pose and near the prediction: one of the two is near the truth.
+  std::vector<int> keyframes = NearestKeyframes(last_pose_);
+  for (int k : NearestKeyframes(predicted))
+    if (std::find(keyframes.begin(), keyframes.end(), k) == keyframes.end()) keyframes.push_back(k);
+  ++frame_counter_;  // a fresh stamp: points gathered by TrackWithPrior are candidates again
+  std::vector<Guided::Candidate> candidates;
+  for (int k : keyframes) {
+    for (const auto& obs : map_.keyframes[k].observations) {
+      if (point_stamp_[obs.point] == frame_counter_) continue;
+      point_stamp_[obs.point] = frame_counter_;
+      const Eigen::Vector3d pc = predicted.ToCamera(map_.points[obs.point].xyz);
+      if (pc.z() <= 0) continue;
+      const Eigen::Vector2d px = camera.Project(pc);
+      // A point predicted just outside the picture may be inside it: the prediction is off.
+      if (px.x() < -radius || px.y() < -radius || px.x() > camera.width + radius ||
+          px.y() > camera.height + radius)
+        continue;
+      candidates.push_back({px, obs.point});
+    }
+  }
+  const auto matches = Guided::Match(features, candidates, map_, radius, opt.wide_ratio, gray.size());
+  result->wide_matches = static_cast<int>(matches.size());
+  result->times.match_ms += MillisecondsSince(match_start);
+
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  GatherCorrespondences(features, map_, matches, &pixels, &points);
+  AbsolutePoseOptions pose_options = options_.relocalization.pose;
+  pose_options.ransac_max_iterations = opt.wide_ransac_iterations;
+  pose_options.min_inliers = opt.min_inliers;
+  pose_options.max_rms_px = rms_gate_.Gate();
+  pose_options.seed += frame_counter_;
+  const AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+  CopyStats(pose, result);
+  if (!pose.ok) {
+    result->reason += "; wide search: " + pose.reason;
+    return false;
+  }
+  const double jump_deg = std::min(pose.pose.q_cw.angularDistance(predicted.q_cw),
+                                   pose.pose.q_cw.angularDistance(last_pose_.q_cw)) * 180.0 / M_PI;
+  if (jump_deg > opt.wide_max_rotation_deg) {
+    std::ostringstream msg;
+    msg << "; wide search: pose turns " << jump_deg << " deg from the last pose and the prediction";
+    result->reason += msg.str();
+    return false;
+  }
+  result->pose = pose.pose;
+  for (int i : pose.inliers) {
+    tracked_inliers->pixels.emplace_back(pixels[i].x(), pixels[i].y());
+    tracked_inliers->points.push_back(matches[i].point);
+  }
+  return true;
+}
+
 void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const {
   if (!resolution_.reduced() || !options_.refine_on_full_camera || inliers.pixels.empty()) return;
   const auto start = std::chrono::steady_clock::now();
@@ -413,6 +484,10 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   Track2D3D inliers;
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
+    if (!tracked) {
+      inliers = {};
+      tracked = TrackWide(gray, timestamp, &result, &features, &inliers);
+    }
     tracking_reason = result.reason;
   }
   if (tracked) {

@@ -74,6 +74,19 @@ struct TrackingOptions {
   // mirrored on a nearly planar patch explains the points almost as well as the true one).
   double max_rotation_from_prediction_deg = 20;
   int min_inliers = 30;            // below this, fall back to relocalization
+  // When flow and guided matching fail (a motion the pyramid cannot follow: on a hand-held
+  // phone clip 175-275 working pixels between frames several video frames apart), the map
+  // points of the keyframes near the last pose are searched for within this fraction of the
+  // working image's longest side around their predicted projections (0: off), with this ratio,
+  // before falling back to relocalization over the whole map. A pose so found must pass the RMS
+  // gate like any tracked pose and turn at most wide_max_rotation_deg from the nearer of the last
+  // pose and the prediction (on phone-fox the constant-velocity prediction was further off than
+  // no motion at all on 14 of 24 frames; the motions recovered turned 21-24 deg from it); the
+  // frame's `wide_matches` says it was found this way.
+  double wide_radius_fraction = 0.3;
+  double wide_max_rotation_deg = 30;
+  double wide_ratio = 0.8;
+  int wide_ransac_iterations = 500;
   // The largest accepted inlier RMS follows the residual scale of recent tracked frames
   // (tracker/residual_gate.h): drifted flow tracks or wrong guided matches (seen in fast turns)
   // fit worse than the camera's genuine poses, and the frame is relocalised instead.
@@ -123,6 +136,7 @@ struct FrameResult {
   double rms_gate_px = 0;  // the largest RMS a tracked pose could have had (tracking only)
   int flow_tracks = 0;     // LK tracks that survived into this frame
   int guided_matches = 0;  // added by guided matching
+  int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
@@ -150,6 +164,9 @@ class Tracker {
   // to relocalization does not extract it again.
   bool TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,
                       std::optional<Features>* features, Track2D3D* inliers);
+  // After TrackWithPrior failed: the wide search around the prediction (wide_radius_fraction).
+  bool TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
+                 std::optional<Features>* features, Track2D3D* inliers);
   calib::Pose Predict(double timestamp) const;
   void RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const;
   void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
