@@ -224,14 +224,8 @@ Clip GenerateGestureClip(const Skeleton& sk, const Clip* base, const LookAtChain
   if (arm.upper < 0 || arm.fore < 0 || arm.hand < 0) throw Error("gesture: no arm chain");
   if (!(sample_rate > 0)) throw Error("gesture: sample rate must be positive");
   const Eigen::Vector3d target = viewpoint.normalized();
-  Clip clip;
-  clip.tracks.resize(sk.size());
-  if (base) clip = *base;
+  Clip clip = StartKeyClip(sk, base, ToString(gesture), target);
   const std::vector<double> times = KeySampleTimes(base, sample_rate);
-  char where[96];
-  std::snprintf(where, sizeof(where), "@%s(%.2f,%.2f,%.2f)", ToString(gesture).data(), target.x(), target.y(),
-                target.z());
-  clip.name = (base ? base->name : std::string("rest")) + where;
   std::vector<int> turned = lookat ? lookat->joints : std::vector<int>{};
   for (int j : {arm.upper, arm.fore})
     if (std::find(turned.begin(), turned.end(), j) == turned.end()) turned.push_back(j);

@@ -194,19 +194,25 @@ std::vector<double> KeySampleTimes(const Clip* base, double sample_rate) {
   return times;
 }
 
+Clip StartKeyClip(const Skeleton& sk, const Clip* base, std::string_view tag, const Eigen::Vector3d& target) {
+  Clip clip;
+  clip.tracks.resize(sk.size());
+  if (base) clip = *base;
+  char where[96];
+  std::snprintf(where, sizeof(where), "@%.*s(%.2f,%.2f,%.2f)", static_cast<int>(tag.size()), tag.data(), target.x(),
+                target.y(), target.z());
+  clip.name = (base ? base->name : std::string("rest")) + where;
+  return clip;
+}
+
 Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain& chain, const Eigen::Vector3d& viewpoint,
                         double sample_rate) {
   if (viewpoint.norm() < 1e-9) throw Error("look-at: the key viewpoint has zero length");
   if (chain.joints.empty()) throw Error("look-at: empty chain");
   if (!(sample_rate > 0)) throw Error("look-at: sample rate must be positive");
   const Eigen::Vector3d target = viewpoint.normalized();
-  Clip clip;
-  clip.tracks.resize(sk.size());
-  if (base) clip = *base;
+  Clip clip = StartKeyClip(sk, base, "lookat", target);
   const std::vector<double> times = KeySampleTimes(base, sample_rate);
-  char where[96];
-  std::snprintf(where, sizeof(where), "@lookat(%.2f,%.2f,%.2f)", target.x(), target.y(), target.z());
-  clip.name = (base ? base->name : std::string("rest")) + where;
   for (int j : chain.joints) clip.tracks[j].rotation.clear();
   LocalPose pose(sk.size());
   for (double t : times) {

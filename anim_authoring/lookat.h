@@ -21,6 +21,7 @@
 
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace arview::anim {
@@ -57,6 +58,11 @@ Clip GenerateLookAtClip(const Skeleton& skeleton, const Clip* base, const LookAt
 // The times a generated key samples: the base clip's duration at `sample_rate` Hz, both ends
 // included (at least two samples); {0} for no base clip or a zero-length one.
 std::vector<double> KeySampleTimes(const Clip* base, double sample_rate);
+
+// A generated key's clip before its chain is turned: a copy of `base` (or empty tracks for
+// every joint of the rest pose), named after the base and `tag`, e.g. "Idle@lookat(0.00,0.00,1.00)";
+// `target` is the key's unit viewpoint.
+Clip StartKeyClip(const Skeleton& skeleton, const Clip* base, std::string_view tag, const Eigen::Vector3d& target);
 
 // The steps GenerateLookAtClip takes per sample, for keys built on top of it (gesture.h).
 // `model` holds the model-space transforms of `pose` and is kept up to date.
