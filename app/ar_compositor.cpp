@@ -3,6 +3,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cstdio>
+#include <iostream>
+
 #include "app/character_bounds.h"
 #include "app/view_hud.h"
 #include "render/hud.h"
@@ -21,6 +24,13 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   for (const anim::AnimatedCharacter* c : characters_) {
     renderer_->AddCharacter(c->character(), c->spec());
     heights_.push_back(RestHeight(c->character(), c->spec().up) * c->spec().scale * c->spec().anchor.scale);
+  }
+  if (options_.ar.lighting == render::LightingMode::kShShadowed && !characters_.empty()) {
+    char line[96];
+    std::snprintf(line, sizeof line, "PRT transfer: %s in %.2f s", renderer_->prt_from_cache() > 0 ? "read from its cache" : "computed",
+                  renderer_->prt_seconds());
+    std::cerr << "note: " << line << "\n";
+    if (!renderer_->prt_cache_note().empty()) std::cerr << "note: " << renderer_->prt_cache_note() << "\n";
   }
   description_ = context_->Description();
 }

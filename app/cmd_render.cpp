@@ -15,6 +15,7 @@
 #include "app/scene_lighting.h"
 #include "calib/camera.h"
 #include "render/ar_renderer.h"
+#include "render/prt_cache.h"
 
 namespace arview::app {
 
@@ -90,6 +91,7 @@ void RunRender(const RenderArgs& args) {
     options.shadow = !args.no_shadow;
     options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
     options.lighting = lighting.mode;
+    options.prt_cache_folder = render::DefaultPrtCacheFolder();
     options.cast_shadow = !args.no_cast_shadow;
     options.occlusion = !args.no_occlusion;
     options.exposure_smoothing = 1.0;  // one frame: its own exposure
@@ -108,7 +110,7 @@ void RunRender(const RenderArgs& args) {
               << (camera.HasDistortion() ? ", undistorted view" : "")
               << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ", lighting "
               << render::LightingModeName(lighting.mode)
-              << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s)" : "")
+              << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s" + (renderer.prt_from_cache() > 0 ? ", from its cache" : "") + ")" : "")
               << ") ["
               << context->Description() << "]\n";
   } catch (const anim::Error& e) {

@@ -2,6 +2,7 @@
 
 #include "app/scene_lighting.h"
 #include "render/offscreen.h"
+#include "render/prt_cache.h"
 
 namespace arview::app {
 
@@ -18,6 +19,9 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"msaa", "none"}));
   cmd->add_option("--lighting", f.lighting, "auto (prt when the scene has a .light.yml), fixed, sh or prt")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "fixed", "sh", "prt"}));
@@ -39,9 +43,11 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.compositor.hmd = f.hmd;
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
+  o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
   o.fade = {f.hold, f.fade};
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
   o.compositor.ar.lighting = lighting.mode;
+  o.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();
   o.compositor.room_light = lighting.light;
 }
 

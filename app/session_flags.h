@@ -9,7 +9,7 @@
 namespace arview::app {
 
 struct SessionFlags {
-  std::string scene, trajectory, stats, gl = "auto";
+  std::string scene, trajectory, stats, gl = "auto", aa = "msaa";
   std::string lighting = "auto", light;  // see app/scene_lighting.h
   bool hmd = false, hud = false;
   double ipd = 0.064, hold = 0.5, fade = 1.0;

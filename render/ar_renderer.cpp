@@ -1,5 +1,7 @@
 #include "render/ar_renderer.h"
 
+#include "render/prt_cache.h"
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -32,9 +34,11 @@ int ArRenderer::AddCharacter(const anim::Character& character, const anim::Chara
   characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
                          std::make_unique<CastShadow>(context_->gl()), LightView{}, 0});
   if (options_.lighting == LightingMode::kShShadowed) {
-    const CharacterTransfer transfer = ComputeShadowedTransfer(character, options_.prt);
-    characters_.back().renderer->SetTransfer(transfer);
-    prt_seconds_ += transfer.seconds;
+    const PrtCacheResult prt = ShadowedTransferCached(character, options_.prt, options_.prt_cache_folder);
+    characters_.back().renderer->SetTransfer(prt.transfer);
+    prt_seconds_ += prt.transfer.seconds;
+    prt_from_cache_ += prt.from_cache;
+    if (!prt.note.empty()) prt_cache_note_ += (prt_cache_note_.empty() ? "" : "; ") + prt.note;
   }
   return static_cast<int>(characters_.size()) - 1;
 }

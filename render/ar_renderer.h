@@ -13,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <span>
@@ -57,6 +58,9 @@ struct ArOptions {
   float cast_shadow_max_strength = 0.8f;
   double exposure_smoothing = 0.5;     // ExposureFollower's share per update (every 4th frame)
   PrtOptions prt;
+  // Where AddCharacter keeps and finds the PRT transfer (render/prt_cache.h); empty: computed
+  // every time. The app passes DefaultPrtCacheFolder().
+  std::filesystem::path prt_cache_folder;
 };
 
 class ArRenderer {
@@ -89,6 +93,10 @@ class ArRenderer {
   Eigen::Vector3d exposure_gain() const { return follower_ ? follower_->gain() : Eigen::Vector3d::Ones(); }
   // Total PRT precomputation time of the characters added so far, seconds.
   double prt_seconds() const { return prt_seconds_; }
+  // How many of the characters' transfers were read from the PRT cache, and why a cache file
+  // was not used or written (empty when all went well).
+  int prt_from_cache() const { return prt_from_cache_; }
+  const std::string& prt_cache_note() const { return prt_cache_note_; }
 
   const calib::Camera& pinhole() const { return pinhole_; }
   const ArOptions& options() const { return options_; }
@@ -135,6 +143,8 @@ class ArRenderer {
   std::unique_ptr<ExposureFollower> follower_;
   std::unique_ptr<DepthProxy> occluders_;
   double prt_seconds_ = 0;
+  int prt_from_cache_ = 0;
+  std::string prt_cache_note_;
   static constexpr int kExposureEvery = 4;
   long frames_since_exposure_ = 0;
 };

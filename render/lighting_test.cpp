@@ -11,12 +11,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <map>
 #include <random>
 
 #include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/prt.h"
+#include "render/prt_cache.h"
 #include "render/room_light.h"
 #include "render/scene_proxy.h"
 #include "render/synth_room.h"
@@ -290,6 +293,99 @@ TEST(Prt, ConvexShapeIsUnshadowedWithTheAdjacencyRelaxation) {
               sphere.meshes[0].positions.size(), relaxed.occluded_share, raw.occluded_share, relaxed.seconds);
   EXPECT_LT(relaxed.occluded_share, 0.002);
   EXPECT_GT(raw.occluded_share, 10 * relaxed.occluded_share + 0.01);
+}
+
+// The transfer read back from the PRT cache is the computed one, bit for bit; a damaged,
+// truncated or foreign file is computed again and replaced; a folder that cannot be written
+// costs the time, not the run.
+bool SameTransfer(const CharacterTransfer& a, const CharacterTransfer& b) {
+  if (a.meshes.size() != b.meshes.size() || a.rays != b.rays || a.occluded_share != b.occluded_share) return false;
+  for (size_t m = 0; m < a.meshes.size(); ++m)
+    if (a.meshes[m] != b.meshes[m]) return false;
+  return true;
+}
+
+struct CacheFolder {
+  fs::path path = fs::temp_directory_path() / ("arview_prt_cache_" + std::to_string(::getpid()));
+  CacheFolder() { fs::remove_all(path); }
+  ~CacheFolder() { fs::remove_all(path); }
+};
+
+TEST(PrtCache, TheSecondRunReadsTheSameTransferFromTheCache) {
+  const anim::Character sphere = RigidCharacter(SphereOrCylinder(0.5, 0));
+  CacheFolder cache;
+  const PrtCacheResult first = ShadowedTransferCached(sphere, {}, cache.path);
+  EXPECT_FALSE(first.from_cache);
+  EXPECT_TRUE(first.note.empty()) << first.note;
+  ASSERT_TRUE(fs::is_regular_file(first.file));
+  EXPECT_EQ(first.file.parent_path(), cache.path);
+  const PrtCacheResult second = ShadowedTransferCached(sphere, {}, cache.path);
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_TRUE(SameTransfer(first.transfer, second.transfer));
+  EXPECT_TRUE(SameTransfer(first.transfer, ComputeShadowedTransfer(sphere, {})));
+  std::printf("PRT of the sphere: computed in %.3f s, read back in %.4f s\n", first.transfer.seconds, second.transfer.seconds);
+  // Other options, or another mesh, are another file.
+  PrtOptions fewer;
+  fewer.directions = 64;
+  EXPECT_NE(PrtCacheKey(sphere, fewer), PrtCacheKey(sphere, {}));
+  anim::Character moved = sphere;
+  moved.meshes[0].positions[0].x() += 1e-6f;
+  EXPECT_NE(PrtCacheKey(moved, {}), PrtCacheKey(sphere, {}));
+  PrtOptions more_threads;
+  more_threads.threads = 7;  // does not change the result, so not the key
+  EXPECT_EQ(PrtCacheKey(sphere, more_threads), PrtCacheKey(sphere, {}));
+}
+
+TEST(PrtCache, ADamagedTruncatedOrForeignFileIsComputedAgainAndReplaced) {
+  const anim::Character sphere = RigidCharacter(SphereOrCylinder(0.5, 0));
+  CacheFolder cache;
+  const PrtCacheResult good = ShadowedTransferCached(sphere, {}, cache.path);
+  const std::uintmax_t size = fs::file_size(good.file);
+  auto damage = [&](const std::function<void(std::string&)>& change) {
+    std::string bytes;
+    {
+      std::ifstream in(good.file, std::ios::binary);
+      bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    change(bytes);
+    std::ofstream(good.file, std::ios::binary | std::ios::trunc) << bytes;
+  };
+  const std::vector<std::pair<std::string, std::function<void(std::string&)>>> cases = {
+      {"checksum mismatch", [](std::string& b) { b[b.size() / 2] ^= 0x40; }},
+      {"checksum mismatch", [](std::string& b) { b.resize(b.size() - 100); }},
+      {"not a PRT cache file", [](std::string& b) { b = "hello"; }},
+  };
+  for (const auto& [why, change] : cases) {
+    damage(change);
+    const PrtCacheResult again = ShadowedTransferCached(sphere, {}, cache.path);
+    EXPECT_FALSE(again.from_cache) << why;
+    EXPECT_NE(again.note.find(why), std::string::npos) << again.note;
+    EXPECT_TRUE(SameTransfer(again.transfer, good.transfer)) << why;
+    EXPECT_EQ(fs::file_size(good.file), size) << why;  // replaced by a good file
+    EXPECT_TRUE(ShadowedTransferCached(sphere, {}, cache.path).from_cache) << why;
+  }
+  // A valid file of another character under this one's name (a hash collision, a copied file).
+  const anim::Character other = RigidCharacter(SphereOrCylinder(0.3, 0));
+  const PrtCacheResult other_result = ShadowedTransferCached(other, {}, cache.path);
+  fs::copy_file(other_result.file, good.file, fs::copy_options::overwrite_existing);
+  const PrtCacheResult foreign = ShadowedTransferCached(sphere, {}, cache.path);
+  EXPECT_FALSE(foreign.from_cache);
+  EXPECT_NE(foreign.note.find("another character"), std::string::npos) << foreign.note;
+  EXPECT_TRUE(SameTransfer(foreign.transfer, good.transfer));
+}
+
+TEST(PrtCache, AFolderThatCannotBeWrittenCostsTheTimeNotTheRun) {
+  const anim::Character sphere = RigidCharacter(SphereOrCylinder(0.5, 0));
+  CacheFolder cache;
+  fs::create_directories(cache.path);
+  std::ofstream(cache.path / "a-file") << "x";
+  const PrtCacheResult r = ShadowedTransferCached(sphere, {}, cache.path / "a-file" / "prt");
+  EXPECT_FALSE(r.from_cache);
+  EXPECT_NE(r.note.find("not cached"), std::string::npos) << r.note;
+  EXPECT_TRUE(SameTransfer(r.transfer, ComputeShadowedTransfer(sphere, {})));
+  const PrtCacheResult none = ShadowedTransferCached(sphere, {}, {});
+  EXPECT_TRUE(none.file.empty());
+  EXPECT_TRUE(none.note.empty());
 }
 
 TEST(Prt, FootOfAWallSeesHalfTheUniformSky) {
