@@ -30,6 +30,7 @@
 #include "recordings/accuracy.h"
 #include "base/image_file.h"
 #include "base/stats.h"
+#include "render/prt_cache.h"
 #include "render/synth_room.h"
 
 namespace arview::app {
@@ -50,6 +51,9 @@ struct DemoArgs {
   bool hmd = false;
   bool no_hud = false;
   double greet_within = 1.4;  // metres
+  std::string size = "640x480";  // the walk's frame size (the room rendered, mapped and replayed at it)
+  int frame_width = 640, frame_height = 480;
+  std::string aa = "msaa";
 };
 
 constexpr int kSteps = 7;
@@ -57,7 +61,8 @@ void Step(int n, const std::string& what) { std::printf("\n[%d/%d] %s\n", n, kSt
 
 // A recording already in `dir` is reused only when it is this walk: same frame count and the
 // same ground-truth poses (checked on a few frames), so a changed walk is never replayed stale.
-bool HoldsWalk(const recordings::Recording& r, int frames, const render::OrbitWalk& walk, double fps) {
+bool HoldsWalk(const recordings::Recording& r, int frames, const render::OrbitWalk& walk, double fps, cv::Size size) {
+  if (r.camera.Size() != size) return false;
   if (static_cast<int>(r.frames.size()) != frames || !r.groundtruth || static_cast<int>(r.groundtruth->size()) != frames) return false;
   for (int i : {0, frames / 3, frames / 2, frames - 1}) {
     const calib::Pose expected = walk.At(i / fps);
@@ -67,14 +72,16 @@ bool HoldsWalk(const recordings::Recording& r, int frames, const render::OrbitWa
   return true;
 }
 
-recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t seed, const render::OffscreenOptions& gl,
-                                 const CancellationToken& cancel) {
+recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t seed, cv::Size size,
+                                 const render::OffscreenOptions& gl, const CancellationToken& cancel) {
   render::SynthRoomOptions o;
+  o.width = size.width;
+  o.height = size.height;
   const render::OrbitWalk walk(frames / o.fps, seed, o.orbit);
   if (fs::exists(dir / "frames.txt")) {
     try {
       recordings::Recording existing = recordings::LoadRecording(dir);
-      if (HoldsWalk(existing, frames, walk, o.fps)) {
+      if (HoldsWalk(existing, frames, walk, o.fps, size)) {
         std::printf("  %s already holds this walk (%d frames): reused\n", dir.c_str(), frames);
         return existing;
       }
@@ -95,7 +102,7 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
     progress.Update(done, total);
   });
   progress.Finish();
-  std::printf("  %d frames at 640x480 with exact ground truth -> %s\n", r.frames, dir.c_str());
+  std::printf("  %d frames at %dx%d with exact ground truth -> %s\n", r.frames, size.width, size.height, dir.c_str());
   return recordings::LoadRecording(dir);
 }
 
@@ -206,6 +213,13 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--height", a->height, "Character height in metres")->capture_default_str()->check(CLI::Range(0.1, 5.0));
   cmd->add_option("--gl", a->gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
   cmd->add_option("--gl-threads", a->gl_threads, "llvmpipe rasterizer threads")->capture_default_str()->check(CLI::Range(0, 16));
+  cmd->add_option("--size", a->size,
+                  "Frame size WxH of the walk (the room is rendered, mapped and replayed at it; field of view kept), "
+                  "e.g. 1280x720; use a --work folder of its own per size, or the walk and map are made again")
+      ->capture_default_str();
+  cmd->add_option("--aa", a->aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"msaa", "none"}));
   cmd->add_flag("--hmd", a->hmd, "Side-by-side stereo output");
   cmd->add_flag("--no-hud", a->no_hud,
                 "No overlay (by default the video shows the view sphere with the keys and the current viewpoint, "
@@ -215,6 +229,11 @@ void AddDemoCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->callback([a] {
+    char tail = 0;
+    if (std::sscanf(a->size.c_str(), "%dx%d%c", &a->frame_width, &a->frame_height, &tail) != 2 || a->frame_width < 160 ||
+        a->frame_height < 120 || a->frame_width > 3840 || a->frame_height > 2160) {
+      throw CommandError("--size must be WxH between 160x120 and 3840x2160, e.g. 1280x720 (got '" + a->size + "')", 2);
+    }
     const fs::path work = a->work;
     fs::create_directories(work);
     const fs::path out = a->out.empty() ? work / "demo.mp4" : fs::path(a->out);
@@ -224,7 +243,7 @@ void AddDemoCommand(CLI::App& app) {
     const ScopedSignalCancellation signals;
 
     Step(1, "Rendering a walk of two laps round the character's spot, with exact ground truth");
-    const recordings::Recording walk = RenderWalk(work / "walk", a->frames, 1, gl, signals.token());
+    const recordings::Recording walk = RenderWalk(work / "walk", a->frames, 1, cv::Size(a->frame_width, a->frame_height), gl, signals.token());
     const int half = a->frames / 2;
     const render::OrbitWalk orbit(a->frames / 30.0, 1, render::OrbitWalkOptions{});
 
@@ -303,8 +322,10 @@ void AddDemoCommand(CLI::App& app) {
     session.compositor.gl = gl;
     session.compositor.hmd = a->hmd;
     session.compositor.hud = !a->no_hud;
+    session.compositor.ar.antialiasing = render::ParseAntialiasing(a->aa);
     const SceneLighting lighting = ResolveSceneLighting(scene, "auto", {});
     session.compositor.ar.lighting = lighting.mode;
+    session.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();
     session.compositor.room_light = lighting.light;
     session.expected_frames = a->frames - half;
     session.cancel = signals.token();

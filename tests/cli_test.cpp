@@ -106,6 +106,10 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
       {{"replay", "/nonexistent/recording", "--map", "/nonexistent/map", "--out", tmp + "/o.mp4"}, "/nonexistent/recording"},
       {{"run", "--device", "/dev/null", "--map", "/nonexistent/map"}, "/nonexistent/map"},
       {{"demo", "--frames", "5"}, "--frames"},
+      {{"demo", "--size", "12x9"}, "--size"},
+      {{"demo", "--size", "1280x720x"}, "--size"},
+      {{"demo", "--aa", "fxaa"}, "--aa"},
+      {{"replay", "/nonexistent/recording", "--map", "/nonexistent/map", "--aa", "fxaa"}, "--aa"},
   };
   for (const Case& c : cases) {
     const auto r = RunArview(c.args);
