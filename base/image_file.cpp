@@ -19,6 +19,8 @@ namespace {
 constexpr std::string_view kPngSignature("\x89PNG\r\n\x1a\n", 8);
 // The IEND chunk: length 0, type, CRC; it ends every complete PNG.
 constexpr std::string_view kPngEnd("\0\0\0\0IEND\xae\x42\x60\x82", 12);
+// SOI, and the 0xFF that starts the marker after it: every JPEG begins so.
+constexpr std::string_view kJpegStart("\xff\xd8\xff", 3);
 
 std::uint32_t BigEndian32(std::string_view bytes, size_t at) {
   const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + at);
@@ -45,6 +47,94 @@ void CheckPngStructure(const std::string& file, std::string_view bytes) {
   }
 }
 
+std::uint32_t BigEndian16(std::string_view bytes, size_t at) {
+  const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + at);
+  return (std::uint32_t{b[0]} << 8) | b[1];
+}
+
+// Frame headers (SOF0-SOF15 but DHT C4, JPG C8 and DAC CC, which share the range).
+bool IsStartOfFrame(unsigned char marker) {
+  return marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+}
+
+// The structure libjpeg would otherwise warn about on stderr ("Premature end of JPEG file",
+// "Corrupt JPEG data: premature end of data segment", "... extraneous bytes before marker")
+// while OpenCV goes on decoding: the marker segments from SOI, each length inside the file, the
+// frame header (SOF) with its size, every scan (SOS) followed by its entropy-coded data (0xFF00
+// stuffing and RST markers inside it) up to the next marker, until EOI. Bytes after EOI are
+// accepted (cameras append data there). What is not checked: the entropy-coded data itself (a
+// bad Huffman code in a complete file still makes libjpeg warn).
+void CheckJpegStructure(const std::string& file, std::string_view bytes) {
+  const auto byte = [&](size_t at) { return static_cast<unsigned char>(bytes[at]); };
+  const auto cut_short = [&]() {
+    return Error(file + ": the JPEG is cut short (it ends before its EOI marker; truncated or still being written?)");
+  };
+  const auto damaged = [&](size_t at, const std::string& what) {
+    return Error(file + ": not a valid JPEG (" + what + " at byte " + std::to_string(at) + ")");
+  };
+  bool frame = false, scan = false;
+  size_t at = 2;  // after SOI
+  for (;;) {
+    if (at >= bytes.size()) throw cut_short();
+    if (byte(at) != 0xff) throw damaged(at, "no marker where one must start");
+    while (at < bytes.size() && byte(at) == 0xff) ++at;  // fill bytes before a marker
+    if (at >= bytes.size()) throw cut_short();
+    const unsigned char marker = byte(at);
+    const size_t marker_at = at - 1;
+    ++at;
+    if (marker == 0xd9) {  // EOI
+      if (!frame || !scan) throw damaged(marker_at, "the EOI marker comes before any frame header and scan");
+      return;
+    }
+    if ((marker >= 0xd0 && marker <= 0xd7) || marker == 0x01) continue;  // RSTn, TEM: no length
+    if (marker == 0x00 || marker == 0xd8) throw damaged(marker_at, "an unexpected marker");
+    if (at + 2 > bytes.size()) throw cut_short();
+    const size_t length = BigEndian16(bytes, at);
+    if (length < 2) throw damaged(marker_at, "a segment length below 2");
+    if (at + length > bytes.size()) throw cut_short();
+    if (IsStartOfFrame(marker)) {
+      // Precision, height, width, component count, then 3 bytes per component.
+      if (frame) throw damaged(marker_at, "a second frame header");
+      if (length < 8 || byte(at + 7) == 0 || length != 8u + 3u * byte(at + 7)) {
+        throw damaged(marker_at, "a frame header whose length does not match its components");
+      }
+      RequireDecodableSize(file, BigEndian16(bytes, at + 5), BigEndian16(bytes, at + 3));
+      frame = true;
+    } else if (marker == 0xda) {  // SOS: its header, then entropy-coded data up to the next marker
+      if (!frame) throw damaged(marker_at, "a scan before the frame header");
+      if (length < 3 || byte(at + 2) == 0 || length != 6u + 2u * byte(at + 2)) {
+        throw damaged(marker_at, "a scan header whose length does not match its components");
+      }
+      size_t data = at + length;
+      const size_t data_start = data;
+      for (;;) {
+        while (data < bytes.size() && byte(data) != 0xff) ++data;
+        if (data + 1 >= bytes.size()) throw cut_short();
+        const unsigned char next = byte(data + 1);
+        if (next == 0x00 || (next >= 0xd0 && next <= 0xd7)) {  // a stuffed 0xFF byte, a restart marker
+          data += 2;
+          continue;
+        }
+        if (next == 0xff) {  // fill bytes: the marker is after them
+          size_t fill = data + 1;
+          while (fill < bytes.size() && byte(fill) == 0xff) ++fill;
+          if (fill >= bytes.size()) throw cut_short();
+          if (byte(fill) == 0x00) {  // not a marker after all: 0xFF 0x00 stuffing after fill
+            data = fill + 1;
+            continue;
+          }
+        }
+        break;
+      }
+      if (data == data_start) throw damaged(data, "a scan without data");
+      scan = true;
+      at = data;
+      continue;
+    }
+    at += length;
+  }
+}
+
 }  // namespace
 
 cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
@@ -53,6 +143,7 @@ cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
   if (bytes.empty()) throw Error(name + ": the image file is empty");
   const std::string_view view(bytes);
   if (view.substr(0, kPngSignature.size()) == kPngSignature) CheckPngStructure(name, view);
+  if (view.substr(0, kJpegStart.size()) == kJpegStart) CheckJpegStructure(name, view);
   cv::Mat image;
   try {
     const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data());
