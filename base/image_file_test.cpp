@@ -12,6 +12,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <zlib.h>
 
 #include "base/error.h"
 #include "tests/support/test_data.h"
@@ -213,21 +214,68 @@ TEST(ReadImageFile, AJpegWithDataAfterItsEoiMarkerIsReadAsItsImage) {
   fs::remove_all(dir);
 }
 
-// The check must not refuse what cameras and encoders write: every real JPEG at hand (the
-// phone video's frames, OpenCV's sample photos) is read, libjpeg printing nothing.
-TEST(ReadImageFile, EveryRealJpegAtHandPassesTheCheck) {
-  const fs::path phone = testing::SharedData("phone-fox/images");
+// Issue 17: a PNG whose structure is complete but whose bytes are damaged made libpng print its
+// own line ("IDAT: incorrect data check", "bad adaptive filter value", "IHDR: CRC error", ...,
+// seen by fuzz_image). Every chunk's CRC is checked first.
+TEST(ReadImageFile, APngWithADamagedChunkIsRefusedBeforeLibpng) {
+  const fs::path dir = TempDir("png_damaged");
+  cv::Mat image(32, 48, CV_8UC3);
+  cv::randu(image, 0, 255);
+  cv::imwrite((dir / "whole.png").string(), image);
+  const std::string whole = Bytes(dir / "whole.png");
+  const size_t idat = whole.find("IDAT") - 4;
+  std::vector<std::pair<std::string, std::string>> cases;  // (bytes, the start of the expected reason)
+  for (size_t at : {idat + 8 + 2, idat + 8 + 40, whole.size() - 12 - 6}) {  // inside the compressed data
+    std::string flipped = whole;
+    flipped[at] = static_cast<char>(flipped[at] ^ 0x10);
+    cases.push_back({flipped, "not a valid PNG (the CRC of its IDAT chunk does not match"});
+  }
+  std::string crc = whole;  // IHDR's CRC itself
+  crc[29] = static_cast<char>(crc[29] ^ 1);
+  cases.push_back({crc, "not a valid PNG (the CRC of its IHDR chunk does not match"});
+  std::string type = whole;
+  type[idat + 5] = '?';
+  cases.push_back({type, "not a valid PNG (a chunk type that is not four letters"});
+  std::string length = whole;
+  length[idat + 1] = 0x70;  // IDAT's length, now past the end
+  cases.push_back({length, "not a valid PNG (a chunk longer than the file"});
+  std::string depth = whole;
+  depth[24] = 3;  // bit depth 3, with its CRC recomputed: a valid chunk with a wrong field
+  const auto ihdr_crc = static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const unsigned char*>(depth.data()) + 12, 17));
+  for (int i = 0; i < 4; ++i) depth[29 + i] = static_cast<char>(ihdr_crc >> (24 - 8 * i));
+  cases.push_back({depth, "not a valid PNG (an IHDR header with invalid fields"});
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const fs::path file = dir / ("damaged" + std::to_string(i) + ".png");
+    Write(file, cases[i].first);
+    const auto [message, printed] = ReadFailure(file);
+    EXPECT_EQ(message.rfind(file.string() + ": " + cases[i].second, 0), 0u) << i << ": " << message;
+    EXPECT_EQ(printed, "") << i;
+  }
+  fs::remove_all(dir);
+}
+
+// The checks must not refuse what cameras and encoders write: every real frame at hand (the
+// phone video's JPEG frames, templeRing's PNG photos, OpenCV's sample photos) is read, libjpeg
+// and libpng printing nothing.
+TEST(ReadImageFile, EveryRealFrameAtHandPassesTheChecks) {
+  const fs::path phone = testing::SharedData("phone-fox/images"), temple = testing::SharedData("templeRing");
   ARVIEW_REQUIRE_DATA_PATH(phone, "../shared/data");
+  ARVIEW_REQUIRE_DATA_PATH(temple, "../shared/data");
   std::vector<fs::path> files;
-  for (const fs::path& folder : {phone, fs::path("/usr/share/doc/opencv-doc/examples/data")}) {
+  size_t jpegs = 0, pngs = 0;
+  for (const fs::path& folder : {phone, temple, fs::path("/usr/share/doc/opencv-doc/examples/data")}) {
     if (!fs::is_directory(folder)) continue;
     for (const auto& entry : fs::directory_iterator(folder)) {
       std::string extension = entry.path().extension().string();
       std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (extension == ".jpg" || extension == ".jpeg") files.push_back(entry.path());
+      if (extension == ".jpg" || extension == ".jpeg") ++jpegs;
+      else if (extension == ".png") ++pngs;
+      else continue;
+      files.push_back(entry.path());
     }
   }
-  ASSERT_GE(files.size(), 60u);
+  EXPECT_GE(jpegs, 67u);
+  EXPECT_GE(pngs, 47u);
   for (const fs::path& file : files) {
     ::testing::internal::CaptureStderr();
     try {
