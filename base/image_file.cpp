@@ -118,7 +118,7 @@ void CheckJpegStructure(const std::string& file, std::string_view bytes) {
   const auto damaged = [&](size_t at, const std::string& what) {
     return Error(file + ": not a valid JPEG (" + what + " at byte " + std::to_string(at) + ")");
   };
-  bool frame = false, scan = false;
+  bool frame = false, scan = false, sequential = false;
   size_t at = 2;  // after SOI
   for (;;) {
     if (at >= bytes.size()) throw cut_short();
@@ -146,10 +146,16 @@ void CheckJpegStructure(const std::string& file, std::string_view bytes) {
       }
       RequireDecodableSize(file, BigEndian16(bytes, at + 5), BigEndian16(bytes, at + 3));
       frame = true;
+      sequential = marker == 0xc0 || marker == 0xc1;  // baseline, extended sequential (Huffman)
     } else if (marker == 0xda) {  // SOS: its header, then entropy-coded data up to the next marker
       if (!frame) throw damaged(marker_at, "a scan before the frame header");
       if (length < 3 || byte(at + 2) == 0 || length != 6u + 2u * byte(at + 2)) {
         throw damaged(marker_at, "a scan header whose length does not match its components");
+      }
+      // A sequential scan covers the whole spectrum at full precision: Ss 0, Se 63, Ah Al 0
+      // (libjpeg warns "Invalid SOS parameters for sequential JPEG" otherwise).
+      if (sequential && (byte(at + length - 3) != 0 || byte(at + length - 2) != 63 || byte(at + length - 1) != 0)) {
+        throw damaged(marker_at, "a sequential scan header with progressive parameters");
       }
       size_t data = at + length;
       const size_t data_start = data;

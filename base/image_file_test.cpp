@@ -179,6 +179,12 @@ TEST(ReadImageFile, ADamagedJpegHeaderIsRefusedBeforeLibjpeg) {
   std::string scan = whole;
   scan[sos + 4] = 0;
   cases.push_back({scan, "not a valid JPEG (a scan header whose length does not match"});
+  // A baseline scan whose spectral end is not 63 (libjpeg: "Invalid SOS parameters for
+  // sequential JPEG"; found by fuzz_image).
+  std::string spectrum = whole;
+  const size_t sos_length = (size_t{static_cast<unsigned char>(whole[sos + 2])} << 8) | static_cast<unsigned char>(whole[sos + 3]);
+  spectrum[sos + 2 + sos_length - 2] = 62;
+  cases.push_back({spectrum, "not a valid JPEG (a sequential scan header with progressive parameters"});
   // The frame header removed: the scan comes first.
   const size_t sof_length = (size_t{static_cast<unsigned char>(whole[sof + 2])} << 8) | static_cast<unsigned char>(whole[sof + 3]);
   cases.push_back({whole.substr(0, sof) + whole.substr(sof + 2 + sof_length), "not a valid JPEG (a scan before the frame header"});

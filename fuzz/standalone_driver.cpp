@@ -54,6 +54,13 @@ extern "C" __attribute__((weak)) int LLVMFuzzerInitialize(int* argc, char*** arg
 // report, before the process exits.
 extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*callback)(void));
 
+// UBSan's defaults, read by its runtime before main. Under gcc, UBSan is a runtime of its own
+// beside ASan's (libubsan, libasan): the death callback set above reaches only ASan's, and a
+// UBSan report ended the process with exit(1) and no input kept (fuzz_driver_selftest's
+// `signed` case found it). With abort_on_error it ends in abort(), whose SIGABRT handler below
+// keeps the input. UBSAN_OPTIONS from the environment still overrides this.
+extern "C" const char* __ubsan_default_options() { return "abort_on_error=1:print_stacktrace=1"; }
+
 namespace {
 
 namespace fs = std::filesystem;
