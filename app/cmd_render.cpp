@@ -70,8 +70,11 @@ void RunRender(const RenderArgs& args) {
   }
   cv::Mat background;
   if (!args.background.empty()) {
-    background = cv::imread(args.background, cv::IMREAD_COLOR);
-    if (background.empty()) throw CommandError(args.background + ": missing or not an image");
+    try {
+      background = ReadImageFile(args.background, cv::IMREAD_COLOR);
+    } catch (const Error& e) {
+      throw CommandError(e.what());
+    }
   }
   const std::string ext = std::filesystem::path(args.out).extension().string();
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") throw CommandError(args.out + ": --out must end in .png or .jpg");

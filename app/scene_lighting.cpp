@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "app/commands.h"
+#include "base/error.h"
+#include "base/image_file.h"
 #include "render/offscreen.h"
 #include "render/scene_proxy.h"
 
@@ -38,8 +40,12 @@ std::optional<PlacedLightReport> EstimatePlacedLight(const map::Map& map, const 
     const map::Keyframe& k = map.keyframes[i * n / take];
     const fs::path path = image_path(k);
     if (path.empty()) continue;
-    cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
-    if (image.empty()) throw CommandError(path.string() + ": keyframe image unreadable");
+    cv::Mat image;
+    try {
+      image = ReadImageFile(path, cv::IMREAD_COLOR);
+    } catch (const Error& e) {
+      throw CommandError(std::string(e.what()) + " (a keyframe image, for the lighting)");
+    }
     if (image.cols != map.camera.width || image.rows != map.camera.height) {
       throw CommandError(path.string() + ": keyframe image is " + std::to_string(image.cols) + "x" +
                          std::to_string(image.rows) + ", the map's camera " + std::to_string(map.camera.width) + "x" +

@@ -1,5 +1,7 @@
 #include "calib/calibration.h"
 
+#include "base/error.h"
+#include "base/image_file.h"
 #include "base/stats.h"
 
 #include <glob.h>
@@ -134,8 +136,14 @@ CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const C
     if (progress) progress(static_cast<int>(i) + 1, static_cast<int>(image_paths.size()));
     ViewReport view;
     view.path = image_paths[i];
-    const cv::Mat gray = cv::imread(image_paths[i], cv::IMREAD_GRAYSCALE);
-    if (gray.empty()) throw CalibrationError(image_paths[i] + ": cannot be read as an image");
+    // ReadImageFile: a cut or damaged photo is one error naming it (cv::imread let libjpeg print
+    // "Premature end of JPEG file" and gave the photo with its missing part grey).
+    cv::Mat gray;
+    try {
+      gray = ReadImageFile(image_paths[i], cv::IMREAD_GRAYSCALE);
+    } catch (const Error& e) {
+      throw CalibrationError(e.what());
+    }
     if (image_size.empty()) {
       image_size = gray.size();
       size_source = image_paths[i];

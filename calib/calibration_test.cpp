@@ -6,6 +6,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "tests/support/test_data.h"
 
@@ -92,7 +94,26 @@ TEST(Calibration, FewerThanThreeUsableViewsIsAnError) {
 
 TEST(Calibration, UnreadableImageIsNamed) {
   const std::string e = ErrorOf([] { Calibrate({"/nonexistent/x.png"}, CalibrationOptions{}); });
-  EXPECT_NE(e.find("/nonexistent/x.png: cannot be read"), std::string::npos) << e;
+  EXPECT_NE(e.find("/nonexistent/x.png: does not exist"), std::string::npos) << e;
+}
+
+// Issue 17: a photo cut short (a copy interrupted) made libjpeg print "Premature end of JPEG
+// file" and the calibration went on with the photo's missing part grey.
+TEST(Calibration, ATruncatedPhotoIsOneErrorNamingItAndLibjpegSaysNothing) {
+  const fs::path photo = fs::path(kOpenCvData) / "left01.jpg";
+  ARVIEW_REQUIRE_DATA_PATH(photo, "Debian package opencv-doc");
+  const fs::path d = TempDir("truncated");
+  std::ifstream in(photo, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const fs::path cut = d / "left01.jpg";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  std::vector<std::string> paths = {cut.string()};
+  for (const char* name : {"left02.jpg", "left03.jpg"}) paths.push_back((fs::path(kOpenCvData) / name).string());
+  ::testing::internal::CaptureStderr();
+  const std::string e = ErrorOf([&] { Calibrate(paths, CalibrationOptions{}); });
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(e.rfind(cut.string() + ": the JPEG is cut short", 0), 0u) << e;
+  fs::remove_all(d);
 }
 
 TEST(Calibration, UnwritableOutputIsAnError) {

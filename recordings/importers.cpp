@@ -91,6 +91,35 @@ std::vector<FrameEntry> StoreStills(const std::vector<fs::path>& images, const f
   return frames;
 }
 
+// The recording folder an import writes into: prepared (PrepareRecordingFolder: created, or an
+// old recording cleared with --force) on construction; unless Commit() is called after the last
+// file is written, the destructor removes everything the import wrote (frames/, camera.yaml,
+// groundtruth.txt, frames.txt) and the folder itself if the import created it. Issue 17: an
+// import that failed on a full disk left frames/000000.png (0 bytes) behind.
+class PreparedOutput {
+ public:
+  PreparedOutput(const fs::path& out_dir, bool overwrite) : out_dir_(out_dir) {
+    std::error_code ec;
+    existed_ = fs::exists(out_dir, ec);
+    PrepareRecordingFolder(out_dir, overwrite);  // throws before touching a folder that is not ours
+  }
+  PreparedOutput(const PreparedOutput&) = delete;
+  PreparedOutput& operator=(const PreparedOutput&) = delete;
+  ~PreparedOutput() {
+    if (committed_) return;
+    std::error_code ec;
+    for (const char* name : {"frames.txt", "camera.yaml", "groundtruth.txt"}) fs::remove(out_dir_ / name, ec);
+    fs::remove_all(out_dir_ / "frames", ec);
+    if (!existed_) fs::remove(out_dir_, ec);  // only if empty: nothing else was there
+  }
+  void Commit() { committed_ = true; }
+
+ private:
+  fs::path out_dir_;
+  bool existed_ = false;
+  bool committed_ = false;
+};
+
 ImportResult Finish(const fs::path& out_dir, const calib::Camera& camera, const std::vector<FrameEntry>& frames,
                     const Trajectory* groundtruth, std::vector<std::string> notes) {
   try {
@@ -316,7 +345,7 @@ ImportResult ImportMiddlebury(const fs::path& source_dir, const fs::path& out_di
   if (options.camera) {
     notes.push_back("--camera ignored: the Middlebury file gives the intrinsics");
   }
-  PrepareRecordingFolder(out_dir, options.overwrite);
+  PreparedOutput prepared(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, "the first image " + images[0].string());
   Trajectory gt;
   for (size_t i = 0; i < views.size(); ++i) {
@@ -325,7 +354,9 @@ ImportResult ImportMiddlebury(const fs::path& source_dir, const fs::path& out_di
   }
   notes.push_back("intrinsics are shared by all " + std::to_string(views.size()) + " images of " +
                   par.filename().string());
-  return Finish(out_dir, camera, frames, &gt, std::move(notes));
+  ImportResult result = Finish(out_dir, camera, frames, &gt, std::move(notes));
+  prepared.Commit();
+  return result;
 }
 
 ImportResult ImportStrecha(const fs::path& source_dir, const fs::path& out_dir, const ImportOptions& options) {
@@ -359,13 +390,15 @@ ImportResult ImportStrecha(const fs::path& source_dir, const fs::path& out_dir, 
   }
   std::vector<std::string> notes;
   if (options.camera) notes.push_back("--camera ignored: the .camera files give the intrinsics");
-  PrepareRecordingFolder(out_dir, options.overwrite);
+  PreparedOutput prepared(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, first_cam.string());
   Trajectory gt;
   for (size_t i = 0; i < cams.size(); ++i) {
     gt.push_back({frames[i].timestamp, calib::Pose::FromCameraToWorld(Eigen::Quaterniond(cams[i].R_wc), cams[i].C)});
   }
-  return Finish(out_dir, camera, frames, &gt, std::move(notes));
+  ImportResult result = Finish(out_dir, camera, frames, &gt, std::move(notes));
+  prepared.Commit();
+  return result;
 }
 
 namespace {
@@ -403,7 +436,7 @@ ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, cons
   const fs::path gt_file = source_dir / "groundtruth.txt";
   std::optional<Trajectory> gt;
   if (fs::exists(gt_file, ec)) gt = ReadTum(gt_file);
-  PrepareRecordingFolder(out_dir, options.overwrite);
+  PreparedOutput prepared(out_dir, options.overwrite);
   std::vector<FrameEntry> frames;
   for (size_t i = 0; i < list.size(); ++i) {
     const fs::path image_file = source_dir / list[i].path;
@@ -416,16 +449,20 @@ ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, cons
   }
   std::vector<std::string> notes;
   if (!gt) notes.push_back(gt_file.string() + " absent: the recording has no ground truth");
-  return Finish(out_dir, camera, frames, gt ? &*gt : nullptr, std::move(notes));
+  ImportResult result = Finish(out_dir, camera, frames, gt ? &*gt : nullptr, std::move(notes));
+  prepared.Commit();
+  return result;
 }
 
 ImportResult ImportImages(const fs::path& source_dir, const fs::path& out_dir, const ImportOptions& options) {
   RequireDirectory(source_dir, "image folder");
   const calib::Camera camera = RequireCamera(options, "images");
   const std::vector<fs::path> images = ImagesInFolder(source_dir);
-  PrepareRecordingFolder(out_dir, options.overwrite);
+  PreparedOutput prepared(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, "--camera");
-  return Finish(out_dir, camera, frames, nullptr, {});
+  ImportResult result = Finish(out_dir, camera, frames, nullptr, {});
+  prepared.Commit();
+  return result;
 }
 
 ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, const ImportOptions& options) {
@@ -459,13 +496,15 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
                   rate);
     notes.push_back(text);
   }
-  PrepareRecordingFolder(out_dir, options.overwrite);
+  PreparedOutput prepared(out_dir, options.overwrite);
   const std::string rel = "frames/" + video_file.filename().string();
   fs::copy_file(video_file, out_dir / rel, fs::copy_options::overwrite_existing, ec);
   if (ec) throw RecordingError((out_dir / rel).string() + ": cannot copy the video (" + ec.message() + ")");
   std::vector<FrameEntry> frames;
   for (double t : stamps) frames.push_back({t, rel});
-  return Finish(out_dir, camera, frames, nullptr, std::move(notes));
+  ImportResult result = Finish(out_dir, camera, frames, nullptr, std::move(notes));
+  prepared.Commit();
+  return result;
 }
 
 const std::vector<std::string>& ImporterKinds() {

@@ -1,6 +1,7 @@
 #include "recordings/importers.h"
 
 #include <fstream>
+#include <iterator>
 #include <iostream>
 #include <sstream>
 #include <unistd.h>
@@ -299,6 +300,33 @@ TEST(ImportImages, TakesImagesInNameOrderWithTheGivenCamera) {
   } catch (const RecordingError& e) {
     EXPECT_NE(std::string(e.what()).find("d.png"), std::string::npos) << e.what();
   }
+}
+
+// Issue 17 §6: an import that failed part-way (a damaged source image, a full disk) left the
+// frames it had copied (on a full disk a 0-byte frames/000000.png) in a folder without frames.txt.
+TEST(ImportImages, AnImportThatFailsPartWayLeavesNothingBehind) {
+  TempDir dir("images_fail");
+  WriteImage(dir.path() / "src/a.png", 64, 48, 1);
+  WriteImage(dir.path() / "src/b.jpg", 64, 48, 2);
+  WriteImage(dir.path() / "src/c.png", 64, 48, 3);
+  std::ifstream in(dir.path() / "src/c.png", std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  in.close();
+  WriteFile(dir.path() / "src/c.png", bytes.substr(0, bytes.size() / 2));  // cut: the third frame fails
+  ImportOptions options;
+  options.camera = SmallCamera();
+  // Into a folder the import creates: the folder goes too.
+  EXPECT_THROW(ImportImages(dir.path() / "src", dir.path() / "new", options), RecordingError);
+  EXPECT_FALSE(fs::exists(dir.path() / "new"));
+  // Into an empty folder the user made: it stays, empty.
+  fs::create_directories(dir.path() / "empty");
+  EXPECT_THROW(ImportImages(dir.path() / "src", dir.path() / "empty", options), RecordingError);
+  EXPECT_TRUE(fs::is_directory(dir.path() / "empty"));
+  EXPECT_TRUE(fs::is_empty(dir.path() / "empty"));
+  // A folder that is not a recording is refused before anything is touched, its files kept.
+  WriteFile(dir.path() / "mine/frames/keep.png", "the user's");
+  EXPECT_THROW(ImportImages(dir.path() / "src", dir.path() / "mine", options), RecordingError);
+  EXPECT_TRUE(fs::exists(dir.path() / "mine/frames/keep.png"));
 }
 
 using test::WriteTestVideo;

@@ -19,11 +19,19 @@ namespace fs = std::filesystem;
 namespace {
 
 void WriteAll(int fd, const std::string& text, const fs::path& file) {
-  // One write() of a short line with O_APPEND: a line is either wholly in the file or not.
+  // One write() of a short line with O_APPEND. On a full disk (or at the file-size limit) it can
+  // write part of the line and return the count: the part is cut off again, so that frames.txt
+  // never ends in half a line (LoadRecording would refuse the whole recording).
+  const off_t before = ::lseek(fd, 0, SEEK_END);
   const ssize_t n = ::write(fd, text.data(), text.size());
-  if (n != static_cast<ssize_t>(text.size())) {
-    throw RecordingError(file.string() + ": write failed (" + std::string(std::strerror(errno)) + ")");
+  if (n == static_cast<ssize_t>(text.size())) return;
+  const std::string why = n < 0 ? std::strerror(errno)
+                                : "only " + std::to_string(n) + " of " + std::to_string(text.size()) +
+                                      " bytes written: the disk is full or the file at its size limit";
+  if (n > 0 && (before < 0 || ::ftruncate(fd, before) != 0)) {
+    throw RecordingError(file.string() + ": cannot write (" + why + "), and cannot cut the partial line off again");
   }
+  throw RecordingError(file.string() + ": cannot write (" + why + ")");
 }
 
 }  // namespace
@@ -76,10 +84,22 @@ void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
   char name[32];
   std::snprintf(name, sizeof(name), "%06d.png", count_);
   const std::string rel = std::string("frames/") + name;
-  WriteImageAtomically(root_ / rel, image, {cv::IMWRITE_PNG_COMPRESSION, 1});  // speed over size
+  try {
+    WriteImageAtomically(root_ / rel, image, {cv::IMWRITE_PNG_COMPRESSION, 1});  // speed over size
+  } catch (const RecordingError&) {
+    throw;
+  } catch (const Error& e) {  // a full disk: the frame is not written, frames.txt untouched
+    throw RecordingError(e.what());
+  }
   char line[96];
   std::snprintf(line, sizeof(line), "%.9f %s\n", timestamp, rel.c_str());
-  WriteAll(fd_, line, list);
+  try {
+    WriteAll(fd_, line, list);
+  } catch (const RecordingError&) {
+    std::error_code ec;
+    fs::remove(root_ / rel, ec);  // not listed: it would be a stray file in frames/
+    throw;
+  }
   if (size_.area() == 0) size_ = image.size();
   last_timestamp_ = timestamp;
   ++count_;

@@ -1,6 +1,16 @@
 #include "recordings/recorder.h"
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+
+#include <cerrno>
+#include <cstring>
 
 #include "recordings/test_helpers.h"
 
@@ -92,6 +102,83 @@ TEST(RecordingWriter, RemovesWhatItCreatedWhenNothingWasRecorded) {
   one.Append(test::MakeImage(64, 48, 0), 0.0);
   EXPECT_FALSE(one.RemoveIfEmpty());
   EXPECT_EQ(LoadRecording(dir.path() / "rec2").frames.size(), 1u);
+}
+
+// Issue 17 §6: the disk fills while recording (a 64 KiB tmpfs; 64x48 frames of about 9 KB). The
+// frame that does not fit is one RecordingError naming the file; what was recorded before it
+// stays a valid recording: every frame listed is on disk whole, nothing else is left in frames/.
+TEST(RecordFrames, ADiskThatFillsMidRecordingLeavesAValidRecordingOfTheFramesBefore) {
+  TempDir dir("record_full");
+  const fs::path mount_point = dir.path() / "small";
+  fs::create_directories(mount_point);
+  if (::mount("tmpfs", mount_point.c_str(), "tmpfs", 0, "size=64k") != 0) {
+    GTEST_SKIP() << "cannot mount a small tmpfs here (needs root and the right to mount): " << std::strerror(errno);
+  }
+  struct Unmount {
+    fs::path at;
+    ~Unmount() { ::umount(at.c_str()); }
+  } unmount{mount_point};
+  FakeSource source(100);
+  RecordingWriter writer(mount_point / "rec", SmallCamera(), false);
+  std::string error;
+  try {
+    RecordFrames(source, writer, 0, {});
+  } catch (const RecordingError& e) {
+    error = e.what();
+  }
+  ASSERT_NE(error, "") << "100 frames fitted in 64 KiB";
+  EXPECT_EQ(error.rfind((mount_point / "rec").string(), 0), 0u) << error;
+  EXPECT_NE(error.find("No space left on device"), std::string::npos) << error;
+  const Recording rec = LoadRecording(mount_point / "rec");
+  EXPECT_GT(rec.frames.size(), 0u);
+  EXPECT_EQ(static_cast<int>(rec.frames.size()), writer.frame_count());
+  for (size_t i = 0; i < rec.frames.size(); ++i) {
+    EXPECT_EQ(cv::norm(rec.ReadImage(static_cast<int>(i)), test::MakeImage(64, 48, static_cast<int>(i)), cv::NORM_INF), 0) << i;
+  }
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(mount_point / "rec/frames")) files += e.is_regular_file();
+  EXPECT_EQ(files, rec.frames.size());
+}
+
+// The same when frames.txt is the file that hits the limit, part-way through a line: 1x1 frames
+// (a PNG of about 70 bytes) and a file-size limit of 1000 bytes (RLIMIT_FSIZE, SIGXFSZ ignored,
+// in a child process), so that the append of line 30-odd is written only in part. That part is
+// cut off again and the frame's PNG removed: frames.txt lists only whole frames.
+TEST(RecordingWriter, AFramesTxtLineCutShortByAFullDiskIsTakenBackWithItsFrame) {
+  TempDir dir("writer_short");
+  const fs::path root = dir.path() / "rec";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{1000, 1000};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    int status = 1;  // no error at all
+    try {
+      RecordingWriter writer(root, std::nullopt, false);
+      for (int i = 0; i < 1000; ++i) writer.Append(cv::Mat(1, 1, CV_8UC3, cv::Scalar(i % 256, 7, 9)), i / 30.0);
+    } catch (const RecordingError& e) {
+      const std::string what = e.what();
+      status = what.rfind((root / "frames.txt").string() + ": cannot write (only ", 0) == 0 ? 0 : 2;
+      if (status != 0) std::fprintf(stderr, "%s\n", what.c_str());
+    } catch (...) {
+      status = 3;
+    }
+    ::_exit(status);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 0) << "1: no error; 2: another error than a short write of frames.txt; 3: not a RecordingError";
+  calib::SaveCamera(calib::Camera::Pinhole(1, 1, 1, 1, 0, 0), root / "camera.yaml");
+  const Recording rec = LoadRecording(root);
+  EXPECT_GT(rec.frames.size(), 10u);
+  for (size_t i = 0; i < rec.frames.size(); ++i) {
+    EXPECT_EQ(rec.ReadImage(static_cast<int>(i)).at<cv::Vec3b>(0, 0)[0], i % 256) << i;
+  }
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(root / "frames")) files += e.is_regular_file();
+  EXPECT_EQ(files, rec.frames.size());
 }
 
 }  // namespace

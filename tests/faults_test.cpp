@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <utility>
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -223,6 +225,69 @@ TEST_F(Faults, TrackOnAFullDiskFailsAndLeavesNoTrajectoryOrStats) {
   EXPECT_EQ(r.err.find("arview: "), r.err.rfind("arview: ")) << r.err;
   const auto left = FilesIn(out);
   EXPECT_TRUE(left.empty()) << "left " << left.front();
+}
+
+// The last `arview:` line of stderr (progress lines come first), and how many there are.
+std::pair<std::string, size_t> ErrorLines(const std::string& err) {
+  size_t count = 0, last = std::string::npos;
+  for (size_t at = 0; at < err.size();) {
+    const size_t end = std::min(err.find('\n', at), err.size());
+    if (err.compare(at, 8, "arview: ") == 0) {
+      ++count;
+      last = at;
+    }
+    at = end + 1;
+  }
+  if (last == std::string::npos) return {"", 0};
+  return {err.substr(last, std::min(err.find('\n', last), err.size()) - last), count};
+}
+
+// Issue 17 §6, the writers the first full-disk test left out: replay into a video (with
+// --trajectory and --stats), into a PNG folder, and --stats alone; import of an image folder;
+// calibrate with --report. A 3-frame rendered room and a random map with its camera, as above.
+TEST_F(Faults, ReplayImportAndCalibrateOnAFullDiskFailWithOneLineAndLeaveNothing) {
+  const fs::path photos = "/usr/share/doc/opencv-doc/examples/data";
+  ARVIEW_REQUIRE_DATA_PATH(photos / "left01.jpg", "Debian package opencv-doc");
+  const fs::path room = dir_ / "room";
+  const auto rendered = RunArview({"synth", "room", "--out", room.string(), "--frames", "3", "--size", "160x120", "--quiet"});
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+  const fs::path map = RandomMap(calib::LoadCamera(room / "camera.yaml"));
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const std::string chessboards = (photos / "left0[1-6].jpg").string();
+  struct Writer {
+    std::string name;
+    std::vector<std::string> args;
+  };
+  const std::vector<Writer> writers = {
+      {"replay into a video", {"replay", room.string(), "--map", map.string(), "--out", (out / "v.mp4").string(),
+                               "--trajectory", (out / "t.txt").string(), "--stats", (out / "s.json").string()}},
+      {"replay into a PNG folder", {"replay", room.string(), "--map", map.string(), "--out", (out / "frames").string()}},
+      {"replay --stats", {"replay", room.string(), "--map", map.string(), "--out", "null", "--stats",
+                          (out / "s.json").string()}},
+      {"import images", {"import", "images", (room / "frames").string(), "--camera", (room / "camera.yaml").string(),
+                         "--out", (out / "imported").string()}},
+      {"calibrate", {"calibrate", "--images", chessboards, "--out", (out / "camera.yaml").string(), "--report",
+                     (out / "report.png").string()}},
+  };
+  for (const auto& w : writers) {
+    // Each must work with room to write: the failure below is the full disk's.
+    const auto ok = RunArview(w.args);
+    ASSERT_EQ(ok.exit_code, 0) << w.name << ": " << ok.err;
+    ASSERT_FALSE(FilesIn(out).empty()) << w.name << " wrote nothing";
+    fs::remove_all(out);
+    fs::create_directories(out);
+    const auto r = RunOnFullDisk(w.args);
+    EXPECT_NE(r.exit_code, 0) << w.name << ": " << r.err;
+    const auto [error, count] = ErrorLines(r.err);
+    EXPECT_EQ(count, 1u) << w.name << ": " << r.err;
+    EXPECT_EQ(error.rfind("arview: " + out.string(), 0), 0u) << w.name << ": " << r.err;
+    EXPECT_NE(error.find("File too large"), std::string::npos) << w.name << ": " << r.err;
+    const auto left = FilesIn(out);
+    EXPECT_TRUE(left.empty()) << w.name << " left " << left.front();
+    fs::remove_all(out);
+    fs::create_directories(out);
+  }
 }
 
 // The same writers into a folder that cannot be written: a read-only tmpfs (permission bits do
