@@ -6,6 +6,7 @@
 //   BM_FoxUpdate/<method>        AnimatedCharacter::Update on the Fox with 8 look-at keys
 //   BM_ScheduleUpdate/<dib>      Animator::Update, BCN_Epileptic (54 joints), a four-action schedule
 //   BM_ScheduleUpdateGesture/<dib>  the same with the gesture a generated point gesture (IK)
+//   BM_FourActionSchedule3600    BM_ScheduleUpdateGesture/dib:0, exactly 3600 updates (callgrind)
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
@@ -218,6 +219,11 @@ void BM_ScheduleUpdate(benchmark::State& state) { ScheduleUpdate(state, testing:
 void BM_ScheduleUpdateGesture(benchmark::State& state) { ScheduleUpdate(state, testing::FourActionSchedule::Gesture::kPoint); }
 BENCHMARK(BM_ScheduleUpdate)->Arg(0)->Arg(1)->ArgName("dib");
 BENCHMARK(BM_ScheduleUpdateGesture)->Arg(0)->Arg(1)->ArgName("dib");
+// BM_ScheduleUpdateGesture/dib:0 for exactly 3600 updates (60 s at 60 Hz) in one run: the same
+// stretch of the stream every time, so that instruction counts repeat (a timed run's iteration
+// count, hence which segments the idle synthesizer draws and checks, depends on the timing):
+//   valgrind --tool=callgrind --toggle-collect='arview::anim::Animator::Update*' bench_anim --benchmark_filter=BM_FourActionSchedule3600
+BENCHMARK(BM_ScheduleUpdateGesture)->Name("BM_FourActionSchedule3600")->Arg(0)->ArgName("dib")->Iterations(3600);
 
 }  // namespace
 }  // namespace arview::anim

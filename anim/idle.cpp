@@ -66,9 +66,16 @@ IdleSynthesizer::IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::
   walks_.resize(model_->component_count());
   coefficients_ = Eigen::VectorXd::Zero(model_->component_count());
   posture_ = model_->mean;
+  const int joints = static_cast<int>(model_->joints.size()), m = model_->component_count();
+  joint_reach_.resize(m, joints);
+  for (int k = 0; k < joints; ++k)
+    for (int i = 0; i < m; ++i) joint_reach_(i, k) = model_->components.block<3, 1>(3 * k, i).norm();
+  component_reach_ = joint_reach_.rowwise().maxCoeff();
   check_coefficients_ = coefficients_;
   check_posture_ = posture_;
-  for (auto& r : check_rotations_) r.resize(model_->joints.size());
+  chord_change_ = coefficients_;
+  for (auto& c : grid_coefficients_) c = coefficients_;
+  for (auto& p : grid_postures_) p = posture_;
   Restart();
 }
 
@@ -145,20 +152,47 @@ void IdleSynthesizer::PostureFromWalks(double t, Eigen::VectorXd& posture) {
   posture = posture.cwiseMax(model_->min).cwiseMin(model_->max);
 }
 
-double IdleSynthesizer::FastestJointSpeed(double from, double to, double limit) {
-  const double step = model_->speed_step, half = 0.5 * step;
-  const int joints = static_cast<int>(model_->joints.size());
-  double fastest = 0;
-  // Grid points every half step; chord n joins grid points n and n + 2 (one step apart).
+const Eigen::VectorXd& IdleSynthesizer::GridPosture(int n, double from) {
+  const int slot = n % 3;
+  if (grid_posture_at_[slot] != n) {
+    const double half = 0.5 * model_->speed_step;
+    PostureFromWalks(from - half + n * half, check_posture_);
+    grid_postures_[slot] = check_posture_;
+    grid_posture_at_[slot] = n;
+  }
+  return grid_postures_[slot];
+}
+
+// Chords every half step, each one step long; chord n joins grid points n − 2 and n. A joint's
+// rotation over a chord turns by at most the length of the change of its rotation vector (the
+// exponential map shortens distances: its differential has norm ≤ 1), clamping each value
+// into its range only shortens that change, and the change of joint k's three rows is
+// Σ_i C_k,i Δc_i, of length ≤ Σ_i |C_k,i| |Δc_i| (|C_k,i|: joint_reach_). So a chord whose
+// bound, over all joints (component_reach_) or then per joint, stays a margin below the
+// limit's angle passes without reconstructing the posture; only the joints whose bound
+// reaches the limit are measured, as before: the two clamped postures rebuilt, the joint's
+// rotations by the exponential map and their angular distance. The margin (1e-9 rad) is far
+// above the rounding of either computation (~1e-14 rad), so every chord is decided as by
+// measuring every joint: the stream is the same bit for bit.
+bool IdleSynthesizer::WithinDataSpeed(double from, double to) {
+  const double limit = model_->speed_limit, step = model_->speed_step, half = 0.5 * step;
+  const double bound = limit * step - 1e-9;
+  const int joints = static_cast<int>(model_->joints.size()), m = model_->component_count();
+  for (int& at : grid_posture_at_) at = -1;
   for (int n = 0;; ++n) {
     const double t = from - half + n * half;
-    PostureFromWalks(t, check_posture_);
-    std::vector<Eigen::Quaterniond>& now = check_rotations_[n % 3];
-    for (int k = 0; k < joints; ++k) now[k] = ExpMap(check_posture_.segment<3>(3 * k));
+    Eigen::VectorXd& c = grid_coefficients_[n % 3];
+    for (int i = 0; i < m; ++i) c[i] = Value(walks_[i], t);
     if (n >= 2) {
-      const std::vector<Eigen::Quaterniond>& before = check_rotations_[(n - 2) % 3];
-      for (int k = 0; k < joints; ++k) fastest = std::max(fastest, before[k].angularDistance(now[k]) / step);
-      if (fastest > limit || t >= to + half) return fastest;
+      chord_change_ = (c - grid_coefficients_[(n - 2) % 3]).cwiseAbs();
+      if (component_reach_.dot(chord_change_) > bound)
+        for (int k = 0; k < joints; ++k) {
+          if (joint_reach_.col(k).dot(chord_change_) <= bound) continue;
+          const Eigen::VectorXd& before = GridPosture(n - 2, from);
+          const Eigen::VectorXd& now = GridPosture(n, from);
+          if (ExpMap(before.segment<3>(3 * k)).angularDistance(ExpMap(now.segment<3>(3 * k))) / step > limit) return false;
+        }
+      if (t >= to + half) return true;
     }
   }
 }
@@ -172,7 +206,7 @@ void IdleSynthesizer::KeepWithinDataSpeed(int i) {
   const double duration = w.t1 - w.t0;
   for (double stretch = 1;; stretch *= kFactor) {
     w.t1 = w.t0 + duration * stretch;
-    if (stretch * kFactor > kMaxStretch || FastestJointSpeed(w.t0, w.t1, model_->speed_limit) <= model_->speed_limit) return;
+    if (stretch * kFactor > kMaxStretch || WithinDataSpeed(w.t0, w.t1)) return;
   }
 }
 

@@ -106,10 +106,14 @@ class IdleSynthesizer : public Blendable {
   void Advance(double t);
   void Step(int component, bool limit_speed);
   void KeepWithinDataSpeed(int component);
-  // The fastest joint's angular speed (rad/s) over chords of one speed_step starting every half
-  // step from `from` − half a step to `to` − half a step, at the walks' current segments; stops
-  // at the first chord above `limit`.
-  double FastestJointSpeed(double from, double to, double limit);
+  // Whether every joint's angular speed (rad/s) over chords of one speed_step starting every half
+  // step from `from` − half a step to `to` − half a step, at the walks' current segments, is at
+  // most the model's speed_limit (the posture reconstructed, clamped and each joint's angle
+  // change measured as rendered; see WithinDataSpeed in idle.cpp for how it is kept cheap).
+  bool WithinDataSpeed(double from, double to);
+  // The clamped posture at grid point n of the current check (time `from` − half a step + n half
+  // steps), computed once per grid point.
+  const Eigen::VectorXd& GridPosture(int n, double from);
   void PostureFromWalks(double t, Eigen::VectorXd& posture);
 
   std::shared_ptr<const Skeleton> skeleton_;
@@ -117,9 +121,16 @@ class IdleSynthesizer : public Blendable {
   std::uint64_t seed_;
   std::vector<Walk> walks_;
   Eigen::VectorXd coefficients_, posture_;
+  // The speed check's bounds, from the model: per joint and component the norm of the
+  // component's 3-row block of that joint's rotation, and per component the largest of them.
+  Eigen::MatrixXd joint_reach_;      // components × joints
+  Eigen::VectorXd component_reach_;  // components
   // Scratch for the speed check (sized once: no allocation per frame).
   Eigen::VectorXd check_coefficients_, check_posture_;
-  std::vector<Eigen::Quaterniond> check_rotations_[3];  // per joint, the last three grid points
+  Eigen::VectorXd grid_coefficients_[3];  // the component values at the last three grid points
+  Eigen::VectorXd chord_change_;          // their change over the chord, absolute values
+  Eigen::VectorXd grid_postures_[3];      // clamped postures at grid points grid_posture_at_
+  int grid_posture_at_[3] = {-1, -1, -1};
 };
 
 }  // namespace arview::anim
