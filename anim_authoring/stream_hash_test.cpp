@@ -8,6 +8,7 @@
 //   anim_authoring_tests --gtest_filter='StreamHash.*' | grep '\[hash\]'   (before and after)
 
 #include "anim_authoring/idle_learning.h"
+#include "base/hash.h"
 #include "anim_authoring/import.h"
 #include "tests/support/four_action_schedule.h"
 #include "tests/support/test_data.h"
@@ -20,14 +21,6 @@
 namespace arview::anim {
 namespace {
 
-struct Fnv1a {
-  std::uint64_t h = 1469598103934665603ull;
-  void Add(const void* data, std::size_t n) {
-    const unsigned char* b = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
-  }
-};
-
 std::uint64_t PostureHash(const std::shared_ptr<const Skeleton>& skeleton, const std::shared_ptr<const IdleModel>& model,
                           std::uint64_t seed) {
   IdleSynthesizer idle(skeleton, model, seed);
@@ -36,7 +29,7 @@ std::uint64_t PostureHash(const std::shared_ptr<const Skeleton>& skeleton, const
     const Eigen::VectorXd& p = idle.Posture(f / 30.0);
     h.Add(p.data(), sizeof(double) * p.size());
   }
-  return h.h;
+  return h.hash;
 }
 
 TEST(StreamHash, IdleStreamsAndFourActionSchedule) {
@@ -63,9 +56,9 @@ TEST(StreamHash, IdleStreamsAndFourActionSchedule) {
   for (int f = 0; f < 600 * 60; ++f)
     for (const Eigen::Matrix4f& m : schedule.Step(1.0 / 60).skinning_matrices) matrices.Add(m.data(), sizeof(float) * 16);
   std::printf("[hash] four-action schedule (point gesture, DLB), 10 min of skinning matrices: %016llx\n",
-              static_cast<unsigned long long>(matrices.h));
-  all.Add(&matrices.h, sizeof matrices.h);
-  std::printf("[hash] all: %016llx\n", static_cast<unsigned long long>(all.h));
+              static_cast<unsigned long long>(matrices.hash));
+  all.Add(&matrices.hash, sizeof matrices.hash);
+  std::printf("[hash] all: %016llx\n", static_cast<unsigned long long>(all.hash));
 
   // They repeat: a new synthesizer with the same seed gives the same stream.
   EXPECT_EQ(PostureHash(fox_skeleton, fox_model, 7), PostureHash(fox_skeleton, fox_model, 7));

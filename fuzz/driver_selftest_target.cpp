@@ -17,14 +17,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "base/hash.h"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string mode = [] {
     const char* m = std::getenv("ARVIEW_FUZZ_SELFTEST");
     return std::string(m ? m : "");
   }();
   if (mode == "log") {
-    std::uint64_t hash = 1469598103934665603ull;
-    for (std::size_t i = 0; i < size; ++i) hash = (hash ^ data[i]) * 1099511628211ull;
+    const std::uint64_t hash = arview::Fnv1aOf(data, size);
     static FILE* log = std::fopen(std::getenv("ARVIEW_FUZZ_SELFTEST_LOG"), "w");
     std::fprintf(log, "%016llx %zu\n", static_cast<unsigned long long>(hash), size);
     std::fflush(log);

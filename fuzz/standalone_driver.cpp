@@ -48,6 +48,8 @@
 #include <thread>
 #include <vector>
 
+#include "base/hash.h"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 extern "C" __attribute__((weak)) int LLVMFuzzerInitialize(int* argc, char*** argv);
 // Present when the program is built with a sanitizer (the asan preset): called after its
@@ -113,12 +115,6 @@ void AppendNumber(char* out, size_t capacity, std::uint64_t value, int base) {
   Append(out, capacity, text);
 }
 
-std::uint64_t Fnv1a(const std::uint8_t* data, size_t size) {
-  std::uint64_t hash = 1469598103934665603ull;
-  for (size_t i = 0; i < size; ++i) hash = (hash ^ data[i]) * 1099511628211ull;
-  return hash;
-}
-
 // Writes the input being run to <artifacts>/<kind>-<hash> and says so on stderr, once.
 void SaveCurrentInput(const char* kind, const char* why) {
   if (g_reported.exchange(true)) return;
@@ -129,7 +125,7 @@ void SaveCurrentInput(const char* kind, const char* why) {
   Append(path, sizeof path, "/");
   Append(path, sizeof path, kind);
   Append(path, sizeof path, "-");
-  AppendNumber(path, sizeof path, data ? Fnv1a(data, size) : 0, 16);
+  AppendNumber(path, sizeof path, data ? arview::Fnv1aOf(data, size) : 0, 16);
   const int fd = ::open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
   bool saved = fd >= 0;
   for (size_t done = 0; saved && done < size;) {

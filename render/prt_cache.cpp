@@ -11,6 +11,7 @@
 
 #include "base/atomic_file.h"
 #include "base/error.h"
+#include "base/hash.h"
 #include "base/input_guard.h"
 
 namespace arview::render {
@@ -23,19 +24,6 @@ constexpr std::string_view kMagic = "ARVPRT1\n";
 constexpr std::uint64_t kTransferVersion = 1;
 // Far above any character's transfer (25k vertices: 0.9 MB), far below a harmful allocation.
 constexpr std::uintmax_t kMaxCacheFileBytes = 512ull << 20;
-
-struct Fnv1a {
-  std::uint64_t hash = 1469598103934665603ull;
-  void Add(const void* data, std::size_t size) {
-    const auto* bytes = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) {
-      hash ^= bytes[i];
-      hash *= 1099511628211ull;
-    }
-  }
-  template <typename T>
-  void AddValue(const T& value) { Add(&value, sizeof(T)); }
-};
 
 template <typename T>
 void Append(std::string& out, const T& value) {
