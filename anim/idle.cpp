@@ -71,8 +71,6 @@ IdleSynthesizer::IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::
   for (int k = 0; k < joints; ++k)
     for (int i = 0; i < m; ++i) joint_reach_(i, k) = model_->components.block<3, 1>(3 * k, i).norm();
   component_reach_ = joint_reach_.rowwise().maxCoeff();
-  check_coefficients_ = coefficients_;
-  check_posture_ = posture_;
   chord_change_ = coefficients_;
   for (auto& c : grid_coefficients_) c = coefficients_;
   for (auto& p : grid_postures_) p = posture_;
@@ -145,19 +143,16 @@ double IdleSynthesizer::Value(const Walk& w, double t) {
   return w.v0 + (w.v1 - w.v0) * SegmentShape(w.shape, std::clamp(x, 0.0, 1.0));
 }
 
-void IdleSynthesizer::PostureFromWalks(double t, Eigen::VectorXd& posture) {
-  for (int i = 0; i < model_->component_count(); ++i) check_coefficients_[i] = Value(walks_[i], t);
-  posture.noalias() = model_->components * check_coefficients_;
+void IdleSynthesizer::ClampedPosture(const Eigen::VectorXd& coefficients, Eigen::VectorXd& posture) const {
+  posture.noalias() = model_->components * coefficients;
   posture += model_->mean;
   posture = posture.cwiseMax(model_->min).cwiseMin(model_->max);
 }
 
-const Eigen::VectorXd& IdleSynthesizer::GridPosture(int n, double from) {
+const Eigen::VectorXd& IdleSynthesizer::GridPosture(int n) {
   const int slot = n % 3;
   if (grid_posture_at_[slot] != n) {
-    const double half = 0.5 * model_->speed_step;
-    PostureFromWalks(from - half + n * half, check_posture_);
-    grid_postures_[slot] = check_posture_;
+    ClampedPosture(grid_coefficients_[slot], grid_postures_[slot]);
     grid_posture_at_[slot] = n;
   }
   return grid_postures_[slot];
@@ -188,8 +183,8 @@ bool IdleSynthesizer::WithinDataSpeed(double from, double to) {
       if (component_reach_.dot(chord_change_) > bound)
         for (int k = 0; k < joints; ++k) {
           if (joint_reach_.col(k).dot(chord_change_) <= bound) continue;
-          const Eigen::VectorXd& before = GridPosture(n - 2, from);
-          const Eigen::VectorXd& now = GridPosture(n, from);
+          const Eigen::VectorXd& before = GridPosture(n - 2);
+          const Eigen::VectorXd& now = GridPosture(n);
           if (ExpMap(before.segment<3>(3 * k)).angularDistance(ExpMap(now.segment<3>(3 * k))) / step > limit) return false;
         }
       if (t >= to + half) return true;
@@ -236,10 +231,7 @@ const Eigen::VectorXd& IdleSynthesizer::Coefficients(double t) {
 }
 
 const Eigen::VectorXd& IdleSynthesizer::Posture(double t) {
-  const Eigen::VectorXd& c = Coefficients(t);
-  posture_.noalias() = model_->components * c;
-  posture_ += model_->mean;
-  posture_ = posture_.cwiseMax(model_->min).cwiseMin(model_->max);
+  ClampedPosture(Coefficients(t), posture_);
   return posture_;
 }
 

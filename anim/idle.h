@@ -111,10 +111,11 @@ class IdleSynthesizer : public Blendable {
   // most the model's speed_limit (the posture reconstructed, clamped and each joint's angle
   // change measured as rendered; see WithinDataSpeed in idle.cpp for how it is kept cheap).
   bool WithinDataSpeed(double from, double to);
-  // The clamped posture at grid point n of the current check (time `from` − half a step + n half
-  // steps), computed once per grid point.
-  const Eigen::VectorXd& GridPosture(int n, double from);
-  void PostureFromWalks(double t, Eigen::VectorXd& posture);
+  // The clamped posture at grid point n of the current check (from grid_coefficients_, which
+  // hold the last three grid points' values), computed once per grid point.
+  const Eigen::VectorXd& GridPosture(int n);
+  // mean + components · coefficients, each value clamped to the training data's range.
+  void ClampedPosture(const Eigen::VectorXd& coefficients, Eigen::VectorXd& posture) const;
 
   std::shared_ptr<const Skeleton> skeleton_;
   std::shared_ptr<const IdleModel> model_;
@@ -126,7 +127,6 @@ class IdleSynthesizer : public Blendable {
   Eigen::MatrixXd joint_reach_;      // components × joints
   Eigen::VectorXd component_reach_;  // components
   // Scratch for the speed check (sized once: no allocation per frame).
-  Eigen::VectorXd check_coefficients_, check_posture_;
   Eigen::VectorXd grid_coefficients_[3];  // the component values at the last three grid points
   Eigen::VectorXd chord_change_;          // their change over the chord, absolute values
   Eigen::VectorXd grid_postures_[3];      // clamped postures at grid points grid_posture_at_
