@@ -43,6 +43,15 @@ class Faults : public ::testing::Test {
 
   void WriteText(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
 
+  // A 3-frame rendered room at 160x120, and RandomMap with its camera (every frame is
+  // relocalized against it and fails: the commands still write their outputs).
+  void RenderTinyRoomAndRandomMap(fs::path* room, fs::path* map) {
+    *room = dir_ / "room";
+    const auto rendered = RunArview({"synth", "room", "--out", room->string(), "--frames", "3", "--size", "160x120", "--quiet"});
+    ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+    *map = RandomMap(calib::LoadCamera(*room / "camera.yaml"));
+  }
+
   // A TUM trajectory of `n` poses 1/30 s apart; `moving` spreads the centres over a circle.
   std::string Trajectory(int n, bool moving) {
     std::string text;
@@ -205,10 +214,9 @@ TEST_F(Faults, EveryWriterOnAFullDiskFailsWithOneLineAndLeavesNothing) {
 // with its camera (every frame is relocalized and fails; the trajectory file is still written).
 TEST_F(Faults, TrackOnAFullDiskFailsAndLeavesNoTrajectoryOrStats) {
   ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
-  const fs::path room = dir_ / "room";
-  const auto rendered = RunArview({"synth", "room", "--out", room.string(), "--frames", "3", "--size", "160x120", "--quiet"});
-  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
-  const fs::path map = RandomMap(calib::LoadCamera(room / "camera.yaml"));
+  fs::path room, map;
+  RenderTinyRoomAndRandomMap(&room, &map);
+  if (HasFatalFailure()) return;
   const fs::path out = dir_ / "out";
   fs::create_directories(out);
   const std::vector<std::string> args = {"track", room.string(), "--map", map.string(), "--out",
@@ -248,10 +256,9 @@ std::pair<std::string, size_t> ErrorLines(const std::string& err) {
 TEST_F(Faults, ReplayImportAndCalibrateOnAFullDiskFailWithOneLineAndLeaveNothing) {
   const fs::path photos = "/usr/share/doc/opencv-doc/examples/data";
   ARVIEW_REQUIRE_DATA_PATH(photos / "left01.jpg", "Debian package opencv-doc");
-  const fs::path room = dir_ / "room";
-  const auto rendered = RunArview({"synth", "room", "--out", room.string(), "--frames", "3", "--size", "160x120", "--quiet"});
-  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
-  const fs::path map = RandomMap(calib::LoadCamera(room / "camera.yaml"));
+  fs::path room, map;
+  RenderTinyRoomAndRandomMap(&room, &map);
+  if (HasFatalFailure()) return;
   const fs::path out = dir_ / "out";
   fs::create_directories(out);
   const std::string chessboards = (photos / "left0[1-6].jpg").string();
