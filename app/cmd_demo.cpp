@@ -19,6 +19,7 @@
 #include "anim_authoring/scene.h"
 #include "app/character_bounds.h"
 #include "app/commands.h"
+#include "app/numeric_flags.h"
 #include "app/demo_figures.h"
 #include "base/atomic_file.h"
 #include "app/pipeline_report.h"
@@ -216,7 +217,8 @@ void AddDemoCommand(CLI::App& app) {
   cmd->add_option("--size", a->size,
                   "Frame size WxH of the walk (the room is rendered, mapped and replayed at it; field of view kept), "
                   "e.g. 1280x720; use a --work folder of its own per size, or the walk and map are made again")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FrameSizeCheck({160, 120}, {3840, 2160}));
   cmd->add_option("--aa", a->aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
       ->capture_default_str()
       ->check(CLI::IsMember({"msaa", "none"}));
@@ -229,11 +231,9 @@ void AddDemoCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->callback([a] {
-    char tail = 0;
-    if (std::sscanf(a->size.c_str(), "%dx%d%c", &a->frame_width, &a->frame_height, &tail) != 2 || a->frame_width < 160 ||
-        a->frame_height < 120 || a->frame_width > 3840 || a->frame_height > 2160) {
-      throw CommandError("--size must be WxH between 160x120 and 3840x2160, e.g. 1280x720 (got '" + a->size + "')", 2);
-    }
+    const cv::Size size = *ParseFrameSize(a->size);  // checked by --size's validator
+    a->frame_width = size.width;
+    a->frame_height = size.height;
     const fs::path work = a->work;
     fs::create_directories(work);
     const fs::path out = a->out.empty() ? work / "demo.mp4" : fs::path(a->out);

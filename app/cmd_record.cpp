@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <iostream>
 #include <optional>
-#include <regex>
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/numeric_flags.h"
 #include "base/cancellation.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
@@ -26,17 +26,8 @@ struct RecordArgs {
   bool force = false;
 };
 
-cv::Size ParseSize(const std::string& text) {
-  static const std::regex pattern("([0-9]{1,5})x([0-9]{1,5})");
-  std::smatch m;
-  if (!std::regex_match(text, m, pattern) || std::stoi(m[1]) == 0 || std::stoi(m[2]) == 0) {
-    throw CommandError("--size '" + text + "' is not WIDTHxHEIGHT (e.g. 640x480)", 2);
-  }
-  return {std::stoi(m[1]), std::stoi(m[2])};
-}
-
 void RunRecord(const RecordArgs& args) {
-  const cv::Size size = ParseSize(args.size);
+  const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
   std::optional<calib::Camera> camera;
   if (!args.camera.empty()) {
     try {
@@ -114,7 +105,8 @@ void AddRecordCommand(CLI::App& app) {
   cmd->add_option("--device", args->device, "V4L2 capture device")->capture_default_str();
   cmd->add_option("--out", args->out, "Recording folder to create")->required();
   cmd->add_option("--size", args->size, "Requested frame size WIDTHxHEIGHT (the driver may choose the nearest)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FrameSizeCheck({16, 16}, {7680, 4320}));
   cmd->add_option("--seconds", args->seconds, "Stop after this many seconds (0: until Ctrl-C)")
       ->check(CLI::Range(0.0, 1e7))
       ->capture_default_str();

@@ -1,11 +1,11 @@
 // arview synth room --out <recording> [--frames N] [--seed S] [--motion-blur N] [--noise sigma] ...
 
 #include <chrono>
-#include <cstdio>
 #include <iostream>
 #include <map>
 
 #include "app/commands.h"
+#include "app/numeric_flags.h"
 #include "render/synth_room.h"
 
 namespace arview::app {
@@ -25,9 +25,9 @@ void RunSynthRoom(SynthArgs& args) {
   render::SynthRoomOptions& o = args.options;
   o.out = args.out;
   o.data_dir = args.data_dir;
-  char tail = 0;
-  if (std::sscanf(args.size.c_str(), "%dx%d%c", &o.width, &o.height, &tail) != 2)
-    throw CommandError("--size must be WxH, e.g. 1920x1080 (got '" + args.size + "')", 2);
+  const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
+  o.width = size.width;
+  o.height = size.height;
   const auto start = std::chrono::steady_clock::now();
   try {
     o.gl.backend = render::ParseGlBackend(args.backend);
@@ -62,7 +62,8 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--noise", o.noise_sigma, "Gaussian sensor noise, standard deviation in grey levels (0 = off)")
       ->default_val(o.noise_sigma);
   room->add_option("--size", args->size, "Frame size WxH, e.g. 1280x720 or 1920x1080 (field of view kept)")
-      ->default_val(args->size);
+      ->default_val(args->size)
+      ->check(FrameSizeCheck({64, 48}, {7680, 4320}));
   room->add_option("--jpeg", o.jpeg_quality, "Write frames as JPEG at this quality, 1..100 (0 = PNG)")
       ->default_val(o.jpeg_quality)
       ->check(CLI::Range(0, 100));

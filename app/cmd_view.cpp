@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/commands.h"
+#include "app/numeric_flags.h"
 #include "base/atomic_file.h"
 #include "app/pipeline_report.h"
 #include "app/stage_stats.h"
@@ -34,15 +35,6 @@ struct ViewArgs {
   bool no_hud = false, no_help = false, json = false;
 };
 
-cv::Size ParseSize(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 64 || h < 64 ||
-      w > 7680 || h > 4320) {
-    throw CommandError("--size: '" + text + "' must be WIDTHxHEIGHT between 64x64 and 7680x4320, e.g. 1280x720");
-  }
-  return {w, h};
-}
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
@@ -84,7 +76,7 @@ void WriteStats(const ViewArgs& a, const nlohmann::ordered_json& stats) {
 
 ViewOptions Options(const ViewArgs& a) {
   ViewOptions o;
-  o.size = ParseSize(a.size);
+  o.size = *ParseFrameSize(a.size);  // checked by --size's validator
   o.fov_deg = a.fov;
   o.character = a.character;
   o.hud = !a.no_hud;
@@ -191,7 +183,9 @@ void AddViewCommand(CLI::App& app) {
       "view", "VR mode: a mouse-driven camera drives the animation; add, remove and save key viewpoints");
   cmd->add_option("--scene", a->scene, "Scene file (YAML, see docs/anim.md)")->required();
   cmd->add_option("--character", a->character, "Character whose keys are authored (default: the first)");
-  cmd->add_option("--size", a->size, "Window or video size")->capture_default_str();
+  cmd->add_option("--size", a->size, "Window or video size")
+      ->capture_default_str()
+      ->check(FrameSizeCheck({64, 64}, {7680, 4320}));
   cmd->add_option("--fov", a->fov, "Vertical field of view, degrees")->capture_default_str()->check(CLI::Range(10.0, 120.0));
   cmd->add_option("--orbit", a->orbit, "Render a scripted orbit without a window, e.g. azimuth=0..360,elevation=15,seconds=8 (needs --out)");
   cmd->add_option("--out", a->out, "With --orbit: a video file (.mp4, .avi, .mkv) or a PNG folder");

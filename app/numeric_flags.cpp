@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 
 namespace arview::app {
 
@@ -38,5 +39,37 @@ void Guard(CLI::App& app) {
 }  // namespace
 
 void GuardNumericOptions(CLI::App& app) { Guard(app); }
+
+std::optional<cv::Size> ParseFrameSize(const std::string& text) {
+  const size_t x = text.find_first_of("xX");
+  if (x == std::string::npos) return std::nullopt;
+  auto dimension = [](std::string_view digits) -> std::optional<int> {
+    if (digits.empty() || digits.size() > 5) return std::nullopt;
+    int value = 0;
+    for (const char c : digits) {
+      if (c < '0' || c > '9') return std::nullopt;
+      value = 10 * value + (c - '0');
+    }
+    return value;
+  };
+  const std::optional<int> width = dimension(std::string_view(text).substr(0, x));
+  const std::optional<int> height = dimension(std::string_view(text).substr(x + 1));
+  if (!width || !height) return std::nullopt;
+  return cv::Size(*width, *height);
+}
+
+CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest) {
+  const std::string range = std::to_string(smallest.width) + "x" + std::to_string(smallest.height) + " and " +
+                            std::to_string(largest.width) + "x" + std::to_string(largest.height);
+  auto check = [smallest, largest, range](std::string& text) -> std::string {
+    const std::optional<cv::Size> size = ParseFrameSize(text);
+    if (!size || size->width < smallest.width || size->height < smallest.height || size->width > largest.width ||
+        size->height > largest.height) {
+      return "'" + text + "' must be WIDTHxHEIGHT between " + range + ", e.g. 1280x720";
+    }
+    return "";
+  };
+  return CLI::Validator(check, "WIDTHxHEIGHT");
+}
 
 }  // namespace arview::app

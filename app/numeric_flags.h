@@ -4,6 +4,10 @@
 // negative value (--seed -1 became 18446744073709551615).
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core/types.hpp>
+
+#include <optional>
+#include <string>
 
 namespace arview::app {
 
@@ -11,5 +15,13 @@ namespace arview::app {
 // a finite number of at most 1e12 in magnitude, and to every unsigned one a check that it is
 // not negative. Call once, after every command is registered.
 void GuardNumericOptions(CLI::App& app);
+
+// A frame size written WIDTHxHEIGHT (digits only, `x` or `X`), as every command's --size takes
+// it; nullopt for anything else (signs, spaces, a trailing character, more than 5 digits).
+std::optional<cv::Size> ParseFrameSize(const std::string& text);
+
+// The --size check of a command: WIDTHxHEIGHT within [smallest, largest] in both dimensions.
+// CLI11 reports its message as "--size: ..." with the usage exit status.
+CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest);
 
 }  // namespace arview::app

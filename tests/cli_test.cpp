@@ -108,6 +108,9 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
       {{"demo", "--frames", "5"}, "--frames"},
       {{"demo", "--size", "12x9"}, "--size"},
       {{"demo", "--size", "1280x720x"}, "--size"},
+      {{"synth", "room", "--out", tmp + "/arview_cli_room", "--size", "1920x"}, "--size"},
+      {{"view", "--size", "32x32"}, "--size"},
+      {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--size", "-640x480"}, "--size"},
       {{"demo", "--aa", "fxaa"}, "--aa"},
       {{"replay", "/nonexistent/recording", "--map", "/nonexistent/map", "--aa", "fxaa"}, "--aa"},
   };
