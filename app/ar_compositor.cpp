@@ -4,7 +4,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cstdio>
-#include <iostream>
 
 #include "app/character_bounds.h"
 #include "app/view_hud.h"
@@ -29,8 +28,8 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
     char line[96];
     std::snprintf(line, sizeof line, "PRT transfer: %s in %.2f s", renderer_->prt_from_cache() > 0 ? "read from its cache" : "computed",
                   renderer_->prt_seconds());
-    std::cerr << "note: " << line << "\n";
-    if (!renderer_->prt_cache_note().empty()) std::cerr << "note: " << renderer_->prt_cache_note() << "\n";
+    load_notes_.push_back(line);
+    if (!renderer_->prt_cache_note().empty()) load_notes_.push_back(renderer_->prt_cache_note());
   }
   description_ = context_->Description();
 }

@@ -34,6 +34,9 @@ class ArCompositor : public FrameCompositor {
   cv::Mat Compose(const FrameToCompose& input) override;
   // The GL context's description.
   std::string Description() const { return description_; }
+  // What loading the characters is worth telling the user (the PRT transfer's time and its
+  // cache), for the command to print as `note:` lines.
+  const std::vector<std::string>& LoadNotes() const { return load_notes_; }
   cv::Size OutputSize() const;
 
  private:
@@ -51,6 +54,7 @@ class ArCompositor : public FrameCompositor {
   std::vector<anim::FrameOutput> outputs_;
   std::vector<const anim::FrameOutput*> output_ptrs_;
   std::string description_;
+  std::vector<std::string> load_notes_;
   std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
   void DrawHud(cv::Mat& frame, const FrameToCompose& input) const;
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <memory>
+#include <iostream>
 
 #include "base/atomic_file.h"
 #include "app/pipeline_report.h"
@@ -49,6 +50,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   }
 
   ArCompositor compositor(map.camera, character_ptrs, o.compositor);
+  for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
   std::unique_ptr<render::FrameSink> sink = render::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
 
   Progress progress("augmenting frames");
