@@ -64,6 +64,9 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--size", args->size, "Frame size WxH, e.g. 1280x720 or 1920x1080 (field of view kept)")
       ->default_val(args->size)
       ->check(FrameSizeCheck({64, 48}, {7680, 4320}));
+  room->add_option("--subset", o.frames_subset,
+                   "Render only these frames of the --frames-long walk, e.g. 0-649:8,650-949 (a sparse lap to map, a "
+                   "dense stretch to track); each exactly as in the whole recording");
   room->add_option("--jpeg", o.jpeg_quality, "Write frames as JPEG at this quality, 1..100 (0 = PNG)")
       ->default_val(o.jpeg_quality)
       ->check(CLI::Range(0, 100));

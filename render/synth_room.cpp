@@ -292,6 +292,20 @@ void ValidateOptions(const SynthRoomOptions& o) {
     fail("--rolling-shutter must be in [0, 1/fps] seconds");
 }
 
+// The walk's frames to render, in order: every one, or the --subset's.
+std::vector<int> FramesToRender(const SynthRoomOptions& o) {
+  if (o.frames_subset.empty()) {
+    std::vector<int> every(o.frames);
+    for (int i = 0; i < o.frames; ++i) every[i] = i;
+    return every;
+  }
+  try {
+    return recordings::ParseFrameSpec(o.frames_subset, o.frames);
+  } catch (const Error& e) {
+    throw RenderError(std::string("synth room: --subset: ") + e.what());
+  }
+}
+
 void PrepareFolder(const SynthRoomOptions& o) {
   std::error_code ec;
   if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) {
@@ -357,6 +371,7 @@ void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
 
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
   ValidateOptions(o);
+  const std::vector<int> indices = FramesToRender(o);
   const RoomScene scene = MakeRoomScene(o.data_dir);
   std::unique_ptr<OffscreenContext> context = OffscreenContext::Create(o.gl);
   PrepareFolder(o);
@@ -376,7 +391,8 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
       throw RenderError((o.out / pending_name).string() + ": cannot write the frame");
     }
   };
-  for (int i = 0; i < o.frames; ++i) {
+  for (size_t n = 0; n < indices.size(); ++n) {
+    const int i = indices[n];
     const double t = i / o.fps;
     cv::Mat image = RenderExposure(renderer, path, t, o);
     ApplyGain(image, o.gain_drift, t);
@@ -397,14 +413,14 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
     });
     entries.push_back({t, name});
     groundtruth.push_back({t, path(t)});
-    if (progress) progress(i + 1, o.frames);
+    if (progress) progress(static_cast<int>(n) + 1, static_cast<int>(indices.size()));
   }
   finish_write();
   calib::SaveCamera(camera, o.out / "camera.yaml");
   recordings::WriteFramesTxt(o.out, entries);
   recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
                        "arview synth room, seed " + std::to_string(o.seed) + ", world: metres, z up, floor z = 0");
-  return {context->Description(), o.frames};
+  return {context->Description(), static_cast<int>(indices.size())};
 }
 
 }  // namespace arview::render

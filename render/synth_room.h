@@ -85,6 +85,11 @@ struct SynthRoomOptions {
   // rendered at its own time); 0: global shutter.
   double rolling_shutter_s = 0.0;
   int samples = 4;               // MSAA samples
+  // Only these frames of the `frames`-long walk are rendered and listed (recordings::
+  // ParseFrameSpec syntax, e.g. "0-649:8,650-949"); empty: every frame. The walk, the noise
+  // and every rendered frame are exactly those of the full recording: a subset makes sizes
+  // whose frames take seconds each affordable (a sparse first lap to map, a dense stretch to track).
+  std::string frames_subset;
   bool overwrite = false;        // replace an existing recording in `out`
   std::filesystem::path data_dir = kOpenCvDocData;
   OffscreenOptions gl;

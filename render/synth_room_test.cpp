@@ -200,6 +200,36 @@ TEST(SynthRoom, WritesALoadableDeterministicRecording) {
   EXPECT_NE(Bytes(a.path / "frames/000003.png"), Bytes(c.path / "frames/000003.png"));
 }
 
+// --subset renders some frames of the walk, each exactly as the whole recording has it.
+TEST(SynthRoom, SubsetRendersTheWholeRecordingsFrames) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  TempDir whole, part, bad;
+  SynthRoomOptions options;
+  options.frames = 4;
+  options.seed = 5;
+  options.noise_sigma = 2.0;
+  options.gl = {GlBackend::kAuto, 2};
+  options.out = whole.path;
+  SynthesizeRoom(options);
+  options.out = part.path;
+  options.frames_subset = "1,3";
+  EXPECT_EQ(SynthesizeRoom(options).frames, 2);
+
+  const recordings::Recording all = recordings::LoadRecording(whole.path);
+  const recordings::Recording some = recordings::LoadRecording(part.path);
+  ASSERT_EQ(some.frames.size(), 2u);
+  ASSERT_EQ(some.groundtruth->size(), 2u);
+  EXPECT_DOUBLE_EQ(some.frames[1].timestamp, all.frames[3].timestamp);
+  EXPECT_EQ((*some.groundtruth)[0].pose.Center(), (*all.groundtruth)[1].pose.Center());
+  EXPECT_EQ(Bytes(part.path / "frames/000003.png"), Bytes(whole.path / "frames/000003.png"));
+  EXPECT_FALSE(fs::exists(part.path / "frames/000002.png"));
+
+  options.out = bad.path;
+  options.frames_subset = "2-4";  // frame 4 is past the walk's end
+  EXPECT_THROW(SynthesizeRoom(options), RenderError);
+  EXPECT_FALSE(fs::exists(bad.path / "frames.txt"));
+}
+
 // The realistic-footage flags: a 1280x720 camera with the same field of view, JPEG frames, a
 // gain change and a rolling shutter, each changing the image and none the ground truth.
 TEST(SynthRoom, RealisticFootageFlags) {
