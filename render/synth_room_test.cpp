@@ -169,15 +169,21 @@ TEST(SynthRoom, GroundTruthProjectsPanelCornersOntoTheRenderedTextures) {
   EXPECT_LT(std::abs(sum.y / checked), 0.1);
 }
 
-TEST(SynthRoom, WritesALoadableDeterministicRecording) {
-  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
-  TempDir a, b, c;
+// A short noisy walk: 4 frames, seed 5, sensor noise on.
+SynthRoomOptions FourNoisyFrames(const fs::path& out) {
   SynthRoomOptions options;
   options.frames = 4;
   options.seed = 5;
   options.noise_sigma = 2.0;
   options.gl = {GlBackend::kAuto, 2};
-  options.out = a.path;
+  options.out = out;
+  return options;
+}
+
+TEST(SynthRoom, WritesALoadableDeterministicRecording) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  TempDir a, b, c;
+  SynthRoomOptions options = FourNoisyFrames(a.path);
   SynthesizeRoom(options);
   options.out = b.path;
   SynthesizeRoom(options);
@@ -204,12 +210,7 @@ TEST(SynthRoom, WritesALoadableDeterministicRecording) {
 TEST(SynthRoom, SubsetRendersTheWholeRecordingsFrames) {
   ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
   TempDir whole, part, bad;
-  SynthRoomOptions options;
-  options.frames = 4;
-  options.seed = 5;
-  options.noise_sigma = 2.0;
-  options.gl = {GlBackend::kAuto, 2};
-  options.out = whole.path;
+  SynthRoomOptions options = FourNoisyFrames(whole.path);
   SynthesizeRoom(options);
   options.out = part.path;
   options.frames_subset = "1,3";
