@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <vector>
@@ -168,6 +169,70 @@ void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::str
   if (depth > max_depth) {
     throw InputError(name + ": nested " + std::to_string(depth) + " levels deep (at most " +
                      std::to_string(max_depth) + " allowed)");
+  }
+}
+
+namespace {
+
+// At most 40 bytes of a line, for a message: bytes outside printable ASCII written \xNN.
+std::string Excerpt(std::string_view line) {
+  std::string out;
+  for (const char c : line.substr(0, 40)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f) {
+      out += c;
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", byte);
+      out += hex;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::string& name) {
+  const size_t start = text.find_first_not_of(" \t\r\n");
+  if (start == std::string_view::npos || text.substr(start, 5) != "%YAML") {
+    throw InputError(name + ": is not OpenCV FileStorage YAML (it must begin with %YAML:1.0)");
+  }
+  RequireYamlDepthAtMost(text, max_depth, name);
+  long long rows = -1;
+  int number = 0;
+  for (size_t begin = 0; begin < text.size(); ++number) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view line = text.substr(begin, end - begin);
+    begin = end + 1;
+    auto fail = [&](const std::string& problem) {
+      throw InputError(name + ": line " + std::to_string(number + 1) + ": " + problem);
+    };
+    if (line.substr(0, 3) == "---") {
+      const size_t after = line.find_first_not_of(" \t\r", 3);
+      if (after != std::string_view::npos && !(after > 3 && line[after] == '#')) {
+        fail("'" + Excerpt(line) + "' is not the document marker '---'");
+      }
+      continue;
+    }
+    const size_t key = line.find_first_not_of(' ');
+    if (key == std::string_view::npos) continue;
+    const std::string_view rest = line.substr(key);
+    const bool is_rows = rest.substr(0, 5) == "rows:", is_cols = rest.substr(0, 5) == "cols:";
+    if (!is_rows && !is_cols) continue;
+    std::string_view value = rest.substr(5);
+    value.remove_prefix(std::min(value.size(), value.find_first_not_of(" \t")));
+    value = value.substr(0, value.find_last_not_of(" \t\r") + 1);
+    if (value.empty() || value.size() > 9 || value.find_first_not_of("0123456789") != std::string_view::npos) {
+      fail(std::string(is_rows ? "matrix rows" : "matrix cols") + " '" + Excerpt(value.substr(0, 20)) + "' is not a whole number");
+    }
+    const long long count = std::stoll(std::string(value));
+    if (is_rows) {
+      rows = count;
+    } else if (rows >= 0 && rows * count > static_cast<long long>(text.size())) {
+      fail("a matrix of " + std::to_string(rows) + " x " + std::to_string(count) +
+           " values is larger than the file could hold");
+    }
   }
 }
 

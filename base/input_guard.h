@@ -53,6 +53,16 @@ int YamlNestingDepth(std::string_view text);
 // Throws InputError("<name>: nested deeper than <max> levels") when the text is too deep.
 void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::string& name);
 
+// The checks OpenCV 4.6's FileStorage YAML reader lacks, for a text about to be handed to it
+// (camera files, room light files). Throws InputError("<name>: ...", naming the line) when
+//  - it does not begin with the %YAML header;
+//  - it nests deeper than max_depth levels (the reader recurses);
+//  - a line beginning "---" is not the document marker itself: "----x" after the header, then
+//    two lines of text, sends the reader into an endless loop (found by fuzz_camera);
+//  - a matrix's rows/cols is not a plain number, or rows x cols is more elements than the text
+//    could hold: the reader allocates the matrix before reading its data (51-85 GB once).
+void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::string& name);
+
 // The first key given twice in one block mapping of a YAML text ("key" and its 1-based line),
 // or nothing. Flow mappings ({a: 1, a: 2}) are not looked into: callers whose files use them
 // check duplicates with their parser.

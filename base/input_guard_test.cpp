@@ -106,6 +106,31 @@ TEST(YamlNestingDepth, TheFuzzersDeepFilesAreRefusedQuickly) {
   EXPECT_NO_THROW(RequireYamlDepthAtMost("a:\n  b: [1, 2, {c: 3}]\n", kMaxYamlDepth, "ok.yaml"));
 }
 
+// Found by the 10-minute fuzz_camera campaign: OpenCV 4.6's reader loops forever on a line
+// "----x" after the header followed by two lines of text ("%YAML:1.\n----\xff\n0\n\xf4" as found).
+TEST(RequireOpenCvYamlShape, RefusesWhatOpenCvsReaderHangsOnOrOverAllocates) {
+  const std::string good =
+      "%YAML:1.0\n---\nk: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]\n";
+  EXPECT_NO_THROW(RequireOpenCvYamlShape(good, 8, "ok.yaml"));
+  EXPECT_NO_THROW(RequireOpenCvYamlShape("%YAML:1.0\n--- # a comment\na: 1\n", 8, "ok.yaml"));
+  const struct {
+    std::string text, message;
+  } cases[] = {
+      {"%YAML:1.\n----\xff\n0\n\xf4", "f.yaml: line 2: '----\\xff' is not the document marker '---'"},
+      {"%YAML:1.0\n----x\n0\na\n", "f.yaml: line 2: '----x' is not the document marker"},
+      {"%YAML:1.0\n---x\n", "line 2: '---x' is not the document marker"},
+      {"%YAML:1.0\nm: !!opencv-matrix\n   rows: 90000\n   cols: 90000\n", "line 4: a matrix of 90000 x 90000 values"},
+      {"%YAML:1.0\nm: !!opencv-matrix\n   rows: +3\n", "line 3: matrix rows '+3' is not a whole number"},
+      {"%YAML:1.0\nm: !!opencv-matrix\n   cols: 1e9\n", "line 3: matrix cols '1e9' is not a whole number"},
+      {"a: 1\n", "f.yaml: is not OpenCV FileStorage YAML"},
+      {"%YAML:1.0\nx: " + std::string(100, '[') + std::string(100, ']') + "\n", "f.yaml: nested"},
+  };
+  for (const auto& c : cases) {
+    const std::string m = MessageOf([&] { RequireOpenCvYamlShape(c.text, 8, "f.yaml"); });
+    EXPECT_NE(m.find(c.message), std::string::npos) << m;
+  }
+}
+
 TEST(FindDuplicateYamlKey, FindsAKeyGivenTwiceInOneMappingOnly) {
   EXPECT_FALSE(FindDuplicateYamlKey("a: 1\nb:\n  a: 2\n  c: 3\nc: 4\n"));
   const auto d = FindDuplicateYamlKey("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\nimage_width: 320\n");

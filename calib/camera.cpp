@@ -171,19 +171,6 @@ const std::set<std::string>& InformationalKeys() {
 // allocate tens of GB, deep nesting overflows its recursive parser's stack, and a key given
 // twice silently keeps the first value.
 void PrecheckCameraText(const std::string& text, const std::string& source) {
-  try {
-    RequireYamlDepthAtMost(text, 8, source);
-  } catch (const InputError& e) {
-    throw CameraError(e.what());
-  }
-  const size_t start = text.find_first_not_of(" \t\r\n");
-  if (start == std::string::npos || text.compare(start, 5, "%YAML") != 0) {
-    throw CameraError(source + ": is not an OpenCV FileStorage YAML camera file (it must begin with %YAML:1.0)");
-  }
-  if (const auto d = FindDuplicateYamlKey(text)) {
-    throw CameraError(source + ": line " + std::to_string(d->line) + ": key '" + d->key + "' given twice (first on line " +
-                      std::to_string(d->first_line) + ")");
-  }
   std::istringstream lines(text);
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
@@ -206,6 +193,17 @@ void PrecheckCameraText(const std::string& text, const std::string& source) {
     } else if (key == "dt" && value != "d" && value != "f") {
       fail("matrix type dt: " + value + " is not a floating-point type (d or f)");
     }
+  }
+  // After the camera's own line checks (their messages are the more specific), before the
+  // duplicate-key scan.
+  try {
+    RequireOpenCvYamlShape(text, 8, source);
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
+  }
+  if (const auto d = FindDuplicateYamlKey(text)) {
+    throw CameraError(source + ": line " + std::to_string(d->line) + ": key '" + d->key + "' given twice (first on line " +
+                      std::to_string(d->first_line) + ")");
   }
 }
 

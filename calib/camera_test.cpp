@@ -120,6 +120,14 @@ TEST(Camera, MatrixHeadersThatMadeOpenCvAllocateGigabytesAreRefused) {
   }
 }
 
+// The 10-minute fuzz_camera campaign's finding (2026-12-02): this 21-byte file sent OpenCV's
+// reader into an endless loop; it is refused before it.
+TEST(Camera, TheCampaignsEndlessLoopFileIsRefusedBeforeTheParser) {
+  const std::string m = LoadError("%YAML:1.\n----\xff\n0\n\xf4");
+  EXPECT_NE(m.find("arview_camera_bad.yaml: line 2: '----"), std::string::npos) << m;
+  EXPECT_NE(m.find("is not the document marker '---'"), std::string::npos) << m;
+}
+
 TEST(Camera, DeepNestingIsRefusedBeforeTheParser) {
   // 50,000 levels overflowed the stack of OpenCV's YAML parser (SIGSEGV).
   const std::string deep = std::string(kGood) + "x: " + std::string(50000, '[') + std::string(50000, ']') + "\n";

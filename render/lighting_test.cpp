@@ -233,6 +233,32 @@ TEST(RoomLight, SavesAndLoadsAndRejectsBadFiles) {
   fs::remove_all(dir);
 }
 
+// What OpenCV's reader would hang on, allocate gigabytes for or recurse into too deeply is
+// refused before it, with one line naming the file.
+TEST(RoomLight, TextsThatHangOrExhaustOpenCvsReaderAreRefusedFirst) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_light_bad_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cases[] = {
+      "%YAML:1.0\n----x\n0\na\n",  // an endless loop in OpenCV 4.6 (fuzz_camera's finding)
+      "%YAML:1.0\nformat: arview room light 1\nsh_rgb: !!opencv-matrix\n   rows: 900000\n   cols: 90000\n"
+      "   dt: d\n   data: [ 0. ]\n",
+      "%YAML:1.0\nx: " + std::string(5000, '[') + std::string(5000, ']') + "\n",
+      "format: arview room light 1\n",  // no header
+  };
+  for (const std::string& text : cases) {
+    { std::ofstream(dir / "l.light.yml") << text; }
+    try {
+      LoadRoomLight(dir / "l.light.yml");
+      ADD_FAILURE() << "loaded: " << text.substr(0, 60);
+    } catch (const LightError& e) {
+      EXPECT_NE(std::string(e.what()).find("l.light.yml"), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(LoadRoomLight("/dev/zero"), LightError);
+  fs::remove_all(dir);
+}
+
 // ---------------------------------------------------------------- PRT
 
 anim::Character RigidCharacter(anim::Mesh mesh, const Eigen::Quaterniond& rest_rotation = Eigen::Quaterniond::Identity()) {

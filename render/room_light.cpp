@@ -9,9 +9,14 @@
 #include <system_error>
 
 #include "base/atomic_file.h"
+#include "base/input_guard.h"
 
 namespace arview::render {
 namespace {
+
+// Our writer nests 5 levels (thumbnails, a thumbnail, its image matrix, the data list); a
+// little room for hand edits, far below what overflows OpenCV's recursive reader.
+constexpr int kMaxRoomLightDepth = 8;
 
 // Equirectangular map of directions: column = azimuth, row = polar angle from +z.
 struct DirectionMap {
@@ -227,9 +232,17 @@ void SaveRoomLight(const RoomLight& light, const std::filesystem::path& file) {
 
 RoomLight LoadRoomLight(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw LightError(file.string() + ": no such room light file");
+  // A regular file of bounded size, and the checks OpenCV's reader lacks, before it sees it.
+  std::string text;
+  try {
+    text = ReadFileUpTo(file, kMaxTextFileBytes);
+    RequireOpenCvYamlShape(text, kMaxRoomLightDepth, file.string());
+  } catch (const InputError& e) {
+    throw LightError(e.what());
+  }
   RoomLight light;
   try {
-    cv::FileStorage fs(file.string(), cv::FileStorage::READ);
+    cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) throw LightError(file.string() + ": cannot read");
     if (static_cast<std::string>(fs["format"]) != "arview room light 1") {
       throw LightError(file.string() + ": not an arview room light file (format line missing)");
