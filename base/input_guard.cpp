@@ -199,6 +199,7 @@ void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::str
   }
   RequireYamlDepthAtMost(text, max_depth, name);
   long long rows = -1;
+  bool top_level_seen = false;
   int number = 0;
   for (size_t begin = 0; begin < text.size(); ++number) {
     size_t end = text.find('\n', begin);
@@ -216,6 +217,12 @@ void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::str
       continue;
     }
     const size_t key = line.find_first_not_of(' ');
+    const size_t content = line.find_first_not_of(" \t\r");
+    if (content == std::string_view::npos || line[content] == '#' || line[0] == '%') continue;
+    if (!top_level_seen) {
+      top_level_seen = true;
+      if (content != 0 || line[0] == '-') fail("'" + Excerpt(line) + "': the top level must be a mapping, its keys at the start of the line");
+    }
     if (key == std::string_view::npos) continue;
     const std::string_view rest = line.substr(key);
     const bool is_rows = rest.substr(0, 5) == "rows:", is_cols = rest.substr(0, 5) == "cols:";

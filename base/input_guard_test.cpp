@@ -107,7 +107,8 @@ TEST(YamlNestingDepth, TheFuzzersDeepFilesAreRefusedQuickly) {
 }
 
 // Found by the 10-minute fuzz_camera campaign: OpenCV 4.6's reader loops forever on a line
-// "----x" after the header followed by two lines of text ("%YAML:1.\n----\xff\n0\n\xf4" as found).
+// "----x" after the header followed by two lines of text ("%YAML:1.\n----\xff\n0\n\xf4" as found);
+// the 10-minute fuzz_room_light run, on an indented first line ("%YAML:1.\n   - 3\n:\n-").
 TEST(RequireOpenCvYamlShape, RefusesWhatOpenCvsReaderHangsOnOrOverAllocates) {
   const std::string good =
       "%YAML:1.0\n---\nk: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]\n";
@@ -123,6 +124,9 @@ TEST(RequireOpenCvYamlShape, RefusesWhatOpenCvsReaderHangsOnOrOverAllocates) {
       {"%YAML:1.0\nm: !!opencv-matrix\n   rows: +3\n", "line 3: matrix rows '+3' is not a whole number"},
       {"%YAML:1.0\nm: !!opencv-matrix\n   cols: 1e9\n", "line 3: matrix cols '1e9' is not a whole number"},
       {"a: 1\n", "f.yaml: is not OpenCV FileStorage YAML"},
+      {"%YAML:1.\n   - 3\n:\n-", "f.yaml: line 2: '   - 3': the top level must be a mapping"},
+      {"%YAML:1.0\n---\n# c\n  a: 1\nb\n", "line 4: '  a: 1': the top level must be a mapping"},
+      {"%YAML:1.0\n- 3\n", "line 2: '- 3': the top level must be a mapping"},
       {"%YAML:1.0\nx: " + std::string(100, '[') + std::string(100, ']') + "\n", "f.yaml: nested"},
   };
   for (const auto& c : cases) {

@@ -240,6 +240,7 @@ TEST(RoomLight, TextsThatHangOrExhaustOpenCvsReaderAreRefusedFirst) {
   fs::create_directories(dir);
   const std::string cases[] = {
       "%YAML:1.0\n----x\n0\na\n",  // an endless loop in OpenCV 4.6 (fuzz_camera's finding)
+      "%YAML:1.\n   - 3\n:\n-",      // another (fuzz_room_light's finding)
       "%YAML:1.0\nformat: arview room light 1\nsh_rgb: !!opencv-matrix\n   rows: 900000\n   cols: 90000\n"
       "   dt: d\n   data: [ 0. ]\n",
       "%YAML:1.0\nx: " + std::string(5000, '[') + std::string(5000, ']') + "\n",
