@@ -437,8 +437,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   RequireModelValuesInRange(result.map, result.model_dir);
   options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
   WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
-  map::SaveMap(result.map, out_dir / map::kMapFileName);
   WriteTopView(result.map, out_dir / "map.png");
+  // The map file last: a disk that fills at an earlier file fails the command without a new
+  // map.arvmap beside the error (each file is written atomically; a previous map stays whole).
+  map::SaveMap(result.map, out_dir / map::kMapFileName);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
 }
