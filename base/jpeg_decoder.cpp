@@ -168,7 +168,8 @@ bool RunLibjpeg(jpeg_decompress_struct& cinfo, QuietErrors& errors, std::string_
 }  // namespace
 
 cv::Mat DecodeJpeg(std::string_view bytes, const std::string& name, int imread_flags, JpegDamage damage) {
-  if (bytes.size() > std::numeric_limits<unsigned long>::max()) throw Error(name + ": the JPEG is too large");
+  // cv::imdecode's fallback below takes an int length.
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) throw Error(name + ": the JPEG is too large");
   QuietErrors errors{};
   errors.damage = damage;
   jpeg_decompress_struct cinfo{};  // zeroed: destroying it is safe even if creating it failed
