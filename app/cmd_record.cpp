@@ -59,20 +59,24 @@ void RunRecord(const RecordArgs& args) {
     std::cerr << "recording " << args.device << " (" << source.CardName() << ", " << source.FormatName() << " "
               << source.size().width << "x" << source.size().height << ") into " << args.out
               << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
-    auto progress = [](const recordings::RecordStats& s) {
+    bool progress_shown = false;  // the progress line is redrawn in place: ended before any other line
+    auto progress = [&](const recordings::RecordStats& s) {
       std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps", s.seconds, s.frames, s.fps);
       std::fflush(stderr);
+      progress_shown = true;
     };
     recordings::RecordStats stats;
     try {
       stats = recordings::RecordFrames(source, writer, args.seconds, signals.token(), progress);
-    } catch (const recordings::SourceError& e) {
-      std::fprintf(stderr, "\n");
+    } catch (const recordings::RecordingError& e) {
+      // The camera failing (SourceError) or the disk (a frame or frames.txt that cannot be
+      // written): either way the frames before stay a valid recording, or none is left.
+      if (progress_shown) std::fprintf(stderr, "\n");
       if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
       throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
                          " frames recorded before stay a valid recording in " + args.out);
     }
-    std::fprintf(stderr, "\n");
+    if (progress_shown) std::fprintf(stderr, "\n");
     if (writer.RemoveIfEmpty()) {
       signals.token().ThrowIfCancelled("stopped before the first frame; nothing was recorded");
       throw CommandError("stopped before the first frame; nothing was recorded");

@@ -106,4 +106,23 @@ void PendingOutput::Commit() {
   committed_ = true;
 }
 
+std::string NoRoomToWrite(const std::filesystem::path& folder) {
+  const std::filesystem::path probe = folder / (".arview-space-probe." + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) return std::strerror(errno);
+  constexpr size_t kProbeBytes = 1 << 20;
+  const std::string zeros(kProbeBytes, '\0');
+  int error = 0;
+  // A short write is the disk filling up: the next one says why.
+  for (size_t done = 0; done < kProbeBytes && error == 0;) {
+    const ssize_t n = ::write(fd, zeros.data() + done, kProbeBytes - done);
+    if (n < 0 && errno != EINTR) error = errno;
+    if (n == 0) error = ENOSPC;
+    if (n > 0) done += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return error != 0 ? std::strerror(error) : std::string();
+}
+
 }  // namespace arview

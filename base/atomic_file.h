@@ -21,6 +21,12 @@ void WriteFileAtomically(const std::filesystem::path& file, std::string_view byt
 // `write` propagates and nothing is written.
 void WriteFileAtomically(const std::filesystem::path& file, const std::function<void(std::ostream&)>& write);
 
+// Why `folder` has no room for 1 MiB more (strerror's text: "No space left on device", "Disk
+// quota exceeded", "File too large" under a file-size limit), or "" when it has: a probe file of
+// that size is written there (and removed). For a child process that failed writing there
+// (COLMAP's SQLite says only "disk I/O error"), so that the cause is said in one line.
+std::string NoRoomToWrite(const std::filesystem::path& folder);
+
 // An output that a library other than ours writes (a video encoder, COLMAP, a sink that grows
 // frame by frame) under a partial name; renamed into place by Commit() once complete, removed
 // on destruction if never committed.

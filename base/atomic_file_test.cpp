@@ -90,27 +90,45 @@ TEST_F(AtomicFileTest, AFailedRenameRemovesTheTemporaryAndNamesTheFile) {
   EXPECT_EQ(FilesInDir(), 1u);  // only the directory: no temporary left
 }
 
-TEST_F(AtomicFileTest, AFailedWriteIsAnErrorAndLeavesNeitherFileNorTemporary) {
-  // A file-size limit makes write() fail with EFBIG part way (SIGXFSZ ignored so that it
-  // returns instead of killing the process), as a full disk would.
+// Runs `body` under a file-size limit of 4 KiB: write() fails with EFBIG part way (SIGXFSZ
+// ignored so that it returns instead of killing the process), as a full disk would.
+template <class Body>
+void UnderA4KiBFileSizeLimit(Body body) {
   struct rlimit old {};
   ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old), 0);
   const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
   struct rlimit small = old;
   small.rlim_cur = 4096;
   ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
-  bool threw = false;
-  std::string message;
-  try {
-    WriteFileAtomically(dir_ / "big.bin", std::string(100000, 'x'));
-  } catch (const Error& e) {
-    threw = true;
-    message = e.what();
-  }
+  body();
   ::setrlimit(RLIMIT_FSIZE, &old);
   std::signal(SIGXFSZ, old_handler);
+}
+
+TEST_F(AtomicFileTest, AFailedWriteIsAnErrorAndLeavesNeitherFileNorTemporary) {
+  bool threw = false;
+  std::string message;
+  UnderA4KiBFileSizeLimit([&] {
+    try {
+      WriteFileAtomically(dir_ / "big.bin", std::string(100000, 'x'));
+    } catch (const Error& e) {
+      threw = true;
+      message = e.what();
+    }
+  });
   EXPECT_TRUE(threw);
   EXPECT_NE(message.find((dir_ / "big.bin").string()), std::string::npos) << message;
+  EXPECT_EQ(FilesInDir(), 0u);
+}
+
+// The probe arview map uses when COLMAP fails: room, a file-size limit of 4 KiB (the probe's
+// write fails part way: the second write says why), a missing folder; no probe file left.
+TEST_F(AtomicFileTest, NoRoomToWriteSaysWhyAndLeavesNoProbe) {
+  EXPECT_EQ(NoRoomToWrite(dir_), "");
+  std::string limited;
+  UnderA4KiBFileSizeLimit([&] { limited = NoRoomToWrite(dir_); });
+  EXPECT_EQ(limited, "File too large");
+  EXPECT_EQ(NoRoomToWrite(dir_ / "missing"), "No such file or directory");
   EXPECT_EQ(FilesInDir(), 0u);
 }
 

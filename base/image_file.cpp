@@ -12,6 +12,7 @@
 #include "base/atomic_file.h"
 #include "base/error.h"
 #include "base/input_guard.h"
+#include "base/jpeg_decoder.h"
 
 namespace arview {
 
@@ -190,15 +191,21 @@ void CheckJpegStructure(const std::string& file, std::string_view bytes) {
 }  // namespace
 
 cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
-  const std::string name = file.string();
-  std::string bytes = ReadFileUpTo(file, kMaxImageFileBytes);  // regular files only (InputError)
-  if (bytes.empty()) throw Error(name + ": the image file is empty");
-  const std::string_view view(bytes);
-  if (view.substr(0, kPngSignature.size()) == kPngSignature) CheckPngStructure(name, view);
-  if (view.substr(0, kJpegStart.size()) == kJpegStart) CheckJpegStructure(name, view);
+  const std::string bytes = ReadFileUpTo(file, kMaxImageFileBytes);  // regular files only (InputError)
+  return DecodeImageBytes(bytes, file.string(), imread_flags);
+}
+
+cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int imread_flags) {
+  if (bytes.empty()) throw Error(name + ": the image is empty (0 bytes)");
+  if (bytes.size() > kMaxImageFileBytes) throw Error(name + ": the image is larger than " + std::to_string(kMaxImageFileBytes) + " bytes");
+  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) CheckPngStructure(name, bytes);
+  if (bytes.substr(0, kJpegStart.size()) == kJpegStart) {
+    CheckJpegStructure(name, bytes);
+    return DecodeJpeg(bytes, name, imread_flags);  // libjpeg's warnings as errors, nothing printed
+  }
   cv::Mat image;
   try {
-    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data());
+    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
     image = cv::imdecode(encoded, imread_flags);
   } catch (const cv::Exception& e) {
     throw Error(name + ": cannot be decoded as an image (" + e.err + ")");

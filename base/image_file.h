@@ -4,6 +4,8 @@
 // cv::Mat only, so modules that include base/ without OpenCV (anim/) do not see OpenCV.
 
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace cv {
@@ -23,15 +25,20 @@ inline constexpr long long kMaxImageSide = 32768;
 inline constexpr long long kMaxImagePixels = 1ll << 28;
 
 // Reads an image file as cv::imread(file, imread_flags) would, but with one clear error
-// (arview::Error naming the file) for every way it can fail: not a regular file or over
-// kMaxImageFileBytes; a PNG whose signature, IHDR header or size is wrong, that is cut short
-// (no IEND chunk at its end) or damaged (a chunk's length past the end, its type not letters,
-// its CRC wrong, which catches damage inside the compressed data); a JPEG whose marker segments are damaged (a length past the
-// end, bytes where a marker must be, a frame header that does not add up, a scan without data),
-// whose size is wrong or that is cut short (no EOI marker after its last scan; data after EOI is
-// accepted); both checked before libpng/libjpeg see the file, so that they print nothing of
-// their own; an image OpenCV cannot decode or refuses (its exception text is kept after ours).
-// Never returns an empty image.
+// (arview::Error naming the file) for every way it can fail, and nothing printed by libpng or
+// libjpeg: not a regular file or over kMaxImageFileBytes; a PNG whose signature, IHDR header or
+// size is wrong, that is cut short (no IEND chunk at its end) or damaged (a chunk's length past
+// the end, its type not letters, its CRC wrong, which catches damage inside the compressed data);
+// a JPEG whose marker segments are damaged (a length past the end, bytes where a marker must be,
+// a frame header that does not add up, a scan without data), whose size is wrong or that is cut
+// short (no EOI marker after its last scan; data after EOI is accepted), all checked before
+// libpng/libjpeg see the file; a JPEG whose entropy-coded data is damaged (libjpeg's warning,
+// kept in our message: base/jpeg_decoder.h); an image OpenCV cannot decode or refuses (its
+// exception text is kept after ours). Never returns an empty image.
 cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags);
+
+// The same for an image already in memory (a texture embedded in an asset), `name` saying where
+// it came from in the errors.
+cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int imread_flags);
 
 }  // namespace arview

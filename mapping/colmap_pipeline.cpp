@@ -115,6 +115,12 @@ class ColmapRunner {
     if (!r.ok()) {
       const std::string how = r.signaled ? "was killed by signal " + std::to_string(r.signal)
                                          : "exited with code " + std::to_string(r.exit_code);
+      // On a full disk COLMAP's output says only "SQLite error ...: disk I/O error", a dozen
+      // times: the cause, found here, is the one line worth printing.
+      if (const std::string full = NoRoomToWrite(log_.parent_path()); !full.empty()) {
+        throw map::MapError(log_.parent_path().string() + ": no room to write (" + full + "): COLMAP " + args.front() +
+                            " (" + stage + " stage) " + how + "; its output is in " + log_.string());
+      }
       throw ColmapStageError("COLMAP " + args.front() + " (" + stage + " stage) " + how + "; its output is in " +
                                  log_.string(),
                              stage, log_, r.tail);
@@ -190,8 +196,9 @@ ImageSet PrepareVideoImages(const recordings::Recording& rec, const fs::path& ou
       WriteImageAtomically(png, frame);
       ++next;
     }
-    std::ofstream out(list);
-    for (int f : *selected) out << f << "\n";
+    std::string text;
+    for (int f : *selected) text += std::to_string(f) + "\n";
+    WriteFileAtomically(list, text);  // on a full disk: one error, and no short list the next run would reuse
     stages.Save("select", inputs.str());
   }
   if (selected->empty()) throw map::MapError(video.string() + ": no usable frames were selected");
@@ -325,11 +332,9 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   if (images.names.size() < 2) throw map::MapError("a map needs at least 2 frames (got " + std::to_string(images.names.size()) + ")");
   const int n = static_cast<int>(images.names.size());
   const fs::path list = out_dir / "image_list.txt";
-  {
-    std::ofstream out(list, std::ios::trunc);
-    for (const auto& name : images.names) out << name << "\n";
-    if (!out.flush()) throw map::MapError(list.string() + ": cannot write");
-  }
+  std::string names;
+  for (const auto& name : images.names) names += name + "\n";
+  WriteFileAtomically(list, names);  // a full disk: "cannot write (<why>)", no empty list left
   const fs::path database = out_dir / "database.db";
   const fs::path sparse = out_dir / "sparse";
   const std::string threads = std::to_string(options.threads);
@@ -347,8 +352,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   std::string inputs = Joined(extract_args);
   for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
 
+  // `discard` removes what a failed or interrupted run of the stage left half written (a database
+  // of some of the frames, a partial model), so that nothing unfinished looks like COLMAP's output.
   auto stage = [&](const std::string& name, const std::string& stage_inputs, const std::function<void()>& prepare,
-                   const std::vector<std::string>& args, bool outputs_exist) {
+                   const std::vector<std::string>& args, bool outputs_exist, const std::function<void()>& discard) {
     t0 = std::chrono::steady_clock::now();
     if (outputs_exist && stages.Matches(name, stage_inputs)) {
       if (cb.note) cb.note(name + ": inputs unchanged since the last run, skipped");
@@ -360,13 +367,18 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     try {
       colmap.Run(name, args, n);
     } catch (const CancelledError& e) {
+      if (discard) discard();
       throw CancelledError(InterruptedStageMessage(options.cancel, name, result.timings), e.signal_number());
+    } catch (const Error&) {
+      if (discard) discard();
+      throw;
     }
     stages.Save(name, stage_inputs);
     result.timings.push_back({name, Seconds(t0), false});
   };
 
-  stage("extract", inputs, [&] { RemoveDatabase(database); }, extract_args, fs::exists(database));
+  const auto remove_database = [&] { RemoveDatabase(database); };
+  stage("extract", inputs, remove_database, extract_args, fs::exists(database), remove_database);
 
   const bool exhaustive = options.matcher == MatcherKind::kExhaustive ||
                           (options.matcher == MatcherKind::kAuto && n <= options.auto_exhaustive_limit);
@@ -380,7 +392,8 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                                          options.quadratic_overlap ? "1" : "0"});
   }
   inputs += "--\n" + Joined(match_args);
-  stage("match", inputs, [&] { ClearMatches(database); }, match_args, true);
+  // Half-written matches stay until the next run clears them (clearing needs room to write).
+  stage("match", inputs, [&] { ClearMatches(database); }, match_args, true, nullptr);
 
   const std::string refine = options.refine_intrinsics ? "1" : "0";
   std::vector<std::string> mapper_args{"mapper", "--database_path", database.string(), "--image_path",
@@ -403,7 +416,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
         fs::remove_all(sparse, ec);
         fs::create_directories(sparse);
       },
-      mapper_args, fs::is_directory(sparse));
+      mapper_args, fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
 
   t0 = std::chrono::steady_clock::now();
   result.model_dir = LargestModel(sparse, &result.models, cb);
@@ -424,8 +437,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   RequireModelValuesInRange(result.map, result.model_dir);
   options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
   WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
-  map::SaveMap(result.map, out_dir / map::kMapFileName);
   WriteTopView(result.map, out_dir / "map.png");
+  // The map file last: a disk that fills at an earlier file fails the command without a new
+  // map.arvmap beside the error (each file is written atomically; a previous map stays whole).
+  map::SaveMap(result.map, out_dir / map::kMapFileName);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
 }

@@ -1,16 +1,23 @@
 // Speed of the per-frame work of live capture and recording, at 640x480: decoding the two
-// V4L2 formats, and writing one frame the way RecordingWriter does (PNG, compression 1).
+// V4L2 formats, and writing one frame the way RecordingWriter does (PNG, compression 1); and of
+// reading one of phone-fox's 1920x1080 JPEG frames, through ReadImageFile (the checks and the
+// decoder replay uses) and through cv::imdecode alone (what it is measured against).
 
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "base/image_file.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
+#include "tests/support/test_data.h"
 
 namespace {
 
@@ -68,6 +75,28 @@ void BM_RecordFrame640x480(benchmark::State& state) {
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_RecordFrame640x480)->Unit(benchmark::kMillisecond);
+
+// phone-fox's first frame (1920x1080, 4:2:0, 387 KB), or empty when ../shared/data is absent.
+std::filesystem::path PhoneFoxFrame() {
+  const std::filesystem::path frame = arview::testing::SharedData("phone-fox/images/0001.jpg");
+  return std::filesystem::is_regular_file(frame) ? frame : std::filesystem::path();
+}
+
+void BM_ReadImageFilePhoneFoxFrame(benchmark::State& state) {
+  const std::filesystem::path frame = PhoneFoxFrame();
+  if (frame.empty()) return state.SkipWithError("phone-fox/images/0001.jpg missing (../shared/data)");
+  for (auto _ : state) benchmark::DoNotOptimize(arview::ReadImageFile(frame, cv::IMREAD_COLOR));
+}
+BENCHMARK(BM_ReadImageFilePhoneFoxFrame)->Unit(benchmark::kMillisecond);
+
+void BM_ImdecodePhoneFoxFrame(benchmark::State& state) {
+  const std::filesystem::path frame = PhoneFoxFrame();
+  if (frame.empty()) return state.SkipWithError("phone-fox/images/0001.jpg missing (../shared/data)");
+  std::ifstream in(frame, std::ios::binary);
+  const std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (auto _ : state) benchmark::DoNotOptimize(cv::imdecode(bytes, cv::IMREAD_COLOR));
+}
+BENCHMARK(BM_ImdecodePhoneFoxFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 BENCHMARK_MAIN();

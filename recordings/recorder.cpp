@@ -39,18 +39,25 @@ void WriteAll(int fd, const std::string& text, const fs::path& file) {
 RecordingWriter::RecordingWriter(const fs::path& root, const std::optional<calib::Camera>& camera, bool overwrite)
     : root_(root), camera_(camera) {
   PrepareRecordingFolder(root_, overwrite);
-  if (camera_) {
-    try {
-      calib::SaveCamera(*camera_, root_ / "camera.yaml");
-    } catch (const calib::CameraError& e) {
-      throw RecordingError(e.what());
+  try {
+    if (camera_) {
+      try {
+        calib::SaveCamera(*camera_, root_ / "camera.yaml");
+      } catch (const calib::CameraError& e) {
+        throw RecordingError(e.what());
+      }
+      size_ = camera_->Size();
     }
-    size_ = camera_->Size();
+    const fs::path file = root_ / "frames.txt";
+    fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw RecordingError(file.string() + ": cannot create (" + std::string(std::strerror(errno)) + ")");
+    WriteAll(fd_, "# timestamp path\n", file);
+  } catch (const RecordingError&) {
+    // Issue 17: on a full disk the header did not fit and an empty frames.txt and frames/ were
+    // left, a recording of nothing. Nothing was recorded: nothing stays.
+    RemoveIfEmpty();
+    throw;
   }
-  const fs::path file = root_ / "frames.txt";
-  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
-  if (fd_ < 0) throw RecordingError(file.string() + ": cannot create (" + std::string(std::strerror(errno)) + ")");
-  WriteAll(fd_, "# timestamp path\n", file);
 }
 
 RecordingWriter::~RecordingWriter() {

@@ -14,9 +14,14 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <string>
+#include <string_view>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "base/error.h"
+#include "base/jpeg_decoder.h"
 
 namespace arview::recordings {
 
@@ -306,11 +311,14 @@ cv::Mat DecodeMjpeg(const uint8_t* data, size_t bytes, int expected_width, int e
   if (bytes > static_cast<size_t>(std::numeric_limits<int>::max() / 2)) throw SourceError("MJPEG frame: too large");
   cv::Mat image;
   try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes), CV_8UC1, const_cast<uint8_t*>(data)), cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    image.release();
+    // Our libjpeg calls, not cv::imdecode: a damaged or cut frame (a USB hiccup) is refused with
+    // libjpeg's reason, where imdecode printed libjpeg's warning and returned the damaged image
+    // (or, for a cut frame, its missing part grey without a word). Padding before EOI is kept.
+    image = DecodeJpeg(std::string_view(reinterpret_cast<const char*>(data), bytes), "MJPEG frame", cv::IMREAD_COLOR,
+                       JpegDamage::kAcceptPaddingBeforeEnd);
+  } catch (const Error& e) {
+    throw SourceError(std::string(e.what()) + " (" + std::to_string(bytes) + " bytes)");
   }
-  if (image.empty()) throw SourceError("MJPEG frame: corrupt JPEG data (" + std::to_string(bytes) + " bytes)");
   if (expected_width > 0 && (image.cols != expected_width || image.rows != expected_height)) {
     throw SourceError("MJPEG frame: decoded " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
                       ", expected " + std::to_string(expected_width) + "x" + std::to_string(expected_height));

@@ -109,5 +109,28 @@ TEST(DecodeMjpeg, RejectsCorruptDataAndWrongSizes) {
   EXPECT_THROW(DecodeMjpeg(nullptr, 0), SourceError);
 }
 
+// A frame cut short by a USB hiccup was decoded by cv::imdecode with its missing part grey and
+// not a word; a frame with flipped bits in its data made libjpeg print "Corrupt JPEG data: ..."
+// on stderr. Both are now skipped as corrupt frames, libjpeg printing nothing; zeros before EOI
+// (webcams pad frames so) still decode to the frame.
+TEST(DecodeMjpeg, CutOrDamagedFramesAreRefusedSilentlyAndPaddedOnesKept) {
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(cv::imencode(".jpg", test::MakeImage(64, 48, 3), jpeg, {cv::IMWRITE_JPEG_QUALITY, 90}));
+  const cv::Mat reference = cv::imdecode(jpeg, cv::IMREAD_COLOR);
+  const std::vector<uint8_t> cut(jpeg.begin(), jpeg.begin() + static_cast<long>(jpeg.size() * 2 / 3));
+  std::vector<uint8_t> padded = jpeg;
+  padded.insert(padded.end() - 2, 16, 0);
+  ::testing::internal::CaptureStderr();
+  try {
+    (void)DecodeMjpeg(cut.data(), cut.size(), 64, 48);
+    ADD_FAILURE() << "a cut frame was decoded";
+  } catch (const SourceError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("MJPEG frame: damaged JPEG data (libjpeg: ", 0), 0u) << e.what();
+  }
+  const cv::Mat kept = DecodeMjpeg(padded.data(), padded.size(), 64, 48);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_EQ(cv::norm(kept, reference, cv::NORM_INF), 0);
+}
+
 }  // namespace
 }  // namespace arview::recordings

@@ -5,7 +5,9 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 
+#include "base/image_file.h"
 #include "render/offscreen.h"
 
 namespace arview::render {
@@ -155,22 +157,27 @@ void main() {
 )";
 
 cv::Mat DecodeTexture(const anim::Texture& t, const std::string& source) {
-  cv::Mat image;
   if (!t.rgba.empty()) {
     if (t.width <= 0 || t.height <= 0 || t.rgba.size() != static_cast<size_t>(t.width) * t.height * 4) {
       throw RenderError(source + ": raw texture has inconsistent size");
     }
-    cv::Mat rgba(t.height, t.width, CV_8UC4, const_cast<std::uint8_t*>(t.rgba.data()));
+    cv::Mat image;
+    const cv::Mat rgba(t.height, t.width, CV_8UC4, const_cast<std::uint8_t*>(t.rgba.data()));
     cv::cvtColor(rgba, image, cv::COLOR_RGBA2BGRA);
-  } else if (!t.encoded.empty()) {
-    image = cv::imdecode(t.encoded, cv::IMREAD_COLOR);
-  } else if (!t.path.empty()) {
-    image = cv::imread(t.path, cv::IMREAD_COLOR);
+    return image;
   }
-  if (image.empty()) {
-    throw RenderError(source + ": cannot decode texture " + (t.path.empty() ? std::string("(embedded)") : t.path));
+  // Through base's checked reader: a cut or damaged texture is one error naming it (and the
+  // asset), where cv::imread/imdecode let libpng and libjpeg print their own lines first.
+  try {
+    if (!t.encoded.empty()) {
+      const std::string_view bytes(reinterpret_cast<const char*>(t.encoded.data()), t.encoded.size());
+      return DecodeImageBytes(bytes, source + " (its embedded texture)", cv::IMREAD_COLOR);
+    }
+    if (!t.path.empty()) return ReadImageFile(t.path, cv::IMREAD_COLOR);
+  } catch (const Error& e) {
+    throw RenderError(t.encoded.empty() ? std::string(e.what()) + " (a texture of " + source + ")" : e.what());
   }
-  return image;
+  throw RenderError(source + ": a texture without an image (no pixels, data or file)");
 }
 
 // Characters are mostly seen face-on: trilinear filtering suffices, and llvmpipe's anisotropic

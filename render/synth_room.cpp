@@ -120,10 +120,11 @@ class SceneBuilder {
   int Texture(const char* name) {
     if (auto it = loaded_.find(name); it != loaded_.end()) return it->second;
     const fs::path path = data_dir_ / name;
-    std::error_code ec;
-    cv::Mat image = fs::is_regular_file(path, ec) ? cv::imread(path.string(), cv::IMREAD_COLOR) : cv::Mat();
-    if (image.empty()) {
-      throw RenderError(path.string() + ": missing or unreadable (the room's photos come from Debian package opencv-doc)");
+    cv::Mat image;
+    try {
+      image = ReadImageFile(path, cv::IMREAD_COLOR);  // a cut or damaged photo: one line naming it
+    } catch (const Error& e) {
+      throw RenderError(std::string(e.what()) + " (the room's photos come from Debian package opencv-doc)");
     }
     aspect_[name] = static_cast<double>(image.cols) / image.rows;
     scene_.textures.push_back(PowerOfTwo(image));

@@ -291,5 +291,29 @@ TEST(SynthRoom, NamesAMissingPhoto) {
   }
 }
 
+// A damaged room photo (here home.jpg cut short) was read by cv::imread, libjpeg printing its
+// own line; now it is one RenderError naming the file, nothing printed.
+TEST(SynthRoom, NamesADamagedPhotoAndLibjpegSaysNothing) {
+  const fs::path photos = kOpenCvDocData;
+  ARVIEW_REQUIRE_DATA_PATH(photos, "Debian package opencv-doc");
+  TempDir dir;
+  fs::create_directories(dir.path);
+  for (const auto& entry : fs::directory_iterator(photos)) {
+    fs::create_symlink(entry.path(), dir.path / entry.path().filename());
+  }
+  const fs::path damaged = dir.path / "home.jpg";
+  const std::string whole = Bytes(photos / "home.jpg");
+  fs::remove(damaged);
+  std::ofstream(damaged, std::ios::binary) << whole.substr(0, whole.size() / 2);
+  ::testing::internal::CaptureStderr();
+  try {
+    MakeRoomScene(dir.path);
+    ADD_FAILURE() << "expected RenderError";
+  } catch (const RenderError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(damaged.string() + ": the JPEG is cut short", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
 }  // namespace
 }  // namespace arview::render

@@ -1,0 +1,199 @@
+#include "base/jpeg_decoder.h"
+
+// jpeglib.h needs FILE and size_t declared before it.
+#include <cstddef>
+#include <cstdio>
+// clang-format off
+#include <jpeglib.h>
+#include <jerror.h>
+// clang-format on
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <csetjmp>
+#include <limits>
+
+#include "base/error.h"
+
+namespace arview {
+
+namespace {
+
+// libjpeg's error manager, extended: its fatal errors and the warnings that mean damaged data
+// jump back to the setjmp in RunLibjpeg with their text; nothing is ever printed. `base` must
+// stay the first member: libjpeg hands our callbacks a pointer to it.
+struct QuietErrors {
+  jpeg_error_mgr base;
+  std::jmp_buf jump;
+  JpegDamage damage;
+  bool damaged;  // a warning jumped (damage), not a fatal error
+  char message[JMSG_LENGTH_MAX];
+};
+
+QuietErrors& ErrorsOf(j_common_ptr cinfo) { return *reinterpret_cast<QuietErrors*>(cinfo->err); }
+
+// libjpeg's warnings that say the decoded pixels are not what was encoded. The others (an
+// unknown JFIF revision, an unknown Adobe colour transform, a damaged ICC profile) are about
+// metadata: the pixels are right, and they are let through silently.
+bool MeansDamagedData(const jpeg_error_mgr& err, JpegDamage damage) {
+  switch (err.msg_code) {
+    case JWRN_EXTRANEOUS_DATA:  // bytes where a marker should be; "before marker 0xd9": padding
+      return damage == JpegDamage::kRefuse || err.msg_parm.i[1] != JPEG_EOI;
+    case JWRN_HIT_MARKER:       // "premature end of data segment"
+    case JWRN_HUFF_BAD_CODE:    // "bad Huffman code"
+    case JWRN_ARITH_BAD_CODE:
+    case JWRN_JPEG_EOF:         // the data ended before EOI
+    case JWRN_MUST_RESYNC:      // a restart marker out of place
+    case JWRN_NOT_SEQUENTIAL:
+    case JWRN_TOO_MUCH_DATA:
+    case JWRN_BOGUS_PROGRESSION:
+      return true;
+    default:
+      return false;
+  }
+}
+
+[[noreturn]] void JumpWithMessage(j_common_ptr cinfo, bool damaged) {
+  QuietErrors& errors = ErrorsOf(cinfo);
+  errors.base.format_message(cinfo, errors.message);
+  errors.damaged = damaged;
+  std::longjmp(errors.jump, 1);
+}
+
+void ErrorExit(j_common_ptr cinfo) { JumpWithMessage(cinfo, false); }
+
+// Level -1 is a warning; 0 and above are trace messages, ignored.
+void EmitMessage(j_common_ptr cinfo, int level) {
+  if (level >= 0) return;
+  QuietErrors& errors = ErrorsOf(cinfo);
+  ++errors.base.num_warnings;
+  if (MeansDamagedData(errors.base, errors.damage)) JumpWithMessage(cinfo, true);
+}
+
+void OutputNothing(j_common_ptr) {}
+
+// The orientation as OpenCV 4.6's ExifReader reads it: the first APP1 segment, its TIFF header 6
+// bytes in (past "Exif\0\0", which it does not check), little-endian for "II" and big-endian
+// otherwise, 42 after the byte order, then the first IFD's 12-byte entries, the first with tag
+// 0x0112 giving the value. 0 when there is none (or the segment ends first).
+unsigned ExifOrientation(const jpeg_decompress_struct& cinfo) {
+  const jpeg_marker_struct* app1 = cinfo.marker_list;
+  while (app1 != nullptr && app1->marker != JPEG_APP0 + 1) app1 = app1->next;
+  constexpr size_t kTiffAt = 6;
+  if (app1 == nullptr || app1->data_length <= kTiffAt) return 0;
+  const JOCTET* tiff = app1->data + kTiffAt;
+  const size_t size = app1->data_length - kTiffAt;
+  const bool little = size >= 2 && tiff[0] == 'I' && tiff[1] == 'I';
+  const auto u16 = [&](size_t at) -> long long {
+    if (at + 1 >= size) return -1;
+    return little ? tiff[at] | (tiff[at + 1] << 8) : (tiff[at] << 8) | tiff[at + 1];
+  };
+  const auto u32 = [&](size_t at) -> long long {
+    if (at + 3 >= size) return -1;
+    return little ? (u16(at) | (u16(at + 2) << 16)) : ((u16(at) << 16) | u16(at + 2));
+  };
+  if (u16(2) != 42) return 0;
+  const long long ifd = u32(4);
+  const long long entries = ifd < 0 ? -1 : u16(static_cast<size_t>(ifd));
+  for (long long i = 0; i < entries; ++i) {
+    const size_t entry = static_cast<size_t>(ifd) + 2 + 12 * static_cast<size_t>(i);
+    const long long tag = u16(entry);
+    if (tag < 0) return 0;
+    if (tag == 0x0112) return static_cast<unsigned>(std::max(u16(entry + 8), 0ll));
+  }
+  return 0;
+}
+
+// OpenCV's ApplyExifOrientation: orientations 2-8 flip and transpose the image to stand upright.
+cv::Mat Oriented(const cv::Mat& image, unsigned orientation) {
+  if (orientation < 2 || orientation > 8) return image;
+  cv::Mat upright = image;
+  if (orientation >= 5) cv::transpose(image, upright);
+  cv::Mat flipped;
+  switch (orientation) {
+    case 2: case 6: cv::flip(upright, flipped, 1); return flipped;   // horizontally
+    case 3: case 7: cv::flip(upright, flipped, -1); return flipped;  // both ways
+    case 4: case 8: cv::flip(upright, flipped, 0); return flipped;   // vertically
+    default: return upright;                                         // 5: transposed only
+  }
+}
+
+// What the caller asked for, in libjpeg's terms. `channels` 0: decode only to look for damage
+// (flags or a colour space this decoder does not reproduce; cv::imdecode decodes it after).
+struct Request {
+  int channels;
+  J_COLOR_SPACE space;
+};
+
+Request RequestFor(const jpeg_decompress_struct& cinfo, int imread_flags) {
+  if (cinfo.num_components == 4) return {0, cinfo.out_color_space};  // CMYK, YCCK
+  const bool colour = imread_flags == cv::IMREAD_COLOR || (imread_flags == cv::IMREAD_UNCHANGED && cinfo.num_components > 1);
+  if (colour) return {3, JCS_EXT_BGR};
+  if (imread_flags == cv::IMREAD_GRAYSCALE || imread_flags == cv::IMREAD_UNCHANGED) return {1, JCS_GRAYSCALE};
+  return {0, cinfo.out_color_space};
+}
+
+// Every libjpeg call, after the setjmp its errors return to: on an error or a damage warning
+// it returns false with errors.message set. Nothing here owns a resource that the jump would
+// skip: `image` is the caller's, libjpeg's memory is freed by jpeg_destroy_decompress.
+bool RunLibjpeg(jpeg_decompress_struct& cinfo, QuietErrors& errors, std::string_view bytes, int imread_flags,
+                cv::Mat& image, unsigned& orientation) {
+  if (setjmp(errors.jump) != 0) return false;
+  jpeg_create_decompress(&cinfo);
+  jpeg_mem_src(&cinfo, reinterpret_cast<const unsigned char*>(bytes.data()), static_cast<unsigned long>(bytes.size()));
+  jpeg_save_markers(&cinfo, JPEG_APP0 + 1, 0xffff);
+  jpeg_read_header(&cinfo, TRUE);
+  const Request request = RequestFor(cinfo, imread_flags);
+  cinfo.out_color_space = request.space;
+  jpeg_start_decompress(&cinfo);
+  JSAMPARRAY scratch = nullptr;
+  if (request.channels > 0) {
+    image.create(static_cast<int>(cinfo.output_height), static_cast<int>(cinfo.output_width), CV_8UC(request.channels));
+  } else {
+    scratch = cinfo.mem->alloc_sarray(reinterpret_cast<j_common_ptr>(&cinfo), JPOOL_IMAGE,
+                                      cinfo.output_width * cinfo.output_components, 1);
+  }
+  while (cinfo.output_scanline < cinfo.output_height) {
+    JSAMPROW row = request.channels > 0 ? image.ptr(static_cast<int>(cinfo.output_scanline)) : scratch[0];
+    // From memory libjpeg never suspends; 0 rows would loop forever.
+    if (jpeg_read_scanlines(&cinfo, &row, 1) != 1) ERREXIT(&cinfo, JERR_INPUT_EMPTY);
+  }
+  orientation = ExifOrientation(cinfo);
+  jpeg_finish_decompress(&cinfo);  // reads up to EOI: trailing damage is seen here
+  return true;
+}
+
+}  // namespace
+
+cv::Mat DecodeJpeg(std::string_view bytes, const std::string& name, int imread_flags, JpegDamage damage) {
+  // cv::imdecode's fallback below takes an int length.
+  if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max())) throw Error(name + ": the JPEG is too large");
+  QuietErrors errors{};
+  errors.damage = damage;
+  jpeg_decompress_struct cinfo{};  // zeroed: destroying it is safe even if creating it failed
+  cinfo.err = jpeg_std_error(&errors.base);
+  errors.base.error_exit = ErrorExit;
+  errors.base.emit_message = EmitMessage;
+  errors.base.output_message = OutputNothing;
+  cv::Mat image;
+  unsigned orientation = 0;
+  const bool decoded = RunLibjpeg(cinfo, errors, bytes, imread_flags, image, orientation);
+  jpeg_destroy_decompress(&cinfo);
+  if (!decoded) {
+    throw Error(name + (errors.damaged ? ": damaged JPEG data (libjpeg: " : ": cannot be decoded as a JPEG (libjpeg: ") +
+                errors.message + ")");
+  }
+  if (!image.empty()) return imread_flags == cv::IMREAD_UNCHANGED ? image : Oriented(image, orientation);
+  // Decoded once without a word; what OpenCV does with these flags or this colour space is its own.
+  try {
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())), imread_flags);
+  } catch (const cv::Exception& e) {
+    throw Error(name + ": cannot be decoded as an image (" + e.err + ")");
+  }
+  if (image.empty()) throw Error(name + ": cannot be read as an image");
+  return image;
+}
+
+}  // namespace arview
