@@ -21,7 +21,7 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
       camera_(camera),
       pinhole_(camera.WithoutDistortion()),
       options_(options),
-      target_(context.gl(), camera.width, camera.height, options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
+      target_(context.gl(), camera.Size(), options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
       shadow_(context.gl()) {
   ProjectionMatrix(pinhole_, options_.clip);  // validates the camera and the clip range
   if (camera_.HasDistortion()) {
@@ -286,11 +286,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
     placed.cast->EndSilhouette();
   }
-  target_.Bind();
-  target_.Scissor(rect);
-  gl.ClearColor(0, 0, 0, 0);
-  gl.ClearDepth(1.0);
-  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  target_.Begin(rect);
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
   const Eigen::Matrix4d view = ViewMatrix(eye);
   // Real things in front of the characters: depth only, before anything is drawn.
@@ -309,11 +305,10 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
-  target_.Scissor({});
   CheckGl(gl, "AR frame");
 
   // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgra(rect);
+  const cv::Mat layer = target_.ReadBgra();
   for (int y = 0; y < rect.height; ++y) {
     const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
     cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
