@@ -284,7 +284,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     draw.silhouette = true;  // front faces seen from the light cover the whole silhouette of closed meshes
     placed.cast->BeginSilhouette();
     placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
-    placed.cast->EndSilhouette();
+    placed.cast->EndSilhouette(options_.cast_shadow_softness);
   }
   target_.Begin(rect);
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
@@ -299,8 +299,7 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
       shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
     }
     if (casts[i]) {
-      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed),
-                                options_.cast_shadow_softness);
+      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed));
     }
     placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
