@@ -194,6 +194,23 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     const double u = pinhole_.fx * c.x() / c.z() + pinhole_.cx, v = pinhole_.fy * c.y() / c.z() + pinhole_.cy;
     u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
   };
+  // A sphere's exact extent on screen: along each image axis, the two tangents from the eye.
+  // (A cube around it, projected, is up to ~1.6x wider for a character close to the camera; the
+  // rectangle's area is what 4x MSAA clears and resolves.)
+  auto add_sphere = [&](const Eigen::Vector3d& world, double r) {
+    const Eigen::Vector3d c = eye.ToCamera(world);
+    far_z = std::max(far_z, c.z() + r);
+    if (c.z() - r <= options_.clip.near_m) {
+      behind = true;
+      return;
+    }
+    const double zz = c.z() * c.z() - r * r;
+    const double ru = r * std::sqrt(c.x() * c.x() + zz), rv = r * std::sqrt(c.y() * c.y() + zz);
+    u0 = std::min(u0, pinhole_.fx * (c.x() * c.z() - ru) / zz + pinhole_.cx);
+    u1 = std::max(u1, pinhole_.fx * (c.x() * c.z() + ru) / zz + pinhole_.cx);
+    v0 = std::min(v0, pinhole_.fy * (c.y() * c.z() - rv) / zz + pinhole_.cy);
+    v1 = std::max(v1, pinhole_.fy * (c.y() * c.z() + rv) / zz + pinhole_.cy);
+  };
   for (size_t i = 0; i < characters_.size(); ++i) {
     const Placed& placed = characters_[i];
     const anim::FrameOutput& frame = *frames[i];
@@ -201,13 +218,13 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     const std::vector<float>& radii = placed.renderer->joint_radii();
     for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
       if (radii[j] <= 0) continue;
-      // A cube around the joint's sphere of influence, enlarged 10% (DQS need not stay inside
-      // the linear blend's hull) and by the joint's own scale.
+      // The joint's sphere of influence, enlarged 10% (DQS need not stay inside the linear
+      // blend's hull) and by the joint's own scale.
       const Eigen::Matrix4d m = model_to_map * frame.model[j];
       const double scale = m.topLeftCorner<3, 3>().colwise().norm().maxCoeff();
       const double r = 1.1 * radii[j] * scale;
       const Eigen::Vector3d centre = m.col(3).head<3>();
-      for (int k = 0; k < 8; ++k) add(centre + r * Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+      add_sphere(centre, r);
     }
     ShadowEllipse e;
     if (options_.shadow && Shadow(placed, frame, &e)) {
