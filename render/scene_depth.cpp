@@ -116,7 +116,7 @@ GlName MakeTextureFramebuffer(const GlApi& gl, int size, bool mipmaps, GlName* t
 
 CastShadow::CastShadow(const GlApi& gl, int size) : gl_(&gl), size_(size) {
   fbo_ = MakeTextureFramebuffer(gl, size, true, &texture_);
-  blurred_fbo_ = MakeTextureFramebuffer(gl, size, false, &blurred_);
+  blurred_fbo_ = MakeTextureFramebuffer(gl, BlurredSize(), false, &blurred_);
   program_ = MakeProgram(gl, "cast shadow", kReceiverVertex, kReceiverFragment);
   const GLuint p = program_.get();
   mvp_ = Uniform(gl, p, "mvp");
@@ -146,13 +146,13 @@ void CastShadow::EndSilhouette(float softness) {
   gl.BindTexture(GL_TEXTURE_2D, texture_.get());
   gl.GenerateMipmap(GL_TEXTURE_2D);
   gl.BindFramebuffer(GL_FRAMEBUFFER, blurred_fbo_.get());
-  gl.Viewport(0, 0, size_, size_);
+  gl.Viewport(0, 0, BlurredSize(), BlurredSize());
   gl.Disable(GL_DEPTH_TEST);
   gl.Disable(GL_CULL_FACE);
   gl.Disable(GL_BLEND);
   gl.UseProgram(blur_program_.get());
   gl.Uniform1f(softness_, softness);
-  gl.Uniform1f(blur_size_, static_cast<float>(size_));
+  gl.Uniform1f(blur_size_, static_cast<float>(BlurredSize()));
   gl.Uniform1i(silhouette_, 0);
   gl.ActiveTexture(GL_TEXTURE0);
   gl.BindVertexArray(vao_.get());

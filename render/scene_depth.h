@@ -6,12 +6,13 @@
 //    parallelogram under that view is then drawn into the layer, each pixel darkened by the
 //    silhouette coverage at its point projected along the light, averaged over 4 taps from a
 //    blurred mip level (a soft, percentage-closer-style edge), computed once per silhouette at
-//    each of its texels and sampled bilinearly by the floor.
+//    half its resolution (the taps read level 1.5) and sampled bilinearly by the floor.
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -50,6 +51,8 @@ class CastShadow {
                     float strength);
 
  private:
+  // The soft coverage's texels a side: half the silhouette's (it is read from level 1.5).
+  int BlurredSize() const { return std::max(1, size_ / 2); }
   const GlApi* gl_;
   int size_;
   GlName texture_, fbo_, blurred_, blurred_fbo_, program_, blur_program_, vao_;
