@@ -21,7 +21,7 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
       camera_(camera),
       pinhole_(camera.WithoutDistortion()),
       options_(options),
-      target_(context.gl(), camera.width, camera.height, options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
+      target_(context.gl(), camera.Size(), options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
       shadow_(context.gl()) {
   ProjectionMatrix(pinhole_, options_.clip);  // validates the camera and the clip range
   if (camera_.HasDistortion()) {
@@ -194,6 +194,23 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     const double u = pinhole_.fx * c.x() / c.z() + pinhole_.cx, v = pinhole_.fy * c.y() / c.z() + pinhole_.cy;
     u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
   };
+  // A sphere's exact extent on screen: along each image axis, the two tangents from the eye.
+  // (A cube around it, projected, is up to ~1.6x wider for a character close to the camera; the
+  // rectangle's area is what 4x MSAA clears and resolves.)
+  auto add_sphere = [&](const Eigen::Vector3d& world, double r) {
+    const Eigen::Vector3d c = eye.ToCamera(world);
+    far_z = std::max(far_z, c.z() + r);
+    if (c.z() - r <= options_.clip.near_m) {
+      behind = true;
+      return;
+    }
+    const double zz = c.z() * c.z() - r * r;
+    const double ru = r * std::sqrt(c.x() * c.x() + zz), rv = r * std::sqrt(c.y() * c.y() + zz);
+    u0 = std::min(u0, pinhole_.fx * (c.x() * c.z() - ru) / zz + pinhole_.cx);
+    u1 = std::max(u1, pinhole_.fx * (c.x() * c.z() + ru) / zz + pinhole_.cx);
+    v0 = std::min(v0, pinhole_.fy * (c.y() * c.z() - rv) / zz + pinhole_.cy);
+    v1 = std::max(v1, pinhole_.fy * (c.y() * c.z() + rv) / zz + pinhole_.cy);
+  };
   for (size_t i = 0; i < characters_.size(); ++i) {
     const Placed& placed = characters_[i];
     const anim::FrameOutput& frame = *frames[i];
@@ -201,13 +218,13 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     const std::vector<float>& radii = placed.renderer->joint_radii();
     for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
       if (radii[j] <= 0) continue;
-      // A cube around the joint's sphere of influence, enlarged 10% (DQS need not stay inside
-      // the linear blend's hull) and by the joint's own scale.
+      // The joint's sphere of influence, enlarged 10% (DQS need not stay inside the linear
+      // blend's hull) and by the joint's own scale.
       const Eigen::Matrix4d m = model_to_map * frame.model[j];
       const double scale = m.topLeftCorner<3, 3>().colwise().norm().maxCoeff();
       const double r = 1.1 * radii[j] * scale;
       const Eigen::Vector3d centre = m.col(3).head<3>();
-      for (int k = 0; k < 8; ++k) add(centre + r * Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+      add_sphere(centre, r);
     }
     ShadowEllipse e;
     if (options_.shadow && Shadow(placed, frame, &e)) {
@@ -284,13 +301,9 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     draw.silhouette = true;  // front faces seen from the light cover the whole silhouette of closed meshes
     placed.cast->BeginSilhouette();
     placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
-    placed.cast->EndSilhouette();
+    placed.cast->EndSilhouette(options_.cast_shadow_softness);
   }
-  target_.Bind();
-  target_.Scissor(rect);
-  gl.ClearColor(0, 0, 0, 0);
-  gl.ClearDepth(1.0);
-  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  target_.Begin(rect);
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
   const Eigen::Matrix4d view = ViewMatrix(eye);
   // Real things in front of the characters: depth only, before anything is drawn.
@@ -303,17 +316,15 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
       shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
     }
     if (casts[i]) {
-      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed),
-                                options_.cast_shadow_softness);
+      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed));
     }
     placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
-  target_.Scissor({});
   CheckGl(gl, "AR frame");
 
   // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgra(rect);
+  const cv::Mat layer = target_.ReadBgra();
   for (int y = 0; y < rect.height; ++y) {
     const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
     cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;

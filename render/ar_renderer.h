@@ -4,7 +4,8 @@
 //
 // Cost: only the screen rectangle that can contain the characters and their shadows (bounded
 // from the posed joints and each joint's skin radius) is cleared, drawn, resolved and read
-// back, as premultiplied RGBA; it is blended over the video frame on the CPU. The video never
+// back, as premultiplied RGBA, in a target about the rectangle's size (RegionTarget: llvmpipe
+// clears a whole target faster than a scissored part); it is blended over the video frame on the CPU. The video never
 // goes through OpenGL, and multisampling costs in proportion to the character's size on screen.
 //
 // Lens distortion: the background is undistorted with maps precomputed once
@@ -132,7 +133,7 @@ class ArRenderer {
   OffscreenContext* context_;
   calib::Camera camera_, pinhole_;
   ArOptions options_;
-  RenderTarget target_;
+  RegionTarget target_;
   cv::Mat undistort_map1_, undistort_map2_;
   ContactShadow shadow_;
   std::vector<Placed> characters_;

@@ -22,8 +22,25 @@ struct CharacterVertex {
   float weights[4];
 };
 
-std::string VertexShader(int joints) {
-  return "#version 450 core\n#define JOINTS " + std::to_string(joints) + R"(
+struct ProgramVariant {
+  bool dual_quaternion = true;
+  LightingMode lighting = LightingMode::kFixed;  // kFixed for the silhouette
+  bool silhouette = false;
+  // 0..7: the silhouette's shading is none, so it has one variant per skinning method.
+  size_t Index() const { return (silhouette ? 6 : 2 * static_cast<size_t>(lighting)) + (dual_quaternion ? 1 : 0); }
+};
+
+// The program's variant, as preprocessor definitions: llvmpipe runs both sides of a branch on a
+// uniform (its SIMD lanes are masked, not skipped), so one program for every mode paid for linear
+// blend and dual-quaternion skinning, the PRT rotation and the SH irradiance in every pass.
+std::string VariantDefines(const ProgramVariant& v) {
+  return "#version 450 core\n#define DUAL_QUATERNION " + std::to_string(v.dual_quaternion ? 1 : 0) +
+         "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n#define SILHOUETTE " +
+         std::to_string(v.silhouette ? 1 : 0) + "\n";
+}
+
+std::string VertexShader(int joints, const ProgramVariant& variant) {
+  return VariantDefines(variant) + "#define JOINTS " + std::to_string(joints) + R"(
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
@@ -35,11 +52,11 @@ layout(location = 7) in vec3 transfer2;  // 6-8
 uniform mat4 mvp;            // projection · view · model_to_map
 uniform mat4 model;          // model_to_map
 uniform mat3 normal_matrix;  // inverse transpose of model_to_map's 3x3
-uniform int method;          // 0: linear blend, 1: dual quaternion
 uniform mat4 skin[JOINTS];
 uniform vec4 dq_real[JOINTS];  // quaternion (x, y, z, w)
 uniform vec4 dq_dual[JOINTS];
-uniform int lighting;        // 0: fixed key + ambient, 1: SH irradiance, 2: SH with PRT transfer
+// LIGHTING 0: fixed key + ambient, 1: SH irradiance, 2: SH with PRT transfer; SILHOUETTE 1:
+// coverage only (the cast shadow's light view). DUAL_QUATERNION 0: linear blend skinning.
 uniform mat3 model_rotation; // model_to_map's rotation, without its scale
 uniform vec3 sh[9];          // incident radiance (map frame), RGB
 out vec3 v_normal;
@@ -73,40 +90,46 @@ void main() {
   vec3 p;
   vec3 n;
   mat3 skin_rotation;
-  if (method == 1) {
-    // Kavan et al. 2007: blend in the hemisphere of the first joint, normalise, apply.
-    vec4 r0 = dq_real[joints.x];
-    vec4 real = vec4(0.0);
-    vec4 dual = vec4(0.0);
-    for (int i = 0; i < 4; ++i) {
-      float w = weights[i];
-      vec4 r = dq_real[joints[i]];
-      if (dot(r, r0) < 0.0) w = -w;
-      real += w * r;
-      dual += w * dq_dual[joints[i]];
-    }
-    float len = length(real);
-    real /= len;
-    dual /= len;
-    // translation = 2 · dual · conj(real)
-    vec3 t = 2.0 * (real.w * dual.xyz - dual.w * real.xyz + cross(real.xyz, dual.xyz));
-    p = rotate(real, position) + t;
-    n = rotate(real, normal);
-    if (lighting == 2) skin_rotation = quat_matrix(real);
-  } else {
-    mat4 m = weights.x * skin[joints.x] + weights.y * skin[joints.y] + weights.z * skin[joints.z] +
-             weights.w * skin[joints.w];
-    p = (m * vec4(position, 1.0)).xyz;
-    n = mat3(m) * normal;
-    if (lighting == 2) {
-      // The rotation of the blended matrix (Gram-Schmidt): SH rotation needs an orthogonal one.
-      vec3 x = normalize(m[0].xyz);
-      vec3 y = normalize(m[1].xyz - dot(m[1].xyz, x) * x);
-      skin_rotation = mat3(x, y, cross(x, y));
-    }
+#if DUAL_QUATERNION
+  // Kavan et al. 2007: blend in the hemisphere of the first joint, normalise, apply.
+  vec4 r0 = dq_real[joints.x];
+  vec4 real = vec4(0.0);
+  vec4 dual = vec4(0.0);
+  for (int i = 0; i < 4; ++i) {
+    float w = weights[i];
+    vec4 r = dq_real[joints[i]];
+    if (dot(r, r0) < 0.0) w = -w;
+    real += w * r;
+    dual += w * dq_dual[joints[i]];
   }
+  float len = length(real);
+  real /= len;
+  dual /= len;
+  // translation = 2 · dual · conj(real)
+  vec3 t = 2.0 * (real.w * dual.xyz - dual.w * real.xyz + cross(real.xyz, dual.xyz));
+  p = rotate(real, position) + t;
+  n = rotate(real, normal);
+#if LIGHTING == 2
+  skin_rotation = quat_matrix(real);
+#endif
+#else
+  mat4 m = weights.x * skin[joints.x] + weights.y * skin[joints.y] + weights.z * skin[joints.z] +
+           weights.w * skin[joints.w];
+  p = (m * vec4(position, 1.0)).xyz;
+  n = mat3(m) * normal;
+#if LIGHTING == 2
+  // The rotation of the blended matrix (Gram-Schmidt): SH rotation needs an orthogonal one.
+  vec3 x = normalize(m[0].xyz);
+  vec3 y = normalize(m[1].xyz - dot(m[1].xyz, x) * x);
+  skin_rotation = mat3(x, y, cross(x, y));
+#endif
+#endif
   v_normal = normal_matrix * n;
-  v_prt = lighting == 2 ? prt_radiance(model_rotation * skin_rotation) : vec3(0.0);
+#if LIGHTING == 2
+  v_prt = prt_radiance(model_rotation * skin_rotation);
+#else
+  v_prt = vec3(0.0);
+#endif
   // Assimp's texture coordinates have v = 0 at the image's bottom; textures are uploaded top
   // row first.
   v_uv = vec2(uv.x, 1.0 - uv.y);
@@ -115,7 +138,8 @@ void main() {
 )";
 }
 
-const char* kFragmentShader = R"(#version 450 core
+std::string FragmentShader(const ProgramVariant& variant) {
+  return VariantDefines(variant) + R"(
 in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_prt;
@@ -124,8 +148,6 @@ uniform vec4 base_color;
 uniform vec3 light;  // map frame, towards the light
 uniform float key;
 uniform float ambient;
-uniform int lighting;
-uniform int silhouette;  // 1: white coverage only (the cast shadow's light view)
 uniform vec3 sh[9];
 out vec4 frag_color;
 
@@ -141,20 +163,26 @@ vec3 sh_irradiance(vec3 n) {
 }
 
 void main() {
-  if (silhouette == 1) {
-    frag_color = vec4(1.0);
-    return;
-  }
+#if SILHOUETTE
+  frag_color = vec4(1.0);
+#else
+  vec4 c = texture(albedo, v_uv) * base_color;
+#if LIGHTING == 2
+  vec3 shade = v_prt;
+#else
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;
-  vec4 c = texture(albedo, v_uv) * base_color;
-  vec3 shade;
-  if (lighting == 1) shade = sh_irradiance(n);
-  else if (lighting == 2) shade = v_prt;
-  else shade = vec3(ambient + key * max(dot(n, light), 0.0));
+#if LIGHTING == 1
+  vec3 shade = sh_irradiance(n);
+#else
+  vec3 shade = vec3(ambient + key * max(dot(n, light), 0.0));
+#endif
+#endif
   frag_color = vec4(c.rgb * shade, 1.0);
+#endif
 }
 )";
+}
 
 cv::Mat DecodeTexture(const anim::Texture& t, const std::string& source) {
   if (!t.rgba.empty()) {
@@ -199,14 +227,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     throw RenderError(character.source + ": " + std::to_string(joints_) + " joints; the vertex shader takes at most " +
                       std::to_string(MaxJoints(gl)));
   }
-  program_ = MakeProgram(gl, "character", VertexShader(joints_), kFragmentShader);
-  const GLuint p = program_.get();
-  loc_ = {Uniform(gl, p, "mvp"),     Uniform(gl, p, "model"),   Uniform(gl, p, "normal_matrix"),
-          Uniform(gl, p, "method"),  Uniform(gl, p, "skin"),    Uniform(gl, p, "dq_real"),
-          Uniform(gl, p, "dq_dual"), Uniform(gl, p, "light"),   Uniform(gl, p, "key"),
-          Uniform(gl, p, "ambient"), Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo"),
-          Uniform(gl, p, "lighting"), Uniform(gl, p, "model_rotation"), Uniform(gl, p, "sh"),
-          Uniform(gl, p, "silhouette")};
+  ProgramFor(true, LightingMode::kFixed, false);  // the default one, so that a shader error shows here
   white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
   for (const anim::Texture& t : character.textures) {
     textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, kCharacterAnisotropy, true}));
@@ -280,6 +301,23 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   CheckGl(gl, "character upload (" + character.source + ")");
 }
 
+const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting, bool silhouette) {
+  const ProgramVariant variant{dual_quaternion, silhouette ? LightingMode::kFixed : lighting, silhouette};
+  std::unique_ptr<Program>& slot = programs_.at(variant.Index());
+  if (slot) return *slot;
+  const GlApi& gl = *gl_;
+  auto program = std::make_unique<Program>();
+  program->program = MakeProgram(gl, "character", VertexShader(joints_, variant), FragmentShader(variant));
+  const GLuint p = program->program.get();
+  program->loc = {Uniform(gl, p, "mvp"),        Uniform(gl, p, "model"),   Uniform(gl, p, "normal_matrix"),
+                  Uniform(gl, p, "skin"),       Uniform(gl, p, "dq_real"), Uniform(gl, p, "dq_dual"),
+                  Uniform(gl, p, "light"),      Uniform(gl, p, "key"),     Uniform(gl, p, "ambient"),
+                  Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo"),  Uniform(gl, p, "model_rotation"),
+                  Uniform(gl, p, "sh")};
+  slot = std::move(program);
+  return *slot;
+}
+
 void CharacterRenderer::SetTransfer(const CharacterTransfer& transfer) {
   const GlApi& gl = *gl_;
   if (transfer.meshes.size() != meshes_.size()) {
@@ -333,43 +371,42 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   } else {
     gl.Disable(GL_CULL_FACE);
   }
-  gl.UseProgram(program_.get());
-  gl.UniformMatrix4fv(loc_.mvp, 1, GL_FALSE, mvp.data());
-  gl.UniformMatrix4fv(loc_.model, 1, GL_FALSE, model.data());
-  gl.UniformMatrix3fv(loc_.normal_matrix, 1, GL_FALSE, normal_matrix.data());
-  gl.Uniform1i(loc_.method, dual ? 1 : 0);
+  const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
+  const Program& program = ProgramFor(dual, lighting, d.silhouette);
+  const Locations& loc = program.loc;
+  gl.UseProgram(program.program.get());
+  gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, mvp.data());
+  gl.UniformMatrix4fv(loc.model, 1, GL_FALSE, model.data());
+  gl.UniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, normal_matrix.data());
   if (dual) {
     for (int j = 0; j < joints_; ++j) {
       const anim::DualQuatf& q = d.skinning_dual_quats[j];
       std::copy_n(q.real().coeffs().data(), 4, &dq_upload_[j * 4]);
       std::copy_n(q.dual().coeffs().data(), 4, &dq_upload_[(joints_ + j) * 4]);
     }
-    gl.Uniform4fv(loc_.dq_real, joints_, dq_upload_.data());
-    gl.Uniform4fv(loc_.dq_dual, joints_, dq_upload_.data() + joints_ * 4);
+    gl.Uniform4fv(loc.dq_real, joints_, dq_upload_.data());
+    gl.Uniform4fv(loc.dq_dual, joints_, dq_upload_.data() + joints_ * 4);
   } else {
-    gl.UniformMatrix4fv(loc_.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
+    gl.UniformMatrix4fv(loc.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
   }
-  const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
-  gl.Uniform1i(loc_.lighting, d.silhouette ? 0 : static_cast<int>(lighting));
-  gl.Uniform1i(loc_.silhouette, d.silhouette ? 1 : 0);
   if (lighting != LightingMode::kFixed && !d.silhouette) {
     float sh[27];
     for (int k = 0; k < 9; ++k)
       for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
-    gl.Uniform3fv(loc_.sh, 9, sh);
+    gl.Uniform3fv(loc.sh, 9, sh);
     Eigen::Matrix3d rotation = d.model_to_map.topLeftCorner<3, 3>();
     rotation /= std::cbrt(std::abs(rotation.determinant()));  // uniform scale out
     const Eigen::Matrix3f r = rotation.cast<float>();
-    gl.UniformMatrix3fv(loc_.model_rotation, 1, GL_FALSE, r.data());
+    gl.UniformMatrix3fv(loc.model_rotation, 1, GL_FALSE, r.data());
   }
-  gl.Uniform3f(loc_.light, light.x(), light.y(), light.z());
-  gl.Uniform1f(loc_.key, d.key);
-  gl.Uniform1f(loc_.ambient, d.ambient);
-  gl.Uniform1i(loc_.albedo, 0);
+  gl.Uniform3f(loc.light, light.x(), light.y(), light.z());
+  gl.Uniform1f(loc.key, d.key);
+  gl.Uniform1f(loc.ambient, d.ambient);
+  gl.Uniform1i(loc.albedo, 0);
   gl.ActiveTexture(GL_TEXTURE0);
   for (const GpuMesh& mesh : meshes_) {
     gl.BindTexture(GL_TEXTURE_2D, mesh.texture >= 0 ? textures_[mesh.texture].get() : white_.get());
-    gl.Uniform4f(loc_.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
+    gl.Uniform4f(loc.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
     gl.BindVertexArray(mesh.vao.get());
     gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   }

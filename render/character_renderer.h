@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -73,7 +75,18 @@ class CharacterRenderer {
   const GlApi* gl_;
   int joints_ = 0;
   int triangles_ = 0;
-  GlName program_;
+  struct Locations {
+    GLint mvp, model, normal_matrix, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
+    GLint model_rotation, sh;
+  };
+  struct Program {
+    GlName program;
+    Locations loc{};
+  };
+  // One program per variant (skinning method x lighting mode, and the silhouette), compiled on
+  // first use: llvmpipe pays for every branch of a shader that branches on uniforms.
+  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool silhouette);
+  std::array<std::unique_ptr<Program>, 8> programs_;
   std::vector<GlName> textures_;
   GlName white_;
   std::vector<GpuMesh> meshes_;
@@ -81,10 +94,6 @@ class CharacterRenderer {
   bool has_transfer_ = false;
   std::vector<float> joint_radii_;
   std::vector<float> dq_upload_;
-  struct Locations {
-    GLint mvp, model, normal_matrix, method, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
-    GLint lighting, model_rotation, sh, silhouette;
-  } loc_{};
 };
 
 // A soft elliptical shadow on a ground plane, drawn before the character into the transparent

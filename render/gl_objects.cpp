@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <vector>
 
 #include "render/offscreen.h"
@@ -217,6 +218,54 @@ void RenderTarget::Scissor(const cv::Rect& rect) const {
   }
   gl_->Enable(GL_SCISSOR_TEST);
   gl_->Scissor(rect.x, height_ - rect.y - rect.height, rect.width, rect.height);
+}
+
+namespace {
+
+// llvmpipe bins and clears in tiles of 64 x 64 pixels.
+constexpr int kTile = 64;
+int RoundUpToTile(int pixels) { return (pixels + kTile - 1) / kTile * kTile; }
+
+}  // namespace
+
+RegionTarget::RegionTarget(const GlApi& gl, cv::Size image, int samples) : gl_(&gl), image_(image), samples_(samples) {
+  RenderTarget(gl, image.width, image.height, samples);  // validates the size and the sample count once
+}
+
+void RegionTarget::Begin(const cv::Rect& rect) {
+  rect_ = rect & cv::Rect(cv::Point(0, 0), image_);
+  if (rect_.empty()) return;
+  // OpenGL counts rows from the bottom. The target's corner is put on the image's 64-pixel grid:
+  // shifted by whole tiles, llvmpipe rasterises the same samples and interpolates within a unit
+  // of the full-image render (test FoxTest.BoundedRenderEqualsFullFrameRender); with a shift of
+  // any number of pixels a few edge pixels moved by up to 3 levels.
+  const int bottom = image_.height - rect_.y - rect_.height;
+  origin_ = cv::Point(rect_.x / kTile * kTile, bottom / kTile * kTile);
+  in_target_ = cv::Rect(rect_.x - origin_.x, bottom - origin_.y, rect_.width, rect_.height);
+  const cv::Size needed(std::min(RoundUpToTile(in_target_.x + in_target_.width), image_.width - origin_.x),
+                        std::min(RoundUpToTile(in_target_.y + in_target_.height), image_.height - origin_.y));
+  const cv::Size have = target_size();
+  const bool fits = needed.width <= have.width && needed.height <= have.height;
+  if (!fits || 2 * needed.area() < have.area()) target_ = std::make_unique<RenderTarget>(*gl_, needed.width, needed.height, samples_);
+  const GlApi& gl = *gl_;
+  target_->Bind();
+  gl.Viewport(-origin_.x, -origin_.y, image_.width, image_.height);
+  target_->Scissor({});
+  gl.ClearColor(0, 0, 0, 0);
+  gl.ClearDepth(1.0);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  target_->Scissor(TargetRect());
+}
+
+cv::Rect RegionTarget::TargetRect() const {
+  // RenderTarget counts rows from the top.
+  return {in_target_.x, target_->height() - in_target_.y - in_target_.height, in_target_.width, in_target_.height};
+}
+
+cv::Mat RegionTarget::ReadBgra() const {
+  if (rect_.empty() || !target_) return cv::Mat(0, 0, CV_8UC4);
+  target_->Scissor({});  // drawing into the region is over
+  return target_->ReadBgra(TargetRect());
 }
 
 }  // namespace arview::render

@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -89,6 +90,37 @@ class RenderTarget {
   int width_, height_, samples_;
   GlName draw_fbo_, color_rb_, depth_rb_;
   GlName resolve_fbo_, resolve_rb_;
+};
+
+// Draws one rectangle of a larger image into a target about the rectangle's size: the viewport
+// is the whole image's, offset by the rectangle's corner, so the image's pixels inside the
+// rectangle land in the target exactly where a full-image target would have them (an integer
+// shift: the same rasterisation). Why: llvmpipe clears a whole target with its fast path (a fill
+// per 64-pixel tile), while a scissored clear is drawn as a quad at every sample; for the
+// character's rectangle at 4x MSAA that was ~1 ms of the frame (docs/render.md).
+// The target is sized up to whole 64-pixel tiles and kept while rectangles fit in it; it is made
+// again for a rectangle that does not fit, or one with less than half its area.
+class RegionTarget {
+ public:
+  RegionTarget(const GlApi& gl, cv::Size image, int samples);
+  // Binds a target for `rect` (image coordinates, row 0 at the top; clipped to the image),
+  // clears it (colour 0, depth 1) and limits drawing to the rectangle. Empty rect: nothing bound.
+  void Begin(const cv::Rect& rect);
+  // The rectangle of the last Begin, resolved and read back (CV_8UC4, row 0 at the top); the
+  // scissor test is off again.
+  cv::Mat ReadBgra() const;
+  cv::Size target_size() const { return target_ ? cv::Size(target_->width(), target_->height()) : cv::Size(); }
+
+ private:
+  // Where the rectangle lies in the target (its rows from the target's top, as RenderTarget counts).
+  cv::Rect TargetRect() const;
+  const GlApi* gl_;
+  cv::Size image_;
+  int samples_;
+  cv::Rect rect_;
+  cv::Point origin_;    // the target's pixel (0, 0) in the image, OpenGL's rows (from the bottom)
+  cv::Rect in_target_;  // rect_ in the target, OpenGL's rows
+  std::unique_ptr<RenderTarget> target_;
 };
 
 }  // namespace arview::render

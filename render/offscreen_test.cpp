@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "render/gl_objects.h"
 #include "render/offscreen.h"
 #include "render/test_scene.h"
 
@@ -55,6 +56,68 @@ TEST(Offscreen, RejectsImpossibleRenderTargets) {
   const GlApi& gl = testing::SharedContext().gl();
   EXPECT_THROW(RenderTarget(gl, 0, 10, 1), RenderError);
   EXPECT_THROW(RenderTarget(gl, 10, 10, 64), RenderError);
+}
+
+// Three coloured triangles across a 640 x 480 image, from gl_VertexID alone (no buffers).
+GlName MakeTrianglesProgram(const GlApi& gl) {
+  return MakeProgram(gl, "region test", R"(#version 450 core
+out vec3 v_color;
+void main() {
+  const vec2 corners[9] = vec2[9](vec2(-0.9, -0.8), vec2(0.7, -0.6), vec2(-0.2, 0.9),
+                                  vec2(0.2, -0.99), vec2(0.99, -0.9), vec2(0.33, 0.97),
+                                  vec2(-0.97, 0.2), vec2(-0.1, 0.05), vec2(-0.6, 0.99));
+  const vec3 colors[3] = vec3[3](vec3(1.0, 0.2, 0.1), vec3(0.1, 0.9, 0.3), vec3(0.2, 0.3, 1.0));
+  v_color = colors[gl_VertexID % 3];
+  gl_Position = vec4(corners[gl_VertexID], 0.1 * float(gl_VertexID / 3), 1.0);
+}
+)", R"(#version 450 core
+in vec3 v_color;
+out vec4 frag_color;
+void main() { frag_color = vec4(v_color, 1.0); }
+)");
+}
+
+void DrawTriangles(const GlApi& gl, GLuint program, GLuint vao) {
+  gl.Enable(GL_DEPTH_TEST);
+  gl.DepthFunc(GL_LESS);
+  gl.Disable(GL_CULL_FACE);
+  gl.UseProgram(program);
+  gl.BindVertexArray(vao);
+  gl.DrawArrays(GL_TRIANGLES, 0, 9);
+  gl.BindVertexArray(0);
+}
+
+// The region's pixels are the full image's, whatever the rectangle, including after the target
+// is made again for a larger rectangle and for one much smaller.
+TEST(Offscreen, RegionTargetDrawsTheFullImagesPixelsInsideItsRectangle) {
+  const GlApi& gl = testing::SharedContext().gl();
+  const cv::Size image(640, 480);
+  GlName program = MakeTrianglesProgram(gl);
+  GlName vao = MakeVertexArray(gl);
+  RenderTarget full(gl, image.width, image.height, 4);
+  full.Bind();
+  gl.ClearColor(0, 0, 0, 0);
+  gl.ClearDepth(1.0);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  DrawTriangles(gl, program.get(), vao.get());
+  RegionTarget region(gl, image, 4);
+  for (const cv::Rect& rect : {cv::Rect(10, 20, 100, 80), cv::Rect(300, 100, 330, 370), cv::Rect(0, 0, 640, 480),
+                               cv::Rect(33, 41, 50, 60), cv::Rect(600, 420, 40, 60), cv::Rect(250, 200, 130, 70)}) {
+    region.Begin(rect);
+    DrawTriangles(gl, program.get(), vao.get());
+    const cv::Mat got = region.ReadBgra();
+    const cv::Mat want = full.ReadBgra(rect);
+    ASSERT_EQ(got.size(), rect.size());
+    cv::Mat diff;
+    cv::absdiff(got, want, diff);
+    double worst = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+    EXPECT_LE(worst, 1) << "rectangle " << rect;
+    EXPECT_GT(cv::countNonZero(want.reshape(1)), 0) << "rectangle " << rect << " shows no triangle";
+    // The target stays about the rectangle's size: at most a tile more on each side and each end.
+    EXPECT_LE(region.target_size().width, rect.width + 2 * 64) << "rectangle " << rect;
+    EXPECT_LE(region.target_size().height, rect.height + 2 * 64) << "rectangle " << rect;
+  }
 }
 
 }  // namespace

@@ -23,18 +23,40 @@ void main() {
 const char* kReceiverFragment = R"(#version 450 core
 in vec3 v_world;
 uniform mat4 light;        // map → light clip (orthographic)
-uniform sampler2D silhouette;
+uniform sampler2D blurred; // the silhouette's soft coverage (CastShadow::EndSilhouette)
 uniform float strength;
-uniform float softness;    // blur radius, texture units
 out vec4 frag_color;
 void main() {
   vec2 uv = (light * vec4(v_world, 1.0)).xy * 0.5 + 0.5;
-  // Four trilinear taps from a blurred mip level: llvmpipe's texture sampling is the cost of
-  // this pass.
+  float a = strength * textureLod(blurred, uv, 0.0).r;
+  // Nothing to darken: 8-bit blending would leave the pixel as it is, so skip it (llvmpipe then
+  // skips the blend at every sample of a block with no shadow).
+  if (a < 0.5 / 255.0) discard;
+  frag_color = vec4(0.0, 0.0, 0.0, a);
+}
+)";
+
+// The soft coverage, once per silhouette: four trilinear taps from a blurred mip level (a soft,
+// percentage-closer-style edge) at each texel, so that the receiver, which covers many more
+// pixels, takes one bilinear tap (llvmpipe's texture sampling was most of its cost).
+const char* kBlurVertex = R"(#version 450 core
+void main() {
+  const vec2 corners[3] = vec2[3](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
+  gl_Position = vec4(corners[gl_VertexID], 0.0, 1.0);
+}
+)";
+
+const char* kBlurFragment = R"(#version 450 core
+uniform sampler2D silhouette;
+uniform float softness;    // blur radius, texture units
+uniform float size;        // texels a side
+out vec4 frag_color;
+void main() {
+  vec2 uv = gl_FragCoord.xy / size;
   const vec2 disc[4] = vec2[4](vec2(-0.5, -0.5), vec2(0.5, -0.5), vec2(-0.5, 0.5), vec2(0.5, 0.5));
   float coverage = 0.0;
   for (int i = 0; i < 4; ++i) coverage += textureLod(silhouette, uv + softness * disc[i], 1.5).r;
-  frag_color = vec4(0.0, 0.0, 0.0, strength * coverage / 4.0);
+  frag_color = vec4(coverage / 4.0);
 }
 )";
 
@@ -73,25 +95,39 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
   return true;
 }
 
-CastShadow::CastShadow(const GlApi& gl, int size) : gl_(&gl), size_(size) {
-  texture_ = MakeTexture(gl, cv::Mat(size, size, CV_8UC3, cv::Scalar::all(0)), {true, 1.f, false});
+namespace {
+
+// A size x size texture (no mipmaps unless asked) with a framebuffer drawing into it.
+GlName MakeTextureFramebuffer(const GlApi& gl, int size, bool mipmaps, GlName* texture) {
+  *texture = MakeTexture(gl, cv::Mat(size, size, CV_8UC3, cv::Scalar::all(0)), {mipmaps, 1.f, false});
   GLuint fbo = 0;
   gl.GenFramebuffers(1, &fbo);
-  fbo_ = GlName(&gl, fbo, [](const GlApi& g, GLuint n) { g.DeleteFramebuffers(1, &n); });
+  GlName framebuffer(&gl, fbo, [](const GlApi& g, GLuint n) { g.DeleteFramebuffers(1, &n); });
   gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
-  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture_.get(), 0);
+  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture->get(), 0);
   if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-    throw RenderError("cast shadow: silhouette framebuffer incomplete");
+    throw RenderError("cast shadow: framebuffer incomplete");
   }
   gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
+  return framebuffer;
+}
+
+}  // namespace
+
+CastShadow::CastShadow(const GlApi& gl, int size) : gl_(&gl), size_(size) {
+  fbo_ = MakeTextureFramebuffer(gl, size, true, &texture_);
+  blurred_fbo_ = MakeTextureFramebuffer(gl, BlurredSize(), false, &blurred_);
   program_ = MakeProgram(gl, "cast shadow", kReceiverVertex, kReceiverFragment);
   const GLuint p = program_.get();
   mvp_ = Uniform(gl, p, "mvp");
   light_ = Uniform(gl, p, "light");
   corners_ = Uniform(gl, p, "corners");
   strength_ = Uniform(gl, p, "strength");
-  softness_ = Uniform(gl, p, "softness");
-  silhouette_ = Uniform(gl, p, "silhouette");
+  blurred_sampler_ = Uniform(gl, p, "blurred");
+  blur_program_ = MakeProgram(gl, "cast shadow blur", kBlurVertex, kBlurFragment);
+  softness_ = Uniform(gl, blur_program_.get(), "softness");
+  blur_size_ = Uniform(gl, blur_program_.get(), "size");
+  silhouette_ = Uniform(gl, blur_program_.get(), "silhouette");
   vao_ = MakeVertexArray(gl);
   CheckGl(gl, "cast shadow setup");
 }
@@ -105,14 +141,27 @@ void CastShadow::BeginSilhouette() {
   gl.Clear(GL_COLOR_BUFFER_BIT);
 }
 
-void CastShadow::EndSilhouette() {
+void CastShadow::EndSilhouette(float softness) {
   const GlApi& gl = *gl_;
   gl.BindTexture(GL_TEXTURE_2D, texture_.get());
   gl.GenerateMipmap(GL_TEXTURE_2D);
+  gl.BindFramebuffer(GL_FRAMEBUFFER, blurred_fbo_.get());
+  gl.Viewport(0, 0, BlurredSize(), BlurredSize());
+  gl.Disable(GL_DEPTH_TEST);
+  gl.Disable(GL_CULL_FACE);
+  gl.Disable(GL_BLEND);
+  gl.UseProgram(blur_program_.get());
+  gl.Uniform1f(softness_, softness);
+  gl.Uniform1f(blur_size_, static_cast<float>(BlurredSize()));
+  gl.Uniform1i(silhouette_, 0);
+  gl.ActiveTexture(GL_TEXTURE0);
+  gl.BindVertexArray(vao_.get());
+  gl.DrawArrays(GL_TRIANGLES, 0, 3);
+  gl.BindVertexArray(0);
 }
 
 void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
-                              float strength, float softness) {
+                              float strength) {
   const GlApi& gl = *gl_;
   const Eigen::Matrix4f mvp = (projection * view).cast<float>();
   const Eigen::Matrix4f to_light = light.map_to_clip.cast<float>();
@@ -129,10 +178,9 @@ void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Ma
   gl.UniformMatrix4fv(light_, 1, GL_FALSE, to_light.data());
   gl.Uniform3fv(corners_, 4, corners);
   gl.Uniform1f(strength_, strength);
-  gl.Uniform1f(softness_, softness);
-  gl.Uniform1i(silhouette_, 0);
+  gl.Uniform1i(blurred_sampler_, 0);
   gl.ActiveTexture(GL_TEXTURE0);
-  gl.BindTexture(GL_TEXTURE_2D, texture_.get());
+  gl.BindTexture(GL_TEXTURE_2D, blurred_.get());
   gl.BindVertexArray(vao_.get());
   gl.DrawArrays(GL_TRIANGLES, 0, 6);
   gl.BindVertexArray(0);

@@ -5,12 +5,14 @@
 //    the light (orthographic, around the character's bounding sphere); the floor's
 //    parallelogram under that view is then drawn into the layer, each pixel darkened by the
 //    silhouette coverage at its point projected along the light, averaged over 4 taps from a
-//    blurred mip level (a soft, percentage-closer-style edge).
+//    blurred mip level (a soft, percentage-closer-style edge), computed once per silhouette at
+//    half its resolution (the taps read level 1.5) and sampled bilinearly by the floor.
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -39,18 +41,23 @@ class CastShadow {
   // Binds the silhouette target (cleared, viewport set): draw the character with
   // LightView::map_to_clip as projection, an identity view, and CharacterDraw::silhouette.
   void BeginSilhouette();
-  // Mipmaps the silhouette; the caller then binds its own framebuffer again.
-  void EndSilhouette();
-  // Into the bound framebuffer, premultiplied black: alpha = strength × coverage.
-  // `softness`: the blur radius as a share of the light view's width.
+  // Mipmaps the silhouette and blurs it into the soft coverage the receiver samples;
+  // `softness`: the blur radius as a share of the light view's width. The caller then binds its
+  // own framebuffer again.
+  void EndSilhouette(float softness);
+  // Into the bound framebuffer, premultiplied black: alpha = strength × soft coverage (pixels
+  // with no shadow are left alone).
   void DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
-                    float strength, float softness);
+                    float strength);
 
  private:
+  // The soft coverage's texels a side: half the silhouette's (it is read from level 1.5).
+  int BlurredSize() const { return std::max(1, size_ / 2); }
   const GlApi* gl_;
   int size_;
-  GlName texture_, fbo_, program_, vao_;
-  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, softness_ = -1, silhouette_ = -1;
+  GlName texture_, fbo_, blurred_, blurred_fbo_, program_, blur_program_, vao_;
+  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, blurred_sampler_ = -1;
+  GLint softness_ = -1, blur_size_ = -1, silhouette_ = -1;
 };
 
 class DepthProxy {
