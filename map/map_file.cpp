@@ -1,6 +1,7 @@
 #include "map/map_file.h"
 
 #include "base/atomic_file.h"
+#include "base/input_guard.h"
 #include "base/stats.h"
 
 #include <algorithm>
@@ -273,12 +274,16 @@ void SaveMap(const Map& map, const fs::path& file) {
 Map LoadMap(const fs::path& path) {
   std::error_code ec;
   const fs::path file = fs::is_directory(path, ec) ? path / kMapFileName : path;
-  std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) throw MapError(file.string() + ": map file missing or unreadable (run 'arview map' first)");
-  const auto size = static_cast<std::size_t>(in.tellg());
-  in.seekg(0);
-  std::vector<char> data(size);
-  if (!in.read(data.data(), static_cast<std::streamsize>(size))) throw MapError(file.string() + ": read error");
+  if (!fs::exists(file, ec)) throw MapError(file.string() + ": map file missing (run 'arview map' first)");
+  // Only a regular file, read whole: a FIFO would block for ever, a link to /dev/zero would read
+  // as an empty map, and a file cut short while it is read (a copy still under way) is refused.
+  std::string data;
+  try {
+    data = ReadFileUpTo(file, kMaxBinaryFileBytes);
+  } catch (const InputError& e) {
+    throw MapError(std::string(e.what()) + " (map file)");
+  }
+  const std::size_t size = data.size();
 
   Reader header(data.data(), std::min(size, kHeaderSize), file);
   char magic[8];

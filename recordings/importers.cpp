@@ -171,7 +171,8 @@ fs::path FindParFile(const fs::path& dir) {
   std::vector<fs::path> found;
   for (const auto& entry : fs::directory_iterator(dir)) {
     const std::string name = entry.path().filename().string();
-    if (entry.is_regular_file() && name.size() > 8 && name.ends_with("_par.txt")) found.push_back(entry.path());
+    // Any kind of entry: a FIFO or a device so named is refused by name when read, not overlooked.
+    if (!entry.is_directory() && name.size() > 8 && name.ends_with("_par.txt")) found.push_back(entry.path());
   }
   if (found.empty()) throw RecordingError(dir.string() + ": no *_par.txt camera file (not a Middlebury folder)");
   if (found.size() > 1) {
@@ -182,8 +183,7 @@ fs::path FindParFile(const fs::path& dir) {
 }
 
 std::vector<MiddleburyView> ReadParFile(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw RecordingError(file.string() + ": cannot open");
+  std::istringstream in(ReadRecordingText(file));
   std::vector<MiddleburyView> views;
   std::string line;
   int line_no = 0;
@@ -259,8 +259,9 @@ struct StrechaCamera {
 };
 
 StrechaCamera ReadStrechaCamera(const fs::path& file) {
-  std::ifstream in(file);
-  if (!in) throw RecordingError(file.string() + ": missing (every image needs its .camera file)");
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw RecordingError(file.string() + ": missing (every image needs its .camera file)");
+  std::istringstream in(ReadRecordingText(file));
   std::vector<std::vector<double>> rows;
   std::vector<int> line_of_row;
   std::string line;

@@ -1,6 +1,7 @@
 #include "recordings/trajectory.h"
 
 #include "base/atomic_file.h"
+#include "base/input_guard.h"
 
 #include <cmath>
 #include <fstream>
@@ -9,9 +10,16 @@
 
 namespace arview::recordings {
 
+std::string ReadRecordingText(const std::filesystem::path& file) {
+  try {
+    return ReadFileUpTo(file, kMaxTextFileBytes);
+  } catch (const InputError& e) {
+    throw RecordingError(e.what());
+  }
+}
+
 Trajectory ReadTum(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw RecordingError(path.string() + ": cannot open trajectory file");
+  std::istringstream in(ReadRecordingText(path));
   Trajectory out;
   std::string line;
   int line_no = 0;

@@ -22,6 +22,11 @@ struct StampedPose {
 
 using Trajectory = std::vector<StampedPose>;
 
+// The whole of a text file the recordings module reads (trajectories, camera files of imported
+// data sets): only a regular file of sane size, since a FIFO or a link to /dev/zero would never
+// end; RecordingError naming the file otherwise.
+std::string ReadRecordingText(const std::filesystem::path& file);
+
 // Reads a TUM file; '#' comments and blank lines are skipped. A malformed line throws
 // RecordingError naming the file and the line number.
 Trajectory ReadTum(const std::filesystem::path& path);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/mount.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include "calib/camera.h"
 #include "map/map_file.h"
 #include "tests/support/run_command.h"
+#include "tests/support/spawn_command.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -418,6 +420,46 @@ TEST_F(Faults, EveryWriterIntoAnUnwritableFolderFailsWithOneLine) {
     ::umount(out.c_str());
   } else {
     fs::permissions(out, fs::perms::owner_all);
+  }
+}
+
+// Issue 17 §3, "only regular files opened as data": a FIFO named as a trajectory (`eval`), as
+// the map file (`map info`, `track`) or as a Middlebury camera file (`import`) made arview wait
+// for a writer for ever; a map file that links to /dev/zero read as an empty, "truncated" map.
+// Each is now refused at once: one line naming the file and saying what it is.
+TEST_F(Faults, AFifoOrADeviceGivenAsADataFileIsRefusedAtOnce) {
+  const fs::path fifo_map = dir_ / "fifo_map", zero_map = dir_ / "zero_map", middlebury = dir_ / "middlebury";
+  for (const fs::path& d : {fifo_map, zero_map, middlebury}) fs::create_directories(d);
+  const fs::path estimate = dir_ / "estimate.txt", groundtruth = dir_ / "groundtruth.txt";
+  ASSERT_EQ(::mkfifo(estimate.c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo((fifo_map / map::kMapFileName).c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", zero_map / map::kMapFileName);
+  ASSERT_EQ(::mkfifo((middlebury / "temple_par.txt").c_str(), 0600), 0);
+  WriteText(groundtruth, Trajectory(10, true));
+
+  struct Case {
+    std::vector<std::string> args;
+    fs::path file;
+    std::string kind;
+  };
+  const std::vector<Case> cases = {
+      {{"eval", estimate.string(), groundtruth.string()}, estimate, "a FIFO"},
+      {{"eval", groundtruth.string(), "/dev/zero"}, "/dev/zero", "a character device"},
+      {{"map", "info", fifo_map.string()}, fifo_map / map::kMapFileName, "a FIFO"},
+      {{"map", "info", zero_map.string()}, zero_map / map::kMapFileName, "a character device"},
+      {{"import", "middlebury", middlebury.string(), "--out", (dir_ / "imported").string()},
+       middlebury / "temple_par.txt", "a FIFO"},
+  };
+  for (const Case& c : cases) {
+    const std::string label = c.args[0] + " " + c.args[1] + ": ";
+    testing::SpawnedArview run(c.args, dir_ / "fifo_run");
+    ASSERT_TRUE(run.WaitExit(std::chrono::seconds(30))) << label << "still waiting after 30 s";
+    const std::string err = run.Stderr();
+    EXPECT_EQ(run.exit_code(), 1) << label << err;
+    EXPECT_EQ(LineCount(err), 1) << label << err;
+    EXPECT_EQ(err.rfind("arview: " + c.file.string() + ": is " + c.kind + ", not a data file", 0), 0u) << label << err;
+    EXPECT_FALSE(fs::exists(dir_ / "imported" / "frames.txt")) << label;
+    run.RemoveLogs();
   }
 }
 
