@@ -20,12 +20,25 @@ void NotBuiltYet(const std::string& command) {
 namespace {
 
 // CLI11 messages may span lines; the contract is one clear line on stderr.
-std::string OneLine(std::string text) {
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = ' ';
+// A message may quote text from a file (a name, a token): line breaks become spaces, so that it
+// stays one line, and other control characters are shown as \xNN (an escape sequence in a
+// hostile file must not drive the terminal). Bytes from 0x80 up pass: UTF-8 file names.
+std::string OneLine(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n' || c == '\r') {
+      out += ' ';
+    } else if ((byte < 0x20 && c != '\t') || byte == 0x7f) {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+      out += escaped;
+    } else {
+      out += c;
+    }
   }
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
 }
 
 }  // namespace

@@ -317,4 +317,20 @@ fs::path ResolveInside(const fs::path& folder, const fs::path& relative, const s
   return resolved;
 }
 
+std::string PrintableForMessage(std::string_view text, size_t max_chars) {
+  std::string out;
+  for (const char c : text) {
+    if (out.size() >= max_chars) return out + "...";
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f && byte != '\\') {
+      out += c;
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+      out += escaped;
+    }
+  }
+  return out;
+}
+
 }  // namespace arview

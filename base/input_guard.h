@@ -86,4 +86,9 @@ inline double RequireFinite(double value, const std::string& what) {
 std::filesystem::path ResolveInside(const std::filesystem::path& folder, const std::filesystem::path& relative,
                                     const std::string& source);
 
+// Text taken from a data file, made fit to quote in a one-line message: bytes outside printable
+// ASCII as \xNN (a name holding a newline would split the line; binary would garble the
+// terminal), cut to `max_chars` with "..." after.
+std::string PrintableForMessage(std::string_view text, size_t max_chars = 120);
+
 }  // namespace arview

@@ -182,3 +182,15 @@ TEST_F(InputGuard, PathsFromDataFilesStayInsideTheirFolder) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+TEST(PrintableForMessage, EscapesWhatIsNotPrintableAsciiAndCutsLongText) {
+  EXPECT_EQ(PrintableForMessage("frames/000001.png"), "frames/000001.png");
+  EXPECT_EQ(PrintableForMessage(std::string("a\nb\x1b\xff\\", 6)), "a\\x0ab\\x1b\\xff\\x5c");
+  EXPECT_EQ(PrintableForMessage(std::string(10, 'x'), 4), "xxxx...");
+}
+
+}  // namespace
+}  // namespace arview

@@ -10,25 +10,19 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz/colmap_fixture.h"
 #include "fuzz/fuzz_support.h"
 #include "mapping/colmap_model.h"
 
 namespace {
 
-void Exec(sqlite3* db, const std::string& sql) {
-  char* error = nullptr;
-  if (sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
-    const std::string message = error ? error : "?";
-    sqlite3_free(error);
-    throw std::runtime_error("fuzz database: " + message);
-  }
-}
+using arview::fuzz::Exec;
+using arview::fuzz::Put;
 
 std::filesystem::path MakeDatabase(const std::filesystem::path& file) {
   sqlite3* db = nullptr;
   if (sqlite3_open(file.c_str(), &db) != SQLITE_OK) throw std::runtime_error("fuzz database: cannot open");
-  Exec(db, "CREATE TABLE images(image_id INTEGER PRIMARY KEY, name TEXT);"
-           "CREATE TABLE descriptors(image_id INTEGER PRIMARY KEY, rows INTEGER, cols INTEGER, data BLOB);");
+  Exec(db, arview::fuzz::kColmapDatabaseSchema);
   for (int id = 1; id <= 4; ++id) {
     Exec(db, "INSERT INTO images VALUES(" + std::to_string(id) + ", 'frames/00000" + std::to_string(id) + ".png');");
     Exec(db, "INSERT INTO descriptors VALUES(" + std::to_string(id) + ", 64, 128, randomblob(8192));");
@@ -51,56 +45,18 @@ std::string_view TakeSized(std::string_view& rest) {
   return part;
 }
 
-template <typename T>
-void Put(std::string& out, T value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
-
 void PutSized(std::string& out, const std::string& part) {
   Put<std::uint32_t>(out, static_cast<std::uint32_t>(part.size()));
   out += part;
 }
 
-// A valid model in COLMAP's binary format: one PINHOLE camera, two images, three points each
-// seen by both images.
+// The small valid model as one input.
 std::string SmallModel() {
-  std::string cameras, images, points;
-  Put<std::uint64_t>(cameras, 1);
-  Put<std::uint32_t>(cameras, 1);  // camera id
-  Put<std::int32_t>(cameras, 1);   // PINHOLE
-  Put<std::uint64_t>(cameras, 640);
-  Put<std::uint64_t>(cameras, 480);
-  for (double v : {500.0, 500.0, 319.5, 239.5}) Put(cameras, v);
-  Put<std::uint64_t>(images, 2);
-  for (std::uint32_t id = 1; id <= 2; ++id) {
-    Put(images, id);
-    for (double v : {1.0, 0.0, 0.0, 0.0, 0.1 * id, 0.0, 0.0}) Put(images, v);
-    Put<std::uint32_t>(images, 1);
-    images += "frames/00000" + std::to_string(id) + ".png";
-    images += '\0';
-    Put<std::uint64_t>(images, 3);
-    for (std::uint64_t p = 1; p <= 3; ++p) {
-      Put(images, 100.0 * p);
-      Put(images, 80.0 * p);
-      Put<std::int64_t>(images, static_cast<std::int64_t>(p));
-    }
-  }
-  Put<std::uint64_t>(points, 3);
-  for (std::uint64_t p = 1; p <= 3; ++p) {
-    Put(points, p);
-    for (double v : {0.1 * p, -0.2, 4.0}) Put(points, v);
-    points += "\x10\x20\x30";
-    Put(points, 0.5);
-    Put<std::uint64_t>(points, 2);
-    for (std::uint32_t id = 1; id <= 2; ++id) {
-      Put(points, id);
-      Put<std::uint32_t>(points, static_cast<std::uint32_t>(p - 1));
-    }
-  }
+  const arview::fuzz::ColmapModelFiles m = arview::fuzz::SmallColmapModel();
   std::string input;
-  PutSized(input, cameras);
-  PutSized(input, images);
-  return input + points;
+  PutSized(input, m.cameras);
+  PutSized(input, m.images);
+  return input + m.points;
 }
 
 }  // namespace

@@ -189,7 +189,7 @@ std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToke
     const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
     if (!std::isfinite(quat.norm()) || std::abs(quat.norm() - 1.0) > 1e-3 ||
         !Eigen::Vector3d(t[0], t[1], t[2]).allFinite()) {
-      r.Fail("image " + std::to_string(im.id) + " ('" + im.name + "') has an invalid pose");
+      r.Fail("image " + std::to_string(im.id) + " ('" + PrintableForMessage(im.name) + "') has an invalid pose");
     }
     im.pose.q_cw = quat.normalized();
     im.pose.t_cw = Eigen::Vector3d(t[0], t[1], t[2]);
@@ -358,7 +358,7 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
     if (frames.empty()) return FrameInfo{};
     const auto it = frames.find(im.name);
     if (it == frames.end()) {
-      throw map::MapError(images_file.string() + ": image '" + im.name + "' is not a frame of the recording");
+      throw map::MapError(images_file.string() + ": image '" + PrintableForMessage(im.name) + "' is not a frame of the recording");
     }
     return it->second;
   };
@@ -403,7 +403,7 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
       const auto& im = images[kf->second];
       if (e.point2d_idx >= im.point3d_ids.size() || im.point3d_ids[e.point2d_idx] != p.id) {
         throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
-                       std::to_string(e.point2d_idx) + " of image '" + im.name + "', which does not refer back to it");
+                       std::to_string(e.point2d_idx) + " of image '" + PrintableForMessage(im.name) + "', which does not refer back to it");
       }
     }
   }
@@ -439,12 +439,12 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
     const auto& im = images[k];
     const std::string db_name = db.ImageName(im.id);
     if (db_name != im.name) {
-      throw map::MapError(database.string() + ": image id " + std::to_string(im.id) + " is '" + db_name + "' but " +
-                     images_file.string() + " calls it '" + im.name + "' (a different database?)");
+      throw map::MapError(database.string() + ": image id " + std::to_string(im.id) + " is '" + PrintableForMessage(db_name) + "' but " +
+                     images_file.string() + " calls it '" + PrintableForMessage(im.name) + "' (a different database?)");
     }
     const cv::Mat desc = db.Descriptors(im.id);
     if (static_cast<std::size_t>(desc.rows) != im.xy.size()) {
-      throw map::MapError(database.string() + ": image '" + im.name + "' has " + std::to_string(desc.rows) +
+      throw map::MapError(database.string() + ": image '" + PrintableForMessage(im.name) + "' has " + std::to_string(desc.rows) +
                      " descriptors but " + std::to_string(im.xy.size()) + " 2D points in " + images_file.string());
     }
     for (const auto& [idx, r] : wanted[k]) desc.row(static_cast<int>(idx)).copyTo(map.descriptors.row(static_cast<int>(r)));
@@ -456,7 +456,7 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
       const auto pi = point_index.find(pid);
       const auto ri = row_of.find(Key(im.id, idx));
       if (pi == point_index.end() || ri == row_of.end()) {
-        throw map::MapError(images_file.string() + ": 2D point " + std::to_string(idx) + " of '" + im.name +
+        throw map::MapError(images_file.string() + ": 2D point " + std::to_string(idx) + " of '" + PrintableForMessage(im.name) +
                        "' refers to 3D point " + std::to_string(pid) + ", whose track does not list it");
       }
       const Eigen::Vector2d px = im.xy[idx] - Eigen::Vector2d(0.5, 0.5);  // COLMAP → OpenCV pixels
@@ -486,12 +486,12 @@ void RequireModelValuesInRange(const map::Map& map, const fs::path& sparse_dir) 
   for (const map::Keyframe& k : map.keyframes) {
     const double t = k.pose.t_cw.cwiseAbs().maxCoeff();
     if (t > map::kMaxCoordinate)
-      throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + k.name +
+      throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + PrintableForMessage(k.name) +
                           "') has a translation of " + big(t).str() + ", beyond " + big(map::kMaxCoordinate).str() +
                           " (a degenerate registration in COLMAP's model)");
     for (const map::KeyframeObservation& o : k.observations)
       if (o.pixel.cwiseAbs().maxCoeff() > map::kMaxPixel)
-        throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + k.name +
+        throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + PrintableForMessage(k.name) +
                             "') has a 2D point at (" + big(o.pixel.x()).str() + ", " + big(o.pixel.y()).str() +
                             "), beyond " + big(map::kMaxPixel).str() + " pixels");
   }

@@ -182,6 +182,40 @@ TEST_P(CancellationBySignal, ReplayIntoAPngFolder) {
   run.RemoveLogs();
 }
 
+// Issue 17 §6: a frame deleted while `arview replay` runs. The replay (looping over the room, so
+// that the frame is read again after it is gone) stops at that frame with one line naming it;
+// the video, trajectory and stats are not left looking complete.
+TEST_F(Cancellation, AFrameDeletedMidReplayStopsItWithOneLineNamingTheFrame) {
+  const fs::path work = Work("replay_deleted_frame");
+  fs::copy(Room(), work / "room", fs::copy_options::recursive | fs::copy_options::create_hard_links);
+  const fs::path video = work / "out.mp4", trajectory = work / "trajectory.txt", stats = work / "stats.json";
+  SpawnedArview run({"replay", (work / "room").string(), "--map", SyntheticMap().string(), "--out", video.string(),
+                     "--trajectory", trajectory.string(), "--stats", stats.string(), "--loop", "1000"},
+                    work.string() + "_log");
+  ASSERT_TRUE(run.WaitFor([&] { return run.Stderr().find("augmenting frames") != std::string::npos; },
+                          std::chrono::seconds(60)))
+      << run.Stderr();
+  const fs::path frame = work / "room" / "frames" / "000030.png";
+  ASSERT_TRUE(fs::remove(frame));
+  ASSERT_TRUE(run.WaitExit(std::chrono::seconds(60))) << "still running 60 s after a frame was deleted";
+  const std::string err = run.Stderr();
+  EXPECT_EQ(run.exit_code(), 1) << err;
+  size_t error_lines = 0;
+  for (size_t at = err.find("arview: "); at != std::string::npos; at = err.find("arview: ", at + 1)) ++error_lines;
+  EXPECT_EQ(error_lines, 1u) << err;
+  const std::string expected = "arview: " + frame.string() + ": does not exist\n";
+  EXPECT_TRUE(err.size() >= expected.size() && err.compare(err.size() - expected.size(), expected.size(), expected) == 0)
+      << "the last line should name the deleted frame:\n" << err;
+  for (const fs::path& f : {video, work / "out.partial.mp4", trajectory, stats}) {
+    EXPECT_FALSE(fs::exists(f)) << f << " was left behind";
+  }
+  std::error_code ec;
+  for (const auto& e : fs::recursive_directory_iterator(work, ec)) {
+    EXPECT_NE(e.path().extension(), ".tmp") << e.path() << ": a temporary file was left behind";
+  }
+  run.RemoveLogs();
+}
+
 INSTANTIATE_TEST_SUITE_P(Signals, CancellationBySignal, ::testing::Values(SIGINT, SIGTERM), SignalLabel);
 
 // SIGKILL cannot be handled: the kernel must take COLMAP down with arview. A COLMAP that

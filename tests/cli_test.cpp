@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 #include <regex>
 
 #include "tests/support/run_command.h"
@@ -152,6 +155,28 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
     EXPECT_NE(r.err.find(c.flag), std::string::npos) << c.flag << ": " << r.err;
   }
   EXPECT_FALSE(std::filesystem::exists(tmp + "/arview_cli_seed"));
+}
+
+// Messages quote text from files (a token, a name): a line break in it must not split the line,
+// and an escape sequence in a hostile file must not reach the terminal.
+TEST(Cli, TextQuotedFromAFileStaysOneLineWithoutControlCharacters) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_quoted_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path escape_file = dir / "escape.txt", good = dir / "good.txt";
+  std::ofstream(escape_file) << "0 0 0 0 0 0 0 1 \x1b[2J\n";
+  std::ofstream(good) << "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 0 1 0 0 0 0 1\n";
+  const std::filesystem::path newline_name = dir / "two\nlines.txt";
+  for (const auto& estimate : {escape_file, newline_name}) {
+    const auto r = RunArview({"eval", estimate.string(), good.string()});
+    EXPECT_NE(r.exit_code, 0) << r.err;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.rfind("arview: " + dir.string() + "/", 0), 0u) << r.err;
+  }
+  EXPECT_NE(RunArview({"eval", escape_file.string(), good.string()}).err.find("'\\x1b[2J'"), std::string::npos);
+  EXPECT_NE(RunArview({"eval", newline_name.string(), good.string()}).err.find("two lines.txt"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
