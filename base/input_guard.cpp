@@ -176,18 +176,7 @@ namespace {
 
 // At most 40 bytes of a line, for a message: bytes outside printable ASCII written \xNN.
 std::string Excerpt(std::string_view line) {
-  std::string out;
-  for (const char c : line.substr(0, 40)) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte >= 0x20 && byte < 0x7f) {
-      out += c;
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", byte);
-      out += hex;
-    }
-  }
-  return out;
+  return PrintableForMessage(line.substr(0, 40), 40 * 4);  // every byte fits, escaped
 }
 
 }  // namespace
