@@ -1,6 +1,7 @@
 #include "recordings/importers.h"
 
 #include "base/image_file.h"
+#include "base/input_guard.h"
 
 #include <algorithm>
 #include <cmath>
@@ -417,7 +418,8 @@ ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, cons
   RequireDirectory(source_dir, "TUM RGB-D folder");
   const fs::path rgb_txt = source_dir / "rgb.txt";
   std::error_code ec;
-  if (!fs::is_regular_file(rgb_txt, ec)) throw RecordingError(rgb_txt.string() + ": missing (a TUM RGB-D folder has rgb.txt)");
+  // A FIFO or a device so named is refused by ReadFrameList, naming what it is.
+  if (!fs::exists(rgb_txt, ec)) throw RecordingError(rgb_txt.string() + ": missing (a TUM RGB-D folder has rgb.txt)");
   const std::vector<FrameEntry> list = ReadFrameList(rgb_txt);
   calib::Camera camera;
   std::string camera_source = "--camera";
@@ -467,8 +469,11 @@ ImportResult ImportImages(const fs::path& source_dir, const fs::path& out_dir, c
 }
 
 ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, const ImportOptions& options) {
-  std::error_code ec;
-  if (!fs::is_regular_file(video_file, ec)) throw RecordingError(video_file.string() + ": video file does not exist");
+  try {
+    RequireRegularFile(video_file);  // "does not exist", or what it is instead (a FIFO, a device)
+  } catch (const InputError& e) {
+    throw RecordingError(std::string(e.what()) + " (the video to import)");
+  }
   const calib::Camera camera = RequireCamera(options, "video");
   cv::VideoCapture cap;
   if (!cap.open(video_file.string(), cv::CAP_FFMPEG)) {
@@ -499,6 +504,7 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
   }
   PreparedOutput prepared(out_dir, options.overwrite);
   const std::string rel = "frames/" + video_file.filename().string();
+  std::error_code ec;
   fs::copy_file(video_file, out_dir / rel, fs::copy_options::overwrite_existing, ec);
   if (ec) throw RecordingError((out_dir / rel).string() + ": cannot copy the video (" + ec.message() + ")");
   std::vector<FrameEntry> frames;

@@ -425,7 +425,8 @@ TEST_F(Faults, EveryWriterIntoAnUnwritableFolderFailsWithOneLine) {
 
 // Issue 17 §3, "only regular files opened as data": a FIFO named as a trajectory (`eval`), as
 // the map file (`map info`, `track`) or as a Middlebury camera file (`import`) made arview wait
-// for a writer for ever; a map file that links to /dev/zero read as an empty, "truncated" map.
+// for a writer for ever; a map file that links to /dev/zero read as an empty, "truncated" map; a
+// FIFO or /dev/zero given to `import video` or as a TUM folder's rgb.txt was "missing".
 // Each is now refused at once: one line naming the file and saying what it is.
 TEST_F(Faults, AFifoOrADeviceGivenAsADataFileIsRefusedAtOnce) {
   const fs::path fifo_map = dir_ / "fifo_map", zero_map = dir_ / "zero_map", middlebury = dir_ / "middlebury";
@@ -436,6 +437,11 @@ TEST_F(Faults, AFifoOrADeviceGivenAsADataFileIsRefusedAtOnce) {
   fs::create_symlink("/dev/zero", zero_map / map::kMapFileName);
   ASSERT_EQ(::mkfifo((middlebury / "temple_par.txt").c_str(), 0600), 0);
   WriteText(groundtruth, Trajectory(10, true));
+  const fs::path tum = dir_ / "tum", video = dir_ / "walk.mp4", camera = dir_ / "camera.yaml";
+  fs::create_directories(tum);
+  ASSERT_EQ(::mkfifo((tum / "rgb.txt").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo(video.c_str(), 0600), 0);
+  calib::SaveCamera(calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5), camera);
 
   struct Case {
     std::vector<std::string> args;
@@ -449,6 +455,11 @@ TEST_F(Faults, AFifoOrADeviceGivenAsADataFileIsRefusedAtOnce) {
       {{"map", "info", zero_map.string()}, zero_map / map::kMapFileName, "a character device"},
       {{"import", "middlebury", middlebury.string(), "--out", (dir_ / "imported").string()},
        middlebury / "temple_par.txt", "a FIFO"},
+      {{"import", "tum", tum.string(), "--out", (dir_ / "imported").string()}, tum / "rgb.txt", "a FIFO"},
+      {{"import", "video", video.string(), "--out", (dir_ / "imported").string(), "--camera", camera.string()},
+       video, "a FIFO"},
+      {{"import", "video", "/dev/zero", "--out", (dir_ / "imported").string(), "--camera", camera.string()},
+       "/dev/zero", "a character device"},
   };
   for (const Case& c : cases) {
     const std::string label = c.args[0] + " " + c.args[1] + ": ";
