@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <png.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -19,6 +20,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "base/error.h"
+#include "base/image_file.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -332,6 +334,17 @@ std::uint32_t BigEndian32(const std::string& bytes, size_t at) {
   return (std::uint32_t{b[0]} << 24) | (std::uint32_t{b[1]} << 16) | (std::uint32_t{b[2]} << 8) | b[3];
 }
 
+std::string BigEndian32(std::uint32_t v) {
+  return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8), static_cast<char>(v)};
+}
+
+// A chunk as a writer makes it: length, type, data, the CRC computed over type and data.
+std::string Chunk(const std::string& type, const std::string& data) {
+  const std::string body = type + data;
+  const auto crc = static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
+  return BigEndian32(static_cast<std::uint32_t>(data.size())) + body + BigEndian32(crc);
+}
+
 // Where the first chunk of `type` starts, and its data.
 std::pair<size_t, std::string> FindChunk(const std::string& png, const std::string& type) {
   for (size_t at = 8; at + 12 <= png.size();) {
@@ -341,6 +354,106 @@ std::pair<size_t, std::string> FindChunk(const std::string& png, const std::stri
   }
   ADD_FAILURE() << "no " << type << " chunk";
   return {std::string::npos, {}};
+}
+
+// The PNG with its first chunk of `type` replaced by `chunks` (CRCs computed as a writer would).
+std::string ReplaceChunk(const std::string& png, const std::string& type, const std::string& chunks) {
+  const auto [at, data] = FindChunk(png, type);
+  return png.substr(0, at) + chunks + png.substr(at + 12 + data.size());
+}
+
+fs::path TempFile(const std::string& name) {
+  return fs::path(::testing::TempDir()) / ("arview_png_" + std::to_string(::getpid()) + "_" + name);
+}
+
+// ReadImageFile on `png` written to a file: its image or error, and what was printed.
+Decoded ReadThroughTheReader(const std::string& png, const fs::path& file, int flags = cv::IMREAD_COLOR) {
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << png;
+  Decoded d;
+  ::testing::internal::CaptureStderr();
+  try {
+    d.image = ReadImageFile(file, flags);
+  } catch (const Error& e) {
+    d.error = e.what();
+  }
+  d.printed = ::testing::internal::GetCapturedStderr();
+  return d;
+}
+
+// Issue 17: a PNG written with its CRCs computed over damaged compressed data passes
+// ReadImageFile's chunk check, and libpng printed "libpng error: IDAT: invalid distance too far
+// back", "libpng warning: IDAT: incorrect data check", ... through OpenCV. A byte changed at 40
+// places in the IDAT data, its CRC recomputed: ReadImageFile is one error naming the file and
+// quoting libpng, or, where libpng saw nothing, imdecode's image; neither prints anything.
+TEST(ReadImageFile, DamagedPngDataUnderARecomputedCrcIsOneErrorNamingTheFileAndLibpngSaysNothing) {
+  const fs::path file = TempFile("idat.png");
+  const std::string whole = Imencode(Picture(64, 48));
+  const auto [idat_at, idat] = FindChunk(whole, "IDAT");
+  ASSERT_GT(idat.size(), 100u);
+  int refused = 0;
+  for (int i = 0; i < 40; ++i) {
+    std::string data = idat;
+    const size_t at = 2 + (data.size() - 2) * i / 40;  // past the zlib header's two bytes
+    data[at] = static_cast<char>(data[at] ^ 0x5a);
+    const std::string damaged = ReplaceChunk(whole, "IDAT", Chunk("IDAT", data));
+    const auto [expected, libpng_said] = Imdecode(damaged, cv::IMREAD_COLOR);
+    const Decoded ours = ReadThroughTheReader(damaged, file);
+    EXPECT_EQ(ours.printed, "") << "byte " << at;
+    if (ours.error.empty()) {
+      EXPECT_EQ(libpng_said, "") << "read although libpng complained, byte " << at;
+      ExpectSameImage(ours.image, expected, "byte " + std::to_string(at));
+    } else {
+      ++refused;
+      EXPECT_NE(libpng_said, "") << "refused although libpng saw nothing, byte " << at << ": " << ours.error;
+      EXPECT_EQ(ours.error.rfind(file.string() + ": damaged PNG data (libpng: ", 0), 0u) << ours.error;
+      EXPECT_EQ(ours.error.find('\n'), std::string::npos) << ours.error;
+    }
+  }
+  // zlib's Adler-32 over the decompressed data catches every change the inflater survives.
+  EXPECT_EQ(refused, 40);
+  fs::remove(file);
+}
+
+// The image data made wrong in the ways the chunk walk accepts (every length inside the file,
+// every CRC right): an IDAT cut short, with bytes after the end of the stream, one IDAT too
+// many after the image, a tRNS longer than the palette.
+// OpenCV's libpng printed an error or a warning for each (and returned an image for the
+// warnings); here each is one error naming the file, nothing printed. A damaged metadata chunk
+// (a pHYs of the wrong length: libpng warns "pHYs: invalid") is dropped as OpenCV drops it, the
+// image read, but silently.
+TEST(ReadImageFile, ImageDataTheChunkWalkAcceptsButLibpngRefusesIsOneErrorNamingTheFile) {
+  const fs::path file = TempFile("data.png");
+  const std::string whole = Imencode(Picture(32, 24));
+  const auto [idat_at, idat] = FindChunk(whole, "IDAT");
+  const PngKind palette_kind = Kind("palette 8", 16, 8, 8, PNG_COLOR_TYPE_PALETTE);
+  const std::string palette_png = WritePng(palette_kind);
+  const auto [plte_at, plte] = FindChunk(palette_png, "PLTE");
+  const std::string short_palette = ReplaceChunk(palette_png, "PLTE", Chunk("PLTE", plte.substr(0, 3 * 4)));
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"an IDAT cut 1 byte short", ReplaceChunk(whole, "IDAT", Chunk("IDAT", idat.substr(0, idat.size() - 1)))},
+      {"an IDAT cut 5 bytes short", ReplaceChunk(whole, "IDAT", Chunk("IDAT", idat.substr(0, idat.size() - 5)))},
+      {"an IDAT cut to half", ReplaceChunk(whole, "IDAT", Chunk("IDAT", idat.substr(0, idat.size() / 2)))},
+      {"an IDAT with 7 bytes after its stream", ReplaceChunk(whole, "IDAT", Chunk("IDAT", idat + "garbage"))},
+      {"an IDAT after the image's", ReplaceChunk(whole, "IDAT", Chunk("IDAT", idat) + Chunk("tEXt", std::string("a\0b", 3)) + Chunk("IDAT", idat))},
+      {"a tRNS longer than the palette", ReplaceChunk(short_palette, "IDAT", Chunk("tRNS", std::string(6, '\x80')) + Chunk("IDAT", FindChunk(short_palette, "IDAT").second))},
+  };
+  for (const auto& [what, png] : cases) {
+    const auto [expected, libpng_said] = Imdecode(png, cv::IMREAD_COLOR);
+    EXPECT_NE(libpng_said, "") << what << ": the test's own check that libpng complains";
+    const Decoded ours = ReadThroughTheReader(png, file);
+    EXPECT_EQ(ours.printed, "") << what;
+    EXPECT_TRUE(ours.image.empty()) << what;
+    EXPECT_EQ(ours.error.rfind(file.string() + ": damaged PNG data (libpng: ", 0), 0u) << what << ": " << ours.error;
+    EXPECT_EQ(ours.error.find('\n'), std::string::npos) << ours.error;
+  }
+  const std::string bad_phys = ReplaceChunk(whole, "IDAT", Chunk("pHYs", "12345") + Chunk("IDAT", idat));
+  const auto [expected, libpng_said] = Imdecode(bad_phys, cv::IMREAD_COLOR);
+  EXPECT_NE(libpng_said.find("pHYs"), std::string::npos) << libpng_said;
+  const Decoded ours = ReadThroughTheReader(bad_phys, file);
+  EXPECT_EQ(ours.printed, "");
+  EXPECT_EQ(ours.error, "");
+  ExpectSameImage(ours.image, expected, "a pHYs of 5 bytes");
+  fs::remove(file);
 }
 
 // DecodePng alone (ReadImageFile's chunk walk refuses these first): a PNG cut at every length
