@@ -13,6 +13,7 @@
 #include "base/error.h"
 #include "base/input_guard.h"
 #include "base/jpeg_decoder.h"
+#include "base/png_decoder.h"
 
 namespace arview {
 
@@ -42,7 +43,8 @@ void RequireDecodableSize(const std::string& file, long long width, long long he
 // some IDAT. The CRC is what catches damage inside the compressed data, which libpng reports
 // on stderr ("IDAT: incorrect data check", "bad adaptive filter value", "IDAT: CRC error") with
 // OpenCV's decoder: any change of up to 32 bits in a row, and all but 1 in 2^32 of larger
-// ones. Not caught: a writer that computed the CRC over wrong data.
+// ones. Not caught here: a writer that computed the CRC over wrong data, or a chunk cut short
+// with its CRC recomputed; DecodePng (base/png_decoder.h) finds those as it decodes.
 void CheckPngChunks(const std::string& file, std::string_view bytes) {
   const auto damaged = [&](size_t at, const std::string& what) {
     return Error(file + ": not a valid PNG (" + what + " at byte " + std::to_string(at) + ")");
@@ -198,7 +200,10 @@ cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
 cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int imread_flags) {
   if (bytes.empty()) throw Error(name + ": the image is empty (0 bytes)");
   if (bytes.size() > kMaxImageFileBytes) throw Error(name + ": the image is larger than " + std::to_string(kMaxImageFileBytes) + " bytes");
-  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) CheckPngStructure(name, bytes);
+  if (bytes.substr(0, kPngSignature.size()) == kPngSignature) {
+    CheckPngStructure(name, bytes);
+    return DecodePng(bytes, name, imread_flags);  // libpng's errors and warnings ours, nothing printed
+  }
   if (bytes.substr(0, kJpegStart.size()) == kJpegStart) {
     CheckJpegStructure(name, bytes);
     return DecodeJpeg(bytes, name, imread_flags);  // libjpeg's warnings as errors, nothing printed

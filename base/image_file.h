@@ -33,8 +33,10 @@ inline constexpr long long kMaxImagePixels = 1ll << 28;
 // a frame header that does not add up, a scan without data), whose size is wrong or that is cut
 // short (no EOI marker after its last scan; data after EOI is accepted), all checked before
 // libpng/libjpeg see the file; a JPEG whose entropy-coded data is damaged (libjpeg's warning,
-// kept in our message: base/jpeg_decoder.h); an image OpenCV cannot decode or refuses (its
-// exception text is kept after ours). Never returns an empty image.
+// kept in our message: base/jpeg_decoder.h); a PNG whose compressed data, rows or palette are
+// damaged under intact CRCs (libpng's error or warning, kept in our message:
+// base/png_decoder.h); an image OpenCV cannot decode or refuses (its exception text is kept
+// after ours). Never returns an empty image.
 cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags);
 
 // The same for an image already in memory (a texture embedded in an asset), `name` saying where

@@ -285,7 +285,7 @@ TEST(ReadImageFile, EveryRealFrameAtHandPassesTheChecks) {
   for (const fs::path& file : files) {
     ::testing::internal::CaptureStderr();
     try {
-      // The same pixels as cv::imread (JPEGs are decoded by our own libjpeg calls).
+      // The same pixels as cv::imread (JPEGs and PNGs are decoded by our own libjpeg and libpng calls).
       const cv::Mat image = ReadImageFile(file, cv::IMREAD_COLOR);
       const cv::Mat expected = cv::imread(file.string(), cv::IMREAD_COLOR);
       ASSERT_EQ(image.size(), expected.size()) << file;

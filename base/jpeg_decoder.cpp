@@ -11,11 +11,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include <algorithm>
 #include <csetjmp>
 #include <limits>
 
 #include "base/error.h"
+#include "base/exif_orientation.h"
 
 namespace arview {
 
@@ -74,50 +74,14 @@ void EmitMessage(j_common_ptr cinfo, int level) {
 
 void OutputNothing(j_common_ptr) {}
 
-// The orientation as OpenCV 4.6's ExifReader reads it: the first APP1 segment, its TIFF header 6
-// bytes in (past "Exif\0\0", which it does not check), little-endian for "II" and big-endian
-// otherwise, 42 after the byte order, then the first IFD's 12-byte entries, the first with tag
-// 0x0112 giving the value. 0 when there is none (or the segment ends first).
+// The orientation in the first APP1 segment, its TIFF header 6 bytes in (past "Exif\0\0", which
+// OpenCV 4.6 does not check). 0 when there is none.
 unsigned ExifOrientation(const jpeg_decompress_struct& cinfo) {
   const jpeg_marker_struct* app1 = cinfo.marker_list;
   while (app1 != nullptr && app1->marker != JPEG_APP0 + 1) app1 = app1->next;
   constexpr size_t kTiffAt = 6;
   if (app1 == nullptr || app1->data_length <= kTiffAt) return 0;
-  const JOCTET* tiff = app1->data + kTiffAt;
-  const size_t size = app1->data_length - kTiffAt;
-  const bool little = size >= 2 && tiff[0] == 'I' && tiff[1] == 'I';
-  const auto u16 = [&](size_t at) -> long long {
-    if (at + 1 >= size) return -1;
-    return little ? tiff[at] | (tiff[at + 1] << 8) : (tiff[at] << 8) | tiff[at + 1];
-  };
-  const auto u32 = [&](size_t at) -> long long {
-    if (at + 3 >= size) return -1;
-    return little ? (u16(at) | (u16(at + 2) << 16)) : ((u16(at) << 16) | u16(at + 2));
-  };
-  if (u16(2) != 42) return 0;
-  const long long ifd = u32(4);
-  const long long entries = ifd < 0 ? -1 : u16(static_cast<size_t>(ifd));
-  for (long long i = 0; i < entries; ++i) {
-    const size_t entry = static_cast<size_t>(ifd) + 2 + 12 * static_cast<size_t>(i);
-    const long long tag = u16(entry);
-    if (tag < 0) return 0;
-    if (tag == 0x0112) return static_cast<unsigned>(std::max(u16(entry + 8), 0ll));
-  }
-  return 0;
-}
-
-// OpenCV's ApplyExifOrientation: orientations 2-8 flip and transpose the image to stand upright.
-cv::Mat Oriented(const cv::Mat& image, unsigned orientation) {
-  if (orientation < 2 || orientation > 8) return image;
-  cv::Mat upright = image;
-  if (orientation >= 5) cv::transpose(image, upright);
-  cv::Mat flipped;
-  switch (orientation) {
-    case 2: case 6: cv::flip(upright, flipped, 1); return flipped;   // horizontally
-    case 3: case 7: cv::flip(upright, flipped, -1); return flipped;  // both ways
-    case 4: case 8: cv::flip(upright, flipped, 0); return flipped;   // vertically
-    default: return upright;                                         // 5: transposed only
-  }
+  return TiffOrientation(app1->data + kTiffAt, app1->data_length - kTiffAt);
 }
 
 // What the caller asked for, in libjpeg's terms. `channels` 0: decode only to look for damage
@@ -185,7 +149,7 @@ cv::Mat DecodeJpeg(std::string_view bytes, const std::string& name, int imread_f
     throw Error(name + (errors.damaged ? ": damaged JPEG data (libjpeg: " : ": cannot be decoded as a JPEG (libjpeg: ") +
                 errors.message + ")");
   }
-  if (!image.empty()) return imread_flags == cv::IMREAD_UNCHANGED ? image : Oriented(image, orientation);
+  if (!image.empty()) return imread_flags == cv::IMREAD_UNCHANGED ? image : ApplyExifOrientation(image, orientation);
   // Decoded once without a word; what OpenCV does with these flags or this colour space is its own.
   try {
     image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())), imread_flags);

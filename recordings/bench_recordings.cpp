@@ -1,7 +1,8 @@
 // Speed of the per-frame work of live capture and recording, at 640x480: decoding the two
 // V4L2 formats, and writing one frame the way RecordingWriter does (PNG, compression 1); and of
 // reading one of phone-fox's 1920x1080 JPEG frames, through ReadImageFile (the checks and the
-// decoder replay uses) and through cv::imdecode alone (what it is measured against).
+// decoder replay uses) and through cv::imdecode alone (what it is measured against); and the
+// same for templeRing's 640x480 PNG photos, all of them each iteration.
 
 #include <unistd.h>
 
@@ -9,12 +10,14 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "base/image_file.h"
+#include "base/png_decoder.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
 #include "tests/support/test_data.h"
@@ -97,6 +100,57 @@ void BM_ImdecodePhoneFoxFrame(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(cv::imdecode(bytes, cv::IMREAD_COLOR));
 }
 BENCHMARK(BM_ImdecodePhoneFoxFrame)->Unit(benchmark::kMillisecond);
+
+// templeRing's PNG photos (640x480 RGB, 47 files), or none when ../shared/data is absent.
+std::vector<std::filesystem::path> TempleRingPhotos() {
+  std::vector<std::filesystem::path> photos;
+  const std::filesystem::path folder = arview::testing::SharedData("templeRing");
+  if (!std::filesystem::is_directory(folder)) return photos;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() == ".png") photos.push_back(entry.path());
+  }
+  return photos;
+}
+
+std::vector<std::vector<uchar>> TempleRingBytes() {
+  std::vector<std::vector<uchar>> all;
+  for (const auto& photo : TempleRingPhotos()) {
+    std::ifstream in(photo, std::ios::binary);
+    all.emplace_back(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return all;
+}
+
+void BM_ReadImageFileTempleRing(benchmark::State& state) {
+  const auto photos = TempleRingPhotos();
+  if (photos.empty()) return state.SkipWithError("templeRing missing (../shared/data)");
+  for (auto _ : state) {
+    for (const auto& photo : photos) benchmark::DoNotOptimize(arview::ReadImageFile(photo, cv::IMREAD_COLOR));
+  }
+  state.counters["photos"] = static_cast<double>(photos.size());
+}
+BENCHMARK(BM_ReadImageFileTempleRing)->Unit(benchmark::kMillisecond);
+
+void BM_DecodePngTempleRing(benchmark::State& state) {
+  const auto all = TempleRingBytes();
+  if (all.empty()) return state.SkipWithError("templeRing missing (../shared/data)");
+  for (auto _ : state) {
+    for (const auto& bytes : all) {
+      benchmark::DoNotOptimize(arview::DecodePng(
+          std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), "photo", cv::IMREAD_COLOR));
+    }
+  }
+}
+BENCHMARK(BM_DecodePngTempleRing)->Unit(benchmark::kMillisecond);
+
+void BM_ImdecodeTempleRing(benchmark::State& state) {
+  const auto all = TempleRingBytes();
+  if (all.empty()) return state.SkipWithError("templeRing missing (../shared/data)");
+  for (auto _ : state) {
+    for (const auto& bytes : all) benchmark::DoNotOptimize(cv::imdecode(bytes, cv::IMREAD_COLOR));
+  }
+}
+BENCHMARK(BM_ImdecodeTempleRing)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 BENCHMARK_MAIN();

@@ -11,7 +11,7 @@ PACKAGES=(
   libv4l-dev
   libosmesa6-dev libegl-dev libgl-dev libgles-dev
   libassimp-dev assimp-testmodels
-  libsqlite3-dev zlib1g-dev libjpeg62-turbo-dev
+  libsqlite3-dev zlib1g-dev libjpeg62-turbo-dev libpng-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
   ffmpeg
