@@ -29,6 +29,7 @@ ViewAdaptiveBlend::ViewAdaptiveBlend(std::shared_ptr<const Skeleton> skeleton, s
   for (const ViewAdaptiveKey& k : keys_)
     if (k.clip->duration > 0 && distinct.insert(k.clip.get()).second) total += k.clip->duration;
   shared_period_ = distinct.empty() ? 0.0 : total / double(distinct.size());
+  for (const ViewAdaptiveKey& k : keys_) prepared_.emplace_back(*skeleton_, *k.clip, options_.nlerp_sampling);
   weights_.assign(K, 0.0);
   key_poses_.assign(K, LocalPose(skeleton_->size()));
   active_ptrs_.assign(K, nullptr);
@@ -49,8 +50,7 @@ bool ViewAdaptiveBlend::Sample(double t, const FrameInputs& inputs, LocalPose& o
   int active = 0;
   for (int k = 0; k < key_count(); ++k) {
     if (weights_[k] <= 0) continue;
-    if (!SamplingJob{skeleton_.get(), keys_[k].clip.get(), KeyTime(k, t), true, &key_poses_[k], options_.nlerp_sampling}.Run())
-      return false;
+    if (!PreparedSamplingJob{&prepared_[k], KeyTime(k, t), true, &key_poses_[k]}.Run()) return false;
     active_ptrs_[active] = &key_poses_[k];
     active_weights_[active] = weights_[k];
     ++active;

@@ -10,6 +10,7 @@
 //   if (!blend.Sample(t, {viewpoint}, pose)) ...;   blend.weights()[k]
 
 #include "anim/blendable.h"
+#include "anim/prepared_clip.h"
 #include "anim/view_sphere.h"
 
 #include <memory>
@@ -61,6 +62,7 @@ class ViewAdaptiveBlend : public Blendable {
   std::shared_ptr<const Skeleton> skeleton_;
   std::vector<ViewAdaptiveKey> keys_;
   ViewAdaptiveOptions options_;
+  std::vector<PreparedClip> prepared_;  // per key
   ViewSphere sphere_;
   double shared_period_ = 0;
   std::vector<double> weights_;
