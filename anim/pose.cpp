@@ -83,6 +83,8 @@ bool BlendingJob::Validate() const {
     if (!inputs[k] || inputs[k]->size() != output->size() || !(weights[k] >= 0) || !std::isfinite(weights[k])) return false;
     sum += weights[k];
   }
+  for (int j : joints)
+    if (j < 0 || j >= output->size()) return false;
   return sum > 0;
 }
 
@@ -92,7 +94,9 @@ bool BlendingJob::Run() const {
   std::array<DualQuatd, kMaxInputs> q;
   bool all_converged = true;
   int worst = 0;
-  for (int j = 0; j < output->size(); ++j) {
+  const int n = joints.empty() ? output->size() : static_cast<int>(joints.size());
+  for (int i = 0; i < n; ++i) {
+    const int j = joints.empty() ? i : joints[i];
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
     for (std::size_t k = 0; k < K; ++k) {
       q[k] = inputs[k]->rigid[j];

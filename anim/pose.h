@@ -67,8 +67,10 @@ struct BlendingJob {
   BlendMethod method = BlendMethod::kDlb;
   DibOptions<double> dib;
   LocalPose* output = nullptr;
-  // Filled when not null: for DIB, whether every joint converged and the most iterations any
-  // joint took.
+  // The joints to blend (empty: every joint); the others of `output` are left as they are.
+  std::span<const int> joints;
+  // Filled when not null: for DIB, whether every joint blended converged and the most iterations
+  // any took.
   bool* converged = nullptr;
   int* max_iterations = nullptr;
 
