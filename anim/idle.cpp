@@ -1,16 +1,24 @@
 #include "anim/idle.h"
 
+#include "anim/taylor_trig.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace arview::anim {
 namespace {
 
-// Exponential map: a rotation vector (axis · angle) → quaternion.
+// Exponential map: a rotation vector (axis · angle) → quaternion. As Eigen's AngleAxis →
+// Quaternion (cos, sin of half the angle), with sin and cos from their series up to π.
 Eigen::Quaterniond ExpMap(const Eigen::Vector3d& v) {
   const double angle = v.norm();
   if (angle < 1e-12) return Eigen::Quaterniond::Identity();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, v / angle));
+  if (!(angle <= M_PI)) return Eigen::Quaterniond(Eigen::AngleAxisd(angle, v / angle));
+  const Eigen::Array2d sc = TaylorSinCos(0.5 * angle);
+  Eigen::Quaterniond q;
+  q.w() = sc[1];
+  q.vec() = sc[0] * (v / angle);
+  return q;
 }
 
 // A draw in [0, 1) from the walk's generator, the same on every platform (no distribution

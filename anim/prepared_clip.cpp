@@ -1,5 +1,7 @@
 #include "anim/prepared_clip.h"
 
+#include "anim/taylor_trig.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,20 +11,6 @@
 
 namespace arview::anim {
 namespace {
-
-// sin(x) and sin(y) for x, y in [0, π/2]: the Taylor series to x¹⁹ (Horner in x², both at once;
-// the first omitted term, x²¹/21!, is below 3e-16 at π/2), in place of two libm calls.
-Eigen::Array2d SinPair(double x, double y) {
-  const Eigen::Array2d v(x, y);
-  const Eigen::Array2d v2 = v * v;
-  // 1/(2k+1)! with alternating signs, k = 9 down to 1.
-  constexpr double c[] = {-1.0 / 121645100408832000.0, 1.0 / 355687428096000.0, -1.0 / 1307674368000.0,
-                          1.0 / 6227020800.0,          -1.0 / 39916800.0,        1.0 / 362880.0,
-                          -1.0 / 5040.0,               1.0 / 120.0,              -1.0 / 6.0};
-  Eigen::Array2d p = Eigen::Array2d::Constant(c[0]);
-  for (int k = 1; k < 9; ++k) p = p * v2 + c[k];
-  return v + v * (v2 * p);
-}
 
 // Index (from the timeline's start) of the last key with time ≤ t and the fraction toward the
 // next key: SamplingJob's Locate on one timeline.
@@ -165,7 +153,7 @@ bool PreparedSamplingJob::Run() const {
     const PreparedClip::RotationPair& p = c.pairs_[i];
     double s0 = 1 - f, s1 = f;
     if (p.theta != 0) {
-      const Eigen::Array2d s = SinPair((1 - f) * p.theta, f * p.theta);
+      const Eigen::Array2d s = TaylorSin2((1 - f) * p.theta, f * p.theta);
       s0 = s[0] * p.inv_sin;
       s1 = s[1] * p.inv_sin;
     }

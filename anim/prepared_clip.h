@@ -12,7 +12,7 @@
 //     channel;
 //   - slerp's acos and sin(θ): the angle between each pair of neighbouring rotation keys, its
 //     sine and the sign that takes the short way are stored per pair, and sin(fθ), sin((1−f)θ)
-//     come from a polynomial (θ ≤ π/2 on the short way; error below 1e-15) instead of libm;
+//     come from their Taylor series (taylor_trig.h; θ ≤ π/2 on the short way) instead of libm;
 //   - channels with one key or none (the rest value) are constants, and a joint whose rotation
 //     and translation are both constant has its dual quaternion stored.
 
