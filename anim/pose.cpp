@@ -40,11 +40,13 @@ Eigen::Quaterniond SampleRot(const std::vector<Key<Eigen::Quaterniond>>& keys, d
 bool Affine(const Eigen::Matrix4d& m) { return m(3, 0) == 0 && m(3, 1) == 0 && m(3, 2) == 0 && m(3, 3) == 1; }
 
 // a · b for affine a and b (bottom rows 0 0 0 1): the top three rows only, 36 multiplications
-// instead of Eigen's 64 for a general 4×4 product.
+// instead of Eigen's 64 for a general 4×4 product. The bottom row is set (the column sums would
+// give −0 for +0 where a column of b is negative).
 Eigen::Matrix4d AffineProduct(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
   Eigen::Matrix4d m;
   for (int c = 0; c < 4; ++c) m.col(c) = a.col(0) * b(0, c) + a.col(1) * b(1, c) + a.col(2) * b(2, c);
   m.col(3) += a.col(3);
+  m.row(3) << 0, 0, 0, 1;
   return m;
 }
 
