@@ -16,16 +16,21 @@ double Finite(double t) { return std::isfinite(t) ? t : 0.0; }
 
 }  // namespace
 
-ClipSource::ClipSource(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<const Clip> clip, bool nlerp)
-    : skeleton_(std::move(skeleton)), clip_(std::move(clip)), nlerp_(nlerp) {
-  Require(skeleton_ && clip_, "clip source: no skeleton or clip");
-  Require(static_cast<int>(clip_->tracks.size()) == skeleton_->size(),
-          "clip '" + clip_->name + "' has " + std::to_string(clip_->tracks.size()) + " tracks for " +
-              std::to_string(skeleton_->size()) + " joints");
+namespace {
+
+// Throws Error as PreparedClip does for a clip that does not fit, and for none at all.
+PreparedClip PrepareClip(const std::shared_ptr<const Skeleton>& skeleton, const std::shared_ptr<const Clip>& clip, bool nlerp) {
+  Require(skeleton && clip, "clip source: no skeleton or clip");
+  return PreparedClip(*skeleton, *clip, nlerp);
 }
 
+}  // namespace
+
+ClipSource::ClipSource(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<const Clip> clip, bool nlerp)
+    : skeleton_(std::move(skeleton)), clip_(std::move(clip)), prepared_(PrepareClip(skeleton_, clip_, nlerp)) {}
+
 bool ClipSource::Sample(double t, const FrameInputs&, LocalPose& out) {
-  return SamplingJob{skeleton_.get(), clip_.get(), Finite(t), /*loop=*/false, &out, nlerp_}.Run();
+  return PreparedSamplingJob{&prepared_, Finite(t), /*loop=*/false, &out}.Run();
 }
 
 StaticPose::StaticPose(LocalPose pose, double duration) : pose_(std::move(pose)), duration_(duration) {

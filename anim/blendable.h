@@ -13,6 +13,7 @@
 // may keep scratch buffers, so one object is sampled by one thread at a time.
 
 #include "anim/pose.h"
+#include "anim/prepared_clip.h"
 
 #include <limits>
 #include <memory>
@@ -57,7 +58,7 @@ class ClipSource : public Blendable {
  private:
   std::shared_ptr<const Skeleton> skeleton_;
   std::shared_ptr<const Clip> clip_;
-  bool nlerp_;
+  PreparedClip prepared_;
 };
 
 // One pose held (thesis: a single key-frame animated by a curve). Unbounded unless given a

@@ -1,16 +1,24 @@
 #include "anim/idle.h"
 
+#include "anim/taylor_trig.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace arview::anim {
 namespace {
 
-// Exponential map: a rotation vector (axis · angle) → quaternion.
+// Exponential map: a rotation vector (axis · angle) → quaternion. As Eigen's AngleAxis →
+// Quaternion (cos, sin of half the angle), with sin and cos from their series up to π.
 Eigen::Quaterniond ExpMap(const Eigen::Vector3d& v) {
   const double angle = v.norm();
   if (angle < 1e-12) return Eigen::Quaterniond::Identity();
-  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, v / angle));
+  if (!(angle <= M_PI)) return Eigen::Quaterniond(Eigen::AngleAxisd(angle, v / angle));
+  const Eigen::Array2d sc = TaylorSinCos(0.5 * angle);
+  Eigen::Quaterniond q;
+  q.w() = sc[1];
+  q.vec() = sc[0] * (v / angle);
+  return q;
 }
 
 // A draw in [0, 1) from the walk's generator, the same on every platform (no distribution
@@ -66,6 +74,7 @@ IdleSynthesizer::IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::
   walks_.resize(model_->component_count());
   coefficients_ = Eigen::VectorXd::Zero(model_->component_count());
   posture_ = model_->mean;
+  rest_ = LocalPose::Rest(*skeleton_);
   const int joints = static_cast<int>(model_->joints.size()), m = model_->component_count();
   joint_reach_.resize(m, joints);
   for (int k = 0; k < joints; ++k)
@@ -239,15 +248,13 @@ bool IdleSynthesizer::Sample(double t, const FrameInputs&, LocalPose& out) {
   const Skeleton& sk = *skeleton_;
   if (out.size() != sk.size()) return false;
   const Eigen::VectorXd& p = Posture(t);
-  for (int j = 0; j < sk.size(); ++j) {
-    out.rigid[j] = sk.rest[j].Rigid();
-    out.scale[j] = sk.rest[j].scale;
-  }
+  std::copy(rest_.rigid.begin(), rest_.rigid.end(), out.rigid.begin());
+  std::copy(rest_.scale.begin(), rest_.scale.end(), out.scale.begin());
   const int m = static_cast<int>(model_->joints.size());
   for (int k = 0; k < m; ++k) {
     const int j = model_->joints[k];
     const Eigen::Quaterniond r = sk.rest[j].rotation * ExpMap(p.segment<3>(3 * k));
-    out.rigid[j] = DualQuatd::FromRotationTranslation(r, out.rigid[j].Translation());
+    out.rigid[j] = DualQuatd::FromRotationTranslation(r, sk.rest[j].translation);
   }
   const int root = model_->root;
   out.rigid[root] = DualQuatd::FromRotationTranslation(out.rigid[root].Rotation(), sk.rest[root].translation + p.segment<3>(3 * m));

@@ -122,6 +122,7 @@ class IdleSynthesizer : public Blendable {
   std::uint64_t seed_;
   std::vector<Walk> walks_;
   Eigen::VectorXd coefficients_, posture_;
+  LocalPose rest_;  // the skeleton's rest pose: the joints the model does not vary
   // The speed check's bounds, from the model: per joint and component the norm of the
   // component's 3-row block of that joint's rotation, and per component the largest of them.
   Eigen::MatrixXd joint_reach_;      // components × joints

@@ -37,6 +37,19 @@ Eigen::Quaterniond SampleRot(const std::vector<Key<Eigen::Quaterniond>>& keys, d
   return Eigen::Quaterniond((1 - f) * a + f * b);  // normalised by the caller
 }
 
+bool Affine(const Eigen::Matrix4d& m) { return m(3, 0) == 0 && m(3, 1) == 0 && m(3, 2) == 0 && m(3, 3) == 1; }
+
+// a · b for affine a and b (bottom rows 0 0 0 1): the top three rows only, 36 multiplications
+// instead of Eigen's 64 for a general 4×4 product. The bottom row is set (the column sums would
+// give −0 for +0 where a column of b is negative).
+Eigen::Matrix4d AffineProduct(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+  Eigen::Matrix4d m;
+  for (int c = 0; c < 4; ++c) m.col(c) = a.col(0) * b(0, c) + a.col(1) * b(1, c) + a.col(2) * b(2, c);
+  m.col(3) += a.col(3);
+  m.row(3) << 0, 0, 0, 1;
+  return m;
+}
+
 }  // namespace
 
 void LocalPose::Resize(int joints) {
@@ -83,6 +96,8 @@ bool BlendingJob::Validate() const {
     if (!inputs[k] || inputs[k]->size() != output->size() || !(weights[k] >= 0) || !std::isfinite(weights[k])) return false;
     sum += weights[k];
   }
+  for (int j : joints)
+    if (j < 0 || j >= output->size()) return false;
   return sum > 0;
 }
 
@@ -92,7 +107,9 @@ bool BlendingJob::Run() const {
   std::array<DualQuatd, kMaxInputs> q;
   bool all_converged = true;
   int worst = 0;
-  for (int j = 0; j < output->size(); ++j) {
+  const int n = joints.empty() ? output->size() : static_cast<int>(joints.size());
+  for (int i = 0; i < n; ++i) {
+    const int j = joints.empty() ? i : joints[i];
     Eigen::Vector3d s = Eigen::Vector3d::Zero();
     for (std::size_t k = 0; k < K; ++k) {
       q[k] = inputs[k]->rigid[j];
@@ -120,11 +137,14 @@ bool LocalToModelJob::Validate() const {
 
 bool LocalToModelJob::Run() const {
   if (!Validate()) return false;
+  // Every local matrix is affine, and so is every model matrix when root_parent is.
+  const bool affine = Affine(skeleton->root_parent);
   for (int j = 0; j < skeleton->size(); ++j) {
     Eigen::Matrix4d local = input->rigid[j].ToMatrix();
     local.block<3, 3>(0, 0) *= input->scale[j].asDiagonal();
     const int p = skeleton->parents[j];
-    output[j] = (p < 0 ? skeleton->root_parent : output[p]) * local;
+    const Eigen::Matrix4d& parent = p < 0 ? skeleton->root_parent : output[p];
+    output[j] = affine ? AffineProduct(parent, local) : Eigen::Matrix4d(parent * local);
   }
   return true;
 }
@@ -137,7 +157,9 @@ bool SkinningMatricesJob::Validate() const {
 bool SkinningMatricesJob::Run() const {
   if (!Validate()) return false;
   for (int j = 0; j < skeleton->size(); ++j) {
-    const Eigen::Matrix4d m = model[j] * skeleton->inverse_bind[j];
+    const Eigen::Matrix4d& inverse_bind = skeleton->inverse_bind[j];
+    const Eigen::Matrix4d m = Affine(model[j]) && Affine(inverse_bind) ? AffineProduct(model[j], inverse_bind)
+                                                                        : Eigen::Matrix4d(model[j] * inverse_bind);
     matrices[j] = m.cast<float>();
     if (!dual_quats.empty()) {
       // Rotation from the normalised columns (cheaper than an SVD, exact for rigid and for

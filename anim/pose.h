@@ -42,6 +42,8 @@ struct LocalPose {
 // `nlerp` replaces slerp by normalised linear interpolation of the rotation keys: about 2.5x
 // faster sampling, exact at keys and midpoints; between them, on the test assets' clips, within
 // 0.79° of slerp on the Fox and 0.02° on CesiumMan, BCN_Epileptic and CMU 01_01 (import_test).
+// What samples one clip every frame prepares it once instead (prepared_clip.h: the same pose to
+// rounding, without the per-channel key search or slerp's acos).
 struct SamplingJob {
   const Skeleton* skeleton = nullptr;
   const Clip* clip = nullptr;
@@ -65,8 +67,10 @@ struct BlendingJob {
   BlendMethod method = BlendMethod::kDlb;
   DibOptions<double> dib;
   LocalPose* output = nullptr;
-  // Filled when not null: for DIB, whether every joint converged and the most iterations any
-  // joint took.
+  // The joints to blend (empty: every joint); the others of `output` are left as they are.
+  std::span<const int> joints;
+  // Filled when not null: for DIB, whether every joint blended converged and the most iterations
+  // any took.
   bool* converged = nullptr;
   int* max_iterations = nullptr;
 

@@ -32,7 +32,11 @@ Schedule::Schedule(std::shared_ptr<const Skeleton> skeleton, const FrameBlenderO
   if (capacity < 1 || capacity >= kMaxContributors) throw Error("schedule: capacity must be in 1..63");
   if (!(options_.rest_threshold >= 0)) throw Error("schedule: rest_threshold must be non-negative");
   slots_.resize(capacity);
-  for (Slot& s : slots_) s.pose.Resize(skeleton_->size());
+  for (Slot& s : slots_) {
+    s.pose.Resize(skeleton_->size());
+    s.mask_rotation.assign(skeleton_->size(), 1.0);
+    s.mask_translation.assign(skeleton_->size(), 1.0);
+  }
   active_.reserve(capacity);
   rest_ = LocalPose::Rest(*skeleton_);
 }
@@ -69,6 +73,10 @@ int Schedule::Add(Action action) {
     s.live = 1;
     s.weight = 0;
     s.length = length;
+    for (int j = 0; j < skeleton_->size(); ++j) {
+      s.mask_rotation[j] = s.action.params.MaskRotation(j);
+      s.mask_translation[j] = s.action.params.MaskTranslation(j);
+    }
     return static_cast<int>(i);
   }
   throw Error(what + ": the schedule is full (" + std::to_string(slots_.size()) + " actions)");
@@ -226,28 +234,49 @@ void Schedule::Blend(LocalPose& out) {
   JointInputs in;
   converged_ = true;
   const int active_count = static_cast<int>(active_.size());
+  // One layer's contributors to the joint: slot and rotation and translation weights.
+  std::array<int, kMaxContributors> slot;
+  std::array<double, kMaxContributors> wr, wt;
   for (int j = 0; j < sk.size(); ++j) {
     DualQuatd below = rest_.rigid[j];
     Eigen::Vector3d below_scale = rest_.scale[j];
     for (int a = 0; a < active_count;) {
       const int layer = slots_[active_[a]].action.layer;
-      in.Clear();
+      int n = 0;
       for (; a < active_count && slots_[active_[a]].action.layer == layer; ++a) {
         const Slot& s = slots_[active_[a]];
-        const double r = s.weight * s.action.params.MaskRotation(j);
-        const double tr = s.weight * s.action.params.MaskTranslation(j);
+        const double r = s.weight * s.mask_rotation[j];
+        const double tr = s.weight * s.mask_translation[j];
         if (r <= 0 && tr <= 0) continue;
-        DualQuatd q = s.pose.rigid[j];
-        if (s.scaling != 1)
-          q = DualQuatd::FromRotationTranslation(ScaleAboutRest(q.Rotation(), sk.rest[j].rotation, s.scaling), q.Translation());
-        in.Add(q, r, tr, s.pose.scale[j]);
+        slot[n] = active_[a];
+        wr[n] = r;
+        wt[n] = tr;
+        ++n;
       }
+      // Nothing on this layer: what is below stays (it would fill the layer alone).
+      if (n == 0) continue;
+      auto pose_of = [&](const Slot& s) {
+        const DualQuatd& q = s.pose.rigid[j];
+        if (s.scaling == 1) return q;
+        return DualQuatd::FromRotationTranslation(ScaleAboutRest(q.Rotation(), sk.rest[j].rotation, s.scaling), q.Translation());
+      };
       // What is below fills the layer up: to the rest threshold on layer 0 (ozz), to 1 above.
       const bool bottom = layer == slots_[active_[0]].action.layer;
       const double fill = bottom ? options_.rest_threshold : 1.0;
+      // One contributor that fills the layer alone: its pose, unchanged.
+      if (n == 1 && wr[0] >= fill && wt[0] >= fill) {
+        const Slot& s = slots_[slot[0]];
+        below = pose_of(s);
+        below_scale = s.pose.scale[j];
+        continue;
+      }
+      in.Clear();
+      for (int k = 0; k < n; ++k) {
+        const Slot& s = slots_[slot[k]];
+        in.Add(pose_of(s), wr[k], wt[k], s.pose.scale[j]);
+      }
       const double below_r = std::max(0.0, fill - in.sum_r), below_t = std::max(0.0, fill - in.sum_t);
       if (below_r > 0 || below_t > 0) in.Add(below, below_r, below_t, below_scale);
-      if (in.n == 0) continue;
       BlendJoint(in, options_, below, below_scale, converged_);
     }
     out.rigid[j] = below;

@@ -101,6 +101,9 @@ class Schedule : public Blendable {
     double weight = 0;  // this frame's time weight (0: inactive)
     double scaling = 1;
     double length = 0;  // cached object duration
+    // The action's masks multiplied out per joint (BlendingParams::MaskRotation/Translation),
+    // filled by Add; sized with the schedule, so that adding allocates no more than the action.
+    std::vector<double> mask_rotation, mask_translation;
   };
   int free_count() const;
   void Blend(LocalPose& out);

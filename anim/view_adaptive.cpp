@@ -2,9 +2,28 @@
 
 #include <cmath>
 #include <set>
+#include <type_traits>
 
 namespace arview::anim {
 namespace {
+
+template <class V>
+bool SameKeys(const std::vector<Key<V>>& a, const std::vector<Key<V>>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].time != b[i].time) return false;
+    if constexpr (std::is_same_v<V, Eigen::Quaterniond>) {
+      if (a[i].value.coeffs() != b[i].value.coeffs()) return false;
+    } else if (a[i].value != b[i].value) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool SameTrack(const JointTrack& a, const JointTrack& b) {
+  return SameKeys(a.rotation, b.rotation) && SameKeys(a.translation, b.translation) && SameKeys(a.scale, b.scale);
+}
 
 std::vector<Eigen::Vector3d> Directions(const std::vector<ViewAdaptiveKey>& keys) {
   std::vector<Eigen::Vector3d> dirs;
@@ -29,6 +48,19 @@ ViewAdaptiveBlend::ViewAdaptiveBlend(std::shared_ptr<const Skeleton> skeleton, s
   for (const ViewAdaptiveKey& k : keys_)
     if (k.clip->duration > 0 && distinct.insert(k.clip.get()).second) total += k.clip->duration;
   shared_period_ = distinct.empty() ? 0.0 : total / double(distinct.size());
+  // A joint is shared when every key clip has its track and the clips have one length (so that
+  // every key is sampled at the same time: KeyTime).
+  bool same_length = true;
+  for (const ViewAdaptiveKey& k : keys_) same_length = same_length && k.clip->duration == keys_[0].clip->duration;
+  for (int j = 0; j < skeleton_->size(); ++j) {
+    bool same = same_length;
+    for (int k = 1; same && k < K; ++k) same = SameTrack(keys_[k].clip->tracks[j], keys_[0].clip->tracks[j]);
+    (same ? shared_joints_ : varying_joints_).push_back(j);
+  }
+  if (!shared_joints_.empty())
+    shared_ = std::make_unique<PreparedClip>(*skeleton_, *keys_[0].clip, options_.nlerp_sampling, shared_joints_);
+  if (!varying_joints_.empty())
+    for (const ViewAdaptiveKey& k : keys_) prepared_.emplace_back(*skeleton_, *k.clip, options_.nlerp_sampling, varying_joints_);
   weights_.assign(K, 0.0);
   key_poses_.assign(K, LocalPose(skeleton_->size()));
   active_ptrs_.assign(K, nullptr);
@@ -46,23 +78,26 @@ double ViewAdaptiveBlend::KeyTime(int key, double t) const {
 bool ViewAdaptiveBlend::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
   if (!std::isfinite(t)) t = 0;
   sphere_.Weights(inputs.viewpoint, weights_);
+  if (out.size() != skeleton_->size()) return false;
+  converged_ = true;
+  max_iterations_ = 0;
+  if (shared_ && !PreparedSamplingJob{shared_.get(), KeyTime(0, t), true, &out}.Run()) return false;
+  if (varying_joints_.empty()) return true;
   int active = 0;
   for (int k = 0; k < key_count(); ++k) {
     if (weights_[k] <= 0) continue;
-    if (!SamplingJob{skeleton_.get(), keys_[k].clip.get(), KeyTime(k, t), true, &key_poses_[k], options_.nlerp_sampling}.Run())
-      return false;
+    if (!PreparedSamplingJob{&prepared_[k], KeyTime(k, t), true, &key_poses_[k]}.Run()) return false;
     active_ptrs_[active] = &key_poses_[k];
     active_weights_[active] = weights_[k];
     ++active;
   }
-  converged_ = true;
-  max_iterations_ = 0;
   BlendingJob blend;
   blend.inputs = std::span<const LocalPose* const>(active_ptrs_.data(), active);
   blend.weights = std::span<const double>(active_weights_.data(), active);
   blend.method = options_.blend;
   blend.dib = options_.dib;
   blend.output = &out;
+  blend.joints = varying_joints_;
   blend.converged = &converged_;
   blend.max_iterations = &max_iterations_;
   return blend.Run();
