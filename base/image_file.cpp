@@ -190,6 +190,18 @@ void CheckJpegStructure(const std::string& file, std::string_view bytes) {
   }
 }
 
+// The formats besides PNG and JPEG that arview reads (what `import images` takes; BMP for the
+// demo's replay frames), by signature. OpenCV decodes them. Anything else is refused before
+// cv::imdecode, which would offer the bytes to every codec it was built with: a 132-byte input of
+// fuzz_image that OpenCV took for DICOM made GDCM's reader abort the process (an assert).
+std::string_view OtherAcceptedFormat(std::string_view bytes) {
+  using namespace std::string_view_literals;
+  if (bytes.starts_with("BM"sv)) return "BMP";
+  if (bytes.starts_with("II*\0"sv) || bytes.starts_with("MM\0*"sv)) return "TIFF";
+  if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') return "PNM";
+  return {};
+}
+
 }  // namespace
 
 cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
@@ -207,6 +219,10 @@ cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int im
   if (bytes.substr(0, kJpegStart.size()) == kJpegStart) {
     CheckJpegStructure(name, bytes);
     return DecodeJpeg(bytes, name, imread_flags);  // libjpeg's warnings as errors, nothing printed
+  }
+  if (OtherAcceptedFormat(bytes).empty()) {
+    throw Error(name + ": not a PNG, JPEG, BMP, TIFF or PNM image (its first bytes are '" +
+                PrintableForMessage(bytes.substr(0, 8)) + "')");
   }
   cv::Mat image;
   try {

@@ -309,5 +309,39 @@ TEST(ReadImageFile, NotAnImageADirectoryAndAnEmptyFileNameTheFile) {
   fs::remove_all(dir);
 }
 
+// fuzz_image (libFuzzer, stop 23): neither PNG nor JPEG (a PNG signature with a byte dropped) and
+// "DICM" at offset 128, so cv::imdecode handed it to GDCM's DICOM reader, whose assert aborted the
+// process. Only PNG, JPEG, BMP, TIFF and PNM reach a decoder now.
+TEST(ReadImageFile, AFileOfAnotherFormatIsRefusedBeforeOpenCvsDecodersSeeIt) {
+  const fs::path dir = TempDir("otherformat");
+  const std::string campaign_input(
+      "\x89\x50\x4e\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x70\x91\x83\x9b"
+      "\x29\x94\x6a\x53\x65\xa5\x6c\x30\xec\xc2\x5c\x16\x56\x59\x8b\x0b\x1f\x5d\x83\xd3\x51\xcb\xc7\x6b"
+      "\x89\x44\x49\x43\x4d\x0d\x49\xda\x72\x19\xc7\x01\x72\xdc\x79\xed\x07\xd2\x1a\x82\x4a\x94\xbd\xd3"
+      "\x84\x5f\xc5\x44\x49\x43\x4d\x32\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff"
+      "\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff\xff"
+      "\xff\xff\xff\xff\xff\xff\xff\xff\x44\x49\x43\x4d",
+      132);
+  std::string dicom(128, '\0');
+  dicom += "DICM";
+  dicom += std::string(64, '\xff');
+  Write(dir / "campaign.png", campaign_input);
+  Write(dir / "dicom.png", dicom);
+  for (const fs::path& file : {dir / "campaign.png", dir / "dicom.png"}) {
+    const auto [message, printed] = ReadFailure(file);
+    EXPECT_EQ(message.rfind(file.string() + ": not a PNG, JPEG, BMP, TIFF or PNM image", 0), 0u) << message;
+    EXPECT_EQ(printed, "") << file;
+  }
+  // The other formats still read.
+  cv::Mat image(6, 8, CV_8UC3, cv::Scalar(10, 20, 30));
+  for (const char* extension : {".bmp", ".tif", ".ppm"}) {
+    const fs::path file = dir / (std::string("image") + extension);
+    ASSERT_TRUE(cv::imwrite(file.string(), image)) << extension;
+    const cv::Mat read = ReadImageFile(file, cv::IMREAD_COLOR);
+    EXPECT_EQ(cv::norm(read, image, cv::NORM_INF), 0.0) << extension;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace arview
