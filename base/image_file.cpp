@@ -224,6 +224,10 @@ cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int im
     throw Error(name + ": not a PNG, JPEG, BMP, TIFF or PNM image (its first bytes are '" +
                 PrintableForMessage(bytes.substr(0, 8)) + "')");
   }
+  return ImdecodeOrThrow(bytes, name, imread_flags);
+}
+
+cv::Mat ImdecodeOrThrow(std::string_view bytes, const std::string& name, int imread_flags) {
   cv::Mat image;
   try {
     const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));

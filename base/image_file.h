@@ -43,4 +43,8 @@ cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags);
 // it came from in the errors.
 cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int imread_flags);
 
+// cv::imdecode with OpenCV's exception or an empty result as one Error naming `name`; for the
+// decoders' last resort, on bytes already checked.
+cv::Mat ImdecodeOrThrow(std::string_view bytes, const std::string& name, int imread_flags);
+
 }  // namespace arview

@@ -15,6 +15,7 @@
 #include <limits>
 
 #include "base/error.h"
+#include "base/image_file.h"
 #include "base/exif_orientation.h"
 
 namespace arview {
@@ -151,13 +152,7 @@ cv::Mat DecodeJpeg(std::string_view bytes, const std::string& name, int imread_f
   }
   if (!image.empty()) return imread_flags == cv::IMREAD_UNCHANGED ? image : ApplyExifOrientation(image, orientation);
   // Decoded once without a word; what OpenCV does with these flags or this colour space is its own.
-  try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())), imread_flags);
-  } catch (const cv::Exception& e) {
-    throw Error(name + ": cannot be decoded as an image (" + e.err + ")");
-  }
-  if (image.empty()) throw Error(name + ": cannot be read as an image");
-  return image;
+  return ImdecodeOrThrow(bytes, name, imread_flags);
 }
 
 }  // namespace arview

@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "base/error.h"
+#include "base/image_file.h"
 #include "base/exif_orientation.h"
 
 namespace arview {
@@ -213,13 +214,7 @@ cv::Mat DecodePng(std::string_view bytes, const std::string& name, int imread_fl
     return orient ? ApplyExifOrientation(image, orientation) : image;
   }
   // Decoded once without a word; what OpenCV does with these flags is its own.
-  try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())), imread_flags);
-  } catch (const cv::Exception& e) {
-    throw Error(name + ": cannot be decoded as an image (" + e.err + ")");
-  }
-  if (image.empty()) throw Error(name + ": cannot be read as an image");
-  return image;
+  return ImdecodeOrThrow(bytes, name, imread_flags);
 }
 
 }  // namespace arview

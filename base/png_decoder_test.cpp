@@ -21,6 +21,7 @@
 
 #include "base/error.h"
 #include "base/image_file.h"
+#include "tests/support/test_picture.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -28,21 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A photo-like image (smooth shading, shapes, a little noise).
-cv::Mat Picture(int width, int height) {
-  cv::Mat image(height, width, CV_8UC3);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) image.at<cv::Vec3b>(y, x) = cv::Vec3b(x * 255 / width, y * 255 / height, 128);
-  }
-  cv::RNG rng(7);
-  for (int i = 0; i < 12; ++i) {
-    cv::circle(image, {rng.uniform(0, width), rng.uniform(0, height)}, rng.uniform(2, 12),
-               cv::Scalar(rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0, 256)), -1);
-  }
-  cv::Mat noise(height, width, CV_8UC3);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 24);
-  return image + noise;
-}
+cv::Mat Picture(int width, int height) { return testing::PhotoLikePicture(width, height); }
 
 std::string Imencode(const cv::Mat& image) {
   std::vector<unsigned char> encoded;
