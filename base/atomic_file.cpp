@@ -1,5 +1,7 @@
 #include "base/atomic_file.h"
 
+#include <sys/stat.h>
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -44,9 +46,26 @@ int WriteAll(int fd, std::string_view bytes) {
   throw Error(file.string() + ": cannot write (" + what + ")");
 }
 
+// An output path that is there already must be a regular file (or, for a folder output, a
+// folder): renaming over a device, a FIFO or a socket would replace it (as root, `--out
+// /dev/full` replaced the device node with a regular file).
+void RequireReplaceable(const fs::path& file, bool folder_allowed) {
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0) return;  // not there (or a dangling link): written new
+  if (S_ISREG(st.st_mode) || (folder_allowed && S_ISDIR(st.st_mode))) return;
+  const char* kind = S_ISDIR(st.st_mode)   ? "a directory"
+                     : S_ISCHR(st.st_mode) ? "a character device"
+                     : S_ISBLK(st.st_mode) ? "a block device"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "not a regular file";
+  throw Error(file.string() + ": is " + std::string(kind) + ", not a file arview may replace (give a file path)");
+}
+
 }  // namespace
 
 void WriteFileAtomically(const fs::path& file, std::string_view bytes) {
+  RequireReplaceable(file, false);
   const fs::path tmp = TemporaryFor(file);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw Error(file.string() + ": cannot write here (" + Reason(errno) + ")");
@@ -77,6 +96,7 @@ PendingOutput::PendingOutput(fs::path final_path) : final_(std::move(final_path)
   if (final_.filename().empty()) final_ = final_.parent_path();  // "frames/" names the folder
   folder_ = !final_.has_extension();
   partial_ = final_.parent_path() / (final_.stem().string() + ".partial" + final_.extension().string());
+  RequireReplaceable(final_, folder_);
 }
 
 PendingOutput::~PendingOutput() {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/mount.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -472,6 +473,31 @@ TEST_F(Faults, AFifoOrADeviceGivenAsADataFileIsRefusedAtOnce) {
     EXPECT_FALSE(fs::exists(dir_ / "imported" / "frames.txt")) << label;
     run.RemoveLogs();
   }
+}
+
+// Issue 17 §6, /dev/full as the output: every writer writes a temporary beside the output and
+// renames it over the output, so `eval --plot /dev/full` (as root) replaced the device node with
+// a regular file. An output path that exists must now be a regular file (a folder for folder
+// outputs): a device, a FIFO, a socket is refused with one line and left as it was. A character
+// device like /dev/full (1, 7) is made in the test's folder (root only), never the real one.
+TEST_F(Faults, AnOutputThatIsADeviceOrAFifoIsRefusedAndLeftAsItWas) {
+  const fs::path estimate = dir_ / "estimate.txt";
+  WriteText(estimate, Trajectory(30, true));
+  const fs::path fifo = dir_ / "plot_fifo.png", device = dir_ / "full_device.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::vector<std::pair<fs::path, std::string>> outputs = {{fifo, "a FIFO"}};
+  if (::mknod(device.c_str(), S_IFCHR | 0600, makedev(1, 7)) == 0) outputs.push_back({device, "a character device"});
+  for (const auto& [output, kind] : outputs) {
+    const auto r = RunArview({"eval", estimate.string(), estimate.string(), "--plot", output.string()});
+    EXPECT_NE(r.exit_code, 0) << output;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("arview: " + output.string() + ": is " + kind + ", not a file arview may replace", 0), 0u)
+        << r.err;
+    struct stat st {};
+    ASSERT_EQ(::stat(output.c_str(), &st), 0) << output << " is gone";
+    EXPECT_FALSE(S_ISREG(st.st_mode)) << output << " was replaced by a regular file";
+  }
+  for (const std::string& file : FilesIn(dir_)) EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
 }
 
 }  // namespace
