@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "base/error.h"
+#include "base/input_guard.h"
 
 namespace arview {
 namespace {
@@ -53,13 +54,7 @@ void RequireReplaceable(const fs::path& file, bool folder_allowed) {
   struct stat st {};
   if (::stat(file.c_str(), &st) != 0) return;  // not there (or a dangling link): written new
   if (S_ISREG(st.st_mode) || (folder_allowed && S_ISDIR(st.st_mode))) return;
-  const char* kind = S_ISDIR(st.st_mode)   ? "a directory"
-                     : S_ISCHR(st.st_mode) ? "a character device"
-                     : S_ISBLK(st.st_mode) ? "a block device"
-                     : S_ISFIFO(st.st_mode) ? "a FIFO"
-                     : S_ISSOCK(st.st_mode) ? "a socket"
-                                            : "not a regular file";
-  throw Error(file.string() + ": is " + std::string(kind) + ", not a file arview may replace (give a file path)");
+  throw Error(file.string() + ": is " + FileKindOf(st.st_mode) + ", not a file arview may replace (give a file path)");
 }
 
 }  // namespace

@@ -17,14 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string KindOf(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
 
 std::string Bytes(std::uintmax_t n) {
   std::ostringstream ss;
@@ -36,7 +28,7 @@ std::string Bytes(std::uintmax_t n) {
 }
 
 void RequireRegularMode(const fs::path& file, const struct stat& st) {
-  if (!S_ISREG(st.st_mode)) throw InputError(file.string() + ": is " + KindOf(st.st_mode) + ", not a data file");
+  if (!S_ISREG(st.st_mode)) throw InputError(file.string() + ": is " + FileKindOf(st.st_mode) + ", not a data file");
 }
 
 void RequireSizeAtMost(const fs::path& file, std::uintmax_t size, std::uintmax_t max_bytes) {
@@ -320,6 +312,15 @@ std::string PrintableForMessage(std::string_view text, size_t max_chars) {
     }
   }
   return out;
+}
+
+std::string FileKindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
 }
 
 }  // namespace arview

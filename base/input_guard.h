@@ -12,6 +12,8 @@
 // Every failure is an InputError whose what() is the one line for the user, naming the file
 // or flag.
 
+#include <sys/types.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -90,5 +92,9 @@ std::filesystem::path ResolveInside(const std::filesystem::path& folder, const s
 // ASCII as \xNN (a name holding a newline would split the line; binary would garble the
 // terminal), cut to `max_chars` with "..." after.
 std::string PrintableForMessage(std::string_view text, size_t max_chars = 120);
+
+// What a file of this st_mode is, for messages: "a directory", "a character device", "a FIFO",
+// "a socket", ... ("not a regular file" for any other non-regular kind).
+std::string FileKindOf(mode_t mode);
 
 }  // namespace arview
