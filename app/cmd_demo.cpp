@@ -30,6 +30,7 @@
 #include "mapping/colmap_pipeline.h"
 #include "recordings/accuracy.h"
 #include "base/image_file.h"
+#include "base/input_guard.h"
 #include "base/stats.h"
 #include "render/prt_cache.h"
 #include "render/synth_room.h"
@@ -60,10 +61,14 @@ struct DemoArgs {
 constexpr int kSteps = 7;
 void Step(int n, const std::string& what) { std::printf("\n[%d/%d] %s\n", n, kSteps, what.c_str()); std::fflush(stdout); }
 
-// A recording already in `dir` is reused only when it is this walk: same frame count and the
-// same ground-truth poses (checked on a few frames), so a changed walk is never replayed stale.
+// A recording already in `dir` is reused only when it is this walk: the window-lit room (its
+// ground truth's header says so; earlier demos rendered the evenly lit one), same frame count
+// and the same ground-truth poses (checked on a few frames), so a changed walk is never
+// replayed stale.
 bool HoldsWalk(const recordings::Recording& r, int frames, const render::OrbitWalk& walk, double fps, cv::Size size) {
   if (r.camera.Size() != size) return false;
+  const std::string groundtruth = ReadFileUpTo(r.root / "groundtruth.txt", 1 << 20);
+  if (groundtruth.substr(0, groundtruth.find('\n')).find("window light") == std::string::npos) return false;
   if (static_cast<int>(r.frames.size()) != frames || !r.groundtruth || static_cast<int>(r.groundtruth->size()) != frames) return false;
   for (int i : {0, frames / 3, frames / 2, frames - 1}) {
     const calib::Pose expected = walk.At(i / fps);
@@ -94,6 +99,8 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
   o.frames = frames;
   o.seed = seed;
   o.walk = render::RoomWalk::kOrbit;
+  // Daylight through a window: a light the mapped lap sees, so the character casts a shadow.
+  o.light = render::SynthLighting::kWindow;
   o.overwrite = true;
   o.gl = gl;  // Mesa reads the thread count once per process: the same as for the replay
   Progress progress("  rendering");

@@ -90,6 +90,12 @@ void AddSynthCommand(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(std::map<std::string, render::RoomWalk>{{"room", render::RoomWalk::kRoom},
                                                                                    {"orbit", render::RoomWalk::kOrbit}}))
       ->default_str("room");
+  room->add_option("--light", o.light,
+                   "How the room is lit: even (from all round, a light floor) or window (daylight through a window, a "
+                   "dark floor: a light with a direction, as the demo uses)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, render::SynthLighting>{{"even", render::SynthLighting::kEven},
+                                                                                    {"window", render::SynthLighting::kWindow}}))
+      ->default_str("even");
   room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
   room->add_flag("--quiet", args->quiet, "No progress on stderr");
   room->callback([args] { RunSynthRoom(*args); });

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <future>
 #include <random>
+#include <string_view>
 
 #include "recordings/recording.h"
 #include "recordings/trajectory.h"
@@ -138,7 +139,32 @@ class SceneBuilder {
   std::map<std::string, double> aspect_;
 };
 
-void AddWalls(SceneBuilder& builder) {
+// The window of SynthLighting::kWindow takes this photo's place on its wall.
+constexpr const char* kWindowReplaces = "graf1.png";
+
+// A window seen from inside: panes clipped white by the daylight behind them, in a dark frame
+// with a mullion and a transom (their corners give the tracker something to hold on to).
+void AddWindow(SceneBuilder& builder, const Eigen::Vector3d& center, const Eigen::Vector3d& right,
+               const Eigen::Vector3d& up, const Eigen::Vector3d& inward, double width, double height) {
+  auto rectangle = [&](const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double offset, const Eigen::Vector3f& colour) {
+    const Eigen::Vector3d o = center + inward * offset;
+    const Eigen::Vector3d corners[4] = {o + right * lo.x() + up * hi.y(), o + right * hi.x() + up * hi.y(),
+                                        o + right * hi.x() + up * lo.y(), o + right * lo.x() + up * lo.y()};
+    builder.Paint(corners, colour);
+  };
+  const double w = width / 2, h = height / 2, bar = 0.06;
+  const Eigen::Vector3f pane(1.f, 1.f, 1.f), frame(0.3f, 0.27f, 0.24f);
+  rectangle({-w, -h}, {w, h}, kPanelOffset, pane);
+  const double in_front = 2 * kPanelOffset;
+  rectangle({-w, -h}, {-w + bar, h}, in_front, frame);
+  rectangle({w - bar, -h}, {w, h}, in_front, frame);
+  rectangle({-w, h - bar}, {w, h}, in_front, frame);
+  rectangle({-w, -h}, {w, -h + bar}, in_front, frame);
+  rectangle({-bar / 2, -h}, {bar / 2, h}, in_front, frame);              // mullion
+  rectangle({-w, 0.25 * h - bar / 2}, {w, 0.25 * h + bar / 2}, in_front, frame);  // transom
+}
+
+void AddWalls(SceneBuilder& builder, SynthLighting light) {
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   for (const Wall& wall : Walls()) {
     const Eigen::Vector3d right = wall.facing.cross(up);
@@ -150,22 +176,29 @@ void AddWalls(SceneBuilder& builder) {
     const int n = static_cast<int>(wall.images.size());
     const double spacing = wall.length / n;
     for (int i = 0; i < n; ++i) {
+      const double along = -wall.length / 2 + spacing * (i + 0.5);
+      if (light == SynthLighting::kWindow && std::string_view(wall.images[i]) == kWindowReplaces) {
+        AddWindow(builder, base + right * along + up * 1.7, right, up, -wall.facing, 1.4, 1.6);
+        continue;
+      }
       const double height = 1.6;
       const double width = std::min(height * builder.Aspect(wall.images[i]), spacing - 0.2);
-      const double along = -wall.length / 2 + spacing * (i + 0.5);
       const Eigen::Vector3d center = base - wall.facing * kPanelOffset + right * along + up * 1.4;
       builder.Panel(wall.images[i], center, right, up, width, height, wall.shade);
     }
   }
 }
 
-void AddFloorAndCeiling(SceneBuilder& builder) {
+void AddFloorAndCeiling(SceneBuilder& builder, SynthLighting light) {
   const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY();
   const Eigen::Vector3d floor[4] = {{-kHalfX, kHalfY, 0}, {kHalfX, kHalfY, 0}, {kHalfX, -kHalfY, 0}, {-kHalfX, -kHalfY, 0}};
-  builder.Paint(floor, {0.55f, 0.5f, 0.45f});
+  // Under a window the floor is the dark side of the room (the light comes from the side and
+  // above); evenly lit, it is as bright as the walls.
+  const float floor_light = light == SynthLighting::kWindow ? 0.45f : 1.f;
+  builder.Paint(floor, Eigen::Vector3f(0.55f, 0.5f, 0.45f) * floor_light);
   for (int i = 0; i < 4; ++i) {
     const Eigen::Vector3d center((i % 2 ? 0.5 : -0.5) * kHalfX, (i / 2 ? 0.5 : -0.5) * kHalfY, kPanelOffset);
-    builder.Panel(kFloorImages[i], center, x, y, kHalfX - 0.1, kHalfY - 0.1, {0.9f, 0.9f, 0.9f});
+    builder.Panel(kFloorImages[i], center, x, y, kHalfX - 0.1, kHalfY - 0.1, Eigen::Vector3f::Constant(0.9f * floor_light));
   }
   Eigen::Vector3d ceiling[4];
   for (int i = 0; i < 4; ++i) ceiling[i] = floor[i] + Eigen::Vector3d(0, 0, kHeight);
@@ -209,10 +242,10 @@ double SmootherStep(double s) {
 
 }  // namespace
 
-RoomScene MakeRoomScene(const fs::path& data_dir) {
+RoomScene MakeRoomScene(const fs::path& data_dir, SynthLighting light) {
   SceneBuilder builder(data_dir);
-  AddWalls(builder);
-  AddFloorAndCeiling(builder);
+  AddWalls(builder, light);
+  AddFloorAndCeiling(builder, light);
   AddBoxes(builder);
   return builder.Finish();
 }
@@ -373,7 +406,7 @@ void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
   ValidateOptions(o);
   const std::vector<int> indices = FramesToRender(o);
-  const RoomScene scene = MakeRoomScene(o.data_dir);
+  const RoomScene scene = MakeRoomScene(o.data_dir, o.light);
   std::unique_ptr<OffscreenContext> context = OffscreenContext::Create(o.gl);
   PrepareFolder(o);
   const calib::Camera camera = RoomCamera(o.width, o.height);
@@ -420,7 +453,8 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   calib::SaveCamera(camera, o.out / "camera.yaml");
   recordings::WriteFramesTxt(o.out, entries);
   recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
-                       "arview synth room, seed " + std::to_string(o.seed) + ", world: metres, z up, floor z = 0");
+                       "arview synth room, seed " + std::to_string(o.seed) + (o.light == SynthLighting::kWindow ? ", window light" : "") +
+                           ", world: metres, z up, floor z = 0");
   return {context->Description(), static_cast<int>(indices.size())};
 }
 

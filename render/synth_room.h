@@ -40,8 +40,18 @@ struct RoomScene {
   std::vector<RoomPanel> panels;       // the photo rectangles only
 };
 
+// How the room is lit; the light is baked into the surfaces' shades (nothing is lit at render
+// time), so a frame's brightness depends only on what it sees.
+//   kEven:   evenly from all round, a light floor (the tracking tests' room).
+//   kWindow: daylight through a window in the +y wall (x in [−1.575, −0.175], z in [0.9, 2.5]), the
+//            pane clipped white, a dark floor under light walls: the light has a direction that
+//            a camera in the room sees, so `arview place` finds a dominant light above the floor
+//            and the character casts a shadow (`arview demo`). One wall photo (graf1) gives way
+//            to the window.
+enum class SynthLighting { kEven, kWindow };
+
 // Loads the photos from `data_dir`; throws RenderError naming a missing or unreadable file.
-RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData);
+RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData, SynthLighting light = SynthLighting::kEven);
 
 // The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
 // Other sizes keep the horizontal field of view (f and the principal point offset scale with
@@ -69,6 +79,7 @@ enum class RoomWalk { kRoom, kOrbit };
 struct SynthRoomOptions {
   std::filesystem::path out;
   RoomWalk walk = RoomWalk::kRoom;
+  SynthLighting light = SynthLighting::kEven;
   OrbitWalkOptions orbit;        // for RoomWalk::kOrbit
   int frames = 300;
   uint64_t seed = 1;

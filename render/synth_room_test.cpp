@@ -7,6 +7,8 @@
 #include <iterator>
 
 #include "recordings/recording.h"
+#include "render/ray_caster.h"
+#include "render/room_light.h"
 #include "render/synth_room.h"
 #include "render/test_scene.h"
 #include "tests/support/test_data.h"
@@ -167,6 +169,42 @@ TEST(SynthRoom, GroundTruthProjectsPanelCornersOntoTheRenderedTextures) {
   // shift all of them the same way.
   EXPECT_LT(std::abs(sum.x / checked), 0.1);
   EXPECT_LT(std::abs(sum.y / checked), 0.1);
+}
+
+// The room's light as `arview place` measures it for the demo: from keyframes of the orbit
+// walk's first lap (the mapped one), at the demo character's middle, through the room's exact
+// geometry (the demo measures it through the planes of its map, which has no ceiling: the
+// evenly lit room's light then points below the floor, docs/render.md). Lit by the window, the
+// light comes from above the floor and from the window's side (+y), so the character casts a
+// shadow away from it.
+DominantLight DemoRoomLight(SynthLighting lighting) {
+  const RoomScene scene = MakeRoomScene(kOpenCvDocData, lighting);
+  std::vector<Eigen::Vector3f> triangles;
+  for (const TriangleBatch& batch : scene.batches)
+    for (const SceneVertex& v : batch.vertices) triangles.emplace_back(v.position[0], v.position[1], v.position[2]);
+  const TriangleBvh geometry(std::move(triangles));
+  const OrbitWalk walk(1340 / 30.0, 1, OrbitWalkOptions{});
+  RoomRenderer renderer(testing::SharedContext(), scene, RoomCamera(), 4);
+  std::vector<LightKeyframe> keyframes;
+  for (int frame = 0; frame < 670; frame += 14) {
+    const calib::Pose pose = walk.At(frame / 30.0);
+    keyframes.push_back({RoomCamera(), pose, renderer.Render(pose)});
+  }
+  return EstimateRoomLight(keyframes, geometry, walk.Subject() + Eigen::Vector3d(0, 0, 0.86)).dominant;
+}
+
+double ElevationDegrees(const Eigen::Vector3d& direction) { return std::asin(direction.z()) * 180 / M_PI; }
+
+TEST(SynthRoom, TheWindowLitRoomsLightComesFromAboveTheFloorOnTheWindowsSide) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  const DominantLight even = DemoRoomLight(SynthLighting::kEven);
+  const DominantLight window = DemoRoomLight(SynthLighting::kWindow);
+  std::printf("dominant light: evenly lit %.1f deg above the floor (%.2f %.2f %.2f), window-lit %.1f deg (%.2f %.2f %.2f)\n",
+              ElevationDegrees(even.direction), even.direction.x(), even.direction.y(), even.direction.z(),
+              ElevationDegrees(window.direction), window.direction.x(), window.direction.y(), window.direction.z());
+  EXPECT_GT(ElevationDegrees(window.direction), 25);
+  EXPECT_GT(window.direction.y(), 0.2);  // towards the window's wall
+  EXPECT_GT(window.color.minCoeff(), 0.1);
 }
 
 // A short noisy walk: 4 frames, seed 5, sensor noise on.
