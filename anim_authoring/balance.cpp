@@ -155,7 +155,8 @@ BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const Balan
     bool on_feet = true;
     for (int f = rest_frames[r - 1].second; f <= rest_frames[r].first && on_feet; ++f) on_feet = planted[f];
     if (on_feet)
-      a.transitions.push_back({a.rests[r - 1].support, a.rests[r].support, a.rests[r - 1].to, a.rests[r].from, static_cast<int>(r) - 1});
+      a.transitions.push_back(
+          {a.rests[r - 1].support, a.rests[r].support, a.rests[r - 1].to, a.rests[r].from, static_cast<int>(r) - 1});
   }
   return a;
 }

@@ -279,7 +279,8 @@ double LargestJointStep(const std::vector<Eigen::VectorXd>& postures, int joints
   };
   double largest = 0;
   for (std::size_t f = 1; f < postures.size(); ++f)
-    for (int k = 0; k < joints; ++k) largest = std::max(largest, rotation(postures[f - 1], k).angularDistance(rotation(postures[f], k)));
+    for (int k = 0; k < joints; ++k)
+      largest = std::max(largest, rotation(postures[f - 1], k).angularDistance(rotation(postures[f], k)));
   return largest;
 }
 
@@ -457,6 +458,14 @@ TEST(BalanceScene, BuiltFromTheClipTheSceneNames) {
   const Action* idle_action = animator->schedule().Find(animator->schedule().FindByName("idle"));
   ASSERT_NE(idle_action, nullptr);
   EXPECT_NE(dynamic_cast<BalanceShifter*>(idle_action->object.get()), nullptr);
+  // A clip the character does not have: one message naming the scene line and the option.
+  const Scene missing = ParseScene(std::string(kSceneHead) + "      balance: {clip: sway}\n", "/s/scene.yaml");
+  try {
+    BuildIdleLayer(AnimatedCharacter(person, missing.characters[0]));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "/s/scene.yaml:6: idle.balance: clip 'sway' does not exist in person.glb (clips: standing)");
+  }
 }
 
 // The product path on a real recording: BCN_Epileptic idling on its own clip, the scene asking

@@ -1012,7 +1012,9 @@ std::shared_ptr<const BalanceModel> LearnBalance(const AnimatedCharacter& ch, co
       options.analysis.up = Eigen::Vector3d::UnitY();  // motion capture's up, as the idle learner reads it
     } else {
       const Clip* c = ch.character().FindClip(b.clip);
-      if (!c) throw Error("clip '" + b.clip + "' does not exist in " + ch.character().source + " (clips: " + ClipList(ch.character()) + ")");
+      if (!c)
+        throw Error("clip '" + b.clip + "' does not exist in " + ch.character().source + " (clips: " + ClipList(ch.character()) +
+                    ")");
       source.clips.push_back(c);
     }
     std::optional<BalanceModel> model =
