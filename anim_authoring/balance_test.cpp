@@ -81,35 +81,8 @@ TEST(Balance, NoLegsIsAnError) {
 using testing::Stay;
 constexpr Support kL = Support::kLeft, kB = Support::kBoth, kR = Support::kRight;
 
-// Eleven rests (four left, three both, four right) joined by ten transitions of all six kinds,
-// each rest with its own head turn, so that the resting postures of a category differ.
-std::vector<Stay> LongStanding() {
-  return {{kL, 2.0, 0.00, 0.6}, {kB, 1.2, 0.15, 0.6},  {kR, 2.6, -0.10, 0.8}, {kL, 1.4, 0.20, 0.6},
-          {kR, 1.6, -0.15, 0.6}, {kB, 2.2, 0.05, 0.6}, {kL, 3.0, 0.10, 0.8},  {kR, 2.0, -0.20, 0.6},
-          {kL, 1.8, 0.12, 0.6}, {kB, 1.6, -0.05, 0.6}, {kR, 2.0, 0.00, 0.6}};
-}
-
-// The recording as a person's own clip, the idle model learned from it (whose PCA the distance
-// uses) and the balance model.
-struct Learned {
-  Character person;
-  IdleModel idle;
-  std::optional<BalanceModel> balance;
-  BalanceLearningReport report;
-  std::shared_ptr<const Skeleton> skeleton() const { return std::make_shared<const Skeleton>(person.skeleton); }
-};
-
-std::unique_ptr<Learned> LearnFromStanding(const std::vector<Stay>& stays) {
-  auto l = std::make_unique<Learned>();
-  l->person.source = "constructed";
-  l->person.skeleton = testing::StandingSkeleton(true);
-  l->person.clips = {testing::StandingRecording(stays)};
-  const IdleSource own{&l->person, {&l->person.clips[0]}, true};
-  const IdleLearningOptions options;
-  l->idle = LearnIdleModel(l->person.skeleton, {own}, options);
-  l->balance = LearnBalanceModel(l->person.skeleton, own, l->idle, options, {}, &l->report);
-  return l;
-}
+using testing::LearnFromStanding;
+using testing::LongStanding;
 
 int Index(Support s) { return static_cast<int>(s); }
 

@@ -6,11 +6,15 @@
 
 #include "anim/balance_shift.h"
 #include "anim/character.h"
+#include "anim_authoring/balance.h"
+#include "anim_authoring/idle_learning.h"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -91,6 +95,38 @@ inline anim::Clip StandingRecording(const std::vector<Stay>& stays) {
     c.tracks[10].rotation.push_back({t, Eigen::Quaterniond(Eigen::AngleAxisd(head, up))});
   }
   return c;
+}
+
+// Eleven rests (four left, three both, four right) joined by ten transitions of all six kinds,
+// each rest with its own head turn, so that the resting postures of a category differ.
+inline std::vector<Stay> LongStanding() {
+  using anim::Support;
+  constexpr Support kL = Support::kLeft, kB = Support::kBoth, kR = Support::kRight;
+  return {{kL, 2.0, 0.00, 0.6}, {kB, 1.2, 0.15, 0.6},  {kR, 2.6, -0.10, 0.8}, {kL, 1.4, 0.20, 0.6},
+          {kR, 1.6, -0.15, 0.6}, {kB, 2.2, 0.05, 0.6}, {kL, 3.0, 0.10, 0.8},  {kR, 2.0, -0.20, 0.6},
+          {kL, 1.8, 0.12, 0.6}, {kB, 1.6, -0.05, 0.6}, {kR, 2.0, 0.00, 0.6}};
+}
+
+// A person (StandingSkeleton(true)) whose one clip is the recording, the idle model learned from
+// that clip (whose PCA the balance distance uses) and the balance model learned from it.
+struct StandingPerson {
+  anim::Character person;
+  anim::IdleModel idle;
+  std::optional<anim::BalanceModel> balance;
+  anim::BalanceLearningReport report;
+  std::shared_ptr<const anim::Skeleton> skeleton() const { return std::make_shared<const anim::Skeleton>(person.skeleton); }
+};
+
+inline std::unique_ptr<StandingPerson> LearnFromStanding(const std::vector<Stay>& stays) {
+  auto l = std::make_unique<StandingPerson>();
+  l->person.source = "constructed";
+  l->person.skeleton = StandingSkeleton(true);
+  l->person.clips = {StandingRecording(stays)};
+  const anim::IdleSource own{&l->person, {&l->person.clips[0]}, true};
+  const anim::IdleLearningOptions options;
+  l->idle = anim::LearnIdleModel(l->person.skeleton, {own}, options);
+  l->balance = anim::LearnBalanceModel(l->person.skeleton, own, l->idle, options, {}, &l->report);
+  return l;
 }
 
 }  // namespace arview::testing
