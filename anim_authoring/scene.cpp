@@ -767,6 +767,9 @@ class AnimatorBuilder {
     if (file_.empty()) file_ = spec_.asset.string();
   }
 
+  // After Build: notes for the user about layers built without what the scene asked for.
+  const std::vector<std::string>& notes() const { return notes_; }
+
   std::unique_ptr<Animator> Build() {
     FrameBlenderOptions blender;
     blender.method = spec_.blend;
@@ -934,10 +937,7 @@ class AnimatorBuilder {
   AnimatorOverrides overrides_;
   std::string file_;
   BlendablePtr idle_;
-  std::vector<std::string> notes_;
-
- public:
-  const std::vector<std::string>& notes() const { return notes_; }
+  std::vector<std::string> notes_;  // what the user should be told (IdleLayerReport::notes)
 };
 
 // "scene.yaml:<line>: <what>: ", for the idle section's messages.
