@@ -104,8 +104,9 @@ struct BalanceLearningReport {
 // in the posture layout and PCA of `idle` (learned with `idle_options`). Only categories from
 // which the recorded graph can always go on are kept (a category whose only transitions lead
 // where none was recorded out would end the walk). Returns nothing when no transition remains;
-// the report says what the recording held. Throws Error when the source maps onto other joints
-// than the idle model, or has no feet found by name.
+// the report says what the recording held (a recording without a transition is only analysed:
+// `idle` is not read then). Throws Error when the source maps onto other joints than the idle
+// model, or has no feet found by name.
 std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const IdleSource& source, const IdleModel& idle,
                                               const IdleLearningOptions& idle_options, const BalanceLearningOptions& options,
                                               BalanceLearningReport* report = nullptr);

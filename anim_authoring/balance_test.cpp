@@ -439,6 +439,14 @@ TEST(BalanceScene, BuiltFromTheClipTheSceneNames) {
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "/s/scene.yaml:6: idle.balance: clip 'sway' does not exist in person.glb (clips: standing)");
   }
+  // A recording that is not there: the same, with the loader's reason.
+  const Scene absent = ParseScene(std::string(kSceneHead) + "      balance: {motion: no_such.bvh}\n", "/s/scene.yaml");
+  try {
+    BuildIdleLayer(AnimatedCharacter(person, absent.characters[0]));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/s/scene.yaml:6: idle.balance: /s/no_such.bvh", 0), 0u) << e.what();
+  }
 }
 
 // The product path on a real recording: BCN_Epileptic idling on its own clip, the scene asking
