@@ -1,6 +1,9 @@
 // Balance shifts: the analysis on a constructed stance with one known weight shift (the code
-// finds exactly what was built), then what every recording on this machine holds (printed as
-// [balance] lines; docs/anim.md quotes them).
+// finds exactly what was built); the balance-shift layer learned from a longer constructed
+// recording (tests/support/standing_recording.h: the graph is what was built, the walk is seeded
+// and stays on it, fitted segments join the rests without a jump, masks over it hold); the scene
+// option; and what every recording on this machine holds (printed as [balance] lines;
+// docs/anim.md quotes them): no transition, so the learner refuses each with its reason.
 
 #include "anim_authoring/balance.h"
 #include "anim/schedule.h"
@@ -528,7 +531,8 @@ TEST(Balance, WhatTheRecordingsHold) {
   }
   std::printf("[balance] transitions in all recordings: %d (tolerant: %d)\n", transitions, loose_transitions);
   // docs/anim.md says that no recording here holds a balance shift, so that the balance-shift
-  // layer has nothing to learn from: if one ever does, this fails and the layer is to be built.
+  // layer is inactive on all of them: if one ever does, this fails, and the layer is to be
+  // learned from it and the section revisited.
   EXPECT_EQ(transitions, 0);
   EXPECT_EQ(loose_transitions, 0);
 }
