@@ -7,6 +7,8 @@
 //   BM_ScheduleUpdate/<dib>      Animator::Update, BCN_Epileptic (54 joints), a four-action schedule
 //   BM_ScheduleUpdateGesture/<dib>  the same with the gesture a generated point gesture (IK)
 //   BM_FourActionSchedule3600    BM_ScheduleUpdateGesture/dib:0, exactly 3600 updates (callgrind)
+//   BM_IdleLayerSample/<balance> the idle layer alone, without (0) or with (1) the balance shifts
+//                                under its variations, on the constructed 13-joint standing person
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
@@ -14,6 +16,7 @@
 #include "anim/animator.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/four_action_schedule.h"
+#include "tests/support/standing_recording.h"
 #include "tests/support/test_data.h"
 
 #include <benchmark/benchmark.h>
@@ -224,6 +227,29 @@ BENCHMARK(BM_ScheduleUpdateGesture)->Arg(0)->Arg(1)->ArgName("dib");
 // count, hence which segments the idle synthesizer draws and checks, depends on the timing):
 //   valgrind --tool=callgrind --toggle-collect='arview::anim::Animator::Update*' bench_anim --benchmark_filter=BM_FourActionSchedule3600
 BENCHMARK(BM_ScheduleUpdateGesture)->Name("BM_FourActionSchedule3600")->Arg(0)->ArgName("dib")->Iterations(3600);
+
+// The idle layer's own cost per frame at 60 Hz: the idle synthesizer alone (balance:0), or the
+// balance-shift layer with the synthesizer's variations on top (balance:1, what a scene with
+// `idle.balance:` plays), both learned from the constructed recording of a standing person
+// (tests/support/standing_recording.h, 13 joints: no recording on this machine holds a balance
+// shift to learn from).
+void BM_IdleLayerSample(benchmark::State& state) {
+  const auto standing = testing::LearnFromStanding(testing::LongStanding());
+  const auto sk = standing->skeleton();
+  auto idle = std::make_shared<IdleSynthesizer>(sk, std::make_shared<const IdleModel>(standing->idle), 1);
+  BlendablePtr layer = idle;
+  if (state.range(0))
+    layer = std::make_shared<BalanceShifter>(sk, std::make_shared<const BalanceModel>(*standing->balance), 1, idle);
+  LocalPose pose(sk->size());
+  double t = 0;
+  for (auto _ : state) {
+    t += 1.0 / 60;
+    if (!layer->Sample(t, {}, pose)) state.SkipWithError("the layer did not sample");
+    benchmark::DoNotOptimize(pose.rigid.data());
+  }
+  state.SetLabel(state.range(0) ? "balance shifts + idle variations, 13 joints" : "idle variations, 13 joints");
+}
+BENCHMARK(BM_IdleLayerSample)->Arg(0)->Arg(1)->ArgName("balance");
 
 }  // namespace
 }  // namespace arview::anim

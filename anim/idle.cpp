@@ -1,5 +1,6 @@
 #include "anim/idle.h"
 
+#include "anim/seeded_draw.h"
 #include "anim/taylor_trig.h"
 
 #include <algorithm>
@@ -19,21 +20,6 @@ Eigen::Quaterniond ExpMap(const Eigen::Vector3d& v) {
   q.w() = sc[1];
   q.vec() = sc[0] * (v / angle);
   return q;
-}
-
-// A draw in [0, 1) from the walk's generator, the same on every platform (no distribution
-// objects, whose algorithms the standard leaves open).
-double Uniform(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0); }
-
-int Draw(std::mt19937_64& rng, const std::vector<double>& weights) {
-  double total = 0;
-  for (double w : weights) total += w;
-  double x = Uniform(rng) * total;
-  for (std::size_t i = 0; i < weights.size(); ++i) {
-    if (x < weights[i]) return static_cast<int>(i);
-    x -= weights[i];
-  }
-  return static_cast<int>(weights.size()) - 1;
 }
 
 // The normalised shape of a segment at x in [0, 1]: the recorded one linearly interpolated
@@ -244,20 +230,22 @@ const Eigen::VectorXd& IdleSynthesizer::Posture(double t) {
   return posture_;
 }
 
-bool IdleSynthesizer::Sample(double t, const FrameInputs&, LocalPose& out) {
-  const Skeleton& sk = *skeleton_;
-  if (out.size() != sk.size()) return false;
-  const Eigen::VectorXd& p = Posture(t);
-  std::copy(rest_.rigid.begin(), rest_.rigid.end(), out.rigid.begin());
-  std::copy(rest_.scale.begin(), rest_.scale.end(), out.scale.begin());
-  const int m = static_cast<int>(model_->joints.size());
+void PoseFromPosture(const Skeleton& sk, const LocalPose& rest, const std::vector<int>& joints, int root,
+                     const Eigen::VectorXd& p, LocalPose& out) {
+  std::copy(rest.rigid.begin(), rest.rigid.end(), out.rigid.begin());
+  std::copy(rest.scale.begin(), rest.scale.end(), out.scale.begin());
+  const int m = static_cast<int>(joints.size());
   for (int k = 0; k < m; ++k) {
-    const int j = model_->joints[k];
+    const int j = joints[k];
     const Eigen::Quaterniond r = sk.rest[j].rotation * ExpMap(p.segment<3>(3 * k));
     out.rigid[j] = DualQuatd::FromRotationTranslation(r, sk.rest[j].translation);
   }
-  const int root = model_->root;
   out.rigid[root] = DualQuatd::FromRotationTranslation(out.rigid[root].Rotation(), sk.rest[root].translation + p.segment<3>(3 * m));
+}
+
+bool IdleSynthesizer::Sample(double t, const FrameInputs&, LocalPose& out) {
+  if (out.size() != skeleton_->size()) return false;
+  PoseFromPosture(*skeleton_, rest_, model_->joints, model_->root, Posture(t), out);
   return true;
 }
 

@@ -79,6 +79,12 @@ struct IdleModel {
   void Check(int skeleton_joints) const;
 };
 
+// A posture vector (IdleModel's layout) as a pose: the skeleton's rest pose `rest`, each of
+// `joints` turned from its rest rotation by the exponential map of its three values, and `root`
+// moved from its rest translation by the last three. `out` has the skeleton's size; no allocation.
+void PoseFromPosture(const Skeleton& skeleton, const LocalPose& rest, const std::vector<int>& joints, int root,
+                     const Eigen::VectorXd& posture, LocalPose& out);
+
 class IdleSynthesizer : public Blendable {
  public:
   IdleSynthesizer(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<const IdleModel> model, std::uint64_t seed);

@@ -154,9 +154,140 @@ BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const Balan
     if (a.rests[r].support == a.rests[r - 1].support) continue;
     bool on_feet = true;
     for (int f = rest_frames[r - 1].second; f <= rest_frames[r].first && on_feet; ++f) on_feet = planted[f];
-    if (on_feet) a.transitions.push_back({a.rests[r - 1].support, a.rests[r].support, a.rests[r - 1].to, a.rests[r].from});
+    if (on_feet)
+      a.transitions.push_back(
+          {a.rests[r - 1].support, a.rests[r].support, a.rests[r - 1].to, a.rests[r].from, static_cast<int>(r) - 1});
   }
   return a;
+}
+
+}  // namespace arview::anim
+
+namespace arview::anim {
+namespace {
+
+// Keeps the transitions after which the walk can always go on: a transition into a category
+// with no recorded way out is dropped, and so on until nothing changes.
+void KeepLeavable(std::array<std::array<int, kSupports>, kSupports>& counts) {
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int s = 0; s < kSupports; ++s) {
+      const auto& out = counts[s];
+      if (std::any_of(out.begin(), out.end(), [](int n) { return n > 0; })) continue;
+      for (int c = 0; c < kSupports; ++c)
+        if (counts[c][s] > 0) {
+          counts[c][s] = 0;
+          changed = true;
+        }
+    }
+  }
+}
+
+// The recording's transitions as segments (postures from the end of one rest to the start of
+// the next), with the dwell before each (the rest it leaves) per category.
+void AddTransitions(const BalanceAnalysis& a, const std::vector<Eigen::VectorXd>& postures, double rate, BalanceModel& m,
+                    std::array<std::vector<double>, kSupports>& dwell) {
+  for (const BalanceAnalysis::Transition& t : a.transitions) {
+    BalanceModel::Segment segment;
+    segment.from = t.from_support;
+    segment.to = t.to_support;
+    segment.rate = rate;
+    segment.recorded_at = t.from;
+    const long last = std::min(std::lround(t.to * rate), static_cast<long>(postures.size()) - 1);
+    for (long f = std::lround(t.from * rate); f <= last; ++f) segment.frames.push_back(postures[f]);
+    m.segments.push_back(std::move(segment));
+    ++m.counts[static_cast<int>(t.from_support)][static_cast<int>(t.to_support)];
+    const BalanceAnalysis::Rest& rest = a.rests[t.rest];
+    dwell[static_cast<int>(t.from_support)].push_back(rest.to - rest.from);
+  }
+}
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f", s);
+  return buf;
+}
+
+}  // namespace
+
+std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const IdleSource& source, const IdleModel& idle,
+                                              const IdleLearningOptions& idle_options, const BalanceLearningOptions& options,
+                                              BalanceLearningReport* report) {
+  BalanceLearningReport rep;
+  rep.source = source.data->source;
+  BalanceModel m;
+  std::array<std::vector<double>, kSupports> dwell;
+  const double rate = options.analysis.rate;
+  // What each clip holds first: a recording without a transition needs no postures.
+  for (const Clip* clip : source.clips) {
+    BalanceAnalysis a = AnalyseBalance(source.data->skeleton, *clip, options.analysis, source.data->source + " " + clip->name);
+    for (const BalanceAnalysis::Rest& r : a.rests) ++rep.rests[static_cast<int>(r.support)];
+    rep.transitions += static_cast<int>(a.transitions.size());
+    rep.clips.push_back(std::move(a));
+  }
+  for (std::size_t i = 0; i < source.clips.size() && rep.transitions > 0; ++i) {
+    if (rep.clips[i].transitions.empty()) continue;
+    std::vector<int> joints;
+    const std::vector<Eigen::VectorXd> postures = ClipPostures(character, source, *source.clips[i], idle_options, rate, &joints);
+    if (joints != idle.joints)
+      throw Error(rep.clips[i].source + ": maps onto other joints than the idle model's sources; learn both from one kind of rig");
+    AddTransitions(rep.clips[i], postures, rate, m, dwell);
+  }
+  KeepLeavable(m.counts);
+  std::erase_if(m.segments, [&](const BalanceModel::Segment& s) {
+    return m.counts[static_cast<int>(s.from)][static_cast<int>(s.to)] == 0;
+  });
+  for (const BalanceModel::Segment& s : m.segments) {
+    m.rests[static_cast<int>(s.from)].push_back(s.frames.front());
+    m.rests[static_cast<int>(s.to)].push_back(s.frames.back());
+  }
+  for (int c = 0; c < kSupports; ++c)
+    if (m.CanLeave(static_cast<Support>(c))) {
+      m.dwell_min[c] = *std::min_element(dwell[c].begin(), dwell[c].end());
+      m.dwell_max[c] = *std::max_element(dwell[c].begin(), dwell[c].end());
+    }
+  m.joints = idle.joints;
+  m.root = idle.root;
+  m.mean = idle.mean;
+  const int k = std::min(options.components, idle.component_count());
+  m.components = idle.components.leftCols(k);
+  m.eigenvalues = idle.eigenvalues.head(k);
+  rep.learned = !m.segments.empty();
+  rep.segments = static_cast<int>(m.segments.size());
+  rep.counts = m.counts;
+  rep.dwell_min = m.dwell_min;
+  rep.dwell_max = m.dwell_max;
+  rep.components = k;
+  if (report) *report = rep;
+  if (!rep.learned) return std::nullopt;
+  m.Check(character.size());
+  return m;
+}
+
+std::string BalanceLearningReport::Summary() const {
+  double seconds = 0;
+  for (const BalanceAnalysis& a : clips) seconds += a.seconds;
+  std::string s = source + ": " + std::to_string(clips.size()) + (clips.size() == 1 ? " clip, " : " clips, ") + Seconds(seconds) +
+                  " s; rests (" + Seconds(clips.empty() ? 0.0 : clips.front().min_rest_seconds) + " s or more): left " +
+                  std::to_string(rests[0]) + ", both " + std::to_string(rests[1]) + ", right " + std::to_string(rests[2]) +
+                  "; " + std::to_string(transitions) + " transitions";
+  if (!learned) {
+    return s + (transitions == 0 ? ": nothing to learn balance shifts from"
+                                 : ": none leads to a category the recording also leaves, so no walk can go on");
+  }
+  s += "; learned " + std::to_string(segments) + " segments:";
+  for (int c = 0; c < kSupports; ++c) {
+    const int total = counts[c][0] + counts[c][1] + counts[c][2];
+    if (total == 0) continue;
+    s += std::string(" ") + SupportName(static_cast<Support>(c)) + " (dwell " + Seconds(dwell_min[c]) + "-" +
+         Seconds(dwell_max[c]) + " s) to";
+    for (int t = 0; t < kSupports; ++t)
+      if (counts[c][t] > 0)
+        s += std::string(" ") + SupportName(static_cast<Support>(t)) + " " + std::to_string(counts[c][t]) + "/" +
+             std::to_string(total);
+    s += ";";
+  }
+  return s + " distance over " + std::to_string(components) + " components";
 }
 
 }  // namespace arview::anim

@@ -18,16 +18,22 @@
 //
 //   BalanceAnalysis a = AnalyseBalance(cmu.skeleton, cmu.clips[0], {});
 //   a.Summary();   // seconds planted (per support category), resting, rests, transitions
+//
+// LearnBalanceModel then learns the balance-shift layer (anim/balance_shift.h) from what the
+// analysis finds in a recording: the transitions as segments, their ends as the resting
+// postures, the counts and dwell times as the category graph. A recording without a transition
+// teaches nothing: no model, and the report says what was found instead.
 
+#include "anim/balance_shift.h"
 #include "anim/character.h"
+#include "anim_authoring/idle_learning.h"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace arview::anim {
-
-enum class Support { kLeft = 0, kBoth = 1, kRight = 2 };
 
 struct BalanceOptions {
   double rate = 30;
@@ -50,6 +56,7 @@ struct BalanceAnalysis {
   struct Transition {
     Support from_support = Support::kBoth, to_support = Support::kBoth;
     double from = 0, to = 0;  // seconds: the end of one rest to the start of the next
+    int rest = -1;            // the index of the rest it leaves
   };
   std::string source;              // "file clip"
   double seconds = 0;
@@ -71,5 +78,37 @@ struct BalanceAnalysis {
 // Throws Error when the skeleton has no left and right leg with a foot found by name.
 BalanceAnalysis AnalyseBalance(const Skeleton& skeleton, const Clip& clip, const BalanceOptions& options,
                                const std::string& source = "");
+
+struct BalanceLearningOptions {
+  BalanceOptions analysis;  // up: the data's (+Y for motion capture, the character's for its own clips)
+  int components = 10;      // of the idle PCA, in the distance between postures
+};
+
+struct BalanceLearningReport {
+  std::string source;                      // the recording
+  std::vector<BalanceAnalysis> clips;      // what each clip holds
+  std::array<int, kSupports> rests{};      // rests found, per category
+  int transitions = 0;                     // transitions found
+  // Learned (model given): categories that can be left, segments kept, dwell ranges.
+  bool learned = false;
+  int segments = 0;
+  std::array<std::array<int, kSupports>, kSupports> counts{};
+  std::array<double, kSupports> dwell_min{}, dwell_max{};
+  int components = 0;
+  // One line: what was found, and what was learned or why nothing was.
+  std::string Summary() const;
+};
+
+// The balance-shift model from `source`'s clips (a recording of a person standing: motion
+// capture mapped onto the character as the idle learner maps it, or the character's own clips),
+// in the posture layout and PCA of `idle` (learned with `idle_options`). Only categories from
+// which the recorded graph can always go on are kept (a category whose only transitions lead
+// where none was recorded out would end the walk). Returns nothing when no transition remains;
+// the report says what the recording held (a recording without a transition is only analysed:
+// `idle` is not read then). Throws Error when the source maps onto other joints than the idle
+// model, or has no feet found by name.
+std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const IdleSource& source, const IdleModel& idle,
+                                              const IdleLearningOptions& idle_options, const BalanceLearningOptions& options,
+                                              BalanceLearningReport* report = nullptr);
 
 }  // namespace arview::anim

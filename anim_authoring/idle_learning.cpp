@@ -382,6 +382,59 @@ std::vector<std::pair<int, int>> HumanoidJointPairs(const Skeleton& character, c
   return pairs;
 }
 
+namespace {
+
+// The retargeting of one source onto the character: the humanoid joint pairs (or every joint
+// for the character's own clips), the axes and the height ratio.
+Retargeter MakeRetargeter(const Skeleton& ch, const IdleSource& src, const IdleLearningOptions& o) {
+  const Skeleton& da = src.data->skeleton;
+  Retargeter r(ch, da);
+  r.identity = src.is_character;
+  if (r.identity) {
+    for (int j = 0; j < ch.size(); ++j) r.pairs.emplace_back(j, j);
+    return r;
+  }
+  r.pairs = HumanoidJointPairs(ch, da, o.joint_map);
+  if (r.pairs.size() < 6)
+    throw Error(src.data->source + ": only " + std::to_string(r.pairs.size()) +
+                " joints map onto the character by name (give idle.joint_map)");
+  r.a = DataToCharacter(o.forward, o.up);
+  r.height_ratio = RestHeight(ch, o.up) / RestHeight(da, Eigen::Vector3d::UnitY());
+  LocalPose rest = LocalPose::Rest(ch);
+  ModelRotations(ch, rest, r.ch_rest_model);
+  return r;
+}
+
+// The postures of the frames in `runs` ([begin, end) frame ranges of `poses`), retargeted about
+// the data's mean posture over those frames, one sequence per run.
+std::vector<std::vector<Eigen::VectorXd>> RunPostures(Retargeter& r, const std::vector<LocalPose>& poses,
+                                                      const std::vector<std::pair<int, int>>& runs) {
+  const Skeleton& da = r.da;
+  std::vector<std::vector<Eigen::Quaterniond>> per_joint(da.size());
+  Eigen::Vector3d root_sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  std::vector<Eigen::Quaterniond> g;
+  for (auto [b, e] : runs)
+    for (int i = b; i < e; ++i) {
+      ModelRotations(da, poses[i], g);
+      for (int j = 0; j < da.size(); ++j) per_joint[j].push_back(g[j]);
+      root_sum += da.root_parent.block<3, 3>(0, 0) * poses[i].rigid[0].Translation();
+      ++count;
+    }
+  r.data_mean.resize(da.size());
+  for (int j = 0; j < da.size(); ++j) r.data_mean[j] = MeanRotation(per_joint[j]);
+  r.data_root_mean = root_sum / count;
+  std::vector<std::vector<Eigen::VectorXd>> out;
+  for (auto [b, e] : runs) {
+    std::vector<Eigen::VectorXd> seq;
+    for (int i = b; i < e; ++i) seq.push_back(r.Posture(poses[i], g));
+    out.push_back(std::move(seq));
+  }
+  return out;
+}
+
+}  // namespace
+
 PostureSequences TrainingPostures(const Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,
                                   double rate) {
   PostureSequences out;
@@ -389,20 +442,7 @@ PostureSequences TrainingPostures(const Skeleton& ch, const std::vector<IdleSour
   out.root = 0;
   for (const IdleSource& src : sources) {
     const Skeleton& da = src.data->skeleton;
-    Retargeter r(ch, da);
-    r.identity = src.is_character;
-    if (r.identity) {
-      for (int j = 0; j < ch.size(); ++j) r.pairs.emplace_back(j, j);
-    } else {
-      r.pairs = HumanoidJointPairs(ch, da, o.joint_map);
-      if (r.pairs.size() < 6)
-        throw Error(src.data->source + ": only " + std::to_string(r.pairs.size()) +
-                    " joints map onto the character by name (give idle.joint_map)");
-      r.a = DataToCharacter(o.forward, o.up);
-      r.height_ratio = RestHeight(ch, o.up) / RestHeight(da, Eigen::Vector3d::UnitY());
-      LocalPose rest = LocalPose::Rest(ch);
-      ModelRotations(ch, rest, r.ch_rest_model);
-    }
+    Retargeter r = MakeRetargeter(ch, src, o);
     if (out.joints.empty()) out.joints = r.Joints();
     else if (out.joints != r.Joints())
       throw Error(src.data->source + ": maps onto other joints than the first motion source; learn from one kind of rig");
@@ -415,29 +455,18 @@ PostureSequences TrainingPostures(const Skeleton& ch, const std::vector<IdleSour
       const auto runs = src.is_character ? std::vector<std::pair<int, int>>{{0, static_cast<int>(poses.size())}}
                                          : StandingRuns(da, poses, data_joints, rate, data_height, o, out.stillest, src.data->source);
       if (runs.empty()) continue;
-      // The data's mean posture over its standing frames (this clip).
-      std::vector<std::vector<Eigen::Quaterniond>> per_joint(da.size());
-      Eigen::Vector3d root_sum = Eigen::Vector3d::Zero();
-      int count = 0;
-      std::vector<Eigen::Quaterniond> g;
-      for (auto [b, e] : runs)
-        for (int i = b; i < e; ++i) {
-          ModelRotations(da, poses[i], g);
-          for (int j = 0; j < da.size(); ++j) per_joint[j].push_back(g[j]);
-          root_sum += da.root_parent.block<3, 3>(0, 0) * poses[i].rigid[0].Translation();
-          ++count;
-        }
-      r.data_mean.resize(da.size());
-      for (int j = 0; j < da.size(); ++j) r.data_mean[j] = MeanRotation(per_joint[j]);
-      r.data_root_mean = root_sum / count;
-      for (auto [b, e] : runs) {
-        std::vector<Eigen::VectorXd> seq;
-        for (int i = b; i < e; ++i) seq.push_back(r.Posture(poses[i], g));
-        out.segments.push_back(std::move(seq));
-      }
+      for (auto& seq : RunPostures(r, poses, runs)) out.segments.push_back(std::move(seq));
     }
   }
   return out;
+}
+
+std::vector<Eigen::VectorXd> ClipPostures(const Skeleton& ch, const IdleSource& source, const Clip& clip,
+                                          const IdleLearningOptions& o, double rate, std::vector<int>* joints) {
+  Retargeter r = MakeRetargeter(ch, source, o);
+  if (joints) *joints = r.Joints();
+  const std::vector<LocalPose> poses = Resample(source.data->skeleton, clip, rate);
+  return RunPostures(r, poses, {{0, static_cast<int>(poses.size())}}).front();
 }
 
 IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,

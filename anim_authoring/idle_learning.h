@@ -78,4 +78,12 @@ struct PostureSequences {
 PostureSequences TrainingPostures(const Skeleton& character, const std::vector<IdleSource>& sources,
                                   const IdleLearningOptions& options, double rate = 30.0);
 
+// Every frame of `clip` (a clip of source.data) at `rate` Hz as a posture in the layout the
+// learner gives `source` (retargeted about the clip's mean posture, or the character's own
+// rotations), with the character joints of that layout in `joints`: what the balance-shift
+// learner (balance.h) reads a recording as.
+std::vector<Eigen::VectorXd> ClipPostures(const Skeleton& character, const IdleSource& source, const Clip& clip,
+                                          const IdleLearningOptions& options, double rate,
+                                          std::vector<int>* joints = nullptr);
+
 }  // namespace arview::anim

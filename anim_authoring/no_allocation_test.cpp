@@ -5,7 +5,9 @@
 // (__libc_malloc, ...), so every allocation is seen: operator new, Eigen's dynamic matrices,
 // std::vector. Sanitizer builds bring their own allocator; there the test is skipped.
 
+#include "anim/balance_shift.h"
 #include "tests/support/four_action_schedule.h"
+#include "tests/support/standing_recording.h"
 #include "tests/support/test_data.h"
 
 #include <gtest/gtest.h>
@@ -89,6 +91,34 @@ TEST(NoAllocation, FourActionScheduleWithPointGesture) {
 TEST(NoAllocation, FourActionScheduleWithMirroredGesture) {
   ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(testing::kBcnEpileptic), "Debian package assimp-testmodels");
   ExpectUpdatesAllocateNothing(testing::FourActionSchedule::Gesture::kMirroredClip, false);
+}
+
+// The balance-shift layer with the idle synthesizer's variations on top, learned from the
+// constructed standing recording: 10 minutes at 60 Hz, over a hundred transitions chosen and fitted.
+TEST(NoAllocation, BalanceLayerOverTheIdleSynthesizer) {
+#ifndef ARVIEW_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "allocations are not counted in sanitizer builds (they replace malloc)";
+#else
+  const auto standing = testing::LearnFromStanding(testing::LongStanding());
+  ASSERT_TRUE(standing->balance);
+  const auto sk = standing->skeleton();
+  auto idle = std::make_shared<IdleSynthesizer>(sk, std::make_shared<const IdleModel>(standing->idle), 1);
+  BalanceShifter layer(sk, std::make_shared<const BalanceModel>(*standing->balance), 1, idle);
+  LocalPose pose(sk->size());
+  ASSERT_TRUE(layer.Sample(0, {}, pose));
+  const long before = g_allocations.load();
+  bool sampled = true;
+  int transitions = 0, segment = -1;
+  for (int frame = 1; frame <= 36000; ++frame) {
+    sampled = layer.Sample(frame / 60.0, {}, pose) && sampled;
+    transitions += layer.state().segment >= 0 && layer.state().segment != segment;
+    segment = layer.state().segment;
+  }
+  const long allocations = g_allocations.load() - before;
+  EXPECT_TRUE(sampled);
+  EXPECT_GT(transitions, 100);
+  EXPECT_EQ(allocations, 0) << "allocations in 36000 samples";
+#endif
 }
 
 }  // namespace

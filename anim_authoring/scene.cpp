@@ -1,5 +1,6 @@
 #include "anim_authoring/scene.h"
 
+#include "anim_authoring/balance.h"
 #include "anim_authoring/idle_learning.h"
 #include "anim_authoring/yaml.h"
 
@@ -200,7 +201,7 @@ class SceneReader {
   }
 
   IdleSpec Idle(const Node& n, const fs::path& base_dir) const {
-    OnlyKeys(n, {"motion", "clips", "joint_map", "seed", "components"}, "idle");
+    OnlyKeys(n, {"motion", "clips", "joint_map", "seed", "components", "balance"}, "idle");
     IdleSpec idle;
     idle.given = true;
     idle.line = n.line;
@@ -223,7 +224,36 @@ class SceneReader {
     }
     if (const Node* x = n.Find("seed")) idle.seed = static_cast<std::uint64_t>(Integer(*x, "idle.seed", 0, 2147483647));
     if (const Node* x = n.Find("components")) idle.components = Integer(*x, "idle.components", 1, 64);
+    if (const Node* x = n.Find("balance")) idle.balance = Balance(*x, base_dir, idle.components);
     return idle;
+  }
+
+  BalanceSpec Balance(const Node& n, const fs::path& base_dir, int idle_components) const {
+    OnlyKeys(n, {"motion", "clip", "seed", "components"}, "idle.balance");
+    BalanceSpec b;
+    b.given = true;
+    b.line = n.line;
+    const Node* motion = n.Find("motion");
+    const Node* clip = n.Find("clip");
+    if ((motion != nullptr) == (clip != nullptr))
+      Fail(n, "idle.balance needs exactly one of 'motion: <file>' (a recording of a person standing) or 'clip: <name>' "
+              "(a clip of the character)");
+    if (motion) {
+      fs::path p = String(*motion, "idle.balance.motion");
+      if (p.is_relative()) p = base_dir / p;
+      b.motion = fs::absolute(p).lexically_normal();
+    }
+    if (clip) b.clip = String(*clip, "idle.balance.clip");
+    if (const Node* x = n.Find("seed")) b.seed = static_cast<std::uint64_t>(Integer(*x, "idle.balance.seed", 0, 2147483647));
+    if (const Node* x = n.Find("components")) {
+      b.components = Integer(*x, "idle.balance.components", 1, 64);
+      if (b.components > idle_components)
+        Fail(*x, "idle.balance.components: " + std::to_string(b.components) + " is more than the idle model's " +
+                     std::to_string(idle_components) + " (idle.components)");
+    } else {
+      b.components = std::min(b.components, idle_components);
+    }
+    return b;
   }
 
   Curve CurveOf(const Node& n, const std::string& what) const {
@@ -737,6 +767,9 @@ class AnimatorBuilder {
     if (file_.empty()) file_ = spec_.asset.string();
   }
 
+  // After Build: notes for the user about layers built without what the scene asked for.
+  const std::vector<std::string>& notes() const { return notes_; }
+
   std::unique_ptr<Animator> Build() {
     FrameBlenderOptions blender;
     blender.method = spec_.blend;
@@ -830,7 +863,11 @@ class AnimatorBuilder {
         break;
       case ObjectSpec::Kind::kIdle:
         if (!spec_.idle.given) throw Error(At(o.line) + "'idle: true' needs the character's 'idle:' section");
-        if (!idle_) idle_ = BuildIdle(ch_);
+        if (!idle_) {
+          IdleLayerReport report;
+          idle_ = BuildIdleLayer(ch_, &report);
+          notes_.insert(notes_.end(), report.notes.begin(), report.notes.end());
+        }
         b = idle_;
         break;
       case ObjectSpec::Kind::kSchedule: {
@@ -899,22 +936,32 @@ class AnimatorBuilder {
   std::shared_ptr<const Skeleton> sk_;
   AnimatorOverrides overrides_;
   std::string file_;
-  std::shared_ptr<IdleSynthesizer> idle_;
+  BlendablePtr idle_;
+  std::vector<std::string> notes_;  // what the user should be told (IdleLayerReport::notes)
 };
 
-}  // namespace
+// "scene.yaml:<line>: <what>: ", for the idle section's messages.
+std::string IdleWhere(const CharacterSpec& spec, int line, const std::string& what) {
+  return spec.where.substr(0, spec.where.rfind(':')) + ":" + std::to_string(line) + ": " + what + ": ";
+}
 
-std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& ch, std::string* summary) {
-  const CharacterSpec& spec = ch.spec();
-  const std::string where = spec.where.substr(0, spec.where.rfind(':')) + ":" + std::to_string(spec.idle.line) + ": idle: ";
+// The idle section's learning options and sources (the loaded motion files kept in `motion`).
+struct IdleLearningInput {
   std::vector<Character> motion;
-  motion.reserve(spec.idle.motion.size());
-  for (const auto& f : spec.idle.motion) motion.push_back(LoadCharacter(f));
   std::vector<IdleSource> sources;
-  for (const Character& m : motion) {
+  IdleLearningOptions options;
+};
+
+std::unique_ptr<IdleLearningInput> IdleInput(const AnimatedCharacter& ch) {
+  const CharacterSpec& spec = ch.spec();
+  const std::string where = IdleWhere(spec, spec.idle.line, "idle");
+  auto in = std::make_unique<IdleLearningInput>();
+  in->motion.reserve(spec.idle.motion.size());
+  for (const auto& f : spec.idle.motion) in->motion.push_back(LoadCharacter(f));
+  for (const Character& m : in->motion) {
     IdleSource s{&m, {}, false};
     for (const Clip& c : m.clips) s.clips.push_back(&c);
-    sources.push_back(s);
+    in->sources.push_back(s);
   }
   if (!spec.idle.clips.empty()) {
     IdleSource own{&ch.character(), {}, true};
@@ -923,26 +970,96 @@ std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& ch, std::str
       if (!c) throw Error(where + "clip '" + name + "' does not exist in " + ch.character().source);
       own.clips.push_back(c);
     }
-    sources.push_back(own);
+    in->sources.push_back(own);
   }
-  IdleLearningOptions options;
-  options.components = spec.idle.components;
-  options.joint_map = spec.idle.joint_map;
-  options.forward = spec.forward;
-  options.up = spec.up;
+  in->options.components = spec.idle.components;
+  in->options.joint_map = spec.idle.joint_map;
+  in->options.forward = spec.forward;
+  in->options.up = spec.up;
+  return in;
+}
+
+std::shared_ptr<IdleModel> LearnIdle(const AnimatedCharacter& ch, const IdleLearningInput& in, std::string* summary) {
+  const CharacterSpec& spec = ch.spec();
   IdleLearningReport report;
   std::shared_ptr<IdleModel> model;
   try {
-    model = std::make_shared<IdleModel>(LearnIdleModel(ch.character().skeleton, sources, options, &report));
+    model = std::make_shared<IdleModel>(LearnIdleModel(ch.character().skeleton, in.sources, in.options, &report));
+  } catch (const Error& e) {
+    throw Error(IdleWhere(spec, spec.idle.line, "idle") + e.what());
+  }
+  if (summary) *summary = report.Summary();
+  return model;
+}
+
+// The balance-shift model of `idle.balance:` (nothing when its recording holds no transition),
+// in the idle model's posture layout.
+std::shared_ptr<const BalanceModel> LearnBalance(const AnimatedCharacter& ch, const IdleModel& idle, const IdleLearningInput& in,
+                                                 BalanceLearningReport& report) {
+  const CharacterSpec& spec = ch.spec();
+  const BalanceSpec& b = spec.idle.balance;
+  const std::string where = IdleWhere(spec, b.line, "idle.balance");
+  try {
+    std::optional<Character> recording;
+    IdleSource source{&ch.character(), {}, true};
+    BalanceLearningOptions options;
+    options.components = b.components;
+    options.analysis.up = spec.up;
+    if (!b.motion.empty()) {
+      recording = LoadCharacter(b.motion);
+      source = {&*recording, {}, false};
+      for (const Clip& c : recording->clips) source.clips.push_back(&c);
+      options.analysis.up = Eigen::Vector3d::UnitY();  // motion capture's up, as the idle learner reads it
+    } else {
+      const Clip* c = ch.character().FindClip(b.clip);
+      if (!c)
+        throw Error("clip '" + b.clip + "' does not exist in " + ch.character().source + " (clips: " + ClipList(ch.character()) +
+                    ")");
+      source.clips.push_back(c);
+    }
+    std::optional<BalanceModel> model =
+        LearnBalanceModel(ch.character().skeleton, source, idle, in.options, options, &report);
+    return model ? std::make_shared<const BalanceModel>(std::move(*model)) : nullptr;
   } catch (const Error& e) {
     throw Error(where + e.what());
   }
-  if (summary) *summary = report.Summary();
-  return std::make_shared<IdleSynthesizer>(ch.shared_skeleton(), model, spec.idle.seed);
 }
 
-std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides) {
-  return AnimatorBuilder(character, overrides).Build();
+}  // namespace
+
+std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& ch, std::string* summary) {
+  const auto in = IdleInput(ch);
+  return std::make_shared<IdleSynthesizer>(ch.shared_skeleton(), LearnIdle(ch, *in, summary), ch.spec().idle.seed);
+}
+
+BlendablePtr BuildIdleLayer(const AnimatedCharacter& ch, IdleLayerReport* report) {
+  IdleLayerReport rep;
+  const auto in = IdleInput(ch);
+  const std::shared_ptr<IdleModel> idle_model = LearnIdle(ch, *in, &rep.idle);
+  auto idle = std::make_shared<IdleSynthesizer>(ch.shared_skeleton(), idle_model, ch.spec().idle.seed);
+  BlendablePtr layer = idle;
+  const BalanceSpec& b = ch.spec().idle.balance;
+  if (b.given) {
+    BalanceLearningReport balance;
+    if (auto model = LearnBalance(ch, *idle_model, *in, balance)) {
+      layer = std::make_shared<BalanceShifter>(ch.shared_skeleton(), model, b.seed, idle);
+      rep.balance_built = true;
+    } else {
+      rep.notes.push_back(IdleWhere(ch.spec(), b.line, "idle.balance") + balance.Summary() +
+                          "; the character idles without balance shifts");
+    }
+    rep.balance = balance.Summary();
+  }
+  if (report) *report = std::move(rep);
+  return layer;
+}
+
+std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides,
+                                        std::vector<std::string>* notes) {
+  AnimatorBuilder builder(character, overrides);
+  std::unique_ptr<Animator> animator = builder.Build();
+  if (notes) *notes = builder.notes();
+  return animator;
 }
 
 }  // namespace arview::anim

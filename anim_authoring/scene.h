@@ -145,6 +145,17 @@ struct ScheduleSpec {
   double hold_seconds = 0.5, fade_seconds = 1.0;  // tracking loss
   std::string view_action = "view";
 };
+// The balance-shift layer (anim/balance_shift.h) under the idle synthesizer's variations,
+// learned at load from one recording of a person standing (anim_authoring/balance.h).
+struct BalanceSpec {
+  bool given = false;
+  std::filesystem::path motion;  // a recording (every clip of it), absolute; or
+  std::string clip;              // a clip of the character itself
+  std::uint64_t seed = 1;
+  int components = 10;           // of the idle PCA, in the distance between postures
+  int line = 0;
+};
+
 // The idle synthesizer (anim/idle.h), learned at load from motion files and/or clips.
 struct IdleSpec {
   bool given = false;
@@ -153,6 +164,7 @@ struct IdleSpec {
   std::map<std::string, std::string> joint_map;  // data joint → character joint overrides
   std::uint64_t seed = 1;
   int components = 10;
+  BalanceSpec balance;                        // `idle.balance:`
   int line = 0;
 };
 
@@ -272,10 +284,29 @@ struct AnimatorOverrides {
 // curves, masks with scopes resolved on its skeleton, distance triggers and weights), or by
 // default the idle underneath (the `idle:` synthesizer if given, else the look-at base clip
 // looped, else the first clip, else the rest pose) and the view-adaptive action "view" on top.
-// `character` must outlive the animator. Throws Error "scene:line: why".
-std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {});
+// `character` must outlive the animator. Throws Error "scene:line: why". `notes` (if given)
+// receive what the appliance should tell its user: a layer the scene asked for that the data
+// cannot support (see BuildIdleLayer).
+std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {},
+                                        std::vector<std::string>* notes = nullptr);
 
 // The idle synthesizer of the character's `idle:` section (learned here), with what was learned.
 std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& character, std::string* summary = nullptr);
+
+// What BuildIdleLayer learned: the idle synthesizer's summary, the balance learner's (empty
+// without `idle.balance:`), and notes for the user: "scene:line: idle.balance: <recording>: what
+// it holds; 0 transitions: ..." when the balance layer was asked for and not built.
+struct IdleLayerReport {
+  std::string idle, balance;
+  bool balance_built = false;  // the balance-shift layer runs under the synthesizer's variations
+  std::vector<std::string> notes;
+};
+
+// The character's idle layer (`idle: true` objects and the default schedule's idle action): the
+// idle synthesizer, under which, when the scene enables `idle.balance:` and its recording holds
+// balance shifts, the balance-shift layer runs (anim/balance_shift.h: the synthesizer's
+// variations on top of the shifts). A recording without a transition gives the synthesizer alone
+// and a note: nothing is invented. Throws Error "scene:line: idle...: why" for bad data.
+BlendablePtr BuildIdleLayer(const AnimatedCharacter& character, IdleLayerReport* report = nullptr);
 
 }  // namespace arview::anim

@@ -44,6 +44,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     for (const anim::CharacterSpec& spec : scene.characters) {
       characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
       animators.push_back(std::make_unique<LayeredAnimator>(*characters.back(), "", o.fade));
+      for (const std::string& note : animators.back()->notes()) std::cerr << "note: " << note << "\n";
       animator_ptrs.push_back(animators.back().get());
       character_ptrs.push_back(characters.back().get());
     }

@@ -165,6 +165,11 @@ void RunWeights(const AnimArgs& args) {
     arm_deg = std::atan2(d.cross(v).norm(), d.dot(v)) * 180 / M_PI;
   }
   const bool dib = spec->blend == anim::BlendMethod::kDib;
+  // The idle section learned as the appliance learns it: what the data gave each layer.
+  anim::IdleLayerReport idle;
+  if (spec->idle.given) anim::BuildIdleLayer(ch, &idle);
+  const std::string balance_text =
+      idle.balance + (idle.balance_built ? "" : "; the character idles without balance shifts");
   if (args.json) {
     nlohmann::ordered_json j = {{"scene", args.scene},
                                 {"character", spec->name},
@@ -190,6 +195,8 @@ void RunWeights(const AnimArgs& args) {
       j["arm_to_viewpoint_deg"] = arm_deg;
       j["elbow_bend_deg"] = anim::ElbowBendDeg(ch.arm_chain(), out.model);
     }
+    if (spec->idle.given) j["idle"] = idle.idle;
+    if (spec->idle.balance.given) j["balance"] = {{"built", idle.balance_built}, {"summary", idle.balance}};
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -208,6 +215,8 @@ void RunWeights(const AnimArgs& args) {
   if (gesture)
     std::cout << ToString(spec->gesture.side) << " arm (" << ToString(kind) << ") to viewpoint: " << Fixed(arm_deg, 2)
               << " deg, elbow bend " << Fixed(anim::ElbowBendDeg(ch.arm_chain(), out.model), 1) << " deg\n";
+  if (spec->idle.given) std::cout << "idle: " << idle.idle << "\n";
+  if (spec->idle.balance.given) std::cout << "balance: " << balance_text << "\n";
 }
 
 void Guard(const std::function<void()>& f) {
@@ -230,7 +239,8 @@ void AddAnimCommand(CLI::App& app) {
   info->add_flag("--json", args->json, "Print JSON instead of text");
   info->callback([args] { Guard([&] { RunInfo(*args); }); });
 
-  auto* weights = cmd->add_subcommand("weights", "Key weights (and the blended head's and gesturing arm's directions) for one viewpoint");
+  auto* weights = cmd->add_subcommand(
+      "weights", "Key weights (and the blended head's and gesturing arm's directions) for one viewpoint; what the idle section learns");
   weights->add_option("--scene", args->scene, "Scene file (YAML, see docs/anim.md)")->required();
   weights->add_option("--viewpoint", args->viewpoint, "Direction from the character to the viewer, x,y,z in the character's frame")
       ->required();

@@ -18,7 +18,7 @@ LayeredAnimator::LayeredAnimator(anim::AnimatedCharacter& character, const std::
   overrides.idle_clip = idle_clip;
   overrides.hold_seconds = options.hold_seconds;
   overrides.fade_seconds = options.fade_seconds;
-  animator_ = anim::BuildAnimator(character, overrides);
+  animator_ = anim::BuildAnimator(character, overrides, &notes_);
 }
 
 const AnimatedFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d>& camera_center, double time) {

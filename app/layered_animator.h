@@ -55,11 +55,16 @@ class LayeredAnimator {
   const anim::Clip* idle_clip() const { return idle_; }
   const anim::AnimatedCharacter& character() const { return character_; }
   anim::Animator& animator() { return *animator_; }
+  // What the user should be told about the animation built (one line each, for "note: "): a
+  // layer the scene asked for that its data cannot support, e.g. balance shifts from a recording
+  // without a transition.
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   anim::AnimatedCharacter& character_;
   const anim::Clip* idle_ = nullptr;
   std::unique_ptr<anim::Animator> animator_;
+  std::vector<std::string> notes_;
   AnimatedFrame frame_;
 };
 

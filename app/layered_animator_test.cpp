@@ -66,5 +66,22 @@ TEST(LayeredAnimator, UnknownIdleClipIsAnError) {
   EXPECT_THROW(LayeredAnimator(fox, "Dance"), anim::Error);
 }
 
+// The scene asks for balance shifts from a recording that holds none (CMU 01_01): the animator
+// runs on the idle synthesizer alone and says why in one note, which replay, run and view print.
+TEST(LayeredAnimator, NotesABalanceLayerItsDataCannotSupport) {
+  const std::string bcn = "/usr/share/assimp/models/X/BCN_Epileptic.X", cmu = "/usr/share/assimp/models/BVH/01_01.bvh";
+  ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(cmu), "Debian package assimp-testmodels");
+  const anim::Scene scene = anim::ParseScene("characters:\n  - asset: " + bcn +
+                                                 "\n    keys: [{azimuth: 0, generate: lookat}]\n    idle:\n      clips: "
+                                                 "[Epileptisch]\n      balance: {motion: " + cmu + "}\n",
+                                             "bcn-test.yaml");
+  anim::AnimatedCharacter bcn_character(scene.characters.at(0));
+  LayeredAnimator animator(bcn_character);
+  ASSERT_EQ(animator.notes().size(), 1u);
+  EXPECT_EQ(animator.notes()[0].rfind("bcn-test.yaml:6: idle.balance: " + cmu + ": ", 0), 0u) << animator.notes()[0];
+  EXPECT_NE(animator.notes()[0].find("0 transitions"), std::string::npos) << animator.notes()[0];
+  EXPECT_TRUE(animator.Update(Eigen::Vector3d(0, 1, 3), 0.5).skinning_matrices[0].allFinite());
+}
+
 }  // namespace
 }  // namespace arview::app

@@ -38,6 +38,8 @@ class ViewAnimation {
   const anim::AnimatedCharacter& character() const { return *character_; }
   // "Survey", "lookat", "rest", "Walk@0.25": what key k plays.
   std::string KeyLabel(int key) const;
+  // What the animation could not do as the scene asked (LayeredAnimator::notes).
+  const std::vector<std::string>& notes() const { return animator_->notes(); }
   // The character's rest height in map units.
   double height() const { return height_; }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 #include "base/atomic_file.h"
@@ -50,7 +51,10 @@ ViewSession::ViewSession(const std::filesystem::path& scene_file, const ViewOpti
     if (options.character.empty() ? i == 0 : scene_.characters[i].name == options.character) edited_ = static_cast<int>(i);
   }
   if (edited_ < 0) throw std::runtime_error(scene_file_.string() + ": no character named '" + options.character + "'");
-  for (const anim::CharacterSpec& spec : scene_.characters) animations_.push_back(std::make_unique<ViewAnimation>(spec));
+  for (const anim::CharacterSpec& spec : scene_.characters) {
+    animations_.push_back(std::make_unique<ViewAnimation>(spec));
+    for (const std::string& note : animations_.back()->notes()) std::cerr << "note: " << note << "\n";
+  }
   editor_ = KeyEditor(edited().keys());
   choices_ = KeyChoices(edited().asset());
 

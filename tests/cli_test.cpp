@@ -127,6 +127,35 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
   EXPECT_FALSE(std::filesystem::exists(tmp + "/o.partial.mp4"));
 }
 
+// `anim weights` learns a scene's idle section as the appliance does and says what each layer
+// got: BCN_Epileptic idling on its own clip, balance shifts asked of CMU 01_01, which holds none.
+TEST(Cli, AnimWeightsSaysWhatTheIdleAndBalanceLayersLearned) {
+  const std::string bcn = "/usr/share/assimp/models/X/BCN_Epileptic.X", cmu = "/usr/share/assimp/models/BVH/01_01.bvh";
+  ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(cmu), "Debian package assimp-testmodels");
+  const std::string scene = std::filesystem::temp_directory_path() / ("arview_cli_balance_" + std::to_string(::getpid()) + ".yaml");
+  auto write = [&](const std::string& balance) {
+    std::ofstream(scene) << "characters:\n  - asset: " << bcn << "\n    keys: [{azimuth: 0, pose: rest}]\n    idle:\n"
+                         << "      clips: [Epileptisch]\n      balance: " << balance << "\n";
+  };
+  write("{motion: " + cmu + ", seed: 4}");
+  const auto r = RunArview({"anim", "weights", "--scene", scene, "--viewpoint", "0,0,1"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nidle: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nbalance: " + cmu + ": 1 clip, "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("; 0 transitions: nothing to learn balance shifts from; the character idles without balance shifts\n"),
+            std::string::npos)
+      << r.out;
+  const auto json = RunArview({"anim", "weights", "--scene", scene, "--viewpoint", "0,0,1", "--json"});
+  EXPECT_NE(json.out.find("\"built\": false"), std::string::npos) << json.out;
+  // A bad value: one line naming the file, the line and the key.
+  write("{motion: " + cmu + ", seed: many}");
+  const auto bad = RunArview({"anim", "weights", "--scene", scene, "--viewpoint", "0,0,1"});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(LineCount(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find(scene + ":6: idle.balance.seed: expected a number, got 'many'"), std::string::npos) << bad.err;
+  std::filesystem::remove(scene);
+}
+
 }  // namespace
 }  // namespace arview
 
