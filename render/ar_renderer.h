@@ -28,6 +28,7 @@
 #include "render/projection.h"
 #include "render/room_light.h"
 #include "render/scene_depth.h"
+#include "render/shadow_capsules.h"
 
 namespace arview::render {
 
@@ -110,19 +111,23 @@ class ArRenderer {
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
     std::unique_ptr<CastShadow> cast;
-    LightView silhouette_view;   // the light view the cast shadow's silhouette was drawn in
-    long silhouette_frames = 0;  // frames since the silhouette was last drawn (mod kSilhouetteEvery)
+    std::vector<ShadowCapsule> capsules;  // the cast shadow's occluder, bind pose
+    bool casts = false;                   // this frame's cast shadow (UpdateCastShadows)
+    LightView light_view;
   };
-  static constexpr int kSilhouetteEvery = 2;
   struct ShadowEllipse {
     Eigen::Vector3d center, axis_u, axis_v;
   };
   cv::Mat PrepareBackground(const cv::Mat& background);
-  // Draws the characters seen from `eye` and blends them over `frame` (in place).
+  // Draws the characters seen from `eye` and blends them over `frame` (in place), after
+  // UpdateCastShadows of the same frames.
   void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
   bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
-  // The cast shadow's light view for this frame (false: no cast shadow).
-  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const;
+  // Each character's cast shadow for this frame (its coverage uploaded, its light view and floor
+  // quad kept for ScreenBounds and Compose); throws when `frames` is not one per character.
+  void UpdateCastShadows(std::span<const anim::FrameOutput* const> frames);
+  // The cast shadow's light view and soft coverage for this frame (false: no cast shadow).
+  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view, cv::Mat* coverage) const;
   float CastShadowStrength(const Placed& placed) const;
   void FollowExposure(const cv::Mat& background, const calib::Pose& pose);
   // The screen rectangle that contains everything drawn (empty when nothing is in view), and
@@ -137,6 +142,7 @@ class ArRenderer {
   cv::Mat undistort_map1_, undistort_map2_;
   ContactShadow shadow_;
   std::vector<Placed> characters_;
+  cv::Mat coverage_;  // UpdateCastShadows' scratch
   bool used_linear_fallback_ = false;
   bool has_room_light_ = false;
   RoomLight room_light_;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <string>
 
 #include "render/offscreen.h"
 
@@ -22,41 +23,17 @@ void main() {
 
 const char* kReceiverFragment = R"(#version 450 core
 in vec3 v_world;
-uniform mat4 light;        // map → light clip (orthographic)
-uniform sampler2D blurred; // the silhouette's soft coverage (CastShadow::EndSilhouette)
+uniform mat4 light;         // map → light clip (orthographic)
+uniform sampler2D coverage; // the soft coverage in the light view (CastShadow::SetCoverage)
 uniform float strength;
 out vec4 frag_color;
 void main() {
   vec2 uv = (light * vec4(v_world, 1.0)).xy * 0.5 + 0.5;
-  float a = strength * textureLod(blurred, uv, 0.0).r;
+  float a = strength * textureLod(coverage, uv, 0.0).r;
   // Nothing to darken: 8-bit blending would leave the pixel as it is, so skip it (llvmpipe then
   // skips the blend at every sample of a block with no shadow).
   if (a < 0.5 / 255.0) discard;
   frag_color = vec4(0.0, 0.0, 0.0, a);
-}
-)";
-
-// The soft coverage, once per silhouette: four trilinear taps from a blurred mip level (a soft,
-// percentage-closer-style edge) at each texel, so that the receiver, which covers many more
-// pixels, takes one bilinear tap (llvmpipe's texture sampling was most of its cost).
-const char* kBlurVertex = R"(#version 450 core
-void main() {
-  const vec2 corners[3] = vec2[3](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
-  gl_Position = vec4(corners[gl_VertexID], 0.0, 1.0);
-}
-)";
-
-const char* kBlurFragment = R"(#version 450 core
-uniform sampler2D silhouette;
-uniform float softness;    // blur radius, texture units
-uniform float size;        // texels a side
-out vec4 frag_color;
-void main() {
-  vec2 uv = gl_FragCoord.xy / size;
-  const vec2 disc[4] = vec2[4](vec2(-0.5, -0.5), vec2(0.5, -0.5), vec2(-0.5, 0.5), vec2(0.5, 0.5));
-  float coverage = 0.0;
-  for (int i = 0; i < 4; ++i) coverage += textureLod(silhouette, uv + softness * disc[i], 1.5).r;
-  frag_color = vec4(coverage / 4.0);
 }
 )";
 
@@ -79,7 +56,9 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
   const Eigen::Vector3d d = towards_light.normalized();
   const Eigen::Vector3d n = floor_normal.normalized();
   if (!(radius > 0) || d.dot(n) < std::sin(min_elevation_deg * M_PI / 180)) return false;
-  const Eigen::Vector3d x = d.unitOrthogonal();
+  // x: the floor normal across the light (a standing character's shadow stretches along it).
+  Eigen::Vector3d x = n - n.dot(d) * d;
+  x = x.norm() > 1e-6 ? x.normalized() : d.unitOrthogonal();
   const Eigen::Vector3d y = d.cross(x);
   Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
   m.row(0) << x.transpose() / radius, -x.dot(centre) / radius;
@@ -87,77 +66,38 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
   m.row(2) << -d.transpose() / radius, d.dot(centre) / radius;
   m(3, 3) = 1;
   view->map_to_clip = m;
-  const double signs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d q = centre + radius * (signs[k][0] * x + signs[k][1] * y);
-    view->floor_corners[k] = q - d * ((q - floor_point).dot(n) / d.dot(n));
-  }
+  // Along the light down to the floor: q − d ((q − floor_point) · n / (d · n)), affine in q.
+  auto to_floor = [&](const Eigen::Vector3d& q) { return Eigen::Vector3d(q - d * ((q - floor_point).dot(n) / d.dot(n))); };
+  view->floor_origin = to_floor(centre);
+  view->floor_x = to_floor(centre + radius * x) - view->floor_origin;
+  view->floor_y = to_floor(centre + radius * y) - view->floor_origin;
+  view->BoundFloor(-1, 1, -1, 1);
   return true;
 }
 
-namespace {
-
-// A size x size texture (no mipmaps unless asked) with a framebuffer drawing into it.
-GlName MakeTextureFramebuffer(const GlApi& gl, int size, bool mipmaps, GlName* texture) {
-  *texture = MakeTexture(gl, cv::Mat(size, size, CV_8UC3, cv::Scalar::all(0)), {mipmaps, 1.f, false});
-  GLuint fbo = 0;
-  gl.GenFramebuffers(1, &fbo);
-  GlName framebuffer(&gl, fbo, [](const GlApi& g, GLuint n) { g.DeleteFramebuffers(1, &n); });
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo);
-  gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture->get(), 0);
-  if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-    throw RenderError("cast shadow: framebuffer incomplete");
-  }
-  gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
-  return framebuffer;
+void LightView::BoundFloor(double x0, double x1, double y0, double y1) {
+  const double box[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  for (int k = 0; k < 4; ++k) floor_corners[k] = floor_origin + box[k][0] * floor_x + box[k][1] * floor_y;
 }
 
-}  // namespace
-
-CastShadow::CastShadow(const GlApi& gl, int size) : gl_(&gl), size_(size) {
-  fbo_ = MakeTextureFramebuffer(gl, size, true, &texture_);
-  blurred_fbo_ = MakeTextureFramebuffer(gl, BlurredSize(), false, &blurred_);
+CastShadow::CastShadow(const GlApi& gl) : gl_(&gl) {
+  coverage_ = MakeTexture(gl, cv::Mat(kSize, kSize, CV_8UC1, cv::Scalar::all(0)), {false, 1.f, false});
   program_ = MakeProgram(gl, "cast shadow", kReceiverVertex, kReceiverFragment);
   const GLuint p = program_.get();
   mvp_ = Uniform(gl, p, "mvp");
   light_ = Uniform(gl, p, "light");
   corners_ = Uniform(gl, p, "corners");
   strength_ = Uniform(gl, p, "strength");
-  blurred_sampler_ = Uniform(gl, p, "blurred");
-  blur_program_ = MakeProgram(gl, "cast shadow blur", kBlurVertex, kBlurFragment);
-  softness_ = Uniform(gl, blur_program_.get(), "softness");
-  blur_size_ = Uniform(gl, blur_program_.get(), "size");
-  silhouette_ = Uniform(gl, blur_program_.get(), "silhouette");
+  coverage_sampler_ = Uniform(gl, p, "coverage");
   vao_ = MakeVertexArray(gl);
   CheckGl(gl, "cast shadow setup");
 }
 
-void CastShadow::BeginSilhouette() {
-  const GlApi& gl = *gl_;
-  gl.BindFramebuffer(GL_FRAMEBUFFER, fbo_.get());
-  gl.Viewport(0, 0, size_, size_);
-  gl.Disable(GL_SCISSOR_TEST);
-  gl.ClearColor(0, 0, 0, 0);
-  gl.Clear(GL_COLOR_BUFFER_BIT);
-}
-
-void CastShadow::EndSilhouette(float softness) {
-  const GlApi& gl = *gl_;
-  gl.BindTexture(GL_TEXTURE_2D, texture_.get());
-  gl.GenerateMipmap(GL_TEXTURE_2D);
-  gl.BindFramebuffer(GL_FRAMEBUFFER, blurred_fbo_.get());
-  gl.Viewport(0, 0, BlurredSize(), BlurredSize());
-  gl.Disable(GL_DEPTH_TEST);
-  gl.Disable(GL_CULL_FACE);
-  gl.Disable(GL_BLEND);
-  gl.UseProgram(blur_program_.get());
-  gl.Uniform1f(softness_, softness);
-  gl.Uniform1f(blur_size_, static_cast<float>(BlurredSize()));
-  gl.Uniform1i(silhouette_, 0);
-  gl.ActiveTexture(GL_TEXTURE0);
-  gl.BindVertexArray(vao_.get());
-  gl.DrawArrays(GL_TRIANGLES, 0, 3);
-  gl.BindVertexArray(0);
+void CastShadow::SetCoverage(const cv::Mat& coverage) {
+  if (coverage.size() != cv::Size(kSize, kSize) || coverage.type() != CV_8UC1) {
+    throw RenderError("cast shadow: the coverage must be 8-bit, " + std::to_string(kSize) + " x " + std::to_string(kSize));
+  }
+  UpdateTexture(*gl_, coverage_.get(), coverage);
 }
 
 void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
@@ -178,9 +118,9 @@ void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Ma
   gl.UniformMatrix4fv(light_, 1, GL_FALSE, to_light.data());
   gl.Uniform3fv(corners_, 4, corners);
   gl.Uniform1f(strength_, strength);
-  gl.Uniform1i(blurred_sampler_, 0);
+  gl.Uniform1i(coverage_sampler_, 0);
   gl.ActiveTexture(GL_TEXTURE0);
-  gl.BindTexture(GL_TEXTURE_2D, blurred_.get());
+  gl.BindTexture(GL_TEXTURE_2D, coverage_.get());
   gl.BindVertexArray(vao_.get());
   gl.DrawArrays(GL_TRIANGLES, 0, 6);
   gl.BindVertexArray(0);

@@ -1,18 +1,16 @@
 #pragma once
 // Two things the room adds to the character layer (issue 14, items 3 and 4):
 //  - CastShadow: the character's soft shadow on its floor plane from the room's dominant light.
-//    The skinned character is drawn as a white silhouette into a 128 x 128 texture, seen along
-//    the light (orthographic, around the character's bounding sphere); the floor's
-//    parallelogram under that view is then drawn into the layer, each pixel darkened by the
-//    silhouette coverage at its point projected along the light, averaged over 4 taps from a
-//    blurred mip level (a soft, percentage-closer-style edge), computed once per silhouette at
-//    half its resolution (the taps read level 1.5) and sampled bilinearly by the floor.
+//    The character's soft coverage seen along the light (orthographic, around its bounding
+//    sphere; render/shadow_capsules.h: the posed capsules, evaluated on the CPU) is uploaded as
+//    a 64 x 64 texture; the floor's parallelogram under the covered texels is then drawn into
+//    the layer, each pixel darkened by the coverage at its point projected along the light (one
+//    bilinear tap).
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
 #include <Eigen/Core>
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -22,11 +20,19 @@
 
 namespace arview::render {
 
-// The orthographic view along a light: map → light clip space, covering a sphere.
+// The orthographic view along a light: map → light clip space, covering a sphere. Its clip x
+// axis is the floor normal's direction across the light (the way a standing character's shadow
+// stretches), so that a box in clip x, y bounds a shadow tightly on the floor.
 struct LightView {
   Eigen::Matrix4d map_to_clip = Eigen::Matrix4d::Identity();
+  // The floor point seen at light clip (x, y): floor_origin + x · floor_x + y · floor_y.
+  Eigen::Vector3d floor_origin = Eigen::Vector3d::Zero(), floor_x = Eigen::Vector3d::Zero(),
+                  floor_y = Eigen::Vector3d::Zero();
   // The floor's corners under the view (map frame): the shadow can only fall inside them.
+  // MakeLightView puts the whole view's there; BoundFloor narrows them.
   std::array<Eigen::Vector3d, 4> floor_corners;
+  // Narrows floor_corners to the clip box [x0, x1] x [y0, y1].
+  void BoundFloor(double x0, double x1, double y0, double y1);
 };
 // `towards_light` unit; the floor plane through `floor_point` with unit normal `floor_normal`.
 // Returns false when the light is within `min_elevation_deg` of the floor's horizon (the shadow
@@ -37,27 +43,21 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
 
 class CastShadow {
  public:
-  explicit CastShadow(const GlApi& gl, int size = 128);
-  // Binds the silhouette target (cleared, viewport set): draw the character with
-  // LightView::map_to_clip as projection, an identity view, and CharacterDraw::silhouette.
-  void BeginSilhouette();
-  // Mipmaps the silhouette and blurs it into the soft coverage the receiver samples;
-  // `softness`: the blur radius as a share of the light view's width. The caller then binds its
-  // own framebuffer again.
-  void EndSilhouette(float softness);
+  // The coverage's texels a side: the light view spans the character's bounding sphere, so a
+  // texel is 1/32 of its radius, finer than the soft edge (softness 0.03 of its diameter).
+  static constexpr int kSize = 64;
+  explicit CastShadow(const GlApi& gl);
+  // The soft coverage in the light view (CapsuleCoverage: 8-bit, kSize x kSize, row 0 at v = 0).
+  void SetCoverage(const cv::Mat& coverage);
   // Into the bound framebuffer, premultiplied black: alpha = strength × soft coverage (pixels
   // with no shadow are left alone).
   void DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
                     float strength);
 
  private:
-  // The soft coverage's texels a side: half the silhouette's (it is read from level 1.5).
-  int BlurredSize() const { return std::max(1, size_ / 2); }
   const GlApi* gl_;
-  int size_;
-  GlName texture_, fbo_, blurred_, blurred_fbo_, program_, blur_program_, vao_;
-  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, blurred_sampler_ = -1;
-  GLint softness_ = -1, blur_size_ = -1, silhouette_ = -1;
+  GlName coverage_, program_, vao_;
+  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, coverage_sampler_ = -1;
 };
 
 class DepthProxy {
