@@ -32,7 +32,7 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
 
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
   characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
-                         std::make_unique<CastShadow>(context_->gl()), FitShadowCapsules(character), false, LightView{}});
+                         FitShadowCapsules(character), false, LightView{}, cv::Mat()});
   if (options_.lighting == LightingMode::kShShadowed) {
     const PrtCacheResult prt = ShadowedTransferCached(character, options_.prt, options_.prt_cache_folder);
     characters_.back().renderer->SetTransfer(prt.transfer);
@@ -53,6 +53,7 @@ void ArRenderer::SetRoomLight(const RoomLight& light) {
 }
 
 void ArRenderer::SetOccluders(const std::vector<Eigen::Vector3f>& triangles) {
+  occluder_triangles_.assign(triangles.begin(), triangles.begin() + static_cast<std::ptrdiff_t>(triangles.size() / 3 * 3));
   if (triangles.empty()) {
     occluders_.reset();
     return;
@@ -80,8 +81,7 @@ void ArRenderer::UpdateCastShadows(std::span<const anim::FrameOutput* const> fra
   }
   for (size_t i = 0; i < characters_.size(); ++i) {
     Placed& placed = characters_[i];
-    placed.casts = CastShadowView(placed, *frames[i], &placed.light_view, &coverage_);
-    if (placed.casts) placed.cast->SetCoverage(coverage_);
+    placed.casts = CastShadowView(placed, *frames[i], &placed.light_view, &placed.coverage);
   }
 }
 
@@ -105,11 +105,11 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& f
     return false;
   }
   cv::Rect support;
-  CapsuleCoverage(posed, view->map_to_clip, soft / (radius + soft), CastShadow::kSize, coverage, &support);
+  CapsuleCoverage(posed, view->map_to_clip, soft / (radius + soft), kCastShadowTexels, coverage, &support);
   if (support.empty()) return false;
-  // The floor quad drawn (and read back) only under the covered texels, and one more texel each
-  // side for the receiver's bilinear tap.
-  const double texel = 2.0 / CastShadow::kSize;
+  // The floor quad only under the covered texels, and one more texel each side for the bilinear
+  // tap: the pixels DarkenCastShadow visits.
+  const double texel = 2.0 / kCastShadowTexels;
   view->BoundFloor(-1 + (support.x - 1) * texel, -1 + (support.x + support.width + 1) * texel,
                    -1 + (support.y - 1) * texel, -1 + (support.y + support.height + 1) * texel);
   return true;
@@ -223,9 +223,6 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     if (options_.shadow && Shadow(placed, frame, &e)) {
       for (int k = 0; k < 4; ++k) add(e.center + (k & 1 ? 1.0 : -1.0) * e.axis_u + (k & 2 ? 1.0 : -1.0) * e.axis_v);
     }
-    if (placed.casts) {
-      for (const Eigen::Vector3d& corner : placed.light_view.floor_corners) add(corner);
-    }
     if (behind) return full;
   }
   if (u0 > u1) return {};
@@ -248,8 +245,34 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   used_linear_fallback_ = false;
   double farthest = 0;
   const cv::Rect rect = ScreenBounds(eye, frames, &farthest);
-  if (rect.empty()) return;  // nothing in view: the video frame as it is
+  if (!rect.empty()) DrawLayer(rect, eye, frames, farthest);
+  // The cast shadows darken the camera image the layer goes over (the same as a premultiplied
+  // shadow under the characters in the layer), on this thread while llvmpipe's rasterise the
+  // layer's draws.
+  for (const Placed& placed : characters_) {
+    if (!placed.casts) continue;
+    DarkenCastShadow(frame, pinhole_, eye, options_.clip.near_m, placed.light_view, placed.coverage,
+                     CastShadowStrength(placed),
+                     options_.occlusion ? std::span<const Eigen::Vector3f>(occluder_triangles_) : std::span<const Eigen::Vector3f>());
+  }
+  if (rect.empty()) return;  // no character in view: the video frame (and its shadows) as it is
 
+  // Premultiplied alpha over the video: out = fg + bg·(1 − a).
+  const cv::Mat layer = target_.ReadBgra();
+  for (int y = 0; y < rect.height; ++y) {
+    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
+    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
+    for (int x = 0; x < rect.width; ++x) {
+      const int a = fg[x][3];
+      if (a == 0) continue;
+      const int keep = 255 - a;
+      for (int c = 0; c < 3; ++c) bg[x][c] = cv::saturate_cast<uchar>(fg[x][c] + (bg[x][c] * keep + 127) / 255);
+    }
+  }
+}
+
+void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+                           double farthest) {
   const GlApi& gl = context_->gl();
   auto character_draw = [&](const Placed& placed, const anim::FrameOutput& out) {
     const Eigen::Matrix3d rotation = placed.spec->anchor.rotation.normalized().toRotationMatrix();
@@ -279,24 +302,10 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     if (options_.shadow && Shadow(placed, out, &e)) {
       shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
     }
-    if (placed.casts) placed.cast->DrawReceiver(projection, view, placed.light_view, CastShadowStrength(placed));
     placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
   CheckGl(gl, "AR frame");
-
-  // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgra();
-  for (int y = 0; y < rect.height; ++y) {
-    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
-    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
-    for (int x = 0; x < rect.width; ++x) {
-      const int a = fg[x][3];
-      if (a == 0) continue;
-      const int keep = 255 - a;
-      for (int c = 0; c < 3; ++c) bg[x][c] = cv::saturate_cast<uchar>(fg[x][c] + (bg[x][c] * keep + 127) / 255);
-    }
-  }
 }
 
 cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,

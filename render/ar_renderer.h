@@ -110,10 +110,10 @@ class ArRenderer {
     const anim::Character* character;
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
-    std::unique_ptr<CastShadow> cast;
     std::vector<ShadowCapsule> capsules;  // the cast shadow's occluder, bind pose
-    bool casts = false;                   // this frame's cast shadow (UpdateCastShadows)
-    LightView light_view;
+    bool casts = false;                   // this frame's cast shadow (UpdateCastShadows):
+    LightView light_view;                 // its light view and floor quad,
+    cv::Mat coverage;                     // its soft coverage (kCastShadowTexels a side)
   };
   struct ShadowEllipse {
     Eigen::Vector3d center, axis_u, axis_v;
@@ -122,9 +122,13 @@ class ArRenderer {
   // Draws the characters seen from `eye` and blends them over `frame` (in place), after
   // UpdateCastShadows of the same frames.
   void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
+  // Draws the characters' layer (occluders, contact shadows, characters) into `rect` of the
+  // region target, to be read back.
+  void DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+                 double farthest);
   bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
-  // Each character's cast shadow for this frame (its coverage uploaded, its light view and floor
-  // quad kept for ScreenBounds and Compose); throws when `frames` is not one per character.
+  // Each character's cast shadow for this frame (kept in Placed for Compose, which darkens the
+  // camera image with it); throws when `frames` is not one per character.
   void UpdateCastShadows(std::span<const anim::FrameOutput* const> frames);
   // The cast shadow's light view and soft coverage for this frame (false: no cast shadow).
   bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view, cv::Mat* coverage) const;
@@ -142,13 +146,13 @@ class ArRenderer {
   cv::Mat undistort_map1_, undistort_map2_;
   ContactShadow shadow_;
   std::vector<Placed> characters_;
-  cv::Mat coverage_;  // UpdateCastShadows' scratch
   bool used_linear_fallback_ = false;
   bool has_room_light_ = false;
   RoomLight room_light_;
   ShRgb current_sh_{};
   std::unique_ptr<ExposureFollower> follower_;
   std::unique_ptr<DepthProxy> occluders_;
+  std::vector<Eigen::Vector3f> occluder_triangles_;  // the same, for the cast shadow on the CPU
   double prt_seconds_ = 0;
   int prt_from_cache_ = 0;
   std::string prt_cache_note_;

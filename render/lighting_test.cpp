@@ -518,37 +518,51 @@ TEST(Prt, ShaderRotatesTheTransferWithTheSkinning) {
 
 // ---------------------------------------------------------------- cast shadow
 
-TEST(CastShadow, FallsAwayFromTheDominantLightWithin10Degrees) {
+// A 1.6 m post standing on the floor below the analytic room's measuring point, lit by the
+// estimate, seen straight down from 6 m (full frame, no contact shadow), with or without its
+// cast shadow and with the given occluders.
+struct PostScene {
   const AnalyticRoom room;
-  const RoomLight& light = AnalyticEstimate();
-  // A 1.6 m post standing on the floor below the light's measuring point.
-  auto post = std::make_shared<const anim::Character>(RigidCharacter(SphereOrCylinder(0.15, 1.6, 16, 32)));
   anim::CharacterSpec spec;
-  spec.name = "post";
-  spec.anchor.position = {room.position.x(), room.position.y(), 0};
-  spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
-  anim::KeySpec key;
-  key.source = anim::KeySpec::Source::kRestPose;
-  spec.keys.push_back(key);
-  anim::AnimatedCharacter animated(post, spec);
-  // Straight down from 6 m.
+  std::unique_ptr<anim::AnimatedCharacter> animated;
   const calib::Camera camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
-  const Eigen::Vector3d above = spec.anchor.position + Eigen::Vector3d(0, 0, 6);
-  const calib::Pose pose = LookAt(above, spec.anchor.position, Eigen::Vector3d::UnitY());
-  cv::Mat images[2];
-  for (int with = 0; with < 2; ++with) {
+  Eigen::Vector3d above;
+  calib::Pose pose;
+  PostScene() {
+    auto post = std::make_shared<const anim::Character>(RigidCharacter(SphereOrCylinder(0.15, 1.6, 16, 32)));
+    spec.name = "post";
+    spec.anchor.position = {room.position.x(), room.position.y(), 0};
+    spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
+    anim::KeySpec key;
+    key.source = anim::KeySpec::Source::kRestPose;
+    spec.keys.push_back(key);
+    animated = std::make_unique<anim::AnimatedCharacter>(post, spec);
+    above = spec.anchor.position + Eigen::Vector3d(0, 0, 6);
+    pose = LookAt(above, spec.anchor.position, Eigen::Vector3d::UnitY());
+  }
+  cv::Mat Render(bool cast_shadow, const std::vector<Eigen::Vector3f>& occluders = {}) {
     ArOptions options;
     options.lighting = LightingMode::kShUnshadowed;
     options.shadow = false;
-    options.cast_shadow = with == 1;
-    options.occlusion = false;
+    options.cast_shadow = cast_shadow;
     options.full_frame = true;
     ArRenderer renderer(SharedContext(), camera, options);
-    renderer.AddCharacter(animated.character(), animated.spec());
-    renderer.SetRoomLight(light);
-    const anim::FrameOutput* out = &animated.Update(spec.ViewpointFromCamera(pose.Center()), 0);
-    images[with] = renderer.Render(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(200)), pose, {&out, 1});
+    renderer.AddCharacter(animated->character(), animated->spec());
+    renderer.SetRoomLight(AnalyticEstimate());
+    renderer.SetOccluders(occluders);
+    const anim::FrameOutput* out = &animated->Update(spec.ViewpointFromCamera(pose.Center()), 0);
+    return renderer.Render(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(200)), pose, {&out, 1});
   }
+};
+
+TEST(CastShadow, FallsAwayFromTheDominantLightWithin10Degrees) {
+  PostScene scene;
+  const AnalyticRoom& room = scene.room;
+  const RoomLight& light = AnalyticEstimate();
+  const anim::CharacterSpec& spec = scene.spec;
+  const calib::Pose& pose = scene.pose;
+  const Eigen::Vector3d& above = scene.above;
+  const cv::Mat images[2] = {scene.Render(false), scene.Render(true)};
   cv::Mat diff, grey;
   cv::subtract(images[0], images[1], diff);
   cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
@@ -569,6 +583,47 @@ TEST(CastShadow, FallsAwayFromTheDominantLightWithin10Degrees) {
               "estimated light's)\n",
               cv::countNonZero(grey > 2), angle, AngleDeg(fall, away));
   EXPECT_LT(angle, 10.0);
+}
+
+// The shadow falls on the floor behind real things: an occluder (a 0.5 x 0.5 x 0.3 m box on the
+// floor where the post's shadow falls) leaves the floor under it undarkened, and changes nothing
+// around it.
+TEST(CastShadow, IsHiddenByOccludersBetweenTheCameraAndTheFloor) {
+  PostScene scene;
+  Eigen::Vector3d away = -AnalyticEstimate().dominant.direction;
+  away.z() = 0;
+  const Eigen::Vector3d centre = scene.spec.anchor.position + 0.9 * away.normalized();
+  const Eigen::Vector3d lo = centre - Eigen::Vector3d(0.25, 0.25, 0), hi = centre + Eigen::Vector3d(0.25, 0.25, 0.3);
+  const cv::Mat plain = scene.Render(false), shadowed = scene.Render(true), hidden = scene.Render(true, BoxTriangles(lo, hi));
+  // The box's outline on screen.
+  std::vector<cv::Point> corners;
+  for (const Eigen::Vector3d& c : testing::BoxCorners(lo, hi, Eigen::Isometry3d::Identity())) {
+    const Eigen::Vector2d px = scene.camera.Project(scene.pose.ToCamera(c));
+    corners.emplace_back(cvRound(px.x()), cvRound(px.y()));
+  }
+  std::vector<cv::Point> hull;
+  cv::convexHull(corners, hull);
+  cv::Mat box = cv::Mat::zeros(480, 640, CV_8U);
+  cv::fillConvexPoly(box, hull, cv::Scalar(255));
+  cv::Mat inner, outer;
+  cv::erode(box, inner, cv::Mat(), {-1, -1}, 2);
+  cv::dilate(box, outer, cv::Mat(), {-1, -1}, 2);
+  auto darkened = [&](const cv::Mat& image) {
+    cv::Mat diff, grey;
+    cv::absdiff(plain, image, diff);
+    cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+    return grey > 0;
+  };
+  cv::Mat changed;
+  cv::absdiff(shadowed, hidden, changed);
+  cv::cvtColor(changed, changed, cv::COLOR_BGR2GRAY);
+  const int under_box = cv::countNonZero(darkened(shadowed) & inner);
+  std::printf("occluded cast shadow: %d px of the shadow under the box; with the box as occluder %d of them darkened, "
+              "%d px changed outside it\n",
+              under_box, cv::countNonZero(darkened(hidden) & inner), cv::countNonZero(changed & ~outer));
+  ASSERT_GT(under_box, 1000);  // the shadow does fall there
+  EXPECT_EQ(cv::countNonZero(darkened(hidden) & inner), 0);
+  EXPECT_EQ(cv::countNonZero(changed & ~outer), 0);
 }
 
 double IoU(const cv::Mat& a, const cv::Mat& b) {

@@ -2,40 +2,17 @@
 
 #include <Eigen/Geometry>
 
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "render/offscreen.h"
 
 namespace arview::render {
 namespace {
-
-const char* kReceiverVertex = R"(#version 450 core
-uniform mat4 mvp;          // projection · view (map → clip)
-uniform vec3 corners[4];   // the floor parallelogram, map frame
-out vec3 v_world;
-void main() {
-  const int order[6] = int[6](0, 1, 2, 0, 2, 3);
-  v_world = corners[order[gl_VertexID]];
-  gl_Position = mvp * vec4(v_world, 1.0);
-}
-)";
-
-const char* kReceiverFragment = R"(#version 450 core
-in vec3 v_world;
-uniform mat4 light;         // map → light clip (orthographic)
-uniform sampler2D coverage; // the soft coverage in the light view (CastShadow::SetCoverage)
-uniform float strength;
-out vec4 frag_color;
-void main() {
-  vec2 uv = (light * vec4(v_world, 1.0)).xy * 0.5 + 0.5;
-  float a = strength * textureLod(coverage, uv, 0.0).r;
-  // Nothing to darken: 8-bit blending would leave the pixel as it is, so skip it (llvmpipe then
-  // skips the blend at every sample of a block with no shadow).
-  if (a < 0.5 / 255.0) discard;
-  frag_color = vec4(0.0, 0.0, 0.0, a);
-}
-)";
 
 const char* kDepthVertex = R"(#version 450 core
 layout(location = 0) in vec3 position;
@@ -71,6 +48,7 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
   view->floor_origin = to_floor(centre);
   view->floor_x = to_floor(centre + radius * x) - view->floor_origin;
   view->floor_y = to_floor(centre + radius * y) - view->floor_origin;
+  view->floor_normal = n;
   view->BoundFloor(-1, 1, -1, 1);
   return true;
 }
@@ -80,52 +58,99 @@ void LightView::BoundFloor(double x0, double x1, double y0, double y1) {
   for (int k = 0; k < 4; ++k) floor_corners[k] = floor_origin + box[k][0] * floor_x + box[k][1] * floor_y;
 }
 
-CastShadow::CastShadow(const GlApi& gl) : gl_(&gl) {
-  coverage_ = MakeTexture(gl, cv::Mat(kSize, kSize, CV_8UC1, cv::Scalar::all(0)), {false, 1.f, false});
-  program_ = MakeProgram(gl, "cast shadow", kReceiverVertex, kReceiverFragment);
-  const GLuint p = program_.get();
-  mvp_ = Uniform(gl, p, "mvp");
-  light_ = Uniform(gl, p, "light");
-  corners_ = Uniform(gl, p, "corners");
-  strength_ = Uniform(gl, p, "strength");
-  coverage_sampler_ = Uniform(gl, p, "coverage");
-  vao_ = MakeVertexArray(gl);
-  CheckGl(gl, "cast shadow setup");
-}
+namespace {
 
-void CastShadow::SetCoverage(const cv::Mat& coverage) {
-  if (coverage.size() != cv::Size(kSize, kSize) || coverage.type() != CV_8UC1) {
-    throw RenderError("cast shadow: the coverage must be 8-bit, " + std::to_string(kSize) + " x " + std::to_string(kSize));
+// The part of a convex polygon on the positive side of a plane (n · p + d >= 0), in order.
+std::vector<Eigen::Vector3d> ClipPolygon(const std::vector<Eigen::Vector3d>& polygon, const Eigen::Vector4d& plane) {
+  std::vector<Eigen::Vector3d> out;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Eigen::Vector3d& p = polygon[i];
+    const Eigen::Vector3d& q = polygon[(i + 1) % polygon.size()];
+    const double sp = plane.head<3>().dot(p) + plane.w(), sq = plane.head<3>().dot(q) + plane.w();
+    if (sp >= 0) out.push_back(p);
+    if ((sp >= 0) != (sq >= 0)) out.push_back(p + (q - p) * (sp / (sp - sq)));
   }
-  UpdateTexture(*gl_, coverage_.get(), coverage);
+  return out;
 }
 
-void CastShadow::DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
-                              float strength) {
-  const GlApi& gl = *gl_;
-  const Eigen::Matrix4f mvp = (projection * view).cast<float>();
-  const Eigen::Matrix4f to_light = light.map_to_clip.cast<float>();
-  float corners[12];
-  for (int k = 0; k < 4; ++k)
-    for (int c = 0; c < 3; ++c) corners[3 * k + c] = static_cast<float>(light.floor_corners[k][c]);
-  gl.Enable(GL_DEPTH_TEST);
-  gl.DepthMask(GL_FALSE);
-  gl.Disable(GL_CULL_FACE);
-  gl.Enable(GL_BLEND);
-  gl.BlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  gl.UseProgram(program_.get());
-  gl.UniformMatrix4fv(mvp_, 1, GL_FALSE, mvp.data());
-  gl.UniformMatrix4fv(light_, 1, GL_FALSE, to_light.data());
-  gl.Uniform3fv(corners_, 4, corners);
-  gl.Uniform1f(strength_, strength);
-  gl.Uniform1i(coverage_sampler_, 0);
-  gl.ActiveTexture(GL_TEXTURE0);
-  gl.BindTexture(GL_TEXTURE_2D, coverage_.get());
-  gl.BindVertexArray(vao_.get());
-  gl.DrawArrays(GL_TRIANGLES, 0, 6);
-  gl.BindVertexArray(0);
-  gl.Disable(GL_BLEND);
-  gl.DepthMask(GL_TRUE);
+}  // namespace
+
+void DarkenCastShadow(cv::Mat& frame, const calib::Camera& pinhole, const calib::Pose& pose, double near_m,
+                      const LightView& light, const cv::Mat& coverage, float strength,
+                      std::span<const Eigen::Vector3f> occluders) {
+  const Eigen::Vector3d& n = light.floor_normal;
+  const Eigen::Vector3d camera = pose.Center();
+  if (!(strength > 0) || n.dot(camera - light.floor_origin) <= 0) return;  // seen from below: none
+  // Map → camera as planes in the map frame: in front of the near plane; above the floor.
+  const Eigen::Matrix3d r = pose.R();
+  const Eigen::Vector4d in_front(r(2, 0), r(2, 1), r(2, 2), pose.t_cw.z() - near_m);
+  const Eigen::Vector4d above_floor(n.x(), n.y(), n.z(), -n.dot(light.floor_origin));
+  constexpr int kShift = 8;  // sub-pixel bits of the polygon fills
+  auto project = [&](const std::vector<Eigen::Vector3d>& polygon, const cv::Point& origin) {
+    std::vector<cv::Point> points;
+    // In front of the near plane every point is finite; the clamp keeps the fixed-point
+    // coordinates of a point just past the near plane within int (only absurd geometry reaches it).
+    auto fixed_point = [](double pixel) { return cvRound(std::clamp(pixel, -1e6, 1e6) * (1 << kShift)); };
+    for (const Eigen::Vector3d& p : polygon) {
+      const Eigen::Vector3d c = pose.ToCamera(p);
+      points.emplace_back(fixed_point(pinhole.fx * c.x() / c.z() + pinhole.cx - origin.x),
+                          fixed_point(pinhole.fy * c.y() / c.z() + pinhole.cy - origin.y));
+    }
+    return points;
+  };
+  const std::vector<Eigen::Vector3d> quad =
+      ClipPolygon({light.floor_corners.begin(), light.floor_corners.end()}, in_front);
+  if (quad.size() < 3) return;
+  std::vector<cv::Point> outline = project(quad, {0, 0});
+  const cv::Rect fixed = cv::boundingRect(outline);  // in 1/2^kShift pixels
+  const cv::Rect roi = cv::Rect(cv::Point((fixed.x >> kShift) - 1, (fixed.y >> kShift) - 1),
+                                cv::Point(((fixed.x + fixed.width) >> kShift) + 2, ((fixed.y + fixed.height) >> kShift) + 2)) &
+                       cv::Rect(0, 0, frame.cols, frame.rows);
+  if (roi.empty()) return;
+  // Where the floor quad is, less where an occluder is above the floor in front of the camera
+  // (a point on the ray to a floor point that is above the floor lies between the two).
+  cv::Mat inside = cv::Mat::zeros(roi.size(), CV_8U);
+  outline = project(quad, roi.tl());
+  cv::fillConvexPoly(inside, outline, cv::Scalar(255), cv::LINE_8, kShift);
+  for (size_t i = 0; i + 2 < occluders.size(); i += 3) {
+    std::vector<Eigen::Vector3d> triangle = {occluders[i].cast<double>(), occluders[i + 1].cast<double>(),
+                                             occluders[i + 2].cast<double>()};
+    triangle = ClipPolygon(ClipPolygon(triangle, above_floor), in_front);
+    if (triangle.size() < 3) continue;
+    cv::fillConvexPoly(inside, project(triangle, roi.tl()), cv::Scalar(0), cv::LINE_AA, kShift);
+  }
+  // Pixel → light clip (x, y) through the floor: the floor point at clip (x, y) projects to
+  // K (R (o + x fx + y fy) + t), a homography; its inverse, then clip → texel.
+  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
+  k << pinhole.fx, 0, pinhole.cx, 0, pinhole.fy, pinhole.cy, 0, 0, 1;
+  Eigen::Matrix3d clip_to_pixel;
+  clip_to_pixel << r * light.floor_x, r * light.floor_y, r * light.floor_origin + pose.t_cw;
+  clip_to_pixel = k * clip_to_pixel;
+  const double half = kCastShadowTexels / 2.0;
+  Eigen::Matrix3d clip_to_texel;
+  clip_to_texel << half, 0, half - 0.5, 0, half, half - 0.5, 0, 0, 1;
+  Eigen::Matrix3d roi_to_pixel = Eigen::Matrix3d::Identity();
+  roi_to_pixel(0, 2) = roi.x, roi_to_pixel(1, 2) = roi.y;
+  const Eigen::Matrix3d roi_to_texel = clip_to_texel * clip_to_pixel.inverse() * roi_to_pixel;
+  cv::Mat m(3, 3, CV_64F);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m.at<double>(i, j) = roi_to_texel(i, j);
+  cv::Mat shade;
+  cv::warpPerspective(coverage, shade, m, roi.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, 0);
+  const int gain = static_cast<int>(std::lround(std::clamp(strength, 0.f, 1.f) * 65536));
+  for (int y = 0; y < roi.height; ++y) {
+    const std::uint8_t* c = shade.ptr<std::uint8_t>(y);
+    const std::uint8_t* q = inside.ptr<std::uint8_t>(y);
+    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(roi.y + y) + roi.x;
+    for (int x = 0; x < roi.width; ++x) {
+      if (c[x] == 0 || q[x] == 0) continue;
+      // alpha (0..255) = strength × coverage × inside, rounded as the 8-bit layer was.
+      const int a = (c[x] * q[x] * static_cast<std::int64_t>(gain) / 255 + 32768) >> 16;
+      if (a == 0) continue;
+      const int keep = 255 - a;
+      for (int ch = 0; ch < 3; ++ch) bg[x][ch] = static_cast<std::uint8_t>((bg[x][ch] * keep + 127) / 255);
+    }
+  }
 }
 
 DepthProxy::DepthProxy(const GlApi& gl, const std::vector<Eigen::Vector3f>& triangles) : gl_(&gl) {

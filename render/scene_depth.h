@@ -1,11 +1,10 @@
 #pragma once
 // Two things the room adds to the character layer (issue 14, items 3 and 4):
-//  - CastShadow: the character's soft shadow on its floor plane from the room's dominant light.
-//    The character's soft coverage seen along the light (orthographic, around its bounding
-//    sphere; render/shadow_capsules.h: the posed capsules, evaluated on the CPU) is uploaded as
-//    a 64 x 64 texture; the floor's parallelogram under the covered texels is then drawn into
-//    the layer, each pixel darkened by the coverage at its point projected along the light (one
-//    bilinear tap).
+//  - The cast shadow: the character's soft shadow on its floor plane from the room's dominant
+//    light. The character's soft coverage seen along the light (orthographic, around its
+//    bounding sphere; render/shadow_capsules.h: the posed capsules, evaluated on the CPU) is
+//    mapped onto the floor and darkens the camera image directly (DarkenCastShadow), where no
+//    occluder stands between the camera and the floor, before the character layer goes over it.
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
@@ -14,8 +13,11 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
+#include "calib/camera.h"
+#include "calib/pose.h"
 #include "render/gl_objects.h"
 
 namespace arview::render {
@@ -28,6 +30,7 @@ struct LightView {
   // The floor point seen at light clip (x, y): floor_origin + x · floor_x + y · floor_y.
   Eigen::Vector3d floor_origin = Eigen::Vector3d::Zero(), floor_x = Eigen::Vector3d::Zero(),
                   floor_y = Eigen::Vector3d::Zero();
+  Eigen::Vector3d floor_normal = Eigen::Vector3d::UnitZ();  // unit, the light's side
   // The floor's corners under the view (map frame): the shadow can only fall inside them.
   // MakeLightView puts the whole view's there; BoundFloor narrows them.
   std::array<Eigen::Vector3d, 4> floor_corners;
@@ -41,24 +44,23 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
                    const Eigen::Vector3d& floor_point, const Eigen::Vector3d& floor_normal, double min_elevation_deg,
                    LightView* view);
 
-class CastShadow {
- public:
-  // The coverage's texels a side: the light view spans the character's bounding sphere, so a
-  // texel is 1/32 of its radius, finer than the soft edge (softness 0.03 of its diameter).
-  static constexpr int kSize = 64;
-  explicit CastShadow(const GlApi& gl);
-  // The soft coverage in the light view (CapsuleCoverage: 8-bit, kSize x kSize, row 0 at v = 0).
-  void SetCoverage(const cv::Mat& coverage);
-  // Into the bound framebuffer, premultiplied black: alpha = strength × soft coverage (pixels
-  // with no shadow are left alone).
-  void DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
-                    float strength);
+// The cast shadow's coverage texels a side: the light view spans the character's bounding
+// sphere, so a texel is 1/32 of its radius, finer than the soft edge (0.03 of its diameter).
+constexpr int kCastShadowTexels = 64;
 
- private:
-  const GlApi* gl_;
-  GlName coverage_, program_, vao_;
-  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, coverage_sampler_ = -1;
-};
+// Darkens the camera image `frame` (BGR, seen by the pinhole camera `pinhole` from `pose`) by the
+// cast shadow on the floor under `light`: alpha = strength × coverage at the floor point
+// (bilinear; `coverage` from CapsuleCoverage in light.map_to_clip, kCastShadowTexels a side), and
+// out = frame · (1 − alpha), as the 8-bit premultiplied layer's blend did. Only inside the
+// floor quad (light.floor_corners), and not where one of `occluders` (map frame, 3 corners a
+// triangle) lies between the camera and the floor (antialiased edges). Nothing when the camera
+// is below the floor. Why on the CPU: drawn into the character layer, the floor quad widened
+// the rectangle that is cleared, resolved and read back at 4 samples a pixel, and the occluders
+// drawn into it (docs/render.md); a homography warp of a 64 x 64 image and a few polygon fills
+// cost less than those passes.
+void DarkenCastShadow(cv::Mat& frame, const calib::Camera& pinhole, const calib::Pose& pose, double near_m,
+                      const LightView& light, const cv::Mat& coverage, float strength,
+                      std::span<const Eigen::Vector3f> occluders);
 
 class DepthProxy {
  public:
