@@ -220,6 +220,38 @@ TEST(RoomLight, AnalyticEnvironmentIrradianceWithin2PercentAndDirectionWithin5De
   EXPECT_LT(angle, 5.0);
 }
 
+// The one-pass thumbnail of whole blocks (the exposure follower's, every 4th frame) is the area
+// average that cv::resize gives, to 8-bit rounding, and marks the same blocks as clipped.
+TEST(RoomLight, ThumbnailOfWholeBlocksIsTheAreaAverageWithTheClippedBlocksMarked) {
+  cv::Mat image(480, 640, CV_8UC3);
+  cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(250));
+  cv::GaussianBlur(image, image, {0, 0}, 2);
+  image(cv::Rect(110, 50, 4, 2)).setTo(cv::Scalar(40, 252, 40));  // clipped pixels across two blocks
+  image(cv::Rect(300, 300, 1, 1)).setTo(cv::Scalar(255, 255, 255));
+  const cv::Mat thumbnail = LinearThumbnail(image, 40);
+  ASSERT_EQ(thumbnail.size(), cv::Size(40, 30));
+  cv::Mat small, clipped, share;
+  cv::resize(image, small, {40, 30}, 0, 0, cv::INTER_AREA);
+  cv::inRange(image, cv::Scalar::all(0), cv::Scalar::all(kClippedLevel - 1), clipped);
+  cv::resize(clipped, share, {40, 30}, 0, 0, cv::INTER_AREA);
+  int marked = 0, mismatched = 0;
+  double worst = 0;
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const cv::Vec3f t = thumbnail.at<cv::Vec3f>(y, x);
+      const bool is_marked = t == cv::Vec3f::all(kClippedThumbnail);
+      marked += is_marked;
+      mismatched += is_marked != (share.at<std::uint8_t>(y, x) < 255);
+      if (is_marked) continue;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(t[c] * 255.0 - small.at<cv::Vec3b>(y, x)[c]));
+    }
+  std::printf("thumbnail of whole blocks: %d blocks marked clipped (%d differ from the resized mask); worst %.2f levels "
+              "from cv::resize\n", marked, mismatched, worst);
+  EXPECT_EQ(marked, 3);  // the patch straddles blocks 6 and 7 (x 96..111, 112..127), the white pixel one more
+  EXPECT_EQ(mismatched, 0);
+  EXPECT_LE(worst, 1.0 + 1e-4);  // rounding: cv::resize's fixed-point average sometimes rounds the other way
+}
+
 TEST(RoomLight, SavesAndLoadsAndRejectsBadFiles) {
   const RoomLight& light = AnalyticEstimate();
   const fs::path dir = fs::temp_directory_path() / ("arview_light_" + std::to_string(::getpid()));
