@@ -664,7 +664,7 @@ double IoU(const cv::Mat& a, const cv::Mat& b) {
 
 // The capsules against the mesh they stand for, seen from the light: the skinned mesh's outline
 // (anim/'s CPU skinning, filled triangle by triangle) and the capsules' coverage with a hard edge,
-// in the same orthographic view at 256 x 256 (the receiver's texture has 64 x 64).
+// in the same orthographic view at 256 x 256 (the cast shadow's coverage has 64 x 64).
 double CapsuleOutlineIoU(const anim::AnimatedCharacter& animated, const anim::FrameOutput& frame,
                          const Eigen::Vector3d& towards_light, cv::Mat* mesh_mask, cv::Mat* capsule_mask) {
   constexpr int kSize = 256;
