@@ -662,6 +662,21 @@ double IoU(const cv::Mat& a, const cv::Mat& b) {
   return double(cv::countNonZero(a & b)) / std::max(1, cv::countNonZero(a | b));
 }
 
+// The shadow is on the floor's top: a camera below the floor plane sees none of it.
+TEST(CastShadow, IsNotSeenFromBelowTheFloor) {
+  PostScene scene;
+  const cv::Mat from_above[2] = {scene.Render(false), scene.Render(true)};
+  scene.pose = LookAt(scene.spec.anchor.position - Eigen::Vector3d(0.5, 0.5, 6), scene.spec.anchor.position);
+  const cv::Mat from_below[2] = {scene.Render(false), scene.Render(true)};
+  cv::Mat above_diff, below_diff;
+  cv::absdiff(from_above[0], from_above[1], above_diff);
+  cv::absdiff(from_below[0], from_below[1], below_diff);
+  const int above = cv::countNonZero(above_diff.reshape(1)), below = cv::countNonZero(below_diff.reshape(1));
+  std::printf("cast shadow: %d channel values darkened seen from above, %d from below the floor\n", above, below);
+  ASSERT_GT(above, 1000);
+  EXPECT_EQ(below, 0);
+}
+
 // The capsules against the mesh they stand for, seen from the light: the skinned mesh's outline
 // (anim/'s CPU skinning, filled triangle by triangle) and the capsules' coverage with a hard edge,
 // in the same orthographic view at 256 x 256 (the cast shadow's coverage has 64 x 64).
