@@ -32,7 +32,7 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
 
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
   characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
-                         std::make_unique<CastShadow>(context_->gl()), LightView{}, 0});
+                         FitShadowCapsules(character), false, LightView{}, cv::Mat()});
   if (options_.lighting == LightingMode::kShShadowed) {
     const PrtCacheResult prt = ShadowedTransferCached(character, options_.prt, options_.prt_cache_folder);
     characters_.back().renderer->SetTransfer(prt.transfer);
@@ -53,6 +53,7 @@ void ArRenderer::SetRoomLight(const RoomLight& light) {
 }
 
 void ArRenderer::SetOccluders(const std::vector<Eigen::Vector3f>& triangles) {
+  occluder_triangles_.assign(triangles.begin(), triangles.begin() + static_cast<std::ptrdiff_t>(triangles.size() / 3 * 3));
   if (triangles.empty()) {
     occluders_.reset();
     return;
@@ -73,52 +74,44 @@ void ArRenderer::FollowExposure(const cv::Mat& background, const calib::Pose& po
   current_sh_ = Scaled(room_light_.sh, gain);
 }
 
-bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const {
-  if (!options_.cast_shadow || !has_room_light_ || frame.model.empty()) return false;
+void ArRenderer::UpdateCastShadows(std::span<const anim::FrameOutput* const> frames) {
+  if (frames.size() != characters_.size()) {
+    throw RenderError("AR render: " + std::to_string(characters_.size()) + " characters but " +
+                      std::to_string(frames.size()) + " animation frames");
+  }
+  for (size_t i = 0; i < characters_.size(); ++i) {
+    Placed& placed = characters_[i];
+    placed.casts = CastShadowView(placed, *frames[i], &placed.light_view, &placed.coverage);
+  }
+}
+
+bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view,
+                                cv::Mat* coverage) const {
+  if (!options_.cast_shadow || !has_room_light_ || frame.model.empty() || placed.capsules.empty()) return false;
   const anim::CharacterSpec& spec = *placed.spec;
   const Eigen::Matrix4d model_to_map = spec.ModelToMap();
-  const double scale = model_to_map.topLeftCorner<3, 3>().colwise().norm().maxCoeff();
-  const std::vector<float>& radii = placed.renderer->joint_radii();
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Eigen::Matrix4d& joint : frame.model) {
-    const Eigen::Vector3d p = (model_to_map * joint.col(3)).head<3>();
-    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  }
-  const Eigen::Vector3d centre = (lo + hi) / 2;
+  std::vector<Eigen::Matrix4d> joint_to_map(frame.model.size());
+  for (size_t j = 0; j < frame.model.size(); ++j) joint_to_map[j] = model_to_map * frame.model[j];
+  const std::vector<ShadowCapsule> posed = PoseShadowCapsules(placed.capsules, joint_to_map);
+  if (posed.empty()) return false;
+  // The light view around the posed capsules, widened by the soft edge.
+  Eigen::Vector3d centre;
   double radius = 0;
-  for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
-    if (radii[j] <= 0) continue;
-    const Eigen::Vector3d p = (model_to_map * frame.model[j].col(3)).head<3>();
-    radius = std::max(radius, (p - centre).norm() + 1.1 * radii[j] * scale);
-  }
+  CapsuleBounds(posed, &centre, &radius);
+  const double soft = options_.cast_shadow_softness * 2 * radius;
   const Eigen::Vector3d normal = (spec.anchor.rotation.normalized() * spec.up).normalized();
   // Below 15 degrees of elevation the shadow would stretch across the room: none.
-  const Eigen::Vector3d d = room_light_.dominant.direction;
-  if (!MakeLightView(d, centre, radius, spec.anchor.position, normal, 15.0, view)) return false;
-  // The floor quad drawn (and read back) only where the shadow can fall: the joints' spheres
-  // projected along the light, bounded in the floor plane, plus the blur's reach.
-  Eigen::Vector3d e1 = d - d.dot(normal) * normal;
-  if (e1.norm() < 1e-9) e1 = normal.unitOrthogonal();
-  e1.normalize();
-  const Eigen::Vector3d e2 = normal.cross(e1);
-  const Eigen::Vector3d& o = spec.anchor.position;
-  Eigen::Vector2d lo2 = Eigen::Vector2d::Constant(1e300), hi2 = -lo2;
-  for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
-    if (radii[j] <= 0) continue;
-    const Eigen::Vector3d p = (model_to_map * frame.model[j].col(3)).head<3>();
-    const double r = 1.1 * radii[j] * scale;
-    for (int k = 0; k < 8; ++k) {
-      const Eigen::Vector3d q = p + r * Eigen::Vector3d(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
-      const Eigen::Vector3d f = q - d * ((q - o).dot(normal) / d.dot(normal)) - o;
-      const Eigen::Vector2d f2(f.dot(e1), f.dot(e2));
-      lo2 = lo2.cwiseMin(f2), hi2 = hi2.cwiseMax(f2);
-    }
+  if (!MakeLightView(room_light_.dominant.direction, centre, radius + soft, spec.anchor.position, normal, 15.0, view)) {
+    return false;
   }
-  if (lo2.x() > hi2.x()) return false;
-  const double margin = 2.0 * options_.cast_shadow_softness * 2 * radius;
-  lo2 -= Eigen::Vector2d::Constant(margin), hi2 += Eigen::Vector2d::Constant(margin);
-  view->floor_corners = {o + lo2.x() * e1 + lo2.y() * e2, o + hi2.x() * e1 + lo2.y() * e2,
-                         o + hi2.x() * e1 + hi2.y() * e2, o + lo2.x() * e1 + hi2.y() * e2};
+  cv::Rect support;
+  CapsuleCoverage(posed, view->map_to_clip, soft / (radius + soft), kCastShadowTexels, coverage, &support);
+  if (support.empty()) return false;
+  // The floor quad only under the covered texels, and one more texel each side for the bilinear
+  // tap: the pixels DarkenCastShadow visits.
+  const double texel = 2.0 / kCastShadowTexels;
+  view->BoundFloor(-1 + (support.x - 1) * texel, -1 + (support.x + support.width + 1) * texel,
+                   -1 + (support.y - 1) * texel, -1 + (support.y + support.height + 1) * texel);
   return true;
 }
 
@@ -230,10 +223,6 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     if (options_.shadow && Shadow(placed, frame, &e)) {
       for (int k = 0; k < 4; ++k) add(e.center + (k & 1 ? 1.0 : -1.0) * e.axis_u + (k & 2 ? 1.0 : -1.0) * e.axis_v);
     }
-    LightView light;
-    if (CastShadowView(placed, frame, &light)) {
-      for (const Eigen::Vector3d& corner : light.floor_corners) add(corner);
-    }
     if (behind) return full;
   }
   if (u0 > u1) return {};
@@ -253,15 +242,37 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
 }
 
 void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) {
-  if (frames.size() != characters_.size()) {
-    throw RenderError("AR render: " + std::to_string(characters_.size()) + " characters but " +
-                      std::to_string(frames.size()) + " animation frames");
-  }
   used_linear_fallback_ = false;
   double farthest = 0;
   const cv::Rect rect = ScreenBounds(eye, frames, &farthest);
-  if (rect.empty()) return;  // nothing in view: the video frame as it is
+  if (!rect.empty()) DrawLayer(rect, eye, frames, farthest);
+  // The cast shadows darken the camera image the layer goes over (the same as a premultiplied
+  // shadow under the characters in the layer), on this thread while llvmpipe's rasterise the
+  // layer's draws.
+  for (const Placed& placed : characters_) {
+    if (!placed.casts) continue;
+    DarkenCastShadow(frame, pinhole_, eye, options_.clip.near_m, placed.light_view, placed.coverage,
+                     CastShadowStrength(placed),
+                     options_.occlusion ? std::span<const Eigen::Vector3f>(occluder_triangles_) : std::span<const Eigen::Vector3f>());
+  }
+  if (rect.empty()) return;  // no character in view: the video frame (and its shadows) as it is
 
+  // Premultiplied alpha over the video: out = fg + bg·(1 − a).
+  const cv::Mat layer = target_.ReadBgra();
+  for (int y = 0; y < rect.height; ++y) {
+    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
+    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
+    for (int x = 0; x < rect.width; ++x) {
+      const int a = fg[x][3];
+      if (a == 0) continue;
+      const int keep = 255 - a;
+      for (int c = 0; c < 3; ++c) bg[x][c] = cv::saturate_cast<uchar>(fg[x][c] + (bg[x][c] * keep + 127) / 255);
+    }
+  }
+}
+
+void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+                           double farthest) {
   const GlApi& gl = context_->gl();
   auto character_draw = [&](const Placed& placed, const anim::FrameOutput& out) {
     const Eigen::Matrix3d rotation = placed.spec->anchor.rotation.normalized().toRotationMatrix();
@@ -279,30 +290,6 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     draw.sh = current_sh_;
     return draw;
   };
-  // Cast shadows first: each character's silhouette seen from the light, in its own target.
-  std::vector<LightView> light_views(characters_.size());
-  std::vector<bool> casts(characters_.size(), false);
-  for (size_t i = 0; i < characters_.size(); ++i) {
-    Placed& placed = characters_[i];
-    if (!CastShadowView(placed, *frames[i], &light_views[i])) {
-      placed.silhouette_frames = 0;
-      continue;
-    }
-    casts[i] = true;
-    // The silhouette is redrawn every kSilhouetteEvery-th frame (a second pass over every
-    // triangle is the cast shadow's main cost); in between the last one is used with the view
-    // it was drawn in, so the shadow lags the pose by at most one frame.
-    if (placed.silhouette_frames++ % kSilhouetteEvery != 0) {
-      light_views[i].map_to_clip = placed.silhouette_view.map_to_clip;
-      continue;
-    }
-    placed.silhouette_view = light_views[i];
-    CharacterDraw draw = character_draw(placed, *frames[i]);
-    draw.silhouette = true;  // front faces seen from the light cover the whole silhouette of closed meshes
-    placed.cast->BeginSilhouette();
-    placed.renderer->Draw(light_views[i].map_to_clip, Eigen::Matrix4d::Identity(), draw);
-    placed.cast->EndSilhouette(options_.cast_shadow_softness);
-  }
   target_.Begin(rect);
   const Eigen::Matrix4d projection = ProjectionMatrix(pinhole_, options_.clip);
   const Eigen::Matrix4d view = ViewMatrix(eye);
@@ -315,31 +302,16 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
     if (options_.shadow && Shadow(placed, out, &e)) {
       shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
     }
-    if (casts[i]) {
-      placed.cast->DrawReceiver(projection, view, light_views[i], CastShadowStrength(placed));
-    }
     placed.renderer->Draw(projection, view, character_draw(placed, out));
     used_linear_fallback_ = used_linear_fallback_ || placed.renderer->used_linear_fallback();
   }
   CheckGl(gl, "AR frame");
-
-  // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgra();
-  for (int y = 0; y < rect.height; ++y) {
-    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
-    cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
-    for (int x = 0; x < rect.width; ++x) {
-      const int a = fg[x][3];
-      if (a == 0) continue;
-      const int keep = 255 - a;
-      for (int c = 0; c < 3; ++c) bg[x][c] = cv::saturate_cast<uchar>(fg[x][c] + (bg[x][c] * keep + 127) / 255);
-    }
-  }
 }
 
 cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
                            std::span<const anim::FrameOutput* const> frames) {
   FollowExposure(background, pose);
+  UpdateCastShadows(frames);
   cv::Mat frame = PrepareBackground(background);
   Compose(frame, pose, frames);
   return frame;
@@ -349,6 +321,7 @@ cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pos
                                      std::span<const anim::FrameOutput* const> frames, double ipd_m) {
   if (!(ipd_m >= 0 && ipd_m < 0.5)) throw RenderError("interpupillary distance must be in [0, 0.5) m");
   FollowExposure(background, pose);
+  UpdateCastShadows(frames);
   const cv::Mat video = PrepareBackground(background);
   cv::Mat both(camera_.height, 2 * camera_.width, CV_8UC3);
   cv::Mat left = both(cv::Rect(0, 0, camera_.width, camera_.height));

@@ -28,6 +28,7 @@
 #include "render/projection.h"
 #include "render/room_light.h"
 #include "render/scene_depth.h"
+#include "render/shadow_capsules.h"
 
 namespace arview::render {
 
@@ -109,20 +110,28 @@ class ArRenderer {
     const anim::Character* character;
     const anim::CharacterSpec* spec;
     std::unique_ptr<CharacterRenderer> renderer;
-    std::unique_ptr<CastShadow> cast;
-    LightView silhouette_view;   // the light view the cast shadow's silhouette was drawn in
-    long silhouette_frames = 0;  // frames since the silhouette was last drawn (mod kSilhouetteEvery)
+    std::vector<ShadowCapsule> capsules;  // the cast shadow's occluder, bind pose
+    bool casts = false;                   // this frame's cast shadow (UpdateCastShadows):
+    LightView light_view;                 // its light view and floor quad,
+    cv::Mat coverage;                     // its soft coverage (kCastShadowTexels a side)
   };
-  static constexpr int kSilhouetteEvery = 2;
   struct ShadowEllipse {
     Eigen::Vector3d center, axis_u, axis_v;
   };
   cv::Mat PrepareBackground(const cv::Mat& background);
-  // Draws the characters seen from `eye` and blends them over `frame` (in place).
+  // Draws the characters seen from `eye` and blends them over `frame` (in place), after
+  // UpdateCastShadows of the same frames.
   void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
+  // Draws the characters' layer (occluders, contact shadows, characters) into `rect` of the
+  // region target, to be read back.
+  void DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+                 double farthest);
   bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
-  // The cast shadow's light view for this frame (false: no cast shadow).
-  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view) const;
+  // Each character's cast shadow for this frame (kept in Placed for Compose, which darkens the
+  // camera image with it); throws when `frames` is not one per character.
+  void UpdateCastShadows(std::span<const anim::FrameOutput* const> frames);
+  // The cast shadow's light view and soft coverage for this frame (false: no cast shadow).
+  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view, cv::Mat* coverage) const;
   float CastShadowStrength(const Placed& placed) const;
   void FollowExposure(const cv::Mat& background, const calib::Pose& pose);
   // The screen rectangle that contains everything drawn (empty when nothing is in view), and
@@ -143,6 +152,7 @@ class ArRenderer {
   ShRgb current_sh_{};
   std::unique_ptr<ExposureFollower> follower_;
   std::unique_ptr<DepthProxy> occluders_;
+  std::vector<Eigen::Vector3f> occluder_triangles_;  // the same, for the cast shadow on the CPU
   double prt_seconds_ = 0;
   int prt_from_cache_ = 0;
   std::string prt_cache_note_;

@@ -24,10 +24,8 @@ struct CharacterVertex {
 
 struct ProgramVariant {
   bool dual_quaternion = true;
-  LightingMode lighting = LightingMode::kFixed;  // kFixed for the silhouette
-  bool silhouette = false;
-  // 0..7: the silhouette's shading is none, so it has one variant per skinning method.
-  size_t Index() const { return (silhouette ? 6 : 2 * static_cast<size_t>(lighting)) + (dual_quaternion ? 1 : 0); }
+  LightingMode lighting = LightingMode::kFixed;
+  size_t Index() const { return 2 * static_cast<size_t>(lighting) + (dual_quaternion ? 1 : 0); }  // 0..5
 };
 
 // The program's variant, as preprocessor definitions: llvmpipe runs both sides of a branch on a
@@ -35,8 +33,7 @@ struct ProgramVariant {
 // blend and dual-quaternion skinning, the PRT rotation and the SH irradiance in every pass.
 std::string VariantDefines(const ProgramVariant& v) {
   return "#version 450 core\n#define DUAL_QUATERNION " + std::to_string(v.dual_quaternion ? 1 : 0) +
-         "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n#define SILHOUETTE " +
-         std::to_string(v.silhouette ? 1 : 0) + "\n";
+         "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n";
 }
 
 std::string VertexShader(int joints, const ProgramVariant& variant) {
@@ -55,8 +52,8 @@ uniform mat3 normal_matrix;  // inverse transpose of model_to_map's 3x3
 uniform mat4 skin[JOINTS];
 uniform vec4 dq_real[JOINTS];  // quaternion (x, y, z, w)
 uniform vec4 dq_dual[JOINTS];
-// LIGHTING 0: fixed key + ambient, 1: SH irradiance, 2: SH with PRT transfer; SILHOUETTE 1:
-// coverage only (the cast shadow's light view). DUAL_QUATERNION 0: linear blend skinning.
+// LIGHTING 0: fixed key + ambient, 1: SH irradiance, 2: SH with PRT transfer. DUAL_QUATERNION 0:
+// linear blend skinning.
 uniform mat3 model_rotation; // model_to_map's rotation, without its scale
 uniform vec3 sh[9];          // incident radiance (map frame), RGB
 out vec3 v_normal;
@@ -163,9 +160,6 @@ vec3 sh_irradiance(vec3 n) {
 }
 
 void main() {
-#if SILHOUETTE
-  frag_color = vec4(1.0);
-#else
   vec4 c = texture(albedo, v_uv) * base_color;
 #if LIGHTING == 2
   vec3 shade = v_prt;
@@ -179,7 +173,6 @@ void main() {
 #endif
 #endif
   frag_color = vec4(c.rgb * shade, 1.0);
-#endif
 }
 )";
 }
@@ -227,7 +220,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     throw RenderError(character.source + ": " + std::to_string(joints_) + " joints; the vertex shader takes at most " +
                       std::to_string(MaxJoints(gl)));
   }
-  ProgramFor(true, LightingMode::kFixed, false);  // the default one, so that a shader error shows here
+  ProgramFor(true, LightingMode::kFixed);  // the default one, so that a shader error shows here
   white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
   for (const anim::Texture& t : character.textures) {
     textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, kCharacterAnisotropy, true}));
@@ -301,8 +294,8 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   CheckGl(gl, "character upload (" + character.source + ")");
 }
 
-const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting, bool silhouette) {
-  const ProgramVariant variant{dual_quaternion, silhouette ? LightingMode::kFixed : lighting, silhouette};
+const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting) {
+  const ProgramVariant variant{dual_quaternion, lighting};
   std::unique_ptr<Program>& slot = programs_.at(variant.Index());
   if (slot) return *slot;
   const GlApi& gl = *gl_;
@@ -372,7 +365,7 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
     gl.Disable(GL_CULL_FACE);
   }
   const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
-  const Program& program = ProgramFor(dual, lighting, d.silhouette);
+  const Program& program = ProgramFor(dual, lighting);
   const Locations& loc = program.loc;
   gl.UseProgram(program.program.get());
   gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, mvp.data());
@@ -389,7 +382,7 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   } else {
     gl.UniformMatrix4fv(loc.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
   }
-  if (lighting != LightingMode::kFixed && !d.silhouette) {
+  if (lighting != LightingMode::kFixed) {
     float sh[27];
     for (int k = 0; k < 9; ++k)
       for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);

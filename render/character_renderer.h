@@ -40,8 +40,6 @@ struct CharacterDraw {
   bool cull_back_faces = true;
   LightingMode lighting = LightingMode::kFixed;
   ShRgb sh{};  // the room's incident radiance (map frame, RGB) for the SH modes
-  // Coverage only (white, no shading): the cast shadow's view from the light.
-  bool silhouette = false;
 };
 
 class CharacterRenderer {
@@ -83,10 +81,10 @@ class CharacterRenderer {
     GlName program;
     Locations loc{};
   };
-  // One program per variant (skinning method x lighting mode, and the silhouette), compiled on
-  // first use: llvmpipe pays for every branch of a shader that branches on uniforms.
-  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool silhouette);
-  std::array<std::unique_ptr<Program>, 8> programs_;
+  // One program per variant (skinning method x lighting mode), compiled on first use: llvmpipe
+  // pays for every branch of a shader that branches on uniforms.
+  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting);
+  std::array<std::unique_ptr<Program>, 6> programs_;
   std::vector<GlName> textures_;
   GlName white_;
   std::vector<GpuMesh> meshes_;

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <system_error>
+#include <vector>
 
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
@@ -95,9 +97,50 @@ void WritePose(cv::FileStorage& fs, const calib::Pose& pose) {
 
 }  // namespace
 
+namespace {
+
+// LinearThumbnail of an 8-bit BGR image whose sides are whole multiples of the thumbnail's, in
+// one pass: each block's mean (rounded to 8 bits, as cv::resize's area average) and its largest
+// channel value. The exposure follower makes one of these every 4th frame; cv::resize (0.49 ms
+// for 640x480 → 40x30) plus the clipping mask (inRange and its own resize, 0.35 ms) took 0.84 ms
+// of thread CPU on this machine.
+cv::Mat BlockThumbnail(const cv::Mat& image, int width, int height) {
+  const int bw = image.cols / width, bh = image.rows / height, area = bw * bh;
+  cv::Mat linear(height, width, CV_32FC3);
+  std::vector<int> sum(3 * static_cast<size_t>(width));
+  std::vector<std::uint8_t> top(width);
+  for (int by = 0; by < height; ++by) {
+    std::fill(sum.begin(), sum.end(), 0);
+    std::fill(top.begin(), top.end(), 0);
+    for (int y = by * bh; y < (by + 1) * bh; ++y) {
+      const std::uint8_t* p = image.ptr<std::uint8_t>(y);
+      for (int bx = 0; bx < width; ++bx) {
+        int b = 0, g = 0, r = 0, most = 0;
+        for (int x = 0; x < bw; ++x, p += 3) {
+          b += p[0], g += p[1], r += p[2];
+          most = std::max(most, std::max<int>(p[0], std::max(p[1], p[2])));
+        }
+        sum[3 * bx] += b, sum[3 * bx + 1] += g, sum[3 * bx + 2] += r;
+        top[bx] = static_cast<std::uint8_t>(std::max<int>(top[bx], most));
+      }
+    }
+    cv::Vec3f* out = linear.ptr<cv::Vec3f>(by);
+    for (int bx = 0; bx < width; ++bx) {
+      for (int c = 0; c < 3; ++c) out[bx][c] = static_cast<float>((sum[3 * bx + c] + area / 2) / area) / 255.f;
+      if (top[bx] >= kClippedLevel) out[bx] = cv::Vec3f::all(kClippedThumbnail);
+    }
+  }
+  return linear;
+}
+
+}  // namespace
+
 cv::Mat LinearThumbnail(const cv::Mat& image_in, int width) {
   const cv::Mat image = AsColour(image_in, "thumbnail");
   const int height = std::max(1, static_cast<int>(std::lround(width * double(image.rows) / image.cols)));
+  if (image.depth() == CV_8U && image.cols % width == 0 && image.rows % height == 0) {
+    return BlockThumbnail(image, width, height);
+  }
   cv::Mat small, linear;
   cv::resize(image, small, {width, height}, 0, 0, cv::INTER_AREA);
   small.convertTo(linear, CV_32FC3, image.depth() == CV_8U ? 1.0 / 255 : 1.0);

@@ -1,32 +1,41 @@
 #pragma once
 // Two things the room adds to the character layer (issue 14, items 3 and 4):
-//  - CastShadow: the character's soft shadow on its floor plane from the room's dominant light.
-//    The skinned character is drawn as a white silhouette into a 128 x 128 texture, seen along
-//    the light (orthographic, around the character's bounding sphere); the floor's
-//    parallelogram under that view is then drawn into the layer, each pixel darkened by the
-//    silhouette coverage at its point projected along the light, averaged over 4 taps from a
-//    blurred mip level (a soft, percentage-closer-style edge), computed once per silhouette at
-//    half its resolution (the taps read level 1.5) and sampled bilinearly by the floor.
+//  - The cast shadow: the character's soft shadow on its floor plane from the room's dominant
+//    light. The character's soft coverage seen along the light (orthographic, around its
+//    bounding sphere; render/shadow_capsules.h: the posed capsules, evaluated on the CPU) is
+//    mapped onto the floor and darkens the camera image directly (DarkenCastShadow), where no
+//    occluder stands between the camera and the floor, before the character layer goes over it.
 //  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
 #include <Eigen/Core>
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
+#include "calib/camera.h"
+#include "calib/pose.h"
 #include "render/gl_objects.h"
 
 namespace arview::render {
 
-// The orthographic view along a light: map → light clip space, covering a sphere.
+// The orthographic view along a light: map → light clip space, covering a sphere. Its clip x
+// axis is the floor normal's direction across the light (the way a standing character's shadow
+// stretches), so that a box in clip x, y bounds a shadow tightly on the floor.
 struct LightView {
   Eigen::Matrix4d map_to_clip = Eigen::Matrix4d::Identity();
+  // The floor point seen at light clip (x, y): floor_origin + x · floor_x + y · floor_y.
+  Eigen::Vector3d floor_origin = Eigen::Vector3d::Zero(), floor_x = Eigen::Vector3d::Zero(),
+                  floor_y = Eigen::Vector3d::Zero();
+  Eigen::Vector3d floor_normal = Eigen::Vector3d::UnitZ();  // unit, the light's side
   // The floor's corners under the view (map frame): the shadow can only fall inside them.
+  // MakeLightView puts the whole view's there; BoundFloor narrows them.
   std::array<Eigen::Vector3d, 4> floor_corners;
+  // Narrows floor_corners to the clip box [x0, x1] x [y0, y1].
+  void BoundFloor(double x0, double x1, double y0, double y1);
 };
 // `towards_light` unit; the floor plane through `floor_point` with unit normal `floor_normal`.
 // Returns false when the light is within `min_elevation_deg` of the floor's horizon (the shadow
@@ -35,30 +44,23 @@ bool MakeLightView(const Eigen::Vector3d& towards_light, const Eigen::Vector3d& 
                    const Eigen::Vector3d& floor_point, const Eigen::Vector3d& floor_normal, double min_elevation_deg,
                    LightView* view);
 
-class CastShadow {
- public:
-  explicit CastShadow(const GlApi& gl, int size = 128);
-  // Binds the silhouette target (cleared, viewport set): draw the character with
-  // LightView::map_to_clip as projection, an identity view, and CharacterDraw::silhouette.
-  void BeginSilhouette();
-  // Mipmaps the silhouette and blurs it into the soft coverage the receiver samples;
-  // `softness`: the blur radius as a share of the light view's width. The caller then binds its
-  // own framebuffer again.
-  void EndSilhouette(float softness);
-  // Into the bound framebuffer, premultiplied black: alpha = strength × soft coverage (pixels
-  // with no shadow are left alone).
-  void DrawReceiver(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, const LightView& light,
-                    float strength);
+// The cast shadow's coverage texels a side: the light view spans the character's bounding
+// sphere, so a texel is 1/32 of its radius, finer than the soft edge (0.03 of its diameter).
+constexpr int kCastShadowTexels = 64;
 
- private:
-  // The soft coverage's texels a side: half the silhouette's (it is read from level 1.5).
-  int BlurredSize() const { return std::max(1, size_ / 2); }
-  const GlApi* gl_;
-  int size_;
-  GlName texture_, fbo_, blurred_, blurred_fbo_, program_, blur_program_, vao_;
-  GLint mvp_ = -1, light_ = -1, corners_ = -1, strength_ = -1, blurred_sampler_ = -1;
-  GLint softness_ = -1, blur_size_ = -1, silhouette_ = -1;
-};
+// Darkens the camera image `frame` (BGR, seen by the pinhole camera `pinhole` from `pose`) by the
+// cast shadow on the floor under `light`: alpha = strength × coverage at the floor point
+// (bilinear; `coverage` from CapsuleCoverage in light.map_to_clip, kCastShadowTexels a side), and
+// out = frame · (1 − alpha), as the 8-bit premultiplied layer's blend did. Only inside the
+// floor quad (light.floor_corners), and not where one of `occluders` (map frame, 3 corners a
+// triangle) lies between the camera and the floor (antialiased edges). Nothing when the camera
+// is below the floor. Why on the CPU: drawn into the character layer, the floor quad widened
+// the rectangle that is cleared, resolved and read back at 4 samples a pixel, and the occluders
+// drawn into it (docs/render.md); a homography warp of a 64 x 64 image and a few polygon fills
+// cost less than those passes.
+void DarkenCastShadow(cv::Mat& frame, const calib::Camera& pinhole, const calib::Pose& pose, double near_m,
+                      const LightView& light, const cv::Mat& coverage, float strength,
+                      std::span<const Eigen::Vector3f> occluders);
 
 class DepthProxy {
  public:
