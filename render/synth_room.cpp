@@ -194,7 +194,7 @@ void AddFloorAndCeiling(SceneBuilder& builder, SynthLighting light) {
   const Eigen::Vector3d floor[4] = {{-kHalfX, kHalfY, 0}, {kHalfX, kHalfY, 0}, {kHalfX, -kHalfY, 0}, {-kHalfX, -kHalfY, 0}};
   // Under a window the floor is the dark side of the room (the light comes from the side and
   // above); evenly lit, it is as bright as the walls.
-  const float floor_light = light == SynthLighting::kWindow ? 0.45f : 1.f;
+  const float floor_light = light == SynthLighting::kWindow ? 0.6f : 1.f;
   builder.Paint(floor, Eigen::Vector3f(0.55f, 0.5f, 0.45f) * floor_light);
   for (int i = 0; i < 4; ++i) {
     const Eigen::Vector3d center((i % 2 ? 0.5 : -0.5) * kHalfX, (i / 2 ? 0.5 : -0.5) * kHalfY, kPanelOffset);
