@@ -161,22 +161,18 @@ BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const Balan
   return a;
 }
 
-}  // namespace arview::anim
-
-namespace arview::anim {
 namespace {
 
 // Keeps the transitions after which the walk can always go on: a transition into a category
 // with no recorded way out is dropped, and so on until nothing changes.
-void KeepLeavable(std::array<std::array<int, kSupports>, kSupports>& counts) {
+void KeepLeavable(BalanceModel& m) {
   for (bool changed = true; changed;) {
     changed = false;
     for (int s = 0; s < kSupports; ++s) {
-      const auto& out = counts[s];
-      if (std::any_of(out.begin(), out.end(), [](int n) { return n > 0; })) continue;
+      if (m.CanLeave(static_cast<Support>(s))) continue;
       for (int c = 0; c < kSupports; ++c)
-        if (counts[c][s] > 0) {
-          counts[c][s] = 0;
+        if (m.counts[c][s] > 0) {
+          m.counts[c][s] = 0;
           changed = true;
         }
     }
@@ -233,7 +229,7 @@ std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const I
       throw Error(rep.clips[i].source + ": maps onto other joints than the idle model's sources; learn both from one kind of rig");
     AddTransitions(rep.clips[i], postures, rate, m, dwell);
   }
-  KeepLeavable(m.counts);
+  KeepLeavable(m);
   std::erase_if(m.segments, [&](const BalanceModel::Segment& s) {
     return m.counts[static_cast<int>(s.from)][static_cast<int>(s.to)] == 0;
   });
