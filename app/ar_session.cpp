@@ -33,7 +33,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                              " was built for a " + std::to_string(map.camera.width) + "x" +
                              std::to_string(map.camera.height) + " camera");
   }
-  tracker::Tracker tracker(map);
+  tracker::Tracker tracker(map, o.tracker);
 
   std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;

@@ -42,6 +42,8 @@ struct TrackArgs {
   double max_rms_px = 2.5;
   int tracking_min_inliers = 30;
   int replenish_below = 150;
+  int prefetch_below = tracker::TrackingOptions{}.prefetch_below;
+  int prefetch_lag = tracker::TrackingOptions{}.prefetch_lag_frames;
   double guided_radius_px = 10;
   int index_checks = 32;
   unsigned seed = 0;
@@ -69,6 +71,8 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.relocalization.pose.seed = a.seed;
   o.tracking.min_inliers = a.tracking_min_inliers;
   o.tracking.replenish_below = a.replenish_below;
+  o.tracking.prefetch_below = a.prefetch_below;
+  o.tracking.prefetch_lag_frames = a.prefetch_lag;
   o.tracking.guided_radius_px = a.guided_radius_px;
   o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
   o.smoothing.beta = a.smoothing_beta;
@@ -95,6 +99,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"rms_gate_px", r.rms_gate_px},
                               {"flow_tracks", r.flow_tracks},
                               {"guided_matches", r.guided_matches},
+                              {"prefetched_matches", r.prefetched_matches},
                               {"wide_matches", r.wide_matches},
                               {"keypoints", r.keypoints},
                               {"matches", r.matches},
@@ -263,6 +268,12 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(6, 100000));
   cmd->add_option("--replenish-below", a->replenish_below, "Run guided matching when fewer flow tracks survive")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--prefetch-below", a->prefetch_below,
+                  "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
+                  "(in the frame that needs it)")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--prefetch-lag", a->prefetch_lag, "Frames after which features extracted ahead are used")
+      ->capture_default_str()->check(CLI::Range(1, 1000));
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
   cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")

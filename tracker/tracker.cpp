@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -33,6 +34,13 @@ void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
 }
 
 }  // namespace
+
+TrackerOptions RealTimeTrackerOptions() {
+  TrackerOptions options;
+  options.tracking.prefetch_below = 190;
+  options.tracking.prefetch_lag_frames = 6;
+  return options;
+}
 
 calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity) {
   return velocity * last;
@@ -99,6 +107,7 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
   FeatureOptions guided_features = options.relocalization.features;
   guided_features.max_features = options.tracking.guided_max_features;
   guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
+  prefetch_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   point_stamp_.assign(map.points.size(), 0);
   point_keyframes_.resize(map.points.size());
   for (size_t k = 0; k < map.keyframes.size(); ++k)
@@ -120,9 +129,8 @@ std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& p
   return best;
 }
 
-Tracker::~Tracker() = default;
-
 void Tracker::Reset() {
+  DropPrefetch();
   has_pose_ = false;
   has_velocity_ = false;
   last_pyramid_.clear();
@@ -209,6 +217,113 @@ struct Tracker::Guided {
   }
 };
 
+// A frame's guided features being extracted on a worker thread, with what matching them and
+// following them into a later frame needs of it.
+struct Tracker::Prefetch {
+  struct Extracted {
+    Features features;
+    double cpu_ms = 0;  // the worker's CPU time
+  };
+  std::future<Extracted> extracted;
+  std::int64_t frame = 0;  // frames_tracked_ of the frame
+  calib::Pose pose;        // its pose (working camera)
+  std::vector<cv::Mat> pyramid;
+  std::vector<std::uint32_t> tracked_points;  // its followed inliers' map points (covisibility)
+};
+
+Tracker::~Tracker() = default;  // a pending extraction is waited for (std::future of std::async)
+
+void Tracker::DropPrefetch() { prefetch_.reset(); }
+
+void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
+  const TrackingOptions& opt = options_.tracking;
+  if (opt.prefetch_below <= 0 || prefetch_ || result.status != TrackStatus::kTracking) return;
+  if (static_cast<int>(last_inliers_.pixels.size()) >= opt.prefetch_below || last_pyramid_.empty()) return;
+  auto prefetch = std::make_unique<Prefetch>();
+  prefetch->frame = frames_tracked_;
+  prefetch->pose = result.pose;
+  prefetch->pyramid = last_pyramid_;  // shares the images: the next frame builds its own
+  prefetch->tracked_points = last_inliers_.points;
+  // The caller may reuse the frame's buffer once Track() returns.
+  prefetch->extracted = std::async(std::launch::async, [this, image = gray.clone()] {
+    const double cpu_start = ThreadCpuMilliseconds();
+    Prefetch::Extracted out;
+    out.features = relocalizer_->Extract(image, *prefetch_extractor_);
+    out.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
+    return out;
+  });
+  prefetch_ = std::move(prefetch);
+}
+
+int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
+                         std::vector<Eigen::Vector2d>* pixels, std::vector<Eigen::Vector3d>* points,
+                         std::vector<std::uint32_t>* point_ids) {
+  const TrackingOptions& opt = options_.tracking;
+  const calib::Camera& camera = resolution_.work();
+  const std::unique_ptr<Prefetch> prefetch = std::move(prefetch_);
+  const Prefetch::Extracted extracted = prefetch->extracted.get();
+  result->keypoints = static_cast<int>(extracted.features.keypoints.size());
+  result->times.extract_ms += extracted.cpu_ms;
+  result->times.cpu_ms += extracted.cpu_ms;  // Track() adds its own thread's
+  const auto match_start = std::chrono::steady_clock::now();
+  // The map points the prefetched frame's neighbours see, projected with its own pose.
+  std::vector<Guided::Candidate> candidates;
+  const std::vector<int> keyframes = prefetch->tracked_points.empty() ? NearestKeyframes(prefetch->pose)
+                                                                      : CovisibleKeyframes(prefetch->tracked_points);
+  for (int k : keyframes) {
+    for (const auto& obs : map_.keyframes[k].observations) {
+      if (point_stamp_[obs.point] == frame_counter_) continue;  // followed already, or queued
+      point_stamp_[obs.point] = frame_counter_;
+      const Eigen::Vector3d pc = prefetch->pose.ToCamera(map_.points[obs.point].xyz);
+      if (pc.z() <= 0) continue;
+      const Eigen::Vector2d px = camera.Project(pc);
+      if (camera.InImage(px)) candidates.push_back({px, obs.point});
+    }
+  }
+  const auto matches = Guided::Match(extracted.features, candidates, map_, opt.guided_radius_px, opt.guided_ratio,
+                                     camera.Size());
+  // Followed from the prefetched frame into this one, started where this frame's pose puts them;
+  // only as many, spread over the picture, as the flow follows (LK costs ~10 us a point).
+  Track2D3D matched;
+  for (const auto& m : matches) {
+    matched.pixels.push_back(extracted.features.keypoints[m.keypoint].pt);
+    matched.points.push_back(m.point);
+  }
+  matched = SpreadTracks(matched, opt.max_flow_tracks, opt.flow_grid_cell_px, camera.Size());
+  std::vector<cv::Point2f> from, to;
+  std::vector<Eigen::Vector2d> expected;
+  for (size_t i = 0; i < matched.pixels.size(); ++i) {
+    from.push_back(matched.pixels[i]);
+    const Eigen::Vector3d pc = projecting.ToCamera(map_.points[matched.points[i]].xyz);
+    const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
+    expected.push_back(px);
+    to.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : from.back());
+  }
+  int added = 0;
+  if (!from.empty()) {
+    std::vector<unsigned char> status;
+    std::vector<float> error;
+    const cv::Size window(opt.lk_window_px, opt.lk_window_px);
+    cv::calcOpticalFlowPyrLK(
+        prefetch->pyramid, pyramid, from, to, status, error, window, opt.lk_pyramid_levels,
+        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
+        cv::OPTFLOW_USE_INITIAL_FLOW);
+    for (size_t i = 0; i < to.size(); ++i) {
+      const Eigen::Vector2d px(to[i].x, to[i].y);
+      // A track that ends far from where the pose puts its point slid onto something else.
+      if (!status[i] || !camera.InImage(px, 1.0) || (px - expected[i]).norm() > opt.guided_radius_predicted_px) continue;
+      pixels->push_back(px);
+      points->push_back(map_.points[matched.points[i]].xyz);
+      point_ids->push_back(matched.points[i]);
+      ++added;
+    }
+  }
+  result->prefetched_matches = added;
+  result->guided_matches += added;
+  result->times.match_ms += MillisecondsSince(match_start);
+  return added;  // (the LK above is counted with the matching)
+}
+
 calib::Pose Tracker::Predict(double timestamp) const {
   if (!has_velocity_) return last_pose_;
   const double dt = timestamp - last_timestamp_;
@@ -272,7 +387,10 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // 2. Guided matching when the flow tracks have thinned out: map points projected with the
   // pose the surviving tracks give (closer than the prediction after a large or sudden
   // motion), or with the prediction and a wider radius when too few tracks survive.
-  if (result->flow_tracks < opt.replenish_below) {
+  // A prefetched frame is used `prefetch_lag_frames` after it, or as soon as the tracks thin out.
+  const bool prefetch_due =
+      prefetch_ && (frames_tracked_ - prefetch_->frame >= opt.prefetch_lag_frames || result->flow_tracks < opt.replenish_below);
+  if (prefetch_due || result->flow_tracks < opt.replenish_below) {
     calib::Pose projecting = predicted;
     double radius = opt.guided_radius_predicted_px;
     if (result->flow_tracks >= opt.min_inliers) {
@@ -283,33 +401,37 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
         radius = opt.guided_radius_px;
       }
     }
-    const auto extract_start = std::chrono::steady_clock::now();
-    const Features& features = extracted->emplace(relocalizer_->Extract(gray, *guided_extractor_));
-    result->keypoints = static_cast<int>(features.keypoints.size());
-    result->times.extract_ms = MillisecondsSince(extract_start);
-    const auto match_start = std::chrono::steady_clock::now();
-    std::vector<Guided::Candidate> candidates;
-    const std::vector<int> keyframes =
-        point_ids.empty() ? NearestKeyframes(projecting) : CovisibleKeyframes(point_ids);
-    for (int k : keyframes) {
-      for (const auto& obs : map_.keyframes[k].observations) {
-        if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
-        point_stamp_[obs.point] = frame_counter_;
-        const Eigen::Vector3d pc = projecting.ToCamera(map_.points[obs.point].xyz);
-        if (pc.z() <= 0) continue;
-        const Eigen::Vector2d px = camera.Project(pc);
-        if (camera.InImage(px)) candidates.push_back({px, obs.point});
+    if (prefetch_due) {
+      UsePrefetch(pyramid, projecting, result, &pixels, &points, &point_ids);
+    } else {
+      const auto extract_start = std::chrono::steady_clock::now();
+      const Features& features = extracted->emplace(relocalizer_->Extract(gray, *guided_extractor_));
+      result->keypoints = static_cast<int>(features.keypoints.size());
+      result->times.extract_ms = MillisecondsSince(extract_start);
+      const auto match_start = std::chrono::steady_clock::now();
+      std::vector<Guided::Candidate> candidates;
+      const std::vector<int> keyframes =
+          point_ids.empty() ? NearestKeyframes(projecting) : CovisibleKeyframes(point_ids);
+      for (int k : keyframes) {
+        for (const auto& obs : map_.keyframes[k].observations) {
+          if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
+          point_stamp_[obs.point] = frame_counter_;
+          const Eigen::Vector3d pc = projecting.ToCamera(map_.points[obs.point].xyz);
+          if (pc.z() <= 0) continue;
+          const Eigen::Vector2d px = camera.Project(pc);
+          if (camera.InImage(px)) candidates.push_back({px, obs.point});
+        }
       }
+      const auto guided = Guided::Match(features, candidates, map_, radius, opt.guided_ratio, gray.size());
+      for (const auto& m : guided) {
+        const cv::Point2f& p = features.keypoints[m.keypoint].pt;
+        pixels.emplace_back(p.x, p.y);
+        points.push_back(map_.points[m.point].xyz);
+        point_ids.push_back(m.point);
+      }
+      result->guided_matches = static_cast<int>(guided.size());
+      result->times.match_ms = MillisecondsSince(match_start);
     }
-    const auto guided = Guided::Match(features, candidates, map_, radius, opt.guided_ratio, gray.size());
-    for (const auto& m : guided) {
-      const cv::Point2f& p = features.keypoints[m.keypoint].pt;
-      pixels.emplace_back(p.x, p.y);
-      points.push_back(map_.points[m.point].xyz);
-      point_ids.push_back(m.point);
-    }
-    result->guided_matches = static_cast<int>(guided.size());
-    result->times.match_ms = MillisecondsSince(match_start);
   }
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short
@@ -464,6 +586,7 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMilliseconds();
+  ++frames_tracked_;
   FrameResult result;
   const cv::Mat full_gray = image.empty() ? cv::Mat() : ToGray8(image);
   if (full_gray.empty() || full_gray.size() != map_.camera.Size()) {
@@ -523,11 +646,12 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   } else {
     RefineOnFullCamera(inliers, &result);
     Remember(result, timestamp, inliers);
+    MaybePrefetch(gray, result);
     result.center = result.pose.Center();
     result.smoothed_center = smoother_.Filter(result.center, timestamp);
   }
   result.times.total_ms = MillisecondsSince(start);
-  result.times.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
+  result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;  // with a prefetch's worker CPU
   return result;
 }
 

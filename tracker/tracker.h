@@ -66,6 +66,18 @@ struct TrackingOptions {
   // SIFT keypoints for guided matching: more than relocalization uses, since matching them
   // costs little and the tracked pose needs points spread over the whole view.
   int guided_max_features = 2000;
+  // Guided matching's SIFT, extracted ahead on a worker thread: when a tracked frame keeps fewer
+  // flow tracks than `prefetch_below`, its SIFT is extracted in the background while the next
+  // frames track on flow alone; `prefetch_lag_frames` frames later (or sooner, when the flow
+  // tracks fall below replenish_below) the keypoints are matched to the map with that frame's
+  // pose and followed into the current frame by LK. The extraction (60-160 ms at 640x480 here,
+  // 15-30 frames' worth of tracking) then no longer stalls the frame that needs it, and a
+  // pipeline keeps its frame rate. The frame that consumes it waits for it if it is not done,
+  // so results do not depend on timing. 0: off (guided matching extracts in the frame itself),
+  // the default: offline tracking (`arview track`) keeps the exact replenishment its figures were
+  // measured with; the real-time pipeline turns it on (RealTimeTrackerOptions).
+  int prefetch_below = 0;
+  int prefetch_lag_frames = 6;
   // The pose is first refined from the constant-velocity prediction; it is kept when its inliers
   // are at least this fraction of the correspondences, else a short RANSAC runs.
   double prior_min_inlier_ratio = 0.5;
@@ -118,7 +130,7 @@ struct TrackerOptions {
 
 struct StageTimes {
   double flow_ms = 0;
-  double extract_ms = 0;
+  double extract_ms = 0;  // on the worker thread (CPU) for features extracted ahead
   double match_ms = 0;  // global (FLANN) or guided
   double ransac_ms = 0;
   double refine_ms = 0;
@@ -136,12 +148,18 @@ struct FrameResult {
   double rms_gate_px = 0;  // the largest RMS a tracked pose could have had (tracking only)
   int flow_tracks = 0;     // LK tracks that survived into this frame
   int guided_matches = 0;  // added by guided matching
+  int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
   StageTimes times;
 };
+
+// The tracker's options for the real-time pipeline (`arview run`, `replay`, `demo`): guided
+// matching's SIFT extracted ahead (prefetch_below 190, lag 6), so that a frame that replenishes
+// its flow tracks does not stall the stages after it (docs/tracker.md).
+TrackerOptions RealTimeTrackerOptions();
 
 class Tracker {
  public:
@@ -160,6 +178,7 @@ class Tracker {
 
  private:
   struct Guided;
+  struct Prefetch;
   // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
   // to relocalization does not extract it again.
   bool TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,
@@ -170,6 +189,16 @@ class Tracker {
   calib::Pose Predict(double timestamp) const;
   void RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const;
   void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
+  // Starts extracting this frame's guided features on a worker thread when its flow tracks are
+  // thinning (TrackingOptions::prefetch_below).
+  void MaybePrefetch(const cv::Mat& gray, const FrameResult& result);
+  // Waits for a pending extraction and forgets it.
+  void DropPrefetch();
+  // The prefetched frame's keypoints matched to the map and followed by LK into `pyramid`,
+  // appended to the frame's correspondences; the number added.
+  int UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
+                  std::vector<Eigen::Vector2d>* pixels, std::vector<Eigen::Vector3d>* points,
+                  std::vector<std::uint32_t>* point_ids);
   // The inliers whose reprojection error under `pose` (working camera) is within
   // max_track_residual_scales residual scales.
   Track2D3D DropDriftedTracks(const Track2D3D& inliers, const calib::Pose& pose) const;
@@ -183,6 +212,9 @@ class Tracker {
   map::DescriptorIndex index_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<SiftExtractor> guided_extractor_;
+  std::unique_ptr<SiftExtractor> prefetch_extractor_;  // the worker's own, the same settings
+  std::unique_ptr<Prefetch> prefetch_;                 // an extraction ahead, pending or done
+  std::int64_t frames_tracked_ = 0;                    // Track() calls, for the prefetch's lag
   OneEuroFilter smoother_;
 
   // The prior.
