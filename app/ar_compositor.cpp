@@ -60,7 +60,9 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
   return status;
 }
 
-void ArCompositor::DrawHud(cv::Mat& frame, const FrameToCompose& input) const {
+std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose& input) {
+  if (!options_.hud || characters_.empty()) return {};
+  // Everything the drawing needs is copied now: the animations' frames change with the next one.
   std::vector<render::HudSphere> spheres;
   const bool localized = input.track->status != tracker::TrackStatus::kLost;
   for (size_t i = 0; localized && i < characters_.size() && i < input.animations.size(); ++i) {
@@ -69,16 +71,18 @@ void ArCompositor::DrawHud(cv::Mat& frame, const FrameToCompose& input) const {
   }
   render::HudText text;
   text.status = HudStatus(input);
-  const calib::Camera& k = renderer_->pinhole();
   const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
-  if (!options_.hmd) {
-    render::DrawHud(frame, k, pose, spheres, text);
-    return;
-  }
-  for (int eye = 0; eye < 2; ++eye) {
-    cv::Mat half = frame(cv::Rect(eye * k.width, 0, k.width, k.height));
-    render::DrawHud(half, k, render::OffsetEye(pose, (eye == 0 ? -0.5 : 0.5) * options_.ipd_m), spheres, text);
-  }
+  return [spheres = std::move(spheres), text = std::move(text), pose, camera = renderer_->pinhole(), hmd = options_.hmd,
+          ipd_m = options_.ipd_m](cv::Mat& frame) {
+    if (!hmd) {
+      render::DrawHud(frame, camera, pose, spheres, text);
+      return;
+    }
+    for (int eye = 0; eye < 2; ++eye) {
+      cv::Mat half = frame(cv::Rect(eye * camera.width, 0, camera.width, camera.height));
+      render::DrawHud(half, camera, render::OffsetEye(pose, (eye == 0 ? -0.5 : 0.5) * ipd_m), spheres, text);
+    }
+  };
 }
 
 void ArCompositor::BindToThread() { context_->MakeCurrent(); }
@@ -106,10 +110,8 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
   }
   if (localized || characters_.empty()) {
     const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
-    cv::Mat frame = options_.hmd ? renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m)
-                                 : renderer_->Render(input.frame->image, pose, output_ptrs_);
-    if (options_.hud && !characters_.empty()) DrawHud(frame, input);
-    return frame;
+    return options_.hmd ? renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m)
+                        : renderer_->Render(input.frame->image, pose, output_ptrs_);
   }
   // Lost: no pose to register the characters with, so the video is shown alone, undistorted
   // like the augmented frames (the renderer's maps: same K, pinhole output).
@@ -127,8 +129,7 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
   cv::Mat out;
   if (options_.hmd) cv::hconcat(frame, frame, out);
   else out = frame.clone();
-  if (options_.hud && !characters_.empty()) DrawHud(out, input);  // the status says "lost"
-  return out;
+  return out;  // the HUD, drawn by DeferredOverlay, says "lost"
 }
 
 }  // namespace arview::app

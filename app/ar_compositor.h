@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -32,6 +33,8 @@ class ArCompositor : public FrameCompositor {
                const CompositorOptions& options);
   void BindToThread() override;
   cv::Mat Compose(const FrameToCompose& input) override;
+  // The HUD (CompositorOptions::hud), drawn on the sink's thread.
+  std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& input) override;
   // The GL context's description.
   std::string Description() const { return description_; }
   // What loading the characters is worth telling the user (the PRT transfer's time and its
@@ -56,7 +59,6 @@ class ArCompositor : public FrameCompositor {
   std::string description_;
   std::vector<std::string> load_notes_;
   std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
-  void DrawHud(cv::Mat& frame, const FrameToCompose& input) const;
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
   std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
 };

@@ -6,6 +6,7 @@
 #include <mutex>
 #include <thread>
 
+#include <pthread.h>
 #include <sys/resource.h>
 
 #include "anim_authoring/lookat.h"
@@ -20,6 +21,7 @@ struct InFlight {
   Clock::time_point arrival;
   tracker::FrameResult track;
   cv::Mat output;
+  std::function<void(cv::Mat&)> overlay;  // FrameCompositor::DeferredOverlay, run by the sink stage
 };
 
 double ProcessCpuSeconds() {
@@ -27,6 +29,10 @@ double ProcessCpuSeconds() {
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec + 1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
+
+// Stage threads carry their names, so that top -H, perf and gdb tell them apart (at most 15
+// characters: the kernel's limit).
+void NameThisThread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -108,6 +114,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   std::thread capture(guarded(
       [&] {
+        NameThisThread("arview-capture");
         size_t read = 0;
         while (!error.failed() && !stopped() && !sink.StopRequested()) {
           InFlight item;
@@ -123,6 +130,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   std::thread track(guarded(
       [&] {
+        NameThisThread("arview-track");
         while (auto item = to_track.Pop()) {
           if (error.failed() || stopped()) break;
           const Clock::time_point t0 = Clock::now();
@@ -135,6 +143,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   std::thread render(guarded(
       [&] {
+        NameThisThread("arview-render");
         compositor.BindToThread();
         while (auto item = to_render.Pop()) {
           if (error.failed() || stopped()) break;
@@ -161,6 +170,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
           }
           const Clock::time_point t1 = Clock::now();
           item->output = compositor.Compose(compose);
+          item->overlay = compositor.DeferredOverlay(compose);
           stats.Record("render", MsSince(t1));
           {
             std::lock_guard lock(report_mutex);
@@ -179,9 +189,11 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       to_sink));
 
   std::thread write(guarded([&] {
+    NameThisThread("arview-sink");
     while (auto item = to_sink.Pop()) {
       if (error.failed() || stopped()) break;
       const Clock::time_point t0 = Clock::now();
+      if (item->overlay) item->overlay(item->output);
       sink.Write(item->output);
       stats.Record("sink", MsSince(t0));
       stats.Record("latency", MsSince(item->arrival));

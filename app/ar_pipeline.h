@@ -38,6 +38,12 @@ class FrameCompositor {
   virtual void BindToThread() {}
   // The output picture: the video frame, with the character drawn over it when tracked.
   virtual cv::Mat Compose(const FrameToCompose& input) = 0;
+  // Drawing over the composed picture that can wait for the sink's thread (the HUD), called on
+  // the render thread right after Compose: what it returns holds copies of what it draws, and
+  // runs on the sink's thread before the frame is written. The render stage limits the frame
+  // rate on a CPU renderer, and ~1 ms of drawing text and circles need not hold it up. Empty:
+  // nothing to draw.
+  virtual std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& /*input*/) { return {}; }
 };
 
 struct PipelineOptions {
@@ -79,7 +85,7 @@ struct PipelineReport {
   // frame processed, over the run. On a shared machine this is steadier than the frame rate,
   // and it bounds it: two cores give at most 2000 / cpu_ms_per_frame frames per second.
   double cpu_ms_per_frame = 0;
-  std::map<std::string, TimingSummary> stages;  // track, animate, render, sink, latency
+  std::map<std::string, TimingSummary> stages;  // track, animate, render, sink (with the deferred overlay), latency
   std::vector<FrameLog> frames;                 // in processing order (PipelineOptions::keep_frame_logs)
   std::vector<FrameBrief> briefs;               // in processing order, always
   recordings::Trajectory trajectory;            // raw poses of localized frames

@@ -258,9 +258,9 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   if (rect.empty()) return;  // no character in view: the video frame (and its shadows) as it is
 
   // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgra();
+  const cv::Mat layer = target_.ReadBgraBottomUp();  // OpenGL's row order: no flip's copy
   for (int y = 0; y < rect.height; ++y) {
-    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(y);
+    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(rect.height - 1 - y);
     cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
     for (int x = 0; x < rect.width; ++x) {
       const int a = fg[x][3];

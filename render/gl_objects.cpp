@@ -182,7 +182,7 @@ void RenderTarget::Bind() const {
   gl_->Viewport(0, 0, width_, height_);
 }
 
-cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect) const {
+cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect, bool top_down) const {
   const GlApi& gl = *gl_;
   rect &= cv::Rect(0, 0, width_, height_);
   if (rect.empty()) return cv::Mat(0, 0, CV_8UC(channels));
@@ -202,6 +202,7 @@ cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect) const {
   cv::Mat bottom_up(rect.height, rect.width, CV_8UC(channels));
   gl.ReadPixels(x0, y0, rect.width, rect.height, format, GL_UNSIGNED_BYTE, bottom_up.data);
   CheckGl(gl, "read-back");
+  if (!top_down) return bottom_up;
   cv::Mat image;
   cv::flip(bottom_up, image, 0);
   return image;
@@ -210,6 +211,7 @@ cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect) const {
 cv::Mat RenderTarget::ReadBgr() const { return Read(GL_BGR, 3, {0, 0, width_, height_}); }
 cv::Mat RenderTarget::ReadBgra() const { return Read(GL_BGRA, 4, {0, 0, width_, height_}); }
 cv::Mat RenderTarget::ReadBgra(const cv::Rect& rect) const { return Read(GL_BGRA, 4, rect); }
+cv::Mat RenderTarget::ReadBgraBottomUp(const cv::Rect& rect) const { return Read(GL_BGRA, 4, rect, false); }
 
 void RenderTarget::Scissor(const cv::Rect& rect) const {
   if (rect.empty()) {
@@ -266,6 +268,12 @@ cv::Mat RegionTarget::ReadBgra() const {
   if (rect_.empty() || !target_) return cv::Mat(0, 0, CV_8UC4);
   target_->Scissor({});  // drawing into the region is over
   return target_->ReadBgra(TargetRect());
+}
+
+cv::Mat RegionTarget::ReadBgraBottomUp() const {
+  if (rect_.empty() || !target_) return cv::Mat(0, 0, CV_8UC4);
+  target_->Scissor({});
+  return target_->ReadBgraBottomUp(TargetRect());
 }
 
 }  // namespace arview::render

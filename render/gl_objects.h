@@ -81,11 +81,14 @@ class RenderTarget {
   // Only `rect` (image coordinates, row 0 at the top; clipped to the target), resolving only
   // that part: the cost of multisampling then scales with the area drawn.
   cv::Mat ReadBgra(const cv::Rect& rect) const;
+  // The same in OpenGL's row order (row 0 at the bottom), without the flip's copy: for a
+  // caller that walks the rows anyway (the compositing, on the render stage's critical path).
+  cv::Mat ReadBgraBottomUp(const cv::Rect& rect) const;
   // Limits clears and drawing to `rect` (image coordinates); an empty rect disables the limit.
   void Scissor(const cv::Rect& rect) const;
 
  private:
-  cv::Mat Read(GLenum format, int channels, cv::Rect rect) const;
+  cv::Mat Read(GLenum format, int channels, cv::Rect rect, bool top_down = true) const;
   const GlApi* gl_;
   int width_, height_, samples_;
   GlName draw_fbo_, color_rb_, depth_rb_;
@@ -109,6 +112,7 @@ class RegionTarget {
   // The rectangle of the last Begin, resolved and read back (CV_8UC4, row 0 at the top); the
   // scissor test is off again.
   cv::Mat ReadBgra() const;
+  cv::Mat ReadBgraBottomUp() const;  // the same, row 0 at the bottom (RenderTarget::ReadBgraBottomUp)
   cv::Size target_size() const { return target_ ? cv::Size(target_->width(), target_->height()) : cv::Size(); }
 
  private:

@@ -114,6 +114,11 @@ TEST(Offscreen, RegionTargetDrawsTheFullImagesPixelsInsideItsRectangle) {
     cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
     EXPECT_LE(worst, 1) << "rectangle " << rect;
     EXPECT_GT(cv::countNonZero(want.reshape(1)), 0) << "rectangle " << rect << " shows no triangle";
+    // The compositing's read: the same pixels in OpenGL's bottom-up row order.
+    cv::Mat bottom_up = region.ReadBgraBottomUp(), flipped;
+    ASSERT_EQ(bottom_up.size(), rect.size());
+    cv::flip(bottom_up, flipped, 0);
+    EXPECT_EQ(cv::norm(flipped, got, cv::NORM_INF), 0) << "rectangle " << rect;
     // The target stays about the rectangle's size: at most a tile more on each side and each end.
     EXPECT_LE(region.target_size().width, rect.width + 2 * 64) << "rectangle " << rect;
     EXPECT_LE(region.target_size().height, rect.height + 2 * 64) << "rectangle " << rect;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "map/map_file.h"
@@ -67,7 +69,9 @@ void ExpectMapOnADiskThatFillsAfterColmapToFailCleanly(const fs::path& dir) {
     const std::string line = err.substr(last, err.find('\n', last) - last);
     EXPECT_EQ(line.rfind("arview: " + map_dir.string() + "/", 0), 0u) << label << line;
     EXPECT_NE(line.find("File too large"), std::string::npos) << label << line;
-    if (blocks > 0) EXPECT_NE(line.find(map::kMapFileName), std::string::npos) << label << line;
+    if (blocks > 0) {
+      EXPECT_NE(line.find(map::kMapFileName), std::string::npos) << label << line;
+    }
     EXPECT_FALSE(fs::exists(map_file)) << label << "a new map.arvmap beside the error";
     std::error_code ec;
     for (const auto& e : fs::recursive_directory_iterator(map_dir, ec)) {
@@ -120,6 +124,26 @@ TEST(Appliance, TempleRingReplayCompositesEveryFrameAndTheHeadFollowsTheCamera) 
   EXPECT_EQ(std::stoi(m[1]), 23) << "the blended head's forward axis within 20 deg of the camera centre";
   ASSERT_TRUE(std::regex_search(stats, m, std::regex(R"("max_error_deg": ([0-9.]+))")));
   EXPECT_LE(std::stod(m[1]), 20.0);
+
+  // The HUD is drawn on the sink's thread (FrameCompositor::DeferredOverlay): the same frames
+  // with and without it differ, and only in the HUD's places, the character's pixels the same.
+  for (const char* name : {"plain", "hud"}) {
+    std::vector<std::string> args = {"replay", (dir / "temple").string(), "--map", (dir / "map").string(), "--scene",
+                                     (dir / "scene.yaml").string(), "--frames", "1-5:2", "--out", (dir / name).string()};
+    if (std::string(name) == "hud") args.push_back("--hud");
+    run(args);
+  }
+  if (HasFailure()) return;
+  for (const char* frame : {"000000.png", "000002.png"}) {
+    const cv::Mat plain = cv::imread((dir / "plain" / frame).string()), hud = cv::imread((dir / "hud" / frame).string());
+    ASSERT_FALSE(plain.empty()) << frame;
+    ASSERT_EQ(plain.size(), hud.size()) << frame;
+    cv::Mat differs;
+    cv::cvtColor(cv::abs(plain - hud) + cv::abs(hud - plain), differs, cv::COLOR_BGR2GRAY);
+    const int changed = cv::countNonZero(differs);
+    EXPECT_GT(changed, 500) << frame << ": no HUD drawn";
+    EXPECT_LT(changed, plain.total() / 2) << frame << ": the HUD changed most of the picture";
+  }
 
   ExpectMapOnADiskThatFillsAfterColmapToFailCleanly(dir);
   fs::remove_all(dir);
