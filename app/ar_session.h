@@ -27,7 +27,7 @@ struct SessionOptions {
   CompositorOptions compositor;
   FadeOptions fade;
   PipelineOptions pipeline;
-  tracker::TrackerOptions tracker = tracker::RealTimeTrackerOptions();
+  tracker::TrackerOptions tracker;
   long expected_frames = 0;                  // for the progress line (0: unknown)
   // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory, no stats) and
   // RunSession throws CancelledError saying so; the caller removes its partial video.

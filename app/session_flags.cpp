@@ -19,6 +19,11 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  cmd->add_option("--prefetch-below", f.prefetch_below,
+                  "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive, so "
+                  "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
       ->capture_default_str()
       ->check(CLI::IsMember({"msaa", "none"}));
@@ -43,6 +48,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.compositor.hmd = f.hmd;
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
+  o.tracker.tracking.prefetch_below = f.prefetch_below;
   o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
   o.fade = {f.hold, f.fade};
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);

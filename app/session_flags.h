@@ -14,6 +14,7 @@ struct SessionFlags {
   bool hmd = false, hud = false;
   double ipd = 0.064, hold = 0.5, fade = 1.0;
   int gl_threads = 1;
+  int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below
 };
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);

@@ -35,13 +35,6 @@ void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
 
 }  // namespace
 
-TrackerOptions RealTimeTrackerOptions() {
-  TrackerOptions options;
-  options.tracking.prefetch_below = 190;
-  options.tracking.prefetch_lag_frames = 6;
-  return options;
-}
-
 calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity) {
   return velocity * last;
 }

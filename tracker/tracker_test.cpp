@@ -126,12 +126,12 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   ExpectNear(r, far, 0.003, 0.2);
 }
 
-// The real-time pipeline's replenishment: guided matching's SIFT extracted ahead on a worker
+// Replenishment with guided matching's SIFT extracted ahead on a worker
 // thread and used `prefetch_lag_frames` later, its keypoints followed by LK into that frame.
 // Used exactly on schedule (the frame count decides, not the worker's timing: two runs give the
 // same poses bit for bit), and as exact as tracking without it.
 TEST_F(PlanarTrackerTest, FeaturesExtractedAheadAreUsedOnScheduleAndKeepThePoseExact) {
-  TrackerOptions options = RealTimeTrackerOptions();
+  TrackerOptions options;
   options.tracking.prefetch_below = 100000;  // every tracked frame without one pending starts one
   options.tracking.prefetch_lag_frames = 3;
   options.tracking.replenish_below = 0;      // no guided matching in the frame itself
