@@ -25,7 +25,10 @@ struct CharacterVertex {
 struct ProgramVariant {
   bool dual_quaternion = true;
   LightingMode lighting = LightingMode::kFixed;
-  size_t Index() const { return 2 * static_cast<size_t>(lighting) + (dual_quaternion ? 1 : 0); }  // 0..5
+  bool textured = true;  // false: the material's colour alone, no texture fetch
+  size_t Index() const {  // 0..11
+    return 4 * static_cast<size_t>(lighting) + (dual_quaternion ? 2 : 0) + (textured ? 1 : 0);
+  }
 };
 
 // The program's variant, as preprocessor definitions: llvmpipe runs both sides of a branch on a
@@ -33,7 +36,8 @@ struct ProgramVariant {
 // blend and dual-quaternion skinning, the PRT rotation and the SH irradiance in every pass.
 std::string VariantDefines(const ProgramVariant& v) {
   return "#version 450 core\n#define DUAL_QUATERNION " + std::to_string(v.dual_quaternion ? 1 : 0) +
-         "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n";
+         "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n#define TEXTURED " +
+         std::to_string(v.textured ? 1 : 0) + "\n";
 }
 
 std::string VertexShader(int joints, const ProgramVariant& variant) {
@@ -160,7 +164,11 @@ vec3 sh_irradiance(vec3 n) {
 }
 
 void main() {
+#if TEXTURED
   vec4 c = texture(albedo, v_uv) * base_color;
+#else
+  vec4 c = base_color;  // a mesh without a texture: llvmpipe's texture fetch was ~15% of the layer
+#endif
 #if LIGHTING == 2
   vec3 shade = v_prt;
 #else
@@ -220,8 +228,9 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     throw RenderError(character.source + ": " + std::to_string(joints_) + " joints; the vertex shader takes at most " +
                       std::to_string(MaxJoints(gl)));
   }
-  ProgramFor(true, LightingMode::kFixed);  // the default one, so that a shader error shows here
-  white_ = MakeTexture(gl, cv::Mat(1, 1, CV_8UC3, cv::Scalar::all(255)), {false, 1.f, false});
+  // The default ones, so that a shader error shows here.
+  ProgramFor(true, LightingMode::kFixed, true);
+  ProgramFor(true, LightingMode::kFixed, false);
   for (const anim::Texture& t : character.textures) {
     textures_.push_back(MakeTexture(gl, DecodeTexture(t, character.source), {true, kCharacterAnisotropy, true}));
   }
@@ -294,8 +303,8 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   CheckGl(gl, "character upload (" + character.source + ")");
 }
 
-const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting) {
-  const ProgramVariant variant{dual_quaternion, lighting};
+const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured) {
+  const ProgramVariant variant{dual_quaternion, lighting, textured};
   std::unique_ptr<Program>& slot = programs_.at(variant.Index());
   if (slot) return *slot;
   const GlApi& gl = *gl_;
@@ -365,45 +374,64 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
     gl.Disable(GL_CULL_FACE);
   }
   const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
-  const Program& program = ProgramFor(dual, lighting);
-  const Locations& loc = program.loc;
-  gl.UseProgram(program.program.get());
-  gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, mvp.data());
-  gl.UniformMatrix4fv(loc.model, 1, GL_FALSE, model.data());
-  gl.UniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+  float sh[27];
+  for (int k = 0; k < 9; ++k)
+    for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
+  Eigen::Matrix3d rotation = d.model_to_map.topLeftCorner<3, 3>();
+  rotation /= std::cbrt(std::abs(rotation.determinant()));  // uniform scale out
+  const Eigen::Matrix3f model_rotation = rotation.cast<float>();
   if (dual) {
     for (int j = 0; j < joints_; ++j) {
       const anim::DualQuatf& q = d.skinning_dual_quats[j];
       std::copy_n(q.real().coeffs().data(), 4, &dq_upload_[j * 4]);
       std::copy_n(q.dual().coeffs().data(), 4, &dq_upload_[(joints_ + j) * 4]);
     }
+  }
+  // The textured meshes, then those of one colour, each with its program (when it has any).
+  gl.ActiveTexture(GL_TEXTURE0);
+  for (const bool textured : {true, false}) {
+    bool bound = false;
+    for (const GpuMesh& mesh : meshes_) {
+      if ((mesh.texture >= 0) != textured) continue;
+      if (!bound) {
+        UseProgram(ProgramFor(dual, lighting, textured), dual, lighting, mvp, model, normal_matrix, light, sh,
+                   model_rotation, d);
+        bound = true;
+      }
+      if (textured) gl.BindTexture(GL_TEXTURE_2D, textures_[mesh.texture].get());
+      gl.Uniform4f(bound_base_color_, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
+      gl.BindVertexArray(mesh.vao.get());
+      gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+    }
+  }
+  gl.BindVertexArray(0);
+}
+
+void CharacterRenderer::UseProgram(const Program& program, bool dual, LightingMode lighting, const Eigen::Matrix4f& mvp,
+                                   const Eigen::Matrix4f& model, const Eigen::Matrix3f& normal_matrix,
+                                   const Eigen::Vector3f& light, const float* sh, const Eigen::Matrix3f& model_rotation,
+                                   const CharacterDraw& d) {
+  const GlApi& gl = *gl_;
+  const Locations& loc = program.loc;
+  gl.UseProgram(program.program.get());
+  bound_base_color_ = loc.base_color;
+  gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, mvp.data());
+  gl.UniformMatrix4fv(loc.model, 1, GL_FALSE, model.data());
+  gl.UniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, normal_matrix.data());
+  if (dual) {
     gl.Uniform4fv(loc.dq_real, joints_, dq_upload_.data());
     gl.Uniform4fv(loc.dq_dual, joints_, dq_upload_.data() + joints_ * 4);
   } else {
     gl.UniformMatrix4fv(loc.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
   }
   if (lighting != LightingMode::kFixed) {
-    float sh[27];
-    for (int k = 0; k < 9; ++k)
-      for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
     gl.Uniform3fv(loc.sh, 9, sh);
-    Eigen::Matrix3d rotation = d.model_to_map.topLeftCorner<3, 3>();
-    rotation /= std::cbrt(std::abs(rotation.determinant()));  // uniform scale out
-    const Eigen::Matrix3f r = rotation.cast<float>();
-    gl.UniformMatrix3fv(loc.model_rotation, 1, GL_FALSE, r.data());
+    gl.UniformMatrix3fv(loc.model_rotation, 1, GL_FALSE, model_rotation.data());
   }
   gl.Uniform3f(loc.light, light.x(), light.y(), light.z());
   gl.Uniform1f(loc.key, d.key);
   gl.Uniform1f(loc.ambient, d.ambient);
   gl.Uniform1i(loc.albedo, 0);
-  gl.ActiveTexture(GL_TEXTURE0);
-  for (const GpuMesh& mesh : meshes_) {
-    gl.BindTexture(GL_TEXTURE_2D, mesh.texture >= 0 ? textures_[mesh.texture].get() : white_.get());
-    gl.Uniform4f(loc.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
-    gl.BindVertexArray(mesh.vao.get());
-    gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
-  }
-  gl.BindVertexArray(0);
 }
 
 LightingMode ParseLightingMode(const std::string& name) {

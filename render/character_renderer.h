@@ -68,7 +68,7 @@ class CharacterRenderer {
     GLsizei index_count = 0;
     int vertex_count = 0;
     Eigen::Vector4f base_color = Eigen::Vector4f::Ones();
-    int texture = -1;  // index into textures_, −1: white
+    int texture = -1;  // index into textures_, −1: none (the untextured program)
   };
   const GlApi* gl_;
   int joints_ = 0;
@@ -81,12 +81,16 @@ class CharacterRenderer {
     GlName program;
     Locations loc{};
   };
-  // One program per variant (skinning method x lighting mode), compiled on first use: llvmpipe
-  // pays for every branch of a shader that branches on uniforms.
-  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting);
-  std::array<std::unique_ptr<Program>, 6> programs_;
+  // One program per variant (skinning method x lighting mode x textured or not), compiled on
+  // first use: llvmpipe pays for every branch of a shader that branches on uniforms.
+  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured);
+  // Binds `program` and sets the draw's uniforms in it (all but the mesh's colour).
+  void UseProgram(const Program& program, bool dual, LightingMode lighting, const Eigen::Matrix4f& mvp,
+                  const Eigen::Matrix4f& model, const Eigen::Matrix3f& normal_matrix, const Eigen::Vector3f& light,
+                  const float* sh, const Eigen::Matrix3f& model_rotation, const CharacterDraw& d);
+  std::array<std::unique_ptr<Program>, 12> programs_;
+  GLint bound_base_color_ = -1;  // the bound program's base_color location
   std::vector<GlName> textures_;
-  GlName white_;
   std::vector<GpuMesh> meshes_;
   bool used_linear_fallback_ = false;
   bool has_transfer_ = false;

@@ -272,6 +272,67 @@ TEST(ArRenderer, UndistortsTheBackgroundOntoThePinholeView) {
   EXPECT_LT(worst, 0.3);
 }
 
+// A mesh without a texture is drawn by the program without the texture fetch (its material's
+// colour alone), a textured one by the program with it, in the same draw: a red untextured
+// quad beside a white one with a green texture.
+TEST(ArRenderer, DrawsUntexturedMeshesInTheirColourAndTexturedOnesWithTheirTexture) {
+  auto c = std::make_shared<anim::Character>();
+  c->source = "two quads";
+  c->skeleton.names = {"root"};
+  c->skeleton.parents = {-1};
+  c->skeleton.rest = {anim::Transform{}};
+  c->skeleton.inverse_bind = {Eigen::Matrix4d::Identity()};
+  for (const float x0 : {-0.6f, 0.1f}) {  // model space: y up, facing +z
+    anim::Mesh quad;
+    quad.name = x0 < 0 ? "red" : "green";
+    const float x1 = x0 + 0.5f;
+    quad.positions = {{x0, 0.7f, 0}, {x1, 0.7f, 0}, {x1, 1.3f, 0}, {x0, 1.3f, 0}};
+    quad.normals.assign(4, Eigen::Vector3f::UnitZ());
+    quad.uvs = {{0, 1}, {1, 1}, {1, 0}, {0, 0}};
+    quad.joints.assign(4, {0, 0, 0, 0});
+    quad.weights.assign(4, Eigen::Vector4f(1, 0, 0, 0));
+    quad.indices = {0, 1, 2, 0, 2, 3};
+    quad.material = x0 < 0 ? 0 : 1;
+    c->meshes.push_back(quad);
+  }
+  c->materials.push_back({"red", Eigen::Vector4f(0.9f, 0.1f, 0.1f, 1), -1});
+  c->materials.push_back({"textured", Eigen::Vector4f::Ones(), 0});
+  anim::Texture green;
+  green.width = green.height = 2;
+  for (int i = 0; i < 4; ++i) green.rgba.insert(green.rgba.end(), {0, 230, 0, 255});
+  c->textures.push_back(green);
+  anim::CharacterSpec spec;
+  spec.name = "quads";
+  spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
+  anim::KeySpec key;
+  key.source = anim::KeySpec::Source::kRestPose;
+  spec.keys.push_back(key);
+  anim::AnimatedCharacter quads(std::shared_ptr<const anim::Character>(c), spec);
+
+  const calib::Camera camera = TestCamera();
+  const Eigen::Quaterniond level(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));
+  const calib::Pose front = calib::Pose::FromCameraToWorld(level, Eigen::Vector3d(0, -2.2, 1.0));
+  ArOptions options = SilhouetteOptions(anim::SkinningMethod::kDualQuaternion);
+  options.cull_back_faces = false;
+  ArRenderer renderer(testing::SharedContext(), camera, options);
+  renderer.AddCharacter(quads.character(), quads.spec());
+  const anim::FrameOutput* frame = &quads.Update(front.Center(), 0.0);
+  const cv::Mat out = renderer.Render({}, front, {&frame, 1});
+  for (const double x : {-0.35, 0.35}) {
+    const Eigen::Vector2d px = camera.Project(front.ToCamera(Eigen::Vector3d(x, 0, 1.0)));
+    const cv::Scalar bgr = cv::mean(out(cv::Rect(cvRound(px.x()) - 5, cvRound(px.y()) - 5, 11, 11)));
+    if (x < 0) {
+      EXPECT_GT(bgr[2], 60) << "the red quad: " << bgr;
+      EXPECT_GT(bgr[2], 3 * bgr[1]) << "the red quad: " << bgr;
+      EXPECT_GT(bgr[2], 3 * bgr[0]) << "the red quad: " << bgr;
+    } else {
+      EXPECT_GT(bgr[1], 60) << "the green-textured quad: " << bgr;
+      EXPECT_GT(bgr[1], 3 * bgr[2] + 1) << "the green-textured quad: " << bgr;
+      EXPECT_GT(bgr[1], 3 * bgr[0] + 1) << "the green-textured quad: " << bgr;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace arview::render
 
