@@ -356,10 +356,12 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   const bool dual = d.method == anim::SkinningMethod::kDualQuaternion && anim::RigidSkinning(d.skinning_matrices);
   used_linear_fallback_ = d.method == anim::SkinningMethod::kDualQuaternion && !dual;
 
-  const Eigen::Matrix4f mvp = (projection * view * d.model_to_map).cast<float>();
-  const Eigen::Matrix4f model = d.model_to_map.cast<float>();
-  const Eigen::Matrix3f normal_matrix = d.model_to_map.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
-  const Eigen::Vector3f light = d.light_direction_map.normalized().cast<float>();
+  DrawUniforms u;
+  u.dual = dual;
+  u.mvp = (projection * view * d.model_to_map).cast<float>();
+  u.model = d.model_to_map.cast<float>();
+  u.normal_matrix = d.model_to_map.topLeftCorner<3, 3>().inverse().transpose().cast<float>();
+  u.light = d.light_direction_map.normalized().cast<float>();
 
   gl.Enable(GL_DEPTH_TEST);
   gl.DepthFunc(GL_LESS);
@@ -373,13 +375,12 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   } else {
     gl.Disable(GL_CULL_FACE);
   }
-  const LightingMode lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
-  float sh[27];
+  u.lighting = d.lighting == LightingMode::kShShadowed && !has_transfer_ ? LightingMode::kShUnshadowed : d.lighting;
   for (int k = 0; k < 9; ++k)
-    for (int c = 0; c < 3; ++c) sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
+    for (int c = 0; c < 3; ++c) u.sh[3 * k + c] = static_cast<float>(d.sh[k][c]);
   Eigen::Matrix3d rotation = d.model_to_map.topLeftCorner<3, 3>();
   rotation /= std::cbrt(std::abs(rotation.determinant()));  // uniform scale out
-  const Eigen::Matrix3f model_rotation = rotation.cast<float>();
+  u.model_rotation = rotation.cast<float>();
   if (dual) {
     for (int j = 0; j < joints_; ++j) {
       const anim::DualQuatf& q = d.skinning_dual_quats[j];
@@ -390,16 +391,12 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   // The textured meshes, then those of one colour, each with its program (when it has any).
   gl.ActiveTexture(GL_TEXTURE0);
   for (const bool textured : {true, false}) {
-    bool bound = false;
+    const Program* bound = nullptr;
     for (const GpuMesh& mesh : meshes_) {
       if ((mesh.texture >= 0) != textured) continue;
-      if (!bound) {
-        UseProgram(ProgramFor(dual, lighting, textured), dual, lighting, mvp, model, normal_matrix, light, sh,
-                   model_rotation, d);
-        bound = true;
-      }
+      if (bound == nullptr) bound = &UseProgram(ProgramFor(dual, u.lighting, textured), u, d);
       if (textured) gl.BindTexture(GL_TEXTURE_2D, textures_[mesh.texture].get());
-      gl.Uniform4f(bound_base_color_, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
+      gl.Uniform4f(bound->loc.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
       gl.BindVertexArray(mesh.vao.get());
       gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
     }
@@ -407,31 +404,29 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   gl.BindVertexArray(0);
 }
 
-void CharacterRenderer::UseProgram(const Program& program, bool dual, LightingMode lighting, const Eigen::Matrix4f& mvp,
-                                   const Eigen::Matrix4f& model, const Eigen::Matrix3f& normal_matrix,
-                                   const Eigen::Vector3f& light, const float* sh, const Eigen::Matrix3f& model_rotation,
-                                   const CharacterDraw& d) {
+const CharacterRenderer::Program& CharacterRenderer::UseProgram(const Program& program, const DrawUniforms& u,
+                                                                const CharacterDraw& d) {
   const GlApi& gl = *gl_;
   const Locations& loc = program.loc;
   gl.UseProgram(program.program.get());
-  bound_base_color_ = loc.base_color;
-  gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, mvp.data());
-  gl.UniformMatrix4fv(loc.model, 1, GL_FALSE, model.data());
-  gl.UniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, normal_matrix.data());
-  if (dual) {
+  gl.UniformMatrix4fv(loc.mvp, 1, GL_FALSE, u.mvp.data());
+  gl.UniformMatrix4fv(loc.model, 1, GL_FALSE, u.model.data());
+  gl.UniformMatrix3fv(loc.normal_matrix, 1, GL_FALSE, u.normal_matrix.data());
+  if (u.dual) {
     gl.Uniform4fv(loc.dq_real, joints_, dq_upload_.data());
     gl.Uniform4fv(loc.dq_dual, joints_, dq_upload_.data() + joints_ * 4);
   } else {
     gl.UniformMatrix4fv(loc.skin, joints_, GL_FALSE, d.skinning_matrices.data()->data());
   }
-  if (lighting != LightingMode::kFixed) {
-    gl.Uniform3fv(loc.sh, 9, sh);
-    gl.UniformMatrix3fv(loc.model_rotation, 1, GL_FALSE, model_rotation.data());
+  if (u.lighting != LightingMode::kFixed) {
+    gl.Uniform3fv(loc.sh, 9, u.sh);
+    gl.UniformMatrix3fv(loc.model_rotation, 1, GL_FALSE, u.model_rotation.data());
   }
-  gl.Uniform3f(loc.light, light.x(), light.y(), light.z());
+  gl.Uniform3f(loc.light, u.light.x(), u.light.y(), u.light.z());
   gl.Uniform1f(loc.key, d.key);
   gl.Uniform1f(loc.ambient, d.ambient);
   gl.Uniform1i(loc.albedo, 0);
+  return program;
 }
 
 LightingMode ParseLightingMode(const std::string& name) {

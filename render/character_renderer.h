@@ -84,12 +84,18 @@ class CharacterRenderer {
   // One program per variant (skinning method x lighting mode x textured or not), compiled on
   // first use: llvmpipe pays for every branch of a shader that branches on uniforms.
   const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured);
-  // Binds `program` and sets the draw's uniforms in it (all but the mesh's colour).
-  void UseProgram(const Program& program, bool dual, LightingMode lighting, const Eigen::Matrix4f& mvp,
-                  const Eigen::Matrix4f& model, const Eigen::Matrix3f& normal_matrix, const Eigen::Vector3f& light,
-                  const float* sh, const Eigen::Matrix3f& model_rotation, const CharacterDraw& d);
+  // What a draw sets in each program it uses (all but the mesh's colour), computed once a draw.
+  struct DrawUniforms {
+    bool dual = true;
+    LightingMode lighting = LightingMode::kFixed;
+    Eigen::Matrix4f mvp, model;
+    Eigen::Matrix3f normal_matrix, model_rotation;
+    Eigen::Vector3f light;
+    float sh[27] = {};
+  };
+  // Binds `program` and sets the draw's uniforms in it; returns it.
+  const Program& UseProgram(const Program& program, const DrawUniforms& u, const CharacterDraw& d);
   std::array<std::unique_ptr<Program>, 12> programs_;
-  GLint bound_base_color_ = -1;  // the bound program's base_color location
   std::vector<GlName> textures_;
   std::vector<GpuMesh> meshes_;
   bool used_linear_fallback_ = false;
