@@ -123,7 +123,7 @@ std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& p
 }
 
 void Tracker::Reset() {
-  DropPrefetch();
+  prefetch_.reset();  // waits for a pending extraction
   has_pose_ = false;
   has_velocity_ = false;
   last_pyramid_.clear();
@@ -151,10 +151,7 @@ std::vector<int> Tracker::NearestKeyframes(const calib::Pose& pose) const {
 // Guided matching: SIFT keypoints of the frame against map points projected with the predicted
 // pose, only within a small radius, with a ratio test between distinct points.
 struct Tracker::Guided {
-  struct Candidate {
-    Eigen::Vector2d pixel;
-    std::uint32_t point;
-  };
+  using Candidate = GuidedCandidate;
 
   static std::vector<MapMatch> Match(const Features& features, const std::vector<Candidate>& cands,
                                      const map::Map& map, double radius, double ratio,
@@ -210,6 +207,38 @@ struct Tracker::Guided {
   }
 };
 
+std::vector<Tracker::GuidedCandidate> Tracker::GuidedCandidates(const calib::Pose& pose,
+                                                                const std::vector<std::uint32_t>& tracked_points) {
+  const calib::Camera& camera = resolution_.work();
+  const std::vector<int> keyframes = tracked_points.empty() ? NearestKeyframes(pose) : CovisibleKeyframes(tracked_points);
+  std::vector<GuidedCandidate> candidates;
+  for (int k : keyframes) {
+    for (const auto& obs : map_.keyframes[k].observations) {
+      if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
+      point_stamp_[obs.point] = frame_counter_;
+      const Eigen::Vector3d pc = pose.ToCamera(map_.points[obs.point].xyz);
+      if (pc.z() <= 0) continue;
+      const Eigen::Vector2d px = camera.Project(pc);
+      if (camera.InImage(px)) candidates.push_back({px, obs.point});
+    }
+  }
+  return candidates;
+}
+
+std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_pyramid,
+                                               const std::vector<cv::Mat>& to_pyramid,
+                                               const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const {
+  const TrackingOptions& opt = options_.tracking;
+  std::vector<unsigned char> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(
+      from_pyramid, to_pyramid, from, *to, status, error, cv::Size(opt.lk_window_px, opt.lk_window_px),
+      opt.lk_pyramid_levels,
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
+      cv::OPTFLOW_USE_INITIAL_FLOW);
+  return status;
+}
+
 // A frame's guided features being extracted on a worker thread, with what matching them and
 // following them into a later frame needs of it.
 struct Tracker::Prefetch {
@@ -225,8 +254,6 @@ struct Tracker::Prefetch {
 };
 
 Tracker::~Tracker() = default;  // a pending extraction is waited for (std::future of std::async)
-
-void Tracker::DropPrefetch() { prefetch_.reset(); }
 
 void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
   const TrackingOptions& opt = options_.tracking;
@@ -260,19 +287,7 @@ int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose&
   result->times.cpu_ms += extracted.cpu_ms;  // Track() adds its own thread's
   const auto match_start = std::chrono::steady_clock::now();
   // The map points the prefetched frame's neighbours see, projected with its own pose.
-  std::vector<Guided::Candidate> candidates;
-  const std::vector<int> keyframes = prefetch->tracked_points.empty() ? NearestKeyframes(prefetch->pose)
-                                                                      : CovisibleKeyframes(prefetch->tracked_points);
-  for (int k : keyframes) {
-    for (const auto& obs : map_.keyframes[k].observations) {
-      if (point_stamp_[obs.point] == frame_counter_) continue;  // followed already, or queued
-      point_stamp_[obs.point] = frame_counter_;
-      const Eigen::Vector3d pc = prefetch->pose.ToCamera(map_.points[obs.point].xyz);
-      if (pc.z() <= 0) continue;
-      const Eigen::Vector2d px = camera.Project(pc);
-      if (camera.InImage(px)) candidates.push_back({px, obs.point});
-    }
-  }
+  const std::vector<Guided::Candidate> candidates = GuidedCandidates(prefetch->pose, prefetch->tracked_points);
   const auto matches = Guided::Match(extracted.features, candidates, map_, opt.guided_radius_px, opt.guided_ratio,
                                      camera.Size());
   // Followed from the prefetched frame into this one, started where this frame's pose puts them;
@@ -294,13 +309,7 @@ int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose&
   }
   int added = 0;
   if (!from.empty()) {
-    std::vector<unsigned char> status;
-    std::vector<float> error;
-    const cv::Size window(opt.lk_window_px, opt.lk_window_px);
-    cv::calcOpticalFlowPyrLK(
-        prefetch->pyramid, pyramid, from, to, status, error, window, opt.lk_pyramid_levels,
-        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
-        cv::OPTFLOW_USE_INITIAL_FLOW);
+    const std::vector<unsigned char> status = FollowByLk(prefetch->pyramid, pyramid, from, &to);
     for (size_t i = 0; i < to.size(); ++i) {
       const Eigen::Vector2d px(to[i].x, to[i].y);
       // A track that ends far from where the pose puts its point slid onto something else.
@@ -349,13 +358,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
       guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
     }
-    std::vector<unsigned char> status;
-    std::vector<float> error;
-    cv::calcOpticalFlowPyrLK(
-        last_pyramid_, pyramid, last_inliers_.pixels, guess, status, error, window,
-        opt.lk_pyramid_levels,
-        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
-        cv::OPTFLOW_USE_INITIAL_FLOW);
+    const std::vector<unsigned char> status = FollowByLk(last_pyramid_, pyramid, last_inliers_.pixels, &guess);
     for (size_t i = 0; i < guess.size(); ++i) {
       const Eigen::Vector2d px(guess[i].x, guess[i].y);
       if (!status[i] || !camera.InImage(px, 1.0)) continue;
@@ -402,19 +405,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       result->keypoints = static_cast<int>(features.keypoints.size());
       result->times.extract_ms = MillisecondsSince(extract_start);
       const auto match_start = std::chrono::steady_clock::now();
-      std::vector<Guided::Candidate> candidates;
-      const std::vector<int> keyframes =
-          point_ids.empty() ? NearestKeyframes(projecting) : CovisibleKeyframes(point_ids);
-      for (int k : keyframes) {
-        for (const auto& obs : map_.keyframes[k].observations) {
-          if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
-          point_stamp_[obs.point] = frame_counter_;
-          const Eigen::Vector3d pc = projecting.ToCamera(map_.points[obs.point].xyz);
-          if (pc.z() <= 0) continue;
-          const Eigen::Vector2d px = camera.Project(pc);
-          if (camera.InImage(px)) candidates.push_back({px, obs.point});
-        }
-      }
+      const std::vector<Guided::Candidate> candidates = GuidedCandidates(projecting, point_ids);
       const auto guided = Guided::Match(features, candidates, map_, radius, opt.guided_ratio, gray.size());
       for (const auto& m : guided) {
         const cv::Point2f& p = features.keypoints[m.keypoint].pt;

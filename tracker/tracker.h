@@ -74,7 +74,7 @@ struct TrackingOptions {
   // 15-30 frames' worth of tracking) then no longer stalls the frame that needs it, and a
   // pipeline keeps its frame rate. The frame that consumes it waits for it if it is not done,
   // so results do not depend on timing. 0 (the default): off, guided matching extracts in the
-  // frame itself. On the demo's lap it took ~1 fps off no stall worth having (75 against 76 fps)
+  // frame itself. On the demo's lap it gained ~1 fps (76 against 75 fps, within the runs' spread)
   // and cost accuracy (centre error median 4.2-5.5 mm over 9 settings against 4.2 mm: the frame
   // that replenishes is posed on its ~300 followed keypoints rather than ~1000 fresh matches);
   // docs/tracker.md. For a live camera whose frames drop at guided matching's frames.
@@ -176,6 +176,10 @@ class Tracker {
  private:
   struct Guided;
   struct Prefetch;
+  struct GuidedCandidate {  // a map point where a pose projects it, for guided matching
+    Eigen::Vector2d pixel;
+    std::uint32_t point;
+  };
   // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
   // to relocalization does not extract it again.
   bool TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,
@@ -189,8 +193,13 @@ class Tracker {
   // Starts extracting this frame's guided features on a worker thread when its flow tracks are
   // thinning (TrackingOptions::prefetch_below).
   void MaybePrefetch(const cv::Mat& gray, const FrameResult& result);
-  // Waits for a pending extraction and forgets it.
-  void DropPrefetch();
+  // The map points of the keyframes covisible with `tracked_points` (without any, the nearest to
+  // `pose`) that `pose` projects into the working image and that no step of this frame gathered
+  // yet (they are stamped now): what guided matching matches keypoints against.
+  std::vector<GuidedCandidate> GuidedCandidates(const calib::Pose& pose, const std::vector<std::uint32_t>& tracked_points);
+  // Pyramidal LK with the tracking options, `to` holding the starting guesses; the status per point.
+  std::vector<unsigned char> FollowByLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                                        const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const;
   // The prefetched frame's keypoints matched to the map and followed by LK into `pyramid`,
   // appended to the frame's correspondences; the number added.
   int UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
