@@ -61,27 +61,30 @@ Eigen::Vector2d Camera::Project(const Eigen::Vector3d& p) const {
   return NormalizedToPixel({p.x() / p.z(), p.y() / p.z()});
 }
 
+Eigen::Matrix2d DistortionJacobian(const std::array<double, 5>& dist, double x, double y) {
+  const double r2 = x * x + y * y;
+  const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * r2 * k3);
+  Eigen::Matrix2d J;
+  J(0, 0) = radial + 2 * x * x * dradial_dr2 + 2 * p1 * y + 6 * p2 * x;
+  J(0, 1) = 2 * x * y * dradial_dr2 + 2 * p1 * x + 2 * p2 * y;
+  J(1, 0) = J(0, 1);
+  J(1, 1) = radial + 2 * y * y * dradial_dr2 + 6 * p1 * y + 2 * p2 * x;
+  return J;
+}
+
 Eigen::Vector2d Camera::PixelToNormalized(const Eigen::Vector2d& pixel) const {
   const Eigen::Vector2d target((pixel.x() - cx) / fx, (pixel.y() - cy) / fy);
   if (!HasDistortion()) return target;
   Eigen::Vector2d n = target;
   for (int iter = 0; iter < 30; ++iter) {
     // Residual and analytic Jacobian of the distortion at n.
-    const double x = n.x(), y = n.y();
-    const double r2 = x * x + y * y;
-    const double k1 = dist[0], k2 = dist[1], p1 = dist[2], p2 = dist[3], k3 = dist[4];
-    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-    const double dradial_dr2 = k1 + r2 * (2 * k2 + 3 * r2 * k3);
     Eigen::Vector2d d;
-    DistortNormalized(dist.data(), x, y, &d.x(), &d.y());
+    DistortNormalized(dist.data(), n.x(), n.y(), &d.x(), &d.y());
     const Eigen::Vector2d residual = d - target;
     if (residual.squaredNorm() < 1e-26) break;
-    Eigen::Matrix2d J;
-    J(0, 0) = radial + 2 * x * x * dradial_dr2 + 2 * p1 * y + 6 * p2 * x;
-    J(0, 1) = 2 * x * y * dradial_dr2 + 2 * p1 * x + 2 * p2 * y;
-    J(1, 0) = 2 * x * y * dradial_dr2 + 2 * p1 * x + 2 * p2 * y;
-    J(1, 1) = radial + 2 * y * y * dradial_dr2 + 6 * p1 * y + 2 * p2 * x;
-    const Eigen::Vector2d step = J.partialPivLu().solve(residual);
+    const Eigen::Vector2d step = DistortionJacobian(dist, n.x(), n.y()).partialPivLu().solve(residual);
     if (!step.allFinite()) break;
     n -= step;
   }

@@ -31,6 +31,9 @@ inline void DistortNormalized(const D* dist, const T& x, const T& y, T* xd, T* y
   *yd = y * radial + T(dist[2]) * (r2 + T(2) * y * y) + T(dist[3]) * xy2;
 }
 
+// The 2x2 Jacobian of DistortNormalized with respect to (x, y), analytic.
+Eigen::Matrix2d DistortionJacobian(const std::array<double, 5>& dist, double x, double y);
+
 struct Camera {
   int width = 0;
   int height = 0;

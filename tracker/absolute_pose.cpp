@@ -101,7 +101,7 @@ AbsolutePoseResult EstimateAbsolutePose(const calib::Camera& camera,
     wide.loss_scale_px = options.prior_loss_scale_px;
     const RefineResult settled = RefinePose(camera, pixels, points, *options.prior, wide);
     result.stats.refine_ms += MillisecondsSince(refine_start);
-    if (!settled.ok) return Fail(result, PoseFailure::kRefinementFailed, "Ceres refinement failed");
+    if (!settled.ok) return Fail(result, PoseFailure::kRefinementFailed, "pose refinement failed");
     double rms_unused = 0;
     hypothesis = SelectInliers(camera, settled.pose, pixels, points, options.inlier_threshold_px, &rms_unused);
     pose = settled.pose;
@@ -144,7 +144,7 @@ AbsolutePoseResult EstimateAbsolutePose(const calib::Camera& camera,
                                             Gather(points, hypothesis), pose, options.refinement);
     result.stats.refine_ms += MillisecondsSince(refine_start);
     result.stats.refine_iterations = refined.stats.iterations;
-    if (!refined.ok) return Fail(result, PoseFailure::kRefinementFailed, "Ceres refinement failed");
+    if (!refined.ok) return Fail(result, PoseFailure::kRefinementFailed, "pose refinement failed");
     pose = refined.pose;
   }
 

@@ -1,7 +1,7 @@
 #pragma once
-// Non-linear refinement of a camera pose on 2D-3D correspondences with Ceres: reprojection
-// error in pixels through the full camera model (distortion included), a robust loss, the
-// rotation on a quaternion manifold.
+// Non-linear refinement of a camera pose on 2D-3D correspondences: reprojection error in pixels
+// through the full camera model (distortion included), a robust loss (Ceres' definitions), by
+// Levenberg-Marquardt with analytic Jacobians on a rotation increment and the translation.
 
 #include <Eigen/Core>
 
@@ -17,8 +17,8 @@ enum class RobustLoss { kNone, kHuber, kCauchy };
 struct RefineOptions {
   RobustLoss loss = RobustLoss::kCauchy;
   double loss_scale_px = 2.0;  // residual (pixels) where the robust loss starts to bend
-  int max_iterations = 20;
-  double function_tolerance = 1e-8;
+  int max_iterations = 20;       // Levenberg-Marquardt steps tried
+  double function_tolerance = 1e-8;  // converged below this relative decrease of the cost
 };
 
 struct RefineStats {
@@ -29,7 +29,7 @@ struct RefineStats {
 };
 
 struct RefineResult {
-  bool ok = false;  // false if Ceres reported failure or a non-finite pose
+  bool ok = false;  // false for empty or mismatched input, or a non-finite pose
   calib::Pose pose;
   RefineStats stats;
 };
