@@ -45,6 +45,8 @@ struct TrackArgs {
   int prefetch_below = tracker::TrackingOptions{}.prefetch_below;
   int prefetch_lag = tracker::TrackingOptions{}.prefetch_lag_frames;
   double guided_radius_px = 10;
+  int lk_window = tracker::TrackingOptions{}.lk_window_px;
+  int lk_levels = tracker::TrackingOptions{}.lk_pyramid_levels;
   int index_checks = 32;
   unsigned seed = 0;
   int threads = 1;
@@ -74,6 +76,8 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.tracking.prefetch_below = a.prefetch_below;
   o.tracking.prefetch_lag_frames = a.prefetch_lag;
   o.tracking.guided_radius_px = a.guided_radius_px;
+  o.tracking.lk_window_px = a.lk_window;
+  o.tracking.lk_pyramid_levels = a.lk_levels;
   o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
   o.smoothing.beta = a.smoothing_beta;
   o.index.seed = a.seed;
@@ -276,6 +280,12 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(1, 1000));
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
+  cmd->add_option("--lk-window", a->lk_window,
+                  "Optical flow window side, working pixels (odd; larger follows blur and noise better, costs more)")
+      ->capture_default_str()->check(CLI::Range(5, 61));
+  cmd->add_option("--lk-levels", a->lk_levels,
+                  "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")
+      ->capture_default_str()->check(CLI::Range(0, 6));
   cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--working-size", a->working_size,

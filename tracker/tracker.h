@@ -37,10 +37,14 @@ constexpr auto EnumNames(TrackStatus) {
 
 // Every pixel quantity below is in working-resolution pixels (TrackerOptions::working_long_side).
 struct TrackingOptions {
-  int lk_window_px = 21;
-  // 4 levels follow ~80 px of unpredicted motion at the working resolution (frames 2-4 video
-  // frames apart, or the first frame after a relocalization, which has no velocity yet).
-  int lk_pyramid_levels = 4;
+  // An 11x11 window: LK's cost grows with the window's area (21x21 took 2.2x as long on the
+  // demo's lap), and the smaller window was also the more exact there (centre error median
+  // 3.0-3.7 mm against 5.1-5.6 mm with 21x21, frames 1-4 apart; docs/tracker.md).
+  int lk_window_px = 11;
+  // 5 levels follow ~160 px of unpredicted motion at the working resolution (window half-size
+  // x 2^levels: frames 2-4 video frames apart, or the first frame after a relocalization, which
+  // has no velocity yet), as 21x21 with 4 levels did.
+  int lk_pyramid_levels = 5;
   int lk_max_iterations = 20;
   // At most this many inliers are followed into the next frame, spread over the image (LK and
   // refinement time grow with the count; a few hundred well-spread points pin the pose).
