@@ -72,7 +72,7 @@ struct ErrorAccumulator {
   }
 };
 
-void BM_PoseSolver_OpenGV_Ceres(benchmark::State& state) {
+void BM_PoseSolver_OpenGV_LM(benchmark::State& state) {
   const calib::Camera camera = testing::TestCamera();
   AbsolutePoseOptions options;
   options.solver = static_cast<MinimalSolver>(state.range(0));
@@ -95,7 +95,7 @@ void BM_PoseSolver_OpenGV_Ceres(benchmark::State& state) {
   state.counters["refine_ms"] = refine_ms / state.iterations();
   state.SetLabel(ToString(options.solver));
 }
-BENCHMARK(BM_PoseSolver_OpenGV_Ceres)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PoseSolver_OpenGV_LM)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 // The refinement alone, as a tracked frame runs it: 250 correspondences with 0.7 px noise and
 // 10% outliers, Cauchy loss at 2 px, from a start 0.5 deg and 2 cm off. Arg 0: arview's
@@ -430,7 +430,7 @@ struct RealErrors {
   }
 };
 
-void BM_RealCorrespondences_OpenGV_Ceres(benchmark::State& state) {
+void BM_RealCorrespondences_OpenGV_LM(benchmark::State& state) {
   const RealCorrespondences* m = RealMatches();
   if (!m) return state.SkipWithError("no frames");
   const calib::Camera& camera = Real()->map.camera;
@@ -447,7 +447,7 @@ void BM_RealCorrespondences_OpenGV_Ceres(benchmark::State& state) {
   errors.Report(state, i);
   state.SetLabel(Real()->source);
 }
-BENCHMARK(BM_RealCorrespondences_OpenGV_Ceres)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RealCorrespondences_OpenGV_LM)->Unit(benchmark::kMicrosecond);
 
 void BM_RealCorrespondences_OpenCV_RansacRefineLM(benchmark::State& state) {
   const RealCorrespondences* m = RealMatches();
