@@ -62,7 +62,8 @@ void RequireYamlDepthAtMost(std::string_view text, int max_depth, const std::str
 //  - a line beginning "---" is not the document marker itself: "----x" after the header, then
 //    two lines of text, sends the reader into an endless loop (found by fuzz_camera);
 //  - the top level is not a mapping whose keys start the line: an indented first line ("   - 3")
-//    followed by a less indented one loops forever too (found by fuzz_room_light);
+//    followed by a less indented one loops forever too (found by fuzz_room_light), and so does
+//    an indented line after a document end "..." (the same shape, found by fuzz_room_light again);
 //  - a matrix's rows/cols is not a plain number, or rows x cols is more elements than the text
 //    could hold: the reader allocates the matrix before reading its data (51-85 GB once).
 void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::string& name);

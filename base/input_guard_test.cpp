@@ -114,6 +114,7 @@ TEST(RequireOpenCvYamlShape, RefusesWhatOpenCvsReaderHangsOnOrOverAllocates) {
       "%YAML:1.0\n---\nk: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 1., 0., 0., 0., 1., 0., 0., 0., 1. ]\n";
   EXPECT_NO_THROW(RequireOpenCvYamlShape(good, 8, "ok.yaml"));
   EXPECT_NO_THROW(RequireOpenCvYamlShape("%YAML:1.0\n--- # a comment\na: 1\n", 8, "ok.yaml"));
+  EXPECT_NO_THROW(RequireOpenCvYamlShape("%YAML:1.0\na: 1\n...\nb: 2\n", 8, "ok.yaml"));
   const struct {
     std::string text, message;
   } cases[] = {
@@ -127,6 +128,8 @@ TEST(RequireOpenCvYamlShape, RefusesWhatOpenCvsReaderHangsOnOrOverAllocates) {
       {"%YAML:1.\n   - 3\n:\n-", "f.yaml: line 2: '   - 3': the top level must be a mapping"},
       {"%YAML:1.0\n---\n# c\n  a: 1\nb\n", "line 4: '  a: 1': the top level must be a mapping"},
       {"%YAML:1.0\n- 3\n", "line 2: '- 3': the top level must be a mapping"},
+      {"%YAML:1.0\n---\na: 1\n...#b:\n   - 1.\n", "line 5: '   - 1.': the top level must be a mapping"},
+      {"%YAML:1.0\na: 1\n... #b\n   - 1.\n", "line 4: '   - 1.': the top level must be a mapping"},
       {"%YAML:1.0\nx: " + std::string(100, '[') + std::string(100, ']') + "\n", "f.yaml: nested"},
   };
   for (const auto& c : cases) {
