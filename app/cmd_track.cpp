@@ -281,7 +281,7 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
   cmd->add_option("--lk-window", a->lk_window,
-                  "Optical flow window side, working pixels (odd; larger follows blur and noise better, costs more)")
+                  "Optical flow window side, working pixels (larger follows blur and noise better, costs more)")
       ->capture_default_str()->check(CLI::Range(5, 61));
   cmd->add_option("--lk-levels", a->lk_levels,
                   "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")

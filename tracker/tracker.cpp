@@ -225,6 +225,13 @@ std::vector<Tracker::GuidedCandidate> Tracker::GuidedCandidates(const calib::Pos
   return candidates;
 }
 
+std::vector<cv::Mat> Tracker::FlowPyramid(const cv::Mat& gray) const {
+  const TrackingOptions& opt = options_.tracking;
+  std::vector<cv::Mat> pyramid;
+  cv::buildOpticalFlowPyramid(gray, pyramid, cv::Size(opt.lk_window_px, opt.lk_window_px), opt.lk_pyramid_levels);
+  return pyramid;
+}
+
 std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_pyramid,
                                                const std::vector<cv::Mat>& to_pyramid,
                                                const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const {
@@ -343,9 +350,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
 
   // 1. Pyramidal LK from last frame's inliers, started where the prediction puts them.
   const auto flow_start = std::chrono::steady_clock::now();
-  std::vector<cv::Mat> pyramid;
-  const cv::Size window(opt.lk_window_px, opt.lk_window_px);
-  cv::buildOpticalFlowPyramid(gray, pyramid, window, opt.lk_pyramid_levels);
+  std::vector<cv::Mat> pyramid = FlowPyramid(gray);
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> points;
   std::vector<std::uint32_t> point_ids;
@@ -613,10 +618,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
       result.pose = reloc.pose.pose;
       result.reason = tracking_reason;
       inliers = reloc.inliers;
-      if (last_pyramid_.empty() || !has_pose_)
-        cv::buildOpticalFlowPyramid(gray, last_pyramid_,
-                                    cv::Size(options_.tracking.lk_window_px, options_.tracking.lk_window_px),
-                                    options_.tracking.lk_pyramid_levels);
+      if (last_pyramid_.empty() || !has_pose_) last_pyramid_ = FlowPyramid(gray);
     } else {
       result.status = TrackStatus::kLost;
       result.reason = (tracking_reason.empty() ? "" : tracking_reason + "; ") +

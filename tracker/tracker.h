@@ -37,9 +37,9 @@ constexpr auto EnumNames(TrackStatus) {
 
 // Every pixel quantity below is in working-resolution pixels (TrackerOptions::working_long_side).
 struct TrackingOptions {
-  // An 11x11 window: LK's cost grows with the window's area (21x21 took 2.2x as long on the
+  // An 11x11 window: LK's cost grows with the window's area (21x21 took 2.1-3.6x as long on the
   // demo's lap), and the smaller window was also the more exact there (centre error median
-  // 3.0-3.7 mm against 5.1-5.6 mm with 21x21, frames 1-4 apart; docs/tracker.md).
+  // 3.1-3.8 mm against 5.1-5.7 mm with 21x21, frames 1-4 apart; docs/tracker.md).
   int lk_window_px = 11;
   // 5 levels follow ~160 px of unpredicted motion at the working resolution (window half-size
   // x 2^levels: frames 2-4 video frames apart, or the first frame after a relocalization, which
@@ -201,6 +201,8 @@ class Tracker {
   // `pose`) that `pose` projects into the working image and that no step of this frame gathered
   // yet (they are stamped now): what guided matching matches keypoints against.
   std::vector<GuidedCandidate> GuidedCandidates(const calib::Pose& pose, const std::vector<std::uint32_t>& tracked_points);
+  // A frame's image pyramid for LK, with the tracking options' window and levels.
+  std::vector<cv::Mat> FlowPyramid(const cv::Mat& gray) const;
   // Pyramidal LK with the tracking options, `to` holding the starting guesses; the status per point.
   std::vector<unsigned char> FollowByLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
                                         const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const;
