@@ -105,6 +105,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"guided_matches", r.guided_matches},
                               {"prefetched_matches", r.prefetched_matches},
                               {"wide_matches", r.wide_matches},
+                              {"align_zncc", r.align_zncc},
                               {"keypoints", r.keypoints},
                               {"matches", r.matches},
                               {"reason", r.reason}};

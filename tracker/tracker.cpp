@@ -455,6 +455,41 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   return true;
 }
 
+bool Tracker::TrackByAlignment(const std::vector<cv::Mat>& reference_pyramid, const cv::Mat& gray,
+                               double timestamp, FrameResult* result) const {
+  const TrackingOptions& opt = options_.tracking;
+  if (opt.align_max_seconds <= 0 || reference_pyramid.empty()) return false;
+  std::ostringstream msg;
+  const double since_features = timestamp - last_feature_timestamp_;
+  if (!(since_features <= opt.align_max_seconds)) {
+    msg << "; image alignment not tried: " << since_features << " s since the last pose from features, at most "
+        << opt.align_max_seconds << " s";
+    result->reason += msg.str();
+    return false;
+  }
+  const calib::Pose predicted = Predict(timestamp);
+  const Eigen::Quaterniond initial = predicted.q_cw * last_pose_.q_cw.conjugate();
+  const SmallImage reference(reference_pyramid.front(), resolution_.work(), opt.align);
+  const SmallImage current(gray, resolution_.work(), opt.align);
+  const RotationAlignment aligned = AlignRotation(reference, current, initial, opt.align);
+  if (!aligned.ok) {
+    result->reason += "; " + aligned.reason;
+    return false;
+  }
+  const double from_prediction_deg = aligned.rotation.angularDistance(initial) * 180.0 / M_PI;
+  if (from_prediction_deg > opt.align_max_from_prediction_deg) {
+    msg << "; image alignment turns " << from_prediction_deg << " deg from the prediction, at most "
+        << opt.align_max_from_prediction_deg;
+    result->reason += msg.str();
+    return false;
+  }
+  result->pose.q_cw = (aligned.rotation * last_pose_.q_cw).normalized();
+  result->pose.t_cw = -(result->pose.q_cw * predicted.Center());
+  result->align_zncc = aligned.zncc;
+  result->reason += "; rotation by image alignment";
+  return true;
+}
+
 bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                         std::optional<Features>* extracted, Track2D3D* tracked_inliers) {
   const TrackingOptions& opt = options_.tracking;
@@ -564,7 +599,8 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
   } else {
     has_velocity_ = false;
   }
-  if (result.status == TrackStatus::kTracking) rms_gate_.Observe(result.rms_px);
+  if (result.status == TrackStatus::kTracking && result.align_zncc == 0) rms_gate_.Observe(result.rms_px);
+  if (result.align_zncc == 0) last_feature_timestamp_ = timestamp;
   last_pose_ = result.pose;
   last_timestamp_ = timestamp;
   has_pose_ = true;
@@ -590,6 +626,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   }
 
   const cv::Mat gray = resolution_.Reduce(full_gray);
+  const std::vector<cv::Mat> reference_pyramid = last_pyramid_;  // the last posed frame's (shared)
   bool tracked = false;
   std::string tracking_reason;
   std::optional<Features> features;
@@ -620,10 +657,16 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
       inliers = reloc.inliers;
       if (last_pyramid_.empty() || !has_pose_) last_pyramid_ = FlowPyramid(gray);
     } else {
-      result.status = TrackStatus::kLost;
       result.reason = (tracking_reason.empty() ? "" : tracking_reason + "; ") +
                       "relocalization failed: " + reloc.pose.reason;
       result.inliers = 0;
+      if (has_pose_ && TrackByAlignment(reference_pyramid, gray, timestamp, &result)) {
+        result.status = TrackStatus::kTracking;
+        result.rms_px = 0;
+        inliers = {};  // nothing to follow: the next frame starts from guided matching
+      } else {
+        result.status = TrackStatus::kLost;
+      }
     }
   }
 

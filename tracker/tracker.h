@@ -20,6 +20,7 @@
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
 #include "tracker/residual_gate.h"
+#include "tracker/rotation_aligner.h"
 #include "tracker/working_resolution.h"
 
 namespace arview::tracker {
@@ -112,6 +113,17 @@ struct TrackingOptions {
   // Constant-velocity prediction scaled by the time since the last frame over the time the
   // velocity was measured on, within these bounds (a dropped frame doubles the motion).
   double max_prediction_ratio = 4;
+  // A frame that flow, guided matching, the wide search and relocalization all failed on, right
+  // after a posed frame, takes its rotation from aligning its small blurred image with that
+  // frame's (tracker/rotation_aligner.h) and its centre from the constant-velocity prediction,
+  // for at most `align_max_seconds` after the last pose found from features (0: off). Such
+  // frames are whip-pans, smeared by tens of pixels: on the synthetic room's blurred lap (a turn
+  // peaking at 320 deg/s, 1/60 s exposure) flow and SIFT found 1-29 correspondences in 13
+  // consecutive frames. The frame's `align_zncc` says it was posed this way; its pose must turn
+  // at most `align_max_from_prediction_deg` from the prediction.
+  double align_max_seconds = 0.5;
+  double align_max_from_prediction_deg = 15;
+  RotationAlignerOptions align;
 };
 // FLANN's default 64 leaves per query, halved: on templeRing and the synthetic room the same
 // frames localise with the same accuracy, and global matching is ~1.5x faster.
@@ -156,6 +168,9 @@ struct FrameResult {
   int guided_matches = 0;  // added by guided matching
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
+  // > 0: the pose's rotation came from image alignment (TrackingOptions::align_max_seconds), with
+  // this correlation, its centre from the prediction; no correspondence supports it.
+  double align_zncc = 0;
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
@@ -191,6 +206,10 @@ class Tracker {
   // After TrackWithPrior failed: the wide search around the prediction (wide_radius_fraction).
   bool TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                  std::optional<Features>* features, Track2D3D* inliers);
+  // After every feature-based step failed: the rotation from `reference_pyramid` (the last posed
+  // frame's) to `gray` by image alignment, the centre predicted.
+  bool TrackByAlignment(const std::vector<cv::Mat>& reference_pyramid, const cv::Mat& gray, double timestamp,
+                        FrameResult* result) const;
   calib::Pose Predict(double timestamp) const;
   void RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const;
   void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
@@ -235,6 +254,7 @@ class Tracker {
   calib::Pose last_pose_;
   calib::Pose velocity_;  // last_pose ∘ previous⁻¹
   double last_timestamp_ = 0;
+  double last_feature_timestamp_ = 0;  // of the last frame posed from correspondences
   double velocity_dt_ = 0;  // the time velocity_ spans
   std::vector<cv::Mat> last_pyramid_;
   Track2D3D last_inliers_;

@@ -162,6 +162,69 @@ TEST_F(PlanarTrackerTest, FeaturesExtractedAheadAreUsedOnScheduleAndKeepThePoseE
   }
 }
 
+// A whip-pan: the camera pans slowly, then turns 8 degrees a frame for three frames, each smeared
+// over 6 degrees (~55 px) by the exposure, then pans slowly again. Flow and SIFT find too little
+// in the smeared frames (without image alignment they are lost); image alignment keeps their
+// rotation within about a degree, and features take over again afterwards.
+TEST_F(PlanarTrackerTest, WhipPanFramesTakeTheirRotationFromImageAlignment) {
+  const Eigen::Vector3d centre(0.02, 0.01, -0.85);
+  auto turned = [&](double yaw_deg) {
+    const calib::Pose straight = LookAt(centre, {0.02, 0.01, 0});
+    calib::Pose pose = straight;
+    pose.q_cw = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitY()) * straight.q_cw;
+    pose.t_cw = -(pose.q_cw * centre);
+    return pose;
+  };
+  auto smeared = [&](double yaw_a, double yaw_b) {
+    cv::Mat sum = cv::Mat::zeros(map_->camera.Size(), CV_32F);
+    const int samples = 24;
+    for (int s = 0; s < samples; ++s) {
+      cv::Mat render;
+      world_->Render(turned(yaw_a + (s + 0.5) / samples * (yaw_b - yaw_a))).convertTo(render, CV_32F);
+      sum += render;
+    }
+    cv::Mat out;
+    sum.convertTo(out, CV_8U, 1.0 / samples);
+    return out;
+  };
+  // Yaw per frame: slow from -12 to -9 degrees, then three fast frames, then slow from +15.
+  std::vector<double> yaws;
+  for (int i = 0; i < 10; ++i) yaws.push_back(-12 + 0.3 * i);
+  for (int i = 1; i <= 3; ++i) yaws.push_back(-9.3 + 8 * i);
+  for (int i = 1; i <= 6; ++i) yaws.push_back(14.7 + 0.3 * i);
+  auto run = [&](double align_max_seconds) {
+    TrackerOptions options;
+    options.tracking.align_max_seconds = align_max_seconds;
+    Tracker tracker(*map_, options);
+    std::vector<FrameResult> results;
+    for (size_t i = 0; i < yaws.size(); ++i) {
+      const bool fast = i >= 10 && i < 13;
+      const cv::Mat frame = fast ? smeared(yaws[i] - 3, yaws[i] + 3) : world_->Render(turned(yaws[i]));
+      results.push_back(tracker.Track(frame, i / 30.0));
+    }
+    return results;
+  };
+  const std::vector<FrameResult> without = run(0);
+  for (int i = 10; i < 13; ++i)
+    EXPECT_EQ(without[i].status, TrackStatus::kLost) << "frame " << i << ": the test needs frames features cannot pose";
+  const std::vector<FrameResult> with = run(0.5);
+  for (size_t i = 0; i < yaws.size(); ++i) {
+    const FrameResult& r = with[i];
+    ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const bool fast = i >= 10 && i < 13;
+    if (fast) {
+      EXPECT_EQ(r.status, TrackStatus::kTracking) << "frame " << i;
+      EXPECT_GT(r.align_zncc, 0.85) << "frame " << i;
+      EXPECT_EQ(r.inliers, 0) << "frame " << i;
+      ExpectNear(r, turned(yaws[i]), 0.01, 1.5);  // 0.5 degrees a frame, chained (1.1 at the third)
+    } else {
+      EXPECT_EQ(r.align_zncc, 0) << "frame " << i;
+      ExpectNear(r, turned(yaws[i]), 0.003, 0.2);
+    }
+  }
+}
+
 TEST_F(PlanarTrackerTest, FrameOfAnotherSceneIsLostNotAPose) {
   Tracker tracker(*map_);
   for (const char* name : {"left01.jpg", "box_in_scene.png", "fruits.jpg"}) {
