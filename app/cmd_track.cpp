@@ -4,6 +4,7 @@
 // recording's timestamps, lost frames omitted), optional per-frame statistics as JSON, and a
 // summary on stdout (frames localised, median and 95th percentile time per status).
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
@@ -47,6 +48,7 @@ struct TrackArgs {
   double guided_radius_px = 10;
   int lk_window = tracker::TrackingOptions{}.lk_window_px;
   int lk_levels = tracker::TrackingOptions{}.lk_pyramid_levels;
+  double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
   int index_checks = 32;
   unsigned seed = 0;
   int threads = 1;
@@ -78,6 +80,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.tracking.guided_radius_px = a.guided_radius_px;
   o.tracking.lk_window_px = a.lk_window;
   o.tracking.lk_pyramid_levels = a.lk_levels;
+  o.tracking.align_max_seconds = a.align_max_seconds;
   o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
   o.smoothing.beta = a.smoothing_beta;
   o.index.seed = a.seed;
@@ -236,6 +239,12 @@ void RunTrack(const TrackArgs& args) {
               << (it == summaries.end() ? 0 : it->second.wall.count);
   }
   std::cout << ")\n" << std::fixed << std::setprecision(2);
+  const auto aligned = std::count_if(frames.begin(), frames.end(), [](const FrameRecord& f) {
+    return f.result.status == tracker::TrackStatus::kTracking && f.result.align_zncc > 0;
+  });
+  if (aligned > 0)
+    std::cout << "  of the tracking frames, " << aligned
+              << " took their rotation from image alignment (whip-pans: no feature step could pose them)\n";
   for (const auto& [status, s] : summaries)
     std::cout << "  " << std::left << std::setw(12) << status << std::right << " median " << s.wall.median
               << " ms, p95 " << s.wall.p95 << " ms wall; median " << s.cpu.median << " ms, p95 "
@@ -287,6 +296,10 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--lk-levels", a->lk_levels,
                   "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")
       ->capture_default_str()->check(CLI::Range(0, 6));
+  cmd->add_option("--align-max-seconds", a->align_max_seconds,
+                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
+                  "frame before, for at most this long after the last pose from features (0: off)")
+      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--working-size", a->working_size,

@@ -115,8 +115,9 @@ struct TrackingOptions {
   double max_prediction_ratio = 4;
   // A frame that flow, guided matching, the wide search and relocalization all failed on, right
   // after a posed frame, takes its rotation from aligning its small blurred image with that
-  // frame's (tracker/rotation_aligner.h) and its centre from the constant-velocity prediction,
-  // for at most `align_max_seconds` after the last pose found from features (0: off). Such
+  // frame's (tracker/rotation_aligner.h) and its centre from a straight line fitted to the
+  // centres of the last frames posed from features (CentreFitter), for at most
+  // `align_max_seconds` after the last of them (0: off). Such
   // frames are whip-pans, smeared by tens of pixels: on the synthetic room's blurred lap (a turn
   // peaking at 320 deg/s, 1/60 s exposure) flow and SIFT found 1-29 correspondences in 13
   // consecutive frames. The frame's `align_zncc` says it was posed this way; its pose must turn
@@ -169,12 +170,31 @@ struct FrameResult {
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
   // > 0: the pose's rotation came from image alignment (TrackingOptions::align_max_seconds), with
-  // this correlation, its centre from the prediction; no correspondence supports it.
+  // this correlation, its centre from the recent path; no correspondence supports it.
   double align_zncc = 0;
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
   StageTimes times;
+};
+
+// The camera centre extrapolated along a straight line (constant velocity in the world) fitted by
+// least squares to the last few centres: a head or a phone keeps walking while it turns, which
+// the per-frame relative motion (a velocity in the camera's turning frame) would bend, and the
+// fit damps one noisy pose (a relocalization in a blurred frame).
+class CentreFitter {
+ public:
+  explicit CentreFitter(int max_count = 64, double max_span_s = 0.5) : max_count_(max_count), max_span_s_(max_span_s) {}
+  void Add(double timestamp, const Eigen::Vector3d& centre);
+  void Clear() { samples_.clear(); }
+  bool empty() const { return samples_.empty(); }
+  // The fitted line at `timestamp` (the one centre when only one is known).
+  Eigen::Vector3d At(double timestamp) const;
+
+ private:
+  int max_count_;
+  double max_span_s_;
+  std::vector<std::pair<double, Eigen::Vector3d>> samples_;  // oldest first
 };
 
 class Tracker {
@@ -255,6 +275,7 @@ class Tracker {
   calib::Pose velocity_;  // last_pose ∘ previous⁻¹
   double last_timestamp_ = 0;
   double last_feature_timestamp_ = 0;  // of the last frame posed from correspondences
+  CentreFitter feature_centres_;       // their recent centres
   double velocity_dt_ = 0;  // the time velocity_ spans
   std::vector<cv::Mat> last_pyramid_;
   Track2D3D last_inliers_;

@@ -286,6 +286,25 @@ TEST(ConstantVelocity, PredictionRepeatsTheLastMotion) {
   EXPECT_LT((same.t_cw - b.t_cw).norm(), 1e-12);
 }
 
+TEST(CentreFitter, ExtrapolatesTheLineAndDampsOneNoisyCentre) {
+  CentreFitter fitter(16, 1.0);
+  EXPECT_TRUE(fitter.empty());
+  const Eigen::Vector3d start(1, 2, 3), velocity(0.3, 0, -0.1);
+  fitter.Add(0.0, start);
+  EXPECT_TRUE(fitter.At(0.5).isApprox(start));  // one centre: no velocity
+  for (int i = 1; i < 15; ++i) fitter.Add(i / 30.0, start + velocity * (i / 30.0));
+  EXPECT_NEAR((fitter.At(0.8) - (start + velocity * 0.8)).norm(), 0.0, 1e-9);
+  // A 16th centre 3 cm off: the line through it moves by under a quarter of that there.
+  const double t = 15 / 30.0;
+  fitter.Add(t, start + velocity * t + Eigen::Vector3d(0.03, 0, 0));
+  EXPECT_LT((fitter.At(t) - (start + velocity * t)).norm(), 0.0075);
+  // Centres older than the span, or beyond the count, are forgotten.
+  fitter.Add(3.0, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(fitter.At(4.0).isApprox(Eigen::Vector3d::Zero()));
+  fitter.Clear();
+  EXPECT_TRUE(fitter.empty());
+}
+
 TEST(SpreadTracks, KeepsAtMostTheCountSpreadOverTheImage) {
   Track2D3D tracks;
   // 100 tracks crowded in the top-left cell, 10 spread along the bottom row.
