@@ -77,6 +77,7 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
                                     {"rms_px", f.track.rms_px},
                                     {"track_ms", f.track.times.total_ms},
                                     {"idle_weight", f.idle_weight}};
+    if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
     if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
     if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
     if (!f.track.reason.empty()) frame["reason"] = f.track.reason;

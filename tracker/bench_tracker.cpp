@@ -380,6 +380,29 @@ void BM_TrackPlanarAtSize(benchmark::State& state) {
 }
 BENCHMARK(BM_TrackPlanarAtSize)->Args({640, 480})->Args({1280, 720})->Args({1920, 1080})->Unit(benchmark::kMillisecond);
 
+// A whip-pan frame's rotation by image alignment (tracker/rotation_aligner.h): both frames shrunk
+// to the small images (80 and 40 px wide) and aligned, from a prediction 3 degrees off. The
+// frames are the planar scene's at 640x480 and 960x540 (the working image of 1920x1080).
+void BM_AlignRotation(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0)), height = static_cast<int>(state.range(1));
+  const PlanarAtSize* scene = PlanarFramesAt(width, height);
+  if (!scene) return state.SkipWithError("graf1.png missing (Debian package opencv-doc)");
+  const cv::Mat& a = scene->frames[10];
+  const cv::Mat& b = scene->frames[20];
+  const calib::Camera& camera = scene->map.camera;
+  const RotationAlignerOptions options;
+  const Eigen::Quaterniond initial(Eigen::AngleAxisd(3.0 * M_PI / 180, Eigen::Vector3d::UnitY()));
+  int ok = 0;
+  for (auto _ : state) {
+    const SmallImage reference(a, camera, options), current(b, camera, options);
+    const RotationAlignment r = AlignRotation(reference, current, initial, options);
+    ok += r.ok;
+    benchmark::DoNotOptimize(r.rotation);
+  }
+  state.counters["ok_ratio"] = ok / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_AlignRotation)->Args({640, 480})->Args({960, 540})->Unit(benchmark::kMillisecond);
+
 // The same side-by-side on real correspondences: each frame's SIFT matched to the map (as
 // relocalization does), solved by both. With --map/--recording and ground truth, the error is
 // the camera-centre distance after the Sim(3) fitted on the map's keyframes.
