@@ -24,6 +24,11 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
                   "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
+  cmd->add_option("--align-max-seconds", f.align_max_seconds,
+                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
+                  "frame before, for at most this long after the last pose from features (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
       ->capture_default_str()
       ->check(CLI::IsMember({"msaa", "none"}));
@@ -49,6 +54,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
   o.tracker.tracking.prefetch_below = f.prefetch_below;
+  o.tracker.tracking.align_max_seconds = f.align_max_seconds;
   o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
   o.fade = {f.hold, f.fade};
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);

@@ -15,6 +15,7 @@ struct SessionFlags {
   double ipd = 0.064, hold = 0.5, fade = 1.0;
   int gl_threads = 1;
   int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below
+  double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
 };
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
