@@ -59,9 +59,17 @@ TEST(Camera, UndistortPixelAgreesWithOpenCv) {
   }
 }
 
+// A folder of this test process's own: ctest runs each test as its own process, two at a time,
+// and two tests writing one /tmp file raced (one removed it while the other loaded it).
+std::filesystem::path ProcessTempDir() {
+  const auto dir = std::filesystem::temp_directory_path() / ("arview_camera_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 TEST(Camera, SaveLoadRoundTrip) {
   const Camera c = DistortedCamera();
-  const auto path = std::filesystem::temp_directory_path() / "arview_camera_roundtrip.yaml";
+  const auto path = ProcessTempDir() / "arview_camera_roundtrip.yaml";
   SaveCamera(c, path);
   const Camera d = LoadCamera(path);
   EXPECT_EQ(d.width, 640);
@@ -70,20 +78,26 @@ TEST(Camera, SaveLoadRoundTrip) {
   EXPECT_DOUBLE_EQ(d.cy, c.cy);
   for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(d.dist[i], c.dist[i]);
   std::filesystem::remove(path);
+  std::error_code ignored;
+  std::filesystem::remove(path.parent_path(), ignored);
 }
 
 void WriteFile(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
 
 std::string LoadError(const std::string& yaml) {
-  const auto path = std::filesystem::temp_directory_path() / "arview_camera_bad.yaml";
+  const auto path = ProcessTempDir() / "arview_camera_bad.yaml";
   WriteFile(path, yaml);
   try {
     LoadCamera(path);
   } catch (const CameraError& e) {
     std::filesystem::remove(path);
+    std::error_code ignored;
+    std::filesystem::remove(path.parent_path(), ignored);  // the folder, once empty
     return e.what();
   }
   std::filesystem::remove(path);
+  std::error_code ignored;
+  std::filesystem::remove(path.parent_path(), ignored);
   return "";
 }
 
