@@ -15,6 +15,7 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
+#include "app/session_flags.h"
 #include "app/stage_stats.h"
 #include "base/cancellation.h"
 #include "base/atomic_file.h"
@@ -296,10 +297,7 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--lk-levels", a->lk_levels,
                   "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")
       ->capture_default_str()->check(CLI::Range(0, 6));
-  cmd->add_option("--align-max-seconds", a->align_max_seconds,
-                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
-                  "frame before, for at most this long after the last pose from features (0: off)")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  AddAlignMaxSecondsOption(cmd, a->align_max_seconds);
   cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--working-size", a->working_size,

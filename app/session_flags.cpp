@@ -6,6 +6,14 @@
 
 namespace arview::app {
 
+void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
+  cmd->add_option("--align-max-seconds", seconds,
+                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
+                  "frame before, for at most this long after the last pose from features (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+}
+
 void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
   cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)");
@@ -24,11 +32,7 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
                   "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
-  cmd->add_option("--align-max-seconds", f.align_max_seconds,
-                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
-                  "frame before, for at most this long after the last pose from features (0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+  AddAlignMaxSecondsOption(cmd, f.align_max_seconds);
   cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
       ->capture_default_str()
       ->check(CLI::IsMember({"msaa", "none"}));

@@ -19,6 +19,8 @@ struct SessionFlags {
 };
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
+// --align-max-seconds (tracker::TrackingOptions::align_max_seconds), shared with `arview track`.
+void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds);
 // Fills the session options these flags control (throws on a bad --gl value).
 void ApplySessionFlags(const SessionFlags& flags, SessionOptions& options);
 

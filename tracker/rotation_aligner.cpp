@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "tracker/working_resolution.h"
 
@@ -122,7 +123,7 @@ SmallImage::SmallImage(const cv::Mat& gray, const calib::Camera& camera, const R
     cv::Sobel(level.image, level.grad_x, CV_32F, 1, 0, 1, 0.5);
     cv::Sobel(level.image, level.grad_y, CV_32F, 0, 1, 1, 0.5);
     level.camera = ScaleCamera(camera, w, h);
-    for (const Eigen::Vector2d corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w - 1, 0), Eigen::Vector2d(0, h - 1),
+    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w - 1, 0), Eigen::Vector2d(0, h - 1),
                                          Eigen::Vector2d(w - 1, h - 1)}) {
       const Eigen::Vector3d b = level.camera.Unproject(corner);
       level.max_radius2 = std::max(level.max_radius2, (b.x() * b.x() + b.y() * b.y()) / (b.z() * b.z()));
@@ -148,7 +149,7 @@ RotationAlignment AlignRotation(const SmallImage& reference, const SmallImage& c
   Eigen::Matrix3d R = initial.normalized().toRotationMatrix();
   LevelPixels finest;
   for (int k = static_cast<int>(reference.levels().size()) - 1; k >= 0; --k) {
-    const LevelPixels ref = ReferencePixels(reference.levels()[k]);
+    LevelPixels ref = ReferencePixels(reference.levels()[k]);
     for (int it = 0; it < options.max_iterations; ++it) {
       const Eigen::Vector3d delta = GaussNewtonStep(ref, current.levels()[k], R);
       ++out.iterations;
@@ -157,7 +158,7 @@ RotationAlignment AlignRotation(const SmallImage& reference, const SmallImage& c
               .toRotationMatrix() * R;
       if (delta.norm() < kConvergedRadians) break;
     }
-    if (k == 0) finest = ref;
+    if (k == 0) finest = std::move(ref);  // kept for the correlation below
   }
   out.rotation = Eigen::Quaterniond(R).normalized();
   Correlate(finest, current.levels()[0], R, &out.zncc, &out.overlap);

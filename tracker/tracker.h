@@ -117,8 +117,8 @@ struct TrackingOptions {
   // after a posed frame, takes its rotation from aligning its small blurred image with that
   // frame's (tracker/rotation_aligner.h) and its centre from a straight line fitted to the
   // centres of the last frames posed from features (CentreFitter), for at most
-  // `align_max_seconds` after the last of them (0: off). Such
-  // frames are whip-pans, smeared by tens of pixels: on the synthetic room's blurred lap (a turn
+  // `align_max_seconds` after the last of them (0: off). Such frames are whip-pans, smeared by
+  // tens of pixels: on the synthetic room's blurred lap (a turn
   // peaking at 320 deg/s, 1/60 s exposure) flow and SIFT found 1-29 correspondences in 13
   // consecutive frames. The frame's `align_zncc` says it was posed this way; its pose must turn
   // at most `align_max_from_prediction_deg` from the prediction.
