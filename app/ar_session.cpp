@@ -34,6 +34,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                              std::to_string(map.camera.height) + " camera");
   }
   tracker::Tracker tracker(map, o.tracker);
+  tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
 
   std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;

@@ -57,6 +57,7 @@ struct TrackArgs {
   double smoothing_beta = 0.5;
   int working_size = tracker::TrackerOptions{}.working_long_side;
   int sift_size = tracker::RelocalizerOptions{}.sift_long_side;
+  int reloc_sift_size = tracker::RelocalizerOptions{}.reloc_sift_long_side;
 };
 
 tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
@@ -88,6 +89,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.index.checks = a.index_checks;
   o.working_long_side = a.working_size;
   o.relocalization.sift_long_side = a.sift_size;
+  o.relocalization.reloc_sift_long_side = a.reloc_sift_size;
   return o;
 }
 
@@ -165,6 +167,9 @@ void RunTrack(const TrackArgs& args) {
   if (args.sift_size != 0 && args.sift_size < 64)
     throw CommandError("--sift-size must be 0 (the working resolution) or at least 64 (got " +
                        std::to_string(args.sift_size) + ")", 2);
+  if (args.reloc_sift_size != 0 && args.reloc_sift_size < 64)
+    throw CommandError("--reloc-sift-size must be 0 (as --sift-size) or at least 64 (got " +
+                       std::to_string(args.reloc_sift_size) + ")", 2);
   const ScopedSignalCancellation signals;
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
@@ -198,6 +203,7 @@ void RunTrack(const TrackArgs& args) {
   } catch (const map::DescriptorIndexError& e) {
     throw CommandError(args.map + ": " + e.what());
   }
+  tracker->WarmUp();  // the first frame's timing is then a relocalization's, not a process start's
 
   recordings::RecordingSource source(std::move(rec), replay);
   std::vector<FrameRecord> frames;
@@ -307,6 +313,10 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--sift-size", a->sift_size,
                   "Longest side of the image SIFT runs on (relocalization, guided matching; smaller "
                   "working frames are kept as they are); 0: the working resolution")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--reloc-sift-size", a->reloc_sift_size,
+                  "Longest side of the image relocalization's own SIFT runs on when --sift-size reduces "
+                  "the working frame (working frames up to --sift-size are kept as they are); 0: as --sift-size")
       ->capture_default_str()->check(CLI::Range(0, 100000));
   cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
   cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")

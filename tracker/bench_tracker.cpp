@@ -272,6 +272,7 @@ void BM_Relocalize(benchmark::State& state) {
   TrackerOptions options;
   options.relocalization.features.max_features = static_cast<int>(state.range(0));
   options.relocalization.sift_long_side = static_cast<int>(state.range(1));
+  options.relocalization.reloc_sift_long_side = static_cast<int>(state.range(2));
   Tracker tracker(real->map, options);
   size_t i = 0;
   int localized = 0;
@@ -282,12 +283,19 @@ void BM_Relocalize(benchmark::State& state) {
     localized += r.status != TrackStatus::kLost;
   }
   state.counters["localized_ratio"] = static_cast<double>(localized) / state.iterations();
+  const int reloc_side = RelocSiftLongSide(tracker.working_camera(), options.relocalization);
   state.SetLabel(real->source + ", SIFT at longest side " +
-                 (state.range(1) > 0 ? std::to_string(state.range(1)) : std::string("working")));
+                 (reloc_side > 0 ? std::to_string(reloc_side) : std::string("working")));
 }
-// Second argument: RelocalizerOptions::sift_long_side (0: the working resolution); on 640x480
-// frames both are the same image.
-BENCHMARK(BM_Relocalize)->Args({1000, 640})->Args({2000, 640})->Args({1000, 0})->Unit(benchmark::kMillisecond);
+// Arguments: max_features, RelocalizerOptions::sift_long_side (0: the working resolution),
+// reloc_sift_long_side (0: as sift_long_side). On 640x480 frames 640 and 0 are the same image
+// and reloc_sift_long_side does not apply; on larger frames {1000, 640, 480} is the default.
+BENCHMARK(BM_Relocalize)
+    ->Args({1000, 640, 480})
+    ->Args({1000, 640, 0})
+    ->Args({2000, 640, 480})
+    ->Args({1000, 0, 0})
+    ->Unit(benchmark::kMillisecond);
 
 // Continuous tracking over the frames in order, back and forth (no jump at the ends).
 void BM_TrackContinuous(benchmark::State& state) {

@@ -2,6 +2,7 @@
 
 #include "tracker/timing.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -60,16 +61,25 @@ Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
       index_(index),
       options_(options),
       extractor_(options.features),
-      sift_resolution_(camera, options.sift_long_side) {}
+      sift_resolution_(camera, options.sift_long_side),
+      reloc_resolution_(camera, RelocSiftLongSide(camera, options)) {}
 
-Features Relocalizer::Extract(const cv::Mat& gray, const SiftExtractor& extractor) const {
+int RelocSiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options) {
+  const int frame_long_side = std::max(camera.width, camera.height);
+  const bool sift_reduces = options.sift_long_side > 0 && options.sift_long_side < frame_long_side;
+  if (!sift_reduces) return options.sift_long_side;
+  return options.reloc_sift_long_side > 0 ? options.reloc_sift_long_side : options.sift_long_side;
+}
+
+Features Relocalizer::ExtractAt(const cv::Mat& gray, const SiftExtractor& extractor,
+                                const WorkingResolution& resolution) const {
   // The reduction is defined for the camera's size only.
-  const bool reduce = sift_resolution_.reduced() && gray.size() == camera_.Size();
-  Features features = extractor.Extract(reduce ? sift_resolution_.Reduce(ToGray8(gray)) : gray);
+  const bool reduce = resolution.reduced() && gray.size() == camera_.Size();
+  Features features = extractor.Extract(reduce ? resolution.Reduce(ToGray8(gray)) : gray);
   if (!reduce) return features;
-  const auto size_scale = static_cast<float>(sift_resolution_.full_per_work());
+  const auto size_scale = static_cast<float>(resolution.full_per_work());
   for (cv::KeyPoint& kp : features.keypoints) {
-    const Eigen::Vector2d p = sift_resolution_.ToFull({kp.pt.x, kp.pt.y});
+    const Eigen::Vector2d p = resolution.ToFull({kp.pt.x, kp.pt.y});
     kp.pt = cv::Point2f(static_cast<float>(p.x()), static_cast<float>(p.y()));
     kp.size *= size_scale;
   }
@@ -78,7 +88,7 @@ Features Relocalizer::Extract(const cv::Mat& gray, const SiftExtractor& extracto
 
 RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
   const auto start = std::chrono::steady_clock::now();
-  const Features features = Extract(gray, extractor_);
+  const Features features = ExtractAt(gray, extractor_, reloc_resolution_);
   const double extract_ms = MillisecondsSince(start);
   RelocalizationResult result = Relocalize(features);
   result.extract_ms = extract_ms;

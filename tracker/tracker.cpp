@@ -108,6 +108,14 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
       point_keyframes_[obs.point].push_back(static_cast<std::uint32_t>(k));
 }
 
+void Tracker::WarmUp() {
+  const cv::Mat blank(resolution_.work().Size(), CV_8U, cv::Scalar(0));
+  const Features none = relocalizer_->Extract(blank, relocalizer_->extractor());
+  const std::vector<cv::Mat> pyramid = FlowPyramid(blank);
+  const std::vector<map::Neighbor> nearest = index_.Knn(map_.descriptors.ptr<std::uint8_t>(0), 1);
+  (void)none, (void)pyramid, (void)nearest;
+}
+
 std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& points) const {
   std::vector<int> votes(map_.keyframes.size(), 0);
   for (std::uint32_t p : points)

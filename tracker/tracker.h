@@ -208,6 +208,12 @@ class Tracker {
   FrameResult Track(const cv::Mat& image, double timestamp);
   // Forgets the prior: the next frame is relocalised.
   void Reset();
+  // Runs each per-frame step once on a blank working-size frame (SIFT, the flow pyramid, one
+  // descriptor query) and forgets it. A process's first SIFT extraction pays one-time costs
+  // (OpenCV's lazy set-up, the allocator's first touch of its buffers: ~25 ms at 360x640 here)
+  // that would otherwise land on the session's first frame, which is always a relocalization.
+  // Sessions call it once after construction, before frames arrive; the result is unchanged.
+  void WarmUp();
   const TrackerOptions& options() const { return options_; }
   // The camera every per-frame step uses (the map camera scaled to the working resolution).
   const calib::Camera& working_camera() const { return resolution_.work(); }

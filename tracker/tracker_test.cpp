@@ -72,9 +72,9 @@ TEST_F(PlanarTrackerTest, RelocalizesANovelView) {
 }
 
 // A 1280x720 camera (the tracker works at 960x540): relocalization's SIFT on the frame reduced
-// to 640x360 finds the pose as accurately as on the working image (its keypoints mapped back to
-// working pixels; used as found they would miss the pose; the mapping's exactness is
-// WorkingResolution's tests).
+// to 480x270 (the default reloc_sift_long_side, as --sift-size 640 reduces this frame) finds the
+// pose as accurately as on the working image (its keypoints mapped back to working pixels; used
+// as found they would miss the pose; the mapping's exactness is WorkingResolution's tests).
 TEST(PlanarTrackerAtHd, RelocalizesWithSiftOnAReducedImage) {
   const cv::Mat texture = cv::imread(std::string(kOpenCvData) + "graf1.png");
   if (texture.empty()) GTEST_SKIP() << "graf1.png missing (Debian package opencv-doc)";
@@ -97,6 +97,23 @@ TEST(PlanarTrackerAtHd, RelocalizesWithSiftOnAReducedImage) {
     EXPECT_LT(r.rms_px, 1.0) << "reloc size " << reloc_side;
     EXPECT_GE(r.inliers, 50) << "reloc size " << reloc_side;
   }
+}
+
+// Relocalization's own SIFT size: smaller only for frames that --sift-size reduces anyway.
+TEST(RelocSiftLongSide, ReducesOnlyFramesThatSiftReduces) {
+  const calib::Camera vga = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  const calib::Camera working_hd = calib::Camera::Pinhole(540, 960, 800, 800, 269.5, 479.5);  // portrait
+  const RelocalizerOptions defaults;
+  ASSERT_EQ(defaults.sift_long_side, 640);
+  ASSERT_EQ(defaults.reloc_sift_long_side, 480);
+  EXPECT_EQ(RelocSiftLongSide(vga, defaults), 640);        // as SIFT sees it: not reduced
+  EXPECT_EQ(RelocSiftLongSide(working_hd, defaults), 480);  // SIFT reduces it: further still
+  RelocalizerOptions same_as_sift = defaults;
+  same_as_sift.reloc_sift_long_side = 0;
+  EXPECT_EQ(RelocSiftLongSide(working_hd, same_as_sift), 640);
+  RelocalizerOptions working_resolution = defaults;
+  working_resolution.sift_long_side = 0;  // SIFT on the working frame: relocalization too
+  EXPECT_EQ(RelocSiftLongSide(working_hd, working_resolution), 0);
 }
 
 TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
@@ -124,6 +141,24 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
       << r.reason << " flow " << r.flow_tracks << " guided " << r.guided_matches << " inliers "
       << r.inliers << " err " << (r.pose.Center() - far.Center()).norm();
   ExpectNear(r, far, 0.003, 0.2);
+}
+
+// WarmUp runs each step on a blank frame and must leave nothing behind: the same poses, bit for
+// bit, as a tracker that did not warm up, from the first frame (a relocalization) on.
+TEST_F(PlanarTrackerTest, WarmUpChangesNoResult) {
+  Tracker cold(*map_);
+  Tracker warm(*map_);
+  warm.WarmUp();
+  for (int i = 0; i < 5; ++i) {
+    const cv::Mat frame = world_->Render(PathPose(i));
+    const FrameResult a = cold.Track(frame, i / 30.0);
+    const FrameResult b = warm.Track(frame, i / 30.0);
+    ASSERT_NE(a.status, TrackStatus::kLost) << "frame " << i << ": " << a.reason;
+    EXPECT_EQ(a.status, b.status) << "frame " << i;
+    EXPECT_EQ(a.inliers, b.inliers) << "frame " << i;
+    EXPECT_EQ(a.pose.q_cw.coeffs(), b.pose.q_cw.coeffs()) << "frame " << i;
+    EXPECT_EQ(a.pose.t_cw, b.pose.t_cw) << "frame " << i;
+  }
 }
 
 // Replenishment with guided matching's SIFT extracted ahead on a worker
