@@ -36,6 +36,7 @@ struct MapArgs {
   std::string preset = "quality";
   int max_features = 0;  // 0: the preset's
   std::string info_dir;
+  bool info_recheck = false;
 };
 
 // One progress line per stage on stderr: redrawn in place on a terminal, printed at every
@@ -144,7 +145,7 @@ void RunMap(const MapArgs& args) {
   }
 }
 
-void RunInfo(const std::string& dir) {
+void RunInfo(const std::string& dir, bool recheck) {
   try {
     const auto start = std::chrono::steady_clock::now();
     const map::Map map = map::LoadMap(dir);
@@ -170,6 +171,7 @@ void RunInfo(const std::string& dir) {
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
     const fs::path folder = fs::is_directory(dir) ? fs::path(dir) : fs::path(dir).parent_path();
+    if (recheck) mapping::RecheckMap(folder);
     if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
       std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
       for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
@@ -213,7 +215,10 @@ void AddMapCommand(CLI::App& app) {
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();
-  info->callback([args] { RunInfo(args->info_dir); });
+  info->add_flag("--recheck", args->info_recheck,
+                 "Run the map's self-check again from the COLMAP model and database in its folder and rewrite "
+                 "check.json (maps built before a check existed)");
+  info->callback([args] { RunInfo(args->info_dir, args->info_recheck); });
   cmd->callback([args, info] {
     if (info->parsed()) return;
     RunMap(*args);

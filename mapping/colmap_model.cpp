@@ -278,6 +278,44 @@ class Database {
     return m;
   }
 
+  // The verified pairs' essential matrices (two_view_geometries), keyed by COLMAP's image ids.
+  // Nothing when the table or its E column is absent (a database of another COLMAP version): the
+  // map check then skips the comparison.
+  struct PairGeometry {
+    std::uint32_t image_a = 0, image_b = 0;
+    int inliers = 0;
+    int config = 0;  // COLMAP's TwoViewGeometry::ConfigurationType
+    Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();
+  };
+  std::vector<PairGeometry> PairGeometries() {
+    std::vector<PairGeometry> pairs;
+    sqlite3_stmt* raw = nullptr;
+    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config FROM two_view_geometries WHERE rows > 0", -1, &raw,
+                           nullptr) != SQLITE_OK) {
+      sqlite3_finalize(raw);
+      return pairs;
+    }
+    const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> st(raw, sqlite3_finalize);
+    // COLMAP's pair id: image_id1 * kMaxNumImages + image_id2, image_id1 < image_id2.
+    constexpr sqlite3_int64 kMaxNumImages = 2147483647;
+    while (sqlite3_step(st.get()) == SQLITE_ROW) {
+      const sqlite3_int64 pair_id = sqlite3_column_int64(st.get(), 0);
+      const void* blob = sqlite3_column_blob(st.get(), 2);
+      if (pair_id < 0 || !blob || sqlite3_column_bytes(st.get(), 2) != 9 * sizeof(double)) continue;
+      PairGeometry g;
+      g.image_a = static_cast<std::uint32_t>(pair_id / kMaxNumImages);
+      g.image_b = static_cast<std::uint32_t>(pair_id % kMaxNumImages);
+      g.inliers = static_cast<int>(std::min<sqlite3_int64>(sqlite3_column_int64(st.get(), 1), 1 << 30));
+      g.config = sqlite3_column_int(st.get(), 3);
+      // COLMAP writes its matrices transposed, i.e. row by row (database.cc); x_b^T E x_a = 0.
+      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rows_first;
+      std::memcpy(rows_first.data(), blob, 9 * sizeof(double));
+      g.essential = rows_first;
+      pairs.push_back(g);
+    }
+    return pairs;
+  }
+
   std::string ImageName(std::uint32_t image_id) {
     Statement st(*this, "SELECT name FROM images WHERE image_id = ?");
     sqlite3_bind_int64(st.get(), 1, image_id);
@@ -324,6 +362,25 @@ std::uint64_t Key(std::uint32_t image_id, std::uint32_t point2d_idx) {
 std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
   BinaryReader r(sparse_dir / "images.bin", CancellationToken{});
   return r.Read<std::uint64_t>("registered image count");
+}
+
+std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, const map::Map& map) {
+  std::unordered_map<std::uint32_t, int> keyframe_of_image;
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k)
+    keyframe_of_image[map.keyframes[k].colmap_image_id] = static_cast<int>(k);
+  Database db(database);
+  std::vector<TwoViewGeometry> result;
+  for (const auto& pair : db.PairGeometries()) {
+    const auto a = keyframe_of_image.find(pair.image_a), b = keyframe_of_image.find(pair.image_b);
+    if (a == keyframe_of_image.end() || b == keyframe_of_image.end()) continue;  // a frame not registered
+    // Only pairs whose essential matrix COLMAP estimated and kept: CALIBRATED (2), and
+    // PLANAR_OR_PANORAMIC (6: a homography fits as well). UNCALIBRATED (3) pairs fit a fundamental
+    // matrix better than any essential one; their E is not the pair's motion (phone-fox: 8.7
+    // degrees where the frames turned 57).
+    if (pair.config != 2 && pair.config != 6) continue;
+    result.push_back({a->second, b->second, pair.inliers, pair.essential});
+  }
+  return result;
 }
 
 map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,

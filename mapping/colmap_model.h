@@ -13,6 +13,7 @@
 
 #include "base/cancellation.h"
 #include "map/map.h"
+#include "mapping/map_check.h"
 
 namespace arview::mapping {
 
@@ -40,6 +41,11 @@ std::uint64_t CountRegisteredImages(const std::filesystem::path& sparse_dir);
 map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::filesystem::path& database,
                   const FrameLookup& frames = {}, const CancellationToken& cancel = {},
                   std::vector<std::vector<Eigen::Vector2f>>* keypoints = nullptr, bool check_values = true);
+
+// The two-view geometries COLMAP verified between the map's keyframes (its database's
+// two_view_geometries), for mapping/map_check.h. Pairs with an unregistered frame are left out;
+// a database without the table gives none. Throws MapError when the database cannot be opened.
+std::vector<TwoViewGeometry> ReadTwoViewGeometries(const std::filesystem::path& database, const map::Map& map);
 
 // Throws MapError naming the file of `sparse_dir` (images.bin, points3D.bin) that holds the first
 // value a map may not hold.

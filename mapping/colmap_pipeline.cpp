@@ -295,6 +295,22 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 }  // namespace
 
+MapCheck RecheckMap(const fs::path& map_dir) {
+  const map::Map built = map::LoadMap(map_dir);
+  const fs::path database = map_dir / "database.db";
+  int models = 0;
+  const fs::path model_dir = LargestModel(map_dir / "sparse", &models, {});
+  if (model_dir.empty())
+    throw map::MapError((map_dir / "sparse").string() + ": no COLMAP model to check (the folder arview map wrote keeps it)");
+  FrameLookup frames;
+  for (const map::Keyframe& k : built.keyframes) frames[k.name] = {k.frame_index, k.timestamp};
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  const map::Map model = ReadColmapMap(model_dir, database, frames, {}, &keypoints, false);
+  const MapCheck check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
+  WriteMapCheck(check, map_dir / kMapCheckFileName);
+  return check;
+}
+
 std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, int total_images) {
   // sscanf rather than std::regex: no allocation per line, and no GCC 12 false warnings.
   const char* text = line.c_str();
@@ -430,7 +446,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   std::vector<std::vector<Eigen::Vector2f>> keypoints;
   result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
   // The whole map looked at first, so that a degenerate model is refused with the reason too.
-  result.check = CheckMap(result.map, keypoints);
+  result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
   WriteMapCheck(result.check, out_dir / kMapCheckFileName);
   if (cb.warning)
     for (const std::string& w : result.check.warnings) cb.warning(w);

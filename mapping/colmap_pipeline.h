@@ -110,6 +110,11 @@ struct MapBuildResult {
 MapBuildResult BuildMap(const recordings::Recording& recording, const std::filesystem::path& out_dir,
                         const MapBuildOptions& options, const MapBuildCallbacks& callbacks = {});
 
+// The self-check of a map folder that `arview map` wrote (mapping/map_check.h) computed again
+// from the COLMAP model and database kept there, and written to its check.json: for maps built
+// before a check existed, or after its limits changed. Throws MapError naming what is missing.
+MapCheck RecheckMap(const std::filesystem::path& map_dir);
+
 // One line of COLMAP 3.8's output as progress (done, total), or nothing: "Processed file [i/N]",
 // "Matching image [i/N]", "Matching block [a/A, b/B]", "Registering image #id (n)" (n of
 // `total_images`), "Initializing with image pair".

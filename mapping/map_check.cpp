@@ -2,6 +2,7 @@
 
 #include "mapping/map_check.h"
 
+#include <Eigen/SVD>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -113,6 +114,34 @@ double SceneDepth(const map::Map& map) {
   return Median(per_keyframe);
 }
 
+// The map's camera rotations against the pairs' two-view geometry (map_check.h).
+void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
+                             const MapCheckLimits& limits, MapCheck& c) {
+  std::vector<int> compared(map.keyframes.size(), 0), disagreeing(map.keyframes.size(), 0);
+  int pairs = 0, disagree = 0;
+  for (const TwoViewGeometry& g : two_view) {
+    const int n = static_cast<int>(map.keyframes.size());
+    if (g.inliers < limits.two_view_min_inliers || g.keyframe_a < 0 || g.keyframe_b < 0 || g.keyframe_a >= n ||
+        g.keyframe_b >= n || g.keyframe_a == g.keyframe_b)
+      continue;
+    const Eigen::Matrix3d rotation_ab = map.keyframes[g.keyframe_b].pose.R() * map.keyframes[g.keyframe_a].pose.R().transpose();
+    const std::optional<double> off_deg = RotationDisagreementDeg(g.essential, rotation_ab);
+    if (!off_deg) continue;
+    const bool differs = *off_deg > limits.two_view_max_disagreement_deg;
+    ++pairs;
+    disagree += differs;
+    for (int k : {g.keyframe_a, g.keyframe_b}) {
+      ++compared[k];
+      disagreeing[k] += differs;
+    }
+  }
+  c.two_view_pairs = pairs;
+  c.disagreeing_pairs = pairs > 0 ? static_cast<double>(disagree) / pairs : 0;
+  // Keyframes most of whose (at least three) pairs disagree: where the fold is.
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k)
+    if (compared[k] >= 3 && 2 * disagreeing[k] > compared[k]) c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
+}
+
 void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
   if (c.moving_pairs > 0 && c.still_fraction > limits.max_still_fraction)
     c.warnings.push_back(
@@ -133,12 +162,42 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
     c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
                          " of the frames' features: the scene changed while it was filmed, or most of what was "
                          "filmed moved. Record a still scene");
+  if (c.two_view_pairs > 0 && c.disagreeing_pairs > limits.max_disagreeing_pairs) {
+    std::string where;
+    for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
+      where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
+    if (c.disagreeing_frames.size() > 12) where += ", ...";
+    c.warnings.push_back(
+        "disagrees with the frames' own two-view geometry: its camera rotations differ from it in " +
+        Percent(c.disagreeing_pairs) + " of " + std::to_string(c.two_view_pairs) +
+        " well-matched keyframe pairs (by more than " + Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees" +
+        (where.empty() ? std::string(")") : "; most of all frames " + where + ")") +
+        ": COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
+        "and tracking there will be off. Build the map again: remove the map folder's sparse/ and run the same "
+        "arview map (features and matches are kept; COLMAP's mapper starts afresh), or map other frames");
+  }
 }
 
 }  // namespace
 
+std::optional<double> RotationDisagreementDeg(const Eigen::Matrix3d& essential, const Eigen::Matrix3d& rotation_ab) {
+  if (!essential.allFinite() || essential.norm() < 1e-12) return std::nullopt;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(essential, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d s = svd.singularValues();
+  if (s(1) < 1e-6 * s(0)) return std::nullopt;  // rank one: no motion recoverable
+  Eigen::Matrix3d u = svd.matrixU(), v = svd.matrixV();
+  if (u.determinant() < 0) u = -u;
+  if (v.determinant() < 0) v = -v;
+  Eigen::Matrix3d w;
+  w << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  const auto off_deg = [&](const Eigen::Matrix3d& candidate) {
+    return Eigen::AngleAxisd(candidate.transpose() * rotation_ab).angle() * 180.0 / M_PI;
+  };
+  return std::min(off_deg(u * w * v.transpose()), off_deg(u * w.transpose() * v.transpose()));
+}
+
 MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
-                  const MapCheckLimits& limits) {
+                  const std::vector<TwoViewGeometry>& two_view, const MapCheckLimits& limits) {
   MapCheck c;
   c.keyframes = static_cast<int>(map.keyframes.size());
   std::vector<Eigen::Vector3d> centres;
@@ -166,6 +225,7 @@ MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vect
   }
   c.moving_pairs = static_cast<int>(still.size());
   c.still_fraction = Median(still);
+  CompareTwoViewRotations(map, two_view, limits, c);
   AddWarnings(c, limits);
   return c;
 }
@@ -174,7 +234,10 @@ std::string DescribeMapCheck(const MapCheck& c) {
   return "explains " + Percent(c.explained_fraction) + " of the frames' features (median per keyframe); camera path " +
          Fixed(c.extent_ratio, 2) + " x the scene depth; triangulation angle median " +
          Fixed(c.median_triangulation_deg, 1) + " deg; features staying still " + Percent(c.still_fraction) +
-         " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)";
+         " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)" +
+         (c.two_view_pairs > 0 ? "; rotations disagree with the two-view geometry in " + Percent(c.disagreeing_pairs) +
+                                     " of " + std::to_string(c.two_view_pairs) + " pairs"
+                               : std::string());
 }
 
 void WriteMapCheck(const MapCheck& c, const fs::path& file) {
@@ -186,6 +249,9 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
                   {"median_triangulation_deg", c.median_triangulation_deg},
                   {"moving_pairs", c.moving_pairs},
                   {"still_fraction", c.still_fraction},
+                  {"two_view_pairs", c.two_view_pairs},
+                  {"disagreeing_pairs", c.disagreeing_pairs},
+                  {"disagreeing_frames", c.disagreeing_frames},
                   {"flagged", c.flagged()},
                   {"warnings", c.warnings}};
   WriteFileAtomically(file, j.dump(2) + "\n");
@@ -205,6 +271,10 @@ std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
     c.median_triangulation_deg = j.at("median_triangulation_deg").get<double>();
     c.moving_pairs = j.at("moving_pairs").get<int>();
     c.still_fraction = j.at("still_fraction").get<double>();
+    // Absent from check files written before the two-view comparison (2026-12-03).
+    c.two_view_pairs = j.value("two_view_pairs", 0);
+    c.disagreeing_pairs = j.value("disagreeing_pairs", 0.0);
+    c.disagreeing_frames = j.value("disagreeing_frames", std::vector<int>{});
     c.warnings = j.at("warnings").get<std::vector<std::string>>();
     return c;
   } catch (const json::exception& e) {

@@ -15,6 +15,12 @@
 // - the camera path's extent against the scene depth: how far apart the keyframes' centres
 //   are, relative to the median distance of the points they see.
 // - the triangulation angles: per point, the widest angle between two of its rays.
+// - the camera rotations against each pair's own two-view geometry: COLMAP's database keeps, for
+//   every matched pair of frames, the essential matrix estimated from that pair's matches alone.
+//   Its rotation agrees with the map's relative rotation within a degree or two for a
+//   well-matched pair; a part of the path that COLMAP registered wrongly (a fold: on phone-fox a
+//   default map once put frames 0-8 at rotations 10-35 degrees off, all else right, with a
+//   normal reprojection error) disagrees with most of its pairs.
 // The verdict is a list of warnings, each saying what it saw and what to do; the map is still
 // written (a warning, not a refusal: docs/mapping.md, "The map's self-check").
 
@@ -37,7 +43,24 @@ struct MapCheckLimits {
   double min_explained_fraction = 0.05;
   double min_extent_ratio = 0.05;      // path extent / scene depth
   double min_triangulation_deg = 2.0;  // median over points
+  int two_view_min_inliers = 300;        // pairs matched at least this well are compared
+  double two_view_max_disagreement_deg = 10.0;
+  double max_disagreeing_pairs = 0.15;   // more of the compared pairs disagreeing: a fold
 };
+
+// COLMAP's two-view geometry of two keyframes: the essential matrix of their matches alone.
+struct TwoViewGeometry {
+  int keyframe_a = 0, keyframe_b = 0;  // indices into Map::keyframes
+  int inliers = 0;                     // verified matches
+  Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();  // x_b^T E x_a = 0, normalised coordinates
+};
+
+// How far, in degrees, `rotation_ab` (camera a to camera b: R_b R_a^T of world-to-camera
+// rotations) is from the rotation `essential` implies: of the two it admits, the nearer (the
+// other is the first turned by 180 degrees about the baseline). The whole rotation is compared,
+// not only its angle: a fold turns frames about another axis than the path does. A zero or
+// rank-one matrix gives nothing.
+std::optional<double> RotationDisagreementDeg(const Eigen::Matrix3d& essential, const Eigen::Matrix3d& rotation_ab);
 
 struct MapCheck {
   int keyframes = 0;
@@ -48,13 +71,17 @@ struct MapCheck {
   double median_triangulation_deg = 0;
   int moving_pairs = 0;              // consecutive keyframe pairs whose points move >= moving_pair_px
   double still_fraction = 0;         // median over those pairs
+  int two_view_pairs = 0;            // keyframe pairs compared with their two-view geometry
+  double disagreeing_pairs = 0;      // the fraction of those whose rotations disagree
+  std::vector<int> disagreeing_frames;  // frame indices of keyframes most of whose pairs disagree
   std::vector<std::string> warnings;
   bool flagged() const { return !warnings.empty(); }
 };
 
 // `keypoints[k]`: every keypoint COLMAP found in keyframe k (OpenCV pixels), observations or not.
+// `two_view`: the keyframes' two-view geometries (mapping/colmap_model.h); none: not compared.
 MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
-                  const MapCheckLimits& limits = {});
+                  const std::vector<TwoViewGeometry>& two_view = {}, const MapCheckLimits& limits = {});
 
 // The check beside the map (check.json in the map folder): written by `arview map`, printed by
 // `arview map info`. ReadMapCheck: nothing when the file is absent (a map from before the check);

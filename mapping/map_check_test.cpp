@@ -132,5 +132,108 @@ TEST(MapCheck, TheCheckFileRoundTripsAndAnAbsentOneIsNothing) {
   fs::remove_all(dir);
 }
 
+
+namespace two_view {
+
+// The essential matrix of the motion from camera a to camera b (world-to-camera poses):
+// x_b^T E x_a = 0 with E = [t]x R, R = R_b R_a^T, t = t_b - R t_a.
+Eigen::Matrix3d Essential(const calib::Pose& a, const calib::Pose& b) {
+  const Eigen::Matrix3d r = b.R() * a.R().transpose();
+  const Eigen::Vector3d t = b.t_cw - r * a.t_cw;
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  return tx * r;
+}
+
+// Keyframes along a path, each turned a little more about a tilted axis (6 degrees apart).
+map::Map TurningPath(int keyframes) {
+  map::Map m;
+  for (int k = 0; k < keyframes; ++k) {
+    map::Keyframe kf;
+    kf.frame_index = 2 * k;
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.1 * k, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
+    kf.pose = calib::Pose::FromCameraToWorld(turn, Eigen::Vector3d(0.3 * k, 0.05 * k, 0));
+    m.keyframes.push_back(kf);
+  }
+  return m;
+}
+
+// Every pair's geometry from the true poses, matched by `inliers` features.
+std::vector<TwoViewGeometry> TrueGeometries(const map::Map& truth, int inliers) {
+  std::vector<TwoViewGeometry> g;
+  for (int a = 0; a < static_cast<int>(truth.keyframes.size()); ++a)
+    for (int b = a + 1; b < static_cast<int>(truth.keyframes.size()); ++b)
+      g.push_back({a, b, inliers, Essential(truth.keyframes[a].pose, truth.keyframes[b].pose)});
+  return g;
+}
+
+TEST(RotationDisagreementDeg, IsZeroForThePairsOwnRotationAndTheAngleToAnyOther) {
+  const map::Map m = TurningPath(4);
+  const calib::Pose& a = m.keyframes[0].pose;
+  const calib::Pose& b = m.keyframes[3].pose;
+  const Eigen::Matrix3d e = Essential(a, b);
+  const Eigen::Matrix3d r_ab = b.R() * a.R().transpose();
+  EXPECT_NEAR(*RotationDisagreementDeg(e, r_ab), 0, 1e-6);
+  EXPECT_NEAR(*RotationDisagreementDeg(-3.5 * e, r_ab), 0, 1e-6);  // up to scale and sign
+  // Off by 12 degrees about an axis across the turn's: the angle of the turn barely changes, the
+  // rotation does.
+  const Eigen::Matrix3d off = Eigen::AngleAxisd(12 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  EXPECT_NEAR(*RotationDisagreementDeg(e, off * r_ab), 12, 1e-6);
+  // The other direction (E of b to a) is another rotation: the convention matters.
+  EXPECT_GT(*RotationDisagreementDeg(e.transpose(), r_ab), 30);
+  EXPECT_FALSE(RotationDisagreementDeg(Eigen::Matrix3d::Zero(), r_ab));
+  EXPECT_FALSE(RotationDisagreementDeg(Eigen::Matrix3d::Constant(std::nan("")), r_ab));
+}
+
+TEST(MapCheck, RotationsThatAgreeWithEveryPairsGeometryAreNotFlagged) {
+  const map::Map m = TurningPath(10);
+  const MapCheck c = CheckMap(m, {}, TrueGeometries(m, 300));
+  EXPECT_EQ(c.two_view_pairs, 45);
+  EXPECT_EQ(c.disagreeing_pairs, 0);
+  EXPECT_TRUE(c.disagreeing_frames.empty());
+  EXPECT_FALSE(HasWarning(c, "two-view geometry"));
+  EXPECT_NE(DescribeMapCheck(c).find("0.0% of 45 pairs"), std::string::npos) << DescribeMapCheck(c);
+}
+
+// phone-fox's folded default map in miniature: the first keyframes registered at rotations off
+// by 15-25 degrees, the rest right. The fold is flagged and its frames named; pairs matched by
+// fewer than two_view_min_inliers features are not compared.
+TEST(MapCheck, APartOfThePathRegisteredAtWrongRotationsIsFlaggedWithItsFrames) {
+  const map::Map truth = TurningPath(10);
+  map::Map folded = truth;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Quaterniond off(Eigen::AngleAxisd((15 + 5 * k) * M_PI / 180.0, Eigen::Vector3d::UnitX()));
+    folded.keyframes[k].pose.q_cw = off * folded.keyframes[k].pose.q_cw;
+  }
+  const MapCheck c = CheckMap(folded, {}, TrueGeometries(truth, 300));
+  EXPECT_EQ(c.two_view_pairs, 45);
+  // The 3 x 7 pairs between the fold and the rest (the 3 within it may agree), none of the rest's.
+  EXPECT_GE(c.disagreeing_pairs, 21.0 / 45 - 1e-9);
+  EXPECT_LE(c.disagreeing_pairs, 24.0 / 45 + 1e-9);
+  EXPECT_EQ(c.disagreeing_frames, (std::vector<int>{0, 2, 4}));
+  EXPECT_TRUE(HasWarning(c, "frames 0, 2, 4")) << (c.warnings.empty() ? "" : c.warnings[0]);
+
+  const MapCheck weak = CheckMap(folded, {}, TrueGeometries(truth, 299));
+  EXPECT_EQ(weak.two_view_pairs, 0);
+  EXPECT_FALSE(HasWarning(weak, "two-view geometry"));
+}
+
+TEST(MapCheck, TheTwoViewFiguresSurviveTheCheckFile) {
+  const map::Map truth = TurningPath(6);
+  map::Map folded = truth;
+  folded.keyframes[0].pose.q_cw = Eigen::Quaterniond(Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitY())) * folded.keyframes[0].pose.q_cw;
+  const MapCheck c = CheckMap(folded, {}, TrueGeometries(truth, 300));
+  const fs::path file = fs::temp_directory_path() / ("arview_check_two_view_" + std::to_string(::getpid()) + ".json");
+  WriteMapCheck(c, file);
+  const std::optional<MapCheck> back = ReadMapCheck(file);
+  fs::remove(file);
+  ASSERT_TRUE(back);
+  EXPECT_EQ(back->two_view_pairs, c.two_view_pairs);
+  EXPECT_DOUBLE_EQ(back->disagreeing_pairs, c.disagreeing_pairs);
+  EXPECT_EQ(back->disagreeing_frames, c.disagreeing_frames);
+  EXPECT_EQ(back->warnings, c.warnings);
+}
+
+}  // namespace two_view
 }  // namespace
 }  // namespace arview::mapping
