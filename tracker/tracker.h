@@ -222,8 +222,12 @@ class Tracker {
   struct Guided;
   struct Prefetch;
   struct GuidedCandidate {  // a map point where a pose projects it, for guided matching
+    static constexpr std::uint32_t kEveryDescriptor = 0xffffffffu;
     Eigen::Vector2d pixel;
     std::uint32_t point;
+    // The one descriptor row to compare with (the wide search: the nearest keyframe's view of
+    // the point), or kEveryDescriptor: the nearest of all of the point's.
+    std::uint32_t descriptor = kEveryDescriptor;
   };
   // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
   // to relocalization does not extract it again.
