@@ -147,6 +147,8 @@ void RunMap(const MapArgs& args) {
 
 void RunInfo(const std::string& dir, bool recheck) {
   try {
+    // Before anything is printed, so that a folder without COLMAP's model fails with one line.
+    if (recheck) mapping::RecheckMap(fs::is_regular_file(dir) ? fs::path(dir).parent_path() : fs::path(dir));
     const auto start = std::chrono::steady_clock::now();
     const map::Map map = map::LoadMap(dir);
     const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -171,7 +173,6 @@ void RunInfo(const std::string& dir, bool recheck) {
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
     const fs::path folder = fs::is_directory(dir) ? fs::path(dir) : fs::path(dir).parent_path();
-    if (recheck) mapping::RecheckMap(folder);
     if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
       std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
       for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
