@@ -110,10 +110,11 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
 
 void Tracker::WarmUp() {
   const cv::Mat blank(resolution_.work().Size(), CV_8U, cv::Scalar(0));
-  const Features none = relocalizer_->Extract(blank, relocalizer_->extractor());
+  const RelocalizationResult nothing = relocalizer_->Relocalize(blank);  // its own SIFT size
+  const Features none = relocalizer_->Extract(blank, *guided_extractor_);  // guided matching's
   const std::vector<cv::Mat> pyramid = FlowPyramid(blank);
   const std::vector<map::Neighbor> nearest = index_.Knn(map_.descriptors.ptr<std::uint8_t>(0), 1);
-  (void)none, (void)pyramid, (void)nearest;
+  (void)nothing, (void)none, (void)pyramid, (void)nearest;
 }
 
 std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& points) const {
