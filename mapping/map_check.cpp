@@ -173,8 +173,9 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
         " well-matched keyframe pairs (by more than " + Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees" +
         (where.empty() ? std::string(")") : "; most of all frames " + where + ")") +
         ": COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
-        "and tracking there will be off. Build the map again: remove the map folder's sparse/ and run the same "
-        "arview map (features and matches are kept; COLMAP's mapper starts afresh), or map other frames");
+        "and tracking there will be off. Build the map afresh into a new --out folder (COLMAP's matches, and "
+        "with them its model, differ from one build to the next; its mapper run again on the same matches "
+        "gives the same model), or map other frames");
   }
 }
 
