@@ -136,7 +136,7 @@ void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeome
     }
   }
   c.two_view_pairs = pairs;
-  c.disagreeing_pairs = pairs > 0 ? static_cast<double>(disagree) / pairs : 0;
+  c.disagreeing_fraction = pairs > 0 ? static_cast<double>(disagree) / pairs : 0;
   // Keyframes most of whose (at least three) pairs disagree: where the fold is.
   for (std::size_t k = 0; k < map.keyframes.size(); ++k)
     if (compared[k] >= 3 && 2 * disagreeing[k] > compared[k]) c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
@@ -162,14 +162,14 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
     c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
                          " of the frames' features: the scene changed while it was filmed, or most of what was "
                          "filmed moved. Record a still scene");
-  if (c.two_view_pairs > 0 && c.disagreeing_pairs > limits.max_disagreeing_pairs) {
+  if (c.two_view_pairs > 0 && c.disagreeing_fraction > limits.max_disagreeing_fraction) {
     std::string where;
     for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
       where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
     if (c.disagreeing_frames.size() > 12) where += ", ...";
     c.warnings.push_back(
         "disagrees with the frames' own two-view geometry: its camera rotations differ from it in " +
-        Percent(c.disagreeing_pairs) + " of " + std::to_string(c.two_view_pairs) +
+        Percent(c.disagreeing_fraction) + " of " + std::to_string(c.two_view_pairs) +
         " well-matched keyframe pairs (by more than " + Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees" +
         (where.empty() ? std::string(")") : "; most of all frames " + where + ")") +
         ": COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
@@ -236,7 +236,7 @@ std::string DescribeMapCheck(const MapCheck& c) {
          Fixed(c.extent_ratio, 2) + " x the scene depth; triangulation angle median " +
          Fixed(c.median_triangulation_deg, 1) + " deg; features staying still " + Percent(c.still_fraction) +
          " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)" +
-         (c.two_view_pairs > 0 ? "; rotations disagree with the two-view geometry in " + Percent(c.disagreeing_pairs) +
+         (c.two_view_pairs > 0 ? "; rotations disagree with the two-view geometry in " + Percent(c.disagreeing_fraction) +
                                      " of " + std::to_string(c.two_view_pairs) + " pairs"
                                : std::string());
 }
@@ -251,7 +251,7 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
                   {"moving_pairs", c.moving_pairs},
                   {"still_fraction", c.still_fraction},
                   {"two_view_pairs", c.two_view_pairs},
-                  {"disagreeing_pairs", c.disagreeing_pairs},
+                  {"disagreeing_fraction", c.disagreeing_fraction},
                   {"disagreeing_frames", c.disagreeing_frames},
                   {"flagged", c.flagged()},
                   {"warnings", c.warnings}};
@@ -274,7 +274,7 @@ std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
     c.still_fraction = j.at("still_fraction").get<double>();
     // Absent from check files written before the two-view comparison (2026-12-03).
     c.two_view_pairs = j.value("two_view_pairs", 0);
-    c.disagreeing_pairs = j.value("disagreeing_pairs", 0.0);
+    c.disagreeing_fraction = j.value("disagreeing_fraction", 0.0);
     c.disagreeing_frames = j.value("disagreeing_frames", std::vector<int>{});
     c.warnings = j.at("warnings").get<std::vector<std::string>>();
     return c;

@@ -45,7 +45,7 @@ struct MapCheckLimits {
   double min_triangulation_deg = 2.0;  // median over points
   int two_view_min_inliers = 300;        // pairs matched at least this well are compared
   double two_view_max_disagreement_deg = 10.0;
-  double max_disagreeing_pairs = 0.15;   // more of the compared pairs disagreeing: a fold
+  double max_disagreeing_fraction = 0.15;   // more of the compared pairs disagreeing: a fold
 };
 
 // COLMAP's two-view geometry of two keyframes: the essential matrix of their matches alone.
@@ -72,7 +72,7 @@ struct MapCheck {
   int moving_pairs = 0;              // consecutive keyframe pairs whose points move >= moving_pair_px
   double still_fraction = 0;         // median over those pairs
   int two_view_pairs = 0;            // keyframe pairs compared with their two-view geometry
-  double disagreeing_pairs = 0;      // the fraction of those whose rotations disagree
+  double disagreeing_fraction = 0;      // the fraction of those whose rotations disagree
   std::vector<int> disagreeing_frames;  // frame indices of keyframes most of whose pairs disagree
   std::vector<std::string> warnings;
   bool flagged() const { return !warnings.empty(); }

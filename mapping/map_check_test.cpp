@@ -189,7 +189,7 @@ TEST(MapCheck, RotationsThatAgreeWithEveryPairsGeometryAreNotFlagged) {
   const map::Map m = TurningPath(10);
   const MapCheck c = CheckMap(m, {}, TrueGeometries(m, 300));
   EXPECT_EQ(c.two_view_pairs, 45);
-  EXPECT_EQ(c.disagreeing_pairs, 0);
+  EXPECT_EQ(c.disagreeing_fraction, 0);
   EXPECT_TRUE(c.disagreeing_frames.empty());
   EXPECT_FALSE(HasWarning(c, "two-view geometry"));
   EXPECT_NE(DescribeMapCheck(c).find("0.0% of 45 pairs"), std::string::npos) << DescribeMapCheck(c);
@@ -208,8 +208,8 @@ TEST(MapCheck, APartOfThePathRegisteredAtWrongRotationsIsFlaggedWithItsFrames) {
   const MapCheck c = CheckMap(folded, {}, TrueGeometries(truth, 300));
   EXPECT_EQ(c.two_view_pairs, 45);
   // The 3 x 7 pairs between the fold and the rest (the 3 within it may agree), none of the rest's.
-  EXPECT_GE(c.disagreeing_pairs, 21.0 / 45 - 1e-9);
-  EXPECT_LE(c.disagreeing_pairs, 24.0 / 45 + 1e-9);
+  EXPECT_GE(c.disagreeing_fraction, 21.0 / 45 - 1e-9);
+  EXPECT_LE(c.disagreeing_fraction, 24.0 / 45 + 1e-9);
   EXPECT_EQ(c.disagreeing_frames, (std::vector<int>{0, 2, 4}));
   EXPECT_TRUE(HasWarning(c, "frames 0, 2, 4")) << (c.warnings.empty() ? "" : c.warnings[0]);
 
@@ -229,7 +229,7 @@ TEST(MapCheck, TheTwoViewFiguresSurviveTheCheckFile) {
   fs::remove(file);
   ASSERT_TRUE(back);
   EXPECT_EQ(back->two_view_pairs, c.two_view_pairs);
-  EXPECT_DOUBLE_EQ(back->disagreeing_pairs, c.disagreeing_pairs);
+  EXPECT_DOUBLE_EQ(back->disagreeing_fraction, c.disagreeing_fraction);
   EXPECT_EQ(back->disagreeing_frames, c.disagreeing_frames);
   EXPECT_EQ(back->warnings, c.warnings);
 }

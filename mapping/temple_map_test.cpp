@@ -176,7 +176,7 @@ TEST_F(TempleMapTest, TheSelfCheckFlagsNothing) {
   // would disagree) and agreeing (1 of 30 pairs disagreed on a default map; 28% on phone-fox's
   // folded one, 0-7% on its good ones).
   EXPECT_GT(c.two_view_pairs, 10);
-  EXPECT_LT(c.disagreeing_pairs, 0.15);
+  EXPECT_LT(c.disagreeing_fraction, 0.15);
   const auto saved = ReadMapCheck(MapDir() / kMapCheckFileName);
   ASSERT_TRUE(saved);
   EXPECT_FALSE(saved->flagged());
@@ -190,7 +190,7 @@ TEST_F(TempleMapTest, RecheckFromTheFolderGivesTheSameCheck) {
   EXPECT_EQ(again.keyframes, c.keyframes);
   EXPECT_DOUBLE_EQ(again.explained_fraction, c.explained_fraction);
   EXPECT_EQ(again.two_view_pairs, c.two_view_pairs);
-  EXPECT_DOUBLE_EQ(again.disagreeing_pairs, c.disagreeing_pairs);
+  EXPECT_DOUBLE_EQ(again.disagreeing_fraction, c.disagreeing_fraction);
   EXPECT_EQ(again.warnings, c.warnings);
 }
 
