@@ -36,7 +36,11 @@ struct TrackArgs {
   std::string frames;
   std::string stats;
   std::string solver = "kneip";
-  int max_features = 1000;
+  int max_features = tracker::RelocalizerOptions{}.features.max_features;
+  double sift_contrast = tracker::RelocalizerOptions{}.features.contrast_threshold;
+  int reduced_max_features = tracker::RelocalizerOptions{}.reduced_features.max_features;
+  double reduced_sift_contrast = tracker::RelocalizerOptions{}.reduced_features.contrast_threshold;
+  double guided_sift_contrast = tracker::TrackingOptions{}.guided_contrast_threshold;
   double ratio = 0.8;
   double ransac_threshold_px = 4.0;
   int ransac_iterations = 1000;
@@ -68,6 +72,9 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
     throw CommandError(std::string("--solver: ") + e.what());
   }
   o.relocalization.features.max_features = a.max_features;
+  o.relocalization.features.contrast_threshold = a.sift_contrast;
+  o.relocalization.reduced_features.max_features = a.reduced_max_features;
+  o.relocalization.reduced_features.contrast_threshold = a.reduced_sift_contrast;
   o.relocalization.matching.ratio = a.ratio;
   o.relocalization.pose.ransac_threshold_px = a.ransac_threshold_px;
   o.relocalization.pose.inlier_threshold_px = a.ransac_threshold_px;
@@ -80,6 +87,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.tracking.prefetch_below = a.prefetch_below;
   o.tracking.prefetch_lag_frames = a.prefetch_lag;
   o.tracking.guided_radius_px = a.guided_radius_px;
+  o.tracking.guided_contrast_threshold = a.guided_sift_contrast;
   o.tracking.lk_window_px = a.lk_window;
   o.tracking.lk_pyramid_levels = a.lk_levels;
   o.tracking.align_max_seconds = a.align_max_seconds;
@@ -274,8 +282,22 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON");
   cmd->add_option("--solver", a->solver, "Minimal solver in RANSAC: kneip | gao | epnp")
       ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
-  cmd->add_option("--max-features", a->max_features, "SIFT keypoints per frame (strongest kept)")
+  cmd->add_option("--max-features", a->max_features,
+                  "SIFT keypoints relocalization extracts (strongest kept) on frames SIFT sees at their own size "
+                  "(--sift-size does not reduce them)")
       ->capture_default_str()->check(CLI::Range(50, 100000));
+  cmd->add_option("--sift-contrast", a->sift_contrast,
+                  "SIFT contrast threshold (OpenCV's definition) on frames SIFT sees at their own size; 0.02 is the "
+                  "test of COLMAP's default peak threshold, with which the map's features were extracted")
+      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
+  cmd->add_option("--reduced-max-features", a->reduced_max_features,
+                  "SIFT keypoints relocalization uses when --sift-size reduces the working frame (its own SIFT "
+                  "keeps this many; guided matching's features are matched globally through their strongest this many)")
+      ->capture_default_str()->check(CLI::Range(50, 100000));
+  cmd->add_option("--reduced-sift-contrast", a->reduced_sift_contrast,
+                  "SIFT contrast threshold of relocalization when --sift-size reduces the working frame "
+                  "(OpenCV's default 0.04: fewer, stronger keypoints, quicker)")
+      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
   cmd->add_option("--ratio", a->ratio, "Ratio test of global matching")->capture_default_str()->check(CLI::Range(0.1, 1.0));
   cmd->add_option("--ransac-threshold", a->ransac_threshold_px, "Inlier threshold, pixels")
       ->capture_default_str()->check(CLI::Range(0.1, 50.0));
@@ -295,6 +317,9 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(0, 100000));
   cmd->add_option("--prefetch-lag", a->prefetch_lag, "Frames after which features extracted ahead are used")
       ->capture_default_str()->check(CLI::Range(1, 1000));
+  cmd->add_option("--guided-sift-contrast", a->guided_sift_contrast,
+                  "SIFT contrast threshold of guided matching (any working size)")
+      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));
   cmd->add_option("--lk-window", a->lk_window,

@@ -271,8 +271,9 @@ void BM_Relocalize(benchmark::State& state) {
   if (!real) return state.SkipWithError("no frames (opencv-doc missing, no --map)");
   TrackerOptions options;
   options.relocalization.features.max_features = static_cast<int>(state.range(0));
-  options.relocalization.sift_long_side = static_cast<int>(state.range(1));
-  options.relocalization.reloc_sift_long_side = static_cast<int>(state.range(2));
+  options.relocalization.reduced_features.max_features = static_cast<int>(state.range(1));
+  options.relocalization.sift_long_side = static_cast<int>(state.range(2));
+  options.relocalization.reloc_sift_long_side = static_cast<int>(state.range(3));
   Tracker tracker(real->map, options);
   size_t i = 0;
   int localized = 0;
@@ -287,14 +288,16 @@ void BM_Relocalize(benchmark::State& state) {
   state.SetLabel(real->source + ", SIFT at longest side " +
                  (reloc_side > 0 ? std::to_string(reloc_side) : std::string("working")));
 }
-// Arguments: max_features, RelocalizerOptions::sift_long_side (0: the working resolution),
-// reloc_sift_long_side (0: as sift_long_side). On 640x480 frames 640 and 0 are the same image
-// and reloc_sift_long_side does not apply; on larger frames {1000, 640, 480} is the default.
+// Arguments: max_features, reduced_max_features, RelocalizerOptions::sift_long_side (0: the
+// working resolution), reloc_sift_long_side (0: as sift_long_side). On 640x480 frames 640 and 0
+// are the same image and neither reduced_features nor reloc_sift_long_side applies; the
+// defaults are {2000, 1000, 640, 480}.
 BENCHMARK(BM_Relocalize)
-    ->Args({1000, 640, 480})
-    ->Args({1000, 640, 0})
-    ->Args({2000, 640, 480})
-    ->Args({1000, 0, 0})
+    ->Args({2000, 1000, 640, 480})
+    ->Args({1000, 1000, 640, 480})
+    ->Args({2000, 2000, 640, 480})
+    ->Args({2000, 1000, 640, 0})
+    ->Args({2000, 1000, 0, 0})
     ->Unit(benchmark::kMillisecond);
 
 // Continuous tracking over the frames in order, back and forth (no jump at the ends).

@@ -12,6 +12,9 @@ namespace arview::tracker {
 struct FeatureOptions {
   int max_features = 1000;  // strongest responses kept (0 = all)
   int octave_layers = 3;
+  // OpenCV keeps an extremum when |DoG| >= contrast_threshold / octave_layers; COLMAP (the map's
+  // features) when |DoG| >= peak_threshold, 0.02 / 3 by default: 0.02 is the same test as
+  // COLMAP's, 0.04 (OpenCV's default) keeps only the stronger half of the structure.
   double contrast_threshold = 0.04;
   double edge_threshold = 10;
   double sigma = 1.6;

@@ -54,20 +54,52 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
   }
 }
 
+namespace {
+
+bool SiftReducesFrame(const calib::Camera& camera, const RelocalizerOptions& options) {
+  return options.sift_long_side > 0 && options.sift_long_side < std::max(camera.width, camera.height);
+}
+
+}  // namespace
+
+const FeatureOptions& ActiveFeatures(const calib::Camera& camera, const RelocalizerOptions& options) {
+  return SiftReducesFrame(camera, options) ? options.reduced_features : options.features;
+}
+
+Features StrongestFeatures(const Features& features, int max_count) {
+  if (max_count <= 0 || features.keypoints.size() <= static_cast<size_t>(max_count)) return features;
+  std::vector<int> order(features.keypoints.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  // Ties broken by index, so that the selection does not depend on the sort's implementation.
+  const auto stronger = [&](int a, int b) {
+    const float ra = features.keypoints[a].response, rb = features.keypoints[b].response;
+    return ra != rb ? ra > rb : a < b;
+  };
+  std::nth_element(order.begin(), order.begin() + max_count, order.end(), stronger);
+  order.resize(static_cast<size_t>(max_count));
+  std::sort(order.begin(), order.end());
+  Features strongest;
+  strongest.descriptors = cv::Mat(static_cast<int>(order.size()), features.descriptors.cols, features.descriptors.type());
+  for (size_t i = 0; i < order.size(); ++i) {
+    strongest.keypoints.push_back(features.keypoints[order[i]]);
+    features.descriptors.row(order[i]).copyTo(strongest.descriptors.row(static_cast<int>(i)));
+  }
+  return strongest;
+}
+
 Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
                          const map::DescriptorIndex& index, const RelocalizerOptions& options)
     : map_(map),
       camera_(camera),
       index_(index),
       options_(options),
-      extractor_(options.features),
+      reduced_(SiftReducesFrame(camera, options)),
+      extractor_(ActiveFeatures(camera, options)),
       sift_resolution_(camera, options.sift_long_side),
       reloc_resolution_(camera, RelocSiftLongSide(camera, options)) {}
 
 int RelocSiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options) {
-  const int frame_long_side = std::max(camera.width, camera.height);
-  const bool sift_reduces = options.sift_long_side > 0 && options.sift_long_side < frame_long_side;
-  if (!sift_reduces) return options.sift_long_side;
+  if (!SiftReducesFrame(camera, options)) return options.sift_long_side;
   return options.reloc_sift_long_side > 0 ? options.reloc_sift_long_side : options.sift_long_side;
 }
 
@@ -95,7 +127,13 @@ RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
   return result;
 }
 
-RelocalizationResult Relocalizer::Relocalize(const Features& features) const {
+RelocalizationResult Relocalizer::Relocalize(const Features& given) const {
+  // Guided matching's features of a reduced frame: the strongest, as relocalization's own SIFT
+  // would have kept (global matching's cost grows with the keypoints queried).
+  const int max_count = options_.reduced_features.max_features;
+  const bool limit = reduced_ && max_count > 0 && given.keypoints.size() > static_cast<size_t>(max_count);
+  const Features strongest = limit ? StrongestFeatures(given, max_count) : Features{};
+  const Features& features = limit ? strongest : given;
   RelocalizationResult result;
   result.keypoints = static_cast<int>(features.keypoints.size());
   const auto match_start = std::chrono::steady_clock::now();

@@ -41,12 +41,21 @@ struct Track2D3D {
 };
 
 struct RelocalizerOptions {
-  FeatureOptions features;
-  // SIFT (relocalization and the tracker's guided matching) runs on the image reduced to this
-  // longest side (0: the image given, i.e. the tracker's working resolution); keypoints come
-  // back in the given image's pixels. OpenCV's SIFT doubles its input first, so its cost grows
-  // with the pixel count: at 640 a 540x960 working frame costs ~0.45x, while the map's SIFT
-  // (COLMAP, full resolution, doubled too) still holds the coarser scales the smaller image sees.
+  // Relocalization's own SIFT (and the tracker's wide search, which shares its features), in two
+  // regimes by whether sift_long_side reduces the tracker's working frame.
+  // At the frame's own size (640x480: templeRing, the demo's room) every frame of a wide-baseline
+  // set is a relocalization and its precision is the pose's. COLMAP's contrast threshold (0.02:
+  // the weak structure the map holds) with 2000 keypoints brought templeRing's median centre
+  // error from 0.80 to 0.76 mm on a fresh default map; it stays opt-in (`arview track
+  // --sift-contrast 0.02 --max-features 2000`) until the rendered room's blurred lap is measured
+  // with it (docs/tracker.md, "COLMAP's contrast threshold").
+  FeatureOptions features = {.max_features = 1000, .contrast_threshold = 0.04};
+  // On a reduced frame (a 1080p phone) relocalization is the fallback that must be quick, and the
+  // flow and guided matching that follow restore the precision: OpenCV's threshold and 1000
+  // keypoints, and guided matching's features (TrackingOptions) are matched globally through
+  // their strongest max_features. At COLMAP's threshold phone-fox's relocalizations cost ~1.4x
+  // (more extrema to refine and describe, and to search the map for).
+  FeatureOptions reduced_features = {.max_features = 1000, .contrast_threshold = 0.04};
   int sift_long_side = 640;
   // Relocalization's own SIFT (a frame on which guided matching extracted nothing: the first of
   // a session, or after tracking was lost) on a smaller image still, this longest side, when the
@@ -95,14 +104,23 @@ class Relocalizer {
   Features ExtractAt(const cv::Mat& gray, const SiftExtractor& extractor,
                      const WorkingResolution& resolution) const;
 
+  bool reduced_ = false;  // sift_long_side reduces the working frame: reduced_features apply
   SiftExtractor extractor_;
   WorkingResolution sift_resolution_;   // the given image → the image SIFT runs on
   WorkingResolution reloc_resolution_;  // the same for relocalization's own extraction
 };
 
+// The SIFT options for frames of `camera`: options.reduced_features when sift_long_side reduces
+// them, else options.features.
+const FeatureOptions& ActiveFeatures(const calib::Camera& camera, const RelocalizerOptions& options);
+
 // The longest side of relocalization's own SIFT image for frames of `camera` (see
 // RelocalizerOptions::reloc_sift_long_side); 0: the frame as it is.
 int RelocSiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options);
+
+// The `max_count` keypoints of `features` with the strongest response (all of them when there are
+// no more), in their original order.
+Features StrongestFeatures(const Features& features, int max_count);
 
 // Pixels and world points of `matches`, in order, for the pose solver.
 void GatherCorrespondences(const Features& features, const map::Map& map,

@@ -99,6 +99,7 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
   relocalizer_ = std::make_unique<Relocalizer>(map_, resolution_.work(), index_, options.relocalization);
   FeatureOptions guided_features = options.relocalization.features;
   guided_features.max_features = options.tracking.guided_max_features;
+  guided_features.contrast_threshold = options.tracking.guided_contrast_threshold;
   guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   prefetch_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   point_stamp_.assign(map.points.size(), 0);

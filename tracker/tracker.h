@@ -71,6 +71,11 @@ struct TrackingOptions {
   // SIFT keypoints for guided matching: more than relocalization uses, since matching them
   // costs little and the tracked pose needs points spread over the whole view.
   int guided_max_features = 2000;
+  // Guided matching's SIFT contrast threshold (OpenCV's definition, FeatureOptions), at any
+  // working resolution: OpenCV's default. Its matches are searched within a few pixels of the
+  // projection, where the stronger keypoints suffice; relocalization's own SIFT on frames at
+  // their own size uses COLMAP's lower threshold (RelocalizerOptions::features).
+  double guided_contrast_threshold = 0.04;
   // Guided matching's SIFT, extracted ahead on a worker thread: when a tracked frame keeps fewer
   // flow tracks than `prefetch_below`, its SIFT is extracted in the background while the next
   // frames track on flow alone; `prefetch_lag_frames` frames later (or sooner, when the flow
