@@ -105,5 +105,36 @@ TEST(ScaleMotion, DoublesAndHalvesAMotion) {
   EXPECT_NEAR(once.q_cw.angularDistance(m.q_cw), 0, 1e-12);
 }
 
+TEST(RelocalizerFeatures, TheReducedRegimeHasItsOwnSettings) {
+  RelocalizerOptions options;
+  options.features.contrast_threshold = 0.02;
+  options.reduced_features.contrast_threshold = 0.03;
+  EXPECT_EQ(ActiveFeatures(PhoneCamera(), options).contrast_threshold, 0.03);  // 1920 > 640
+  const calib::Camera vga = calib::Camera::Pinhole(640, 480, 500, 500, 320, 240);
+  EXPECT_EQ(ActiveFeatures(vga, options).contrast_threshold, 0.02);  // seen at its own size
+  options.sift_long_side = 0;                                         // the working frame
+  EXPECT_EQ(ActiveFeatures(PhoneCamera(), options).contrast_threshold, 0.02);
+}
+
+TEST(RelocalizerFeatures, StrongestKeepsTheStrongestInTheirOrderWithTheirDescriptors) {
+  Features all;
+  const float responses[] = {0.5f, 0.9f, 0.1f, 0.9f, 0.7f};
+  all.descriptors = cv::Mat(5, 128, CV_8U);
+  for (int i = 0; i < 5; ++i) {
+    all.keypoints.emplace_back(cv::Point2f(static_cast<float>(i), 0.f), 1.f, -1.f, responses[i]);
+    all.descriptors.row(i).setTo(i);
+  }
+  const Features strongest = StrongestFeatures(all, 3);
+  ASSERT_EQ(strongest.keypoints.size(), 3u);
+  ASSERT_EQ(strongest.descriptors.rows, 3);
+  const int expected[] = {1, 3, 4};  // 0.9, 0.9, 0.7, in their original order
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(strongest.keypoints[i].pt.x, static_cast<float>(expected[i]));
+    EXPECT_EQ(strongest.descriptors.at<uint8_t>(i, 127), expected[i]);
+  }
+  EXPECT_EQ(StrongestFeatures(all, 5).keypoints.size(), 5u);
+  EXPECT_EQ(StrongestFeatures(all, 0).keypoints.size(), 5u);  // 0: all
+}
+
 }  // namespace
 }  // namespace arview::tracker
