@@ -46,9 +46,9 @@ struct RelocalizerOptions {
   // At the frame's own size (640x480: templeRing, the demo's room) every frame of a wide-baseline
   // set is a relocalization and its precision is the pose's. COLMAP's contrast threshold (0.02:
   // the weak structure the map holds) with 2000 keypoints brought templeRing's median centre
-  // error from 0.80 to 0.76 mm on a fresh default map; it stays opt-in (`arview track
-  // --sift-contrast 0.02 --max-features 2000`) until the rendered room's blurred lap is measured
-  // with it (docs/tracker.md, "COLMAP's contrast threshold").
+  // error from 0.80 to 0.76 mm on a fresh default map, but the rendered room's blurred lap went
+  // from 4.2 / 24.6 to 5.1 / 33.2 mm (median / max): opt-in (`arview track --sift-contrast 0.02
+  // --max-features 2000`; docs/tracker.md, "COLMAP's contrast threshold").
   FeatureOptions features = {.max_features = 1000, .contrast_threshold = 0.04};
   // On a reduced frame (a 1080p phone) relocalization is the fallback that must be quick, and the
   // flow and guided matching that follow restore the precision: OpenCV's threshold and 1000
