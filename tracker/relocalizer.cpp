@@ -57,7 +57,7 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
 namespace {
 
 bool SiftReducesFrame(const calib::Camera& camera, const RelocalizerOptions& options) {
-  return options.sift_long_side > 0 && options.sift_long_side < std::max(camera.width, camera.height);
+  return WorkingResolution(camera, options.sift_long_side).reduced();
 }
 
 }  // namespace
@@ -93,7 +93,6 @@ Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
       camera_(camera),
       index_(index),
       options_(options),
-      reduced_(SiftReducesFrame(camera, options)),
       extractor_(ActiveFeatures(camera, options)),
       sift_resolution_(camera, options.sift_long_side),
       reloc_resolution_(camera, RelocSiftLongSide(camera, options)) {}
@@ -131,7 +130,7 @@ RelocalizationResult Relocalizer::Relocalize(const Features& given) const {
   // Guided matching's features of a reduced frame: the strongest, as relocalization's own SIFT
   // would have kept (global matching's cost grows with the keypoints queried).
   const int max_count = options_.reduced_features.max_features;
-  const bool limit = reduced_ && max_count > 0 && given.keypoints.size() > static_cast<size_t>(max_count);
+  const bool limit = sift_resolution_.reduced() && max_count > 0 && given.keypoints.size() > static_cast<size_t>(max_count);
   const Features strongest = limit ? StrongestFeatures(given, max_count) : Features{};
   const Features& features = limit ? strongest : given;
   RelocalizationResult result;

@@ -104,9 +104,9 @@ class Relocalizer {
   Features ExtractAt(const cv::Mat& gray, const SiftExtractor& extractor,
                      const WorkingResolution& resolution) const;
 
-  bool reduced_ = false;  // sift_long_side reduces the working frame: reduced_features apply
   SiftExtractor extractor_;
-  WorkingResolution sift_resolution_;   // the given image → the image SIFT runs on
+  WorkingResolution sift_resolution_;   // the given image → the image SIFT runs on (reduced():
+                                        // reduced_features apply)
   WorkingResolution reloc_resolution_;  // the same for relocalization's own extraction
 };
 

@@ -73,8 +73,9 @@ struct TrackingOptions {
   int guided_max_features = 2000;
   // Guided matching's SIFT contrast threshold (OpenCV's definition, FeatureOptions), at any
   // working resolution: OpenCV's default. Its matches are searched within a few pixels of the
-  // projection, where the stronger keypoints suffice; relocalization's own SIFT on frames at
-  // their own size uses COLMAP's lower threshold (RelocalizerOptions::features).
+  // projection, where the stronger keypoints suffice. Kept apart from relocalization's
+  // threshold (RelocalizerOptions::features), which COLMAP's lower one can help on a set of
+  // photos; applied here too, it made the rendered room's blurred lap worse (docs/tracker.md).
   double guided_contrast_threshold = 0.04;
   // Guided matching's SIFT, extracted ahead on a worker thread: when a tracked frame keeps fewer
   // flow tracks than `prefetch_below`, its SIFT is extracted in the background while the next
