@@ -119,7 +119,7 @@ Features Relocalizer::ExtractAt(const cv::Mat& gray, const SiftExtractor& extrac
 
 RelocalizationResult Relocalizer::Relocalize(const cv::Mat& gray) const {
   const auto start = std::chrono::steady_clock::now();
-  const Features features = ExtractAt(gray, extractor_, reloc_resolution_);
+  const Features features = ExtractOwn(gray);
   const double extract_ms = MillisecondsSince(start);
   RelocalizationResult result = Relocalize(features);
   result.extract_ms = extract_ms;

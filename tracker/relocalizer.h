@@ -91,6 +91,13 @@ class Relocalizer {
   Features Extract(const cv::Mat& gray, const SiftExtractor& extractor) const {
     return ExtractAt(gray, extractor, sift_resolution_);
   }
+  // The features Relocalize(gray) extracts: its own extractor on the image reduced to
+  // reloc_sift_long_side.
+  Features ExtractOwn(const cv::Mat& gray) const { return ExtractAt(gray, extractor_, reloc_resolution_); }
+  // Whether ExtractOwn sees a smaller image than Extract (a reduced frame: phone-fox's 1080x1920).
+  bool OwnExtractionSmaller() const {
+    return reloc_resolution_.work().width < sift_resolution_.work().width;
+  }
   // Features already extracted (e.g. by guided matching of the same frame).
   RelocalizationResult Relocalize(const Features& features) const;
   const RelocalizerOptions& options() const { return options_; }
