@@ -1,5 +1,6 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
+//            [--fold-retries N]
 // arview map info <map-dir>
 
 #include <unistd.h>
@@ -35,6 +36,7 @@ struct MapArgs {
   std::string colmap = "colmap";
   std::string preset = "quality";
   int max_features = 0;  // 0: the preset's
+  int fold_retries = mapping::MapBuildOptions().fold_retries;
   std::string info_dir;
   bool info_recheck = false;
 };
@@ -94,6 +96,7 @@ void RunMap(const MapArgs& args) {
   options.colmap = args.colmap;
   if (args.preset == "fast") options.UseFastPreset();
   if (args.max_features > 0) options.max_num_features = args.max_features;
+  options.fold_retries = args.fold_retries;
   const ScopedSignalCancellation signals;
   options.cancel = signals.token();
   ProgressBar bar;
@@ -213,6 +216,12 @@ void AddMapCommand(CLI::App& app) {
                   "orientation, fewer bundle adjustments (about a third less time, about twice the error)")
       ->capture_default_str()
       ->check(CLI::IsMember({"quality", "fast"}));
+  cmd->add_option("--fold-retries", args->fold_retries,
+                  "When the self-check finds part of the path registered at wrong rotations (a fold), match and "
+                  "map again up to this many times and keep the model that agrees best with the frames' two-view "
+                  "geometry (COLMAP's matches differ from run to run; 0: keep the first model)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10));
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();

@@ -293,6 +293,65 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// A folded map (mapping/map_check.h): matching and the mapper run again, up to `retries` times,
+// until a model is not folded. Each try's database (features and matches) and model wait in
+// <out>/fold-tries/<n>/; the try that disagrees least with the two-view geometry is the one left
+// in place, and the folder is removed.
+void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& stages, const MapBuildCallbacks& cb,
+                    const std::function<void()>& match, const std::function<void()>& mapper,
+                    const std::function<void()>& read_model, MapBuildResult* result) {
+  const fs::path database = out_dir / "database.db";
+  const fs::path sparse = out_dir / "sparse";
+  const fs::path tries = out_dir / "fold-tries";
+  std::error_code ec;
+  fs::remove_all(tries, ec);
+  const auto disagreement = [&] {
+    return Percent(result->check.disagreeing_fraction) + " of " + std::to_string(result->check.two_view_pairs) + " pairs";
+  };
+  int best = 0;  // 0: the first model
+  double best_fraction = result->check.disagreeing_fraction;
+  std::string fractions = Percent(best_fraction);  // every try's, for the last note
+  int tried = 0;
+  for (; tried < retries && Folded(result->check); ++tried) {
+    if (cb.note)
+      cb.note("the model looks folded (its rotations disagree with the frames' two-view geometry in " + disagreement() +
+              "): matching again, try " + std::to_string(tried + 1) + " of " + std::to_string(retries));
+    const fs::path aside = tries / std::to_string(tried);
+    fs::create_directories(aside);
+    fs::copy_file(database, aside / "database.db", fs::copy_options::overwrite_existing);
+    fs::rename(sparse, aside / "sparse");
+    stages.Forget("match");
+    stages.Forget("map");
+    match();
+    mapper();
+    read_model();
+    fractions += ", " + Percent(result->check.disagreeing_fraction);
+    if (result->check.disagreeing_fraction < best_fraction) {
+      best = tried + 1;
+      best_fraction = result->check.disagreeing_fraction;
+    }
+  }
+  result->fold_retries = tried;
+  if (best != tried) {
+    // An earlier try disagreed least: its matches and model back in place (every try had the
+    // same stage inputs, so the stage records hold).
+    const fs::path aside = tries / std::to_string(best);
+    RemoveDatabase(database);
+    fs::rename(aside / "database.db", database);
+    fs::remove_all(sparse);
+    fs::rename(aside / "sparse", sparse);
+    read_model();
+  }
+  fs::remove_all(tries, ec);
+  if (!cb.note) return;
+  if (Folded(result->check))
+    cb.note("still folded after matching again " + std::to_string(tried) + (tried == 1 ? " time" : " times") +
+            " (the models disagree in " + fractions + " of the pairs); kept the one that disagrees least (" +
+            disagreement() + (best == 0 ? ", the first" : ", try " + std::to_string(best)) + ")");
+  else
+    cb.note("the model of try " + std::to_string(tried) + " is not folded (" + disagreement() + " disagree)");
+}
+
 }  // namespace
 
 MapCheck RecheckMap(const fs::path& map_dir) {
@@ -408,8 +467,9 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                                          options.quadratic_overlap ? "1" : "0"});
   }
   inputs += "--\n" + Joined(match_args);
+  const std::string match_inputs = inputs;
   // Half-written matches stay until the next run clears them (clearing needs room to write).
-  stage("match", inputs, [&] { ClearMatches(database); }, match_args, true, nullptr);
+  const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, match_args, true, nullptr); };
 
   const std::string refine = options.refine_intrinsics ? "1" : "0";
   std::vector<std::string> mapper_args{"mapper", "--database_path", database.string(), "--image_path",
@@ -426,27 +486,39 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
                                        std::to_string(options.ba_local_max_iterations)};
   mapper_args.insert(mapper_args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
   inputs += "--\n" + Joined(mapper_args);
-  stage(
-      "map", inputs,
-      [&] {
-        fs::remove_all(sparse, ec);
-        fs::create_directories(sparse);
-      },
-      mapper_args, fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
-
+  const std::string mapper_inputs = inputs;
+  const auto mapper = [&] {
+    stage(
+        "map", mapper_inputs,
+        [&] {
+          fs::remove_all(sparse, ec);
+          fs::create_directories(sparse);
+        },
+        mapper_args, fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
+  };
+  // The largest model read and looked at as a whole (first, so that a degenerate model is
+  // refused with the reason too).
+  const auto read_model = [&] {
+    result.model_dir = LargestModel(sparse, &result.models, cb);
+    if (result.model_dir.empty()) {
+      stages.Forget("map");
+      throw ColmapStageError("COLMAP mapper registered no images (no model in " + sparse.string() +
+                                 "): too few matches between the frames? Its output is in " + colmap.log().string(),
+                             "map", colmap.log(), {});
+    }
+    options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+    std::vector<std::vector<Eigen::Vector2f>> keypoints;
+    result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
+    result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
+  };
+  match();
+  mapper();
   t0 = std::chrono::steady_clock::now();
-  result.model_dir = LargestModel(sparse, &result.models, cb);
-  if (result.model_dir.empty()) {
-    stages.Forget("map");
-    throw ColmapStageError("COLMAP mapper registered no images (no model in " + sparse.string() +
-                               "): too few matches between the frames? Its output is in " + colmap.log().string(),
-                           "map", colmap.log(), {});
+  read_model();
+  if (Folded(result.check) && options.fold_retries > 0) {
+    RetryFoldedMap(options.fold_retries, out_dir, stages, cb, match, mapper, read_model, &result);
+    t0 = std::chrono::steady_clock::now();
   }
-  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-  std::vector<std::vector<Eigen::Vector2f>> keypoints;
-  result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
-  // The whole map looked at first, so that a degenerate model is refused with the reason too.
-  result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
   WriteMapCheck(result.check, out_dir / kMapCheckFileName);
   if (cb.warning)
     for (const std::string& w : result.check.warnings) cb.warning(w);

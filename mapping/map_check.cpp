@@ -16,16 +16,17 @@
 #include "base/stats.h"
 
 namespace arview::mapping {
-namespace {
-
-namespace fs = std::filesystem;
-using json = nlohmann::json;
 
 std::string Percent(double fraction) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(fraction < 0.1 ? 1 : 0) << 100 * fraction << "%";
   return s.str();
 }
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
 
 std::string Fixed(double v, int digits) {
   std::ostringstream s;
@@ -162,7 +163,7 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
     c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
                          " of the frames' features: the scene changed while it was filmed, or most of what was "
                          "filmed moved. Record a still scene");
-  if (c.two_view_pairs > 0 && c.disagreeing_fraction > limits.max_disagreeing_fraction) {
+  if (Folded(c, limits)) {
     std::string where;
     for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
       where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
@@ -175,11 +176,16 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
         ": COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
         "and tracking there will be off. Build the map afresh into a new --out folder (COLMAP's matches, and "
         "with them its model, differ from one build to the next; its mapper run again on the same matches "
-        "gives the same model), or map other frames");
+        "gives the same model; `arview map` matches again up to --fold-retries times before it keeps a folded "
+        "map), or map other frames");
   }
 }
 
 }  // namespace
+
+bool Folded(const MapCheck& check, const MapCheckLimits& limits) {
+  return check.two_view_pairs > 0 && check.disagreeing_fraction > limits.max_disagreeing_fraction;
+}
 
 std::optional<double> RotationDisagreementDeg(const Eigen::Matrix3d& essential, const Eigen::Matrix3d& rotation_ab) {
   if (!essential.allFinite() || essential.norm() < 1e-12) return std::nullopt;

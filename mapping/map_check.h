@@ -78,6 +78,10 @@ struct MapCheck {
   bool flagged() const { return !warnings.empty(); }
 };
 
+// Whether `check` found a fold: its rotations disagree with the two-view geometry in more of the
+// compared pairs than `limits` allow.
+bool Folded(const MapCheck& check, const MapCheckLimits& limits = {});
+
 // `keypoints[k]`: every keypoint COLMAP found in keyframe k (OpenCV pixels), observations or not.
 // `two_view`: the keyframes' two-view geometries (mapping/colmap_model.h); none: not compared.
 MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
@@ -89,6 +93,9 @@ MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vect
 inline constexpr const char* kMapCheckFileName = "check.json";
 void WriteMapCheck(const MapCheck& check, const std::filesystem::path& file);
 std::optional<MapCheck> ReadMapCheck(const std::filesystem::path& file);
+
+// A fraction as the check's messages write it: "28%", "5.8%".
+std::string Percent(double fraction);
 
 // One line of figures ("explains 34% of the features, ...").
 std::string DescribeMapCheck(const MapCheck& check);

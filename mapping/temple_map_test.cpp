@@ -13,7 +13,12 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -270,6 +275,90 @@ TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
     ASSERT_EQ(e.log_tail.size(), 2u);
     EXPECT_EQ(e.log_tail[1], "E: something broke");
   }
+}
+
+// A COLMAP that is the real one, except that its mapper's n-th run turns the first k images (by
+// id) of the model it made by 30 degrees about their own x axis, centres kept, for the n-th entry
+// k > 0 of `turned`: a fold, as COLMAP once made on phone-fox.
+fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned) {
+  fs::create_directories(dir);
+  {
+    std::ofstream list(dir / "turned.txt");
+    for (int k : turned) list << k << "\n";
+  }
+  const std::string runs = (dir / "runs").string(), text = (dir / "text").string();
+  const fs::path script = dir / "colmap.sh";
+  std::ofstream out(script);
+  // World-to-camera q, t -> turn * q, turn * t (turn: 30 degrees about x; cos 15, sin 15 degrees).
+  out << "#!/bin/sh\n"
+         "colmap \"$@\" || exit $?\n"
+         "[ \"$1\" = mapper ] || exit 0\n"
+         "n=$(cat '" << runs << "' 2>/dev/null || echo 0); n=$((n + 1)); echo $n > '" << runs << "'\n"
+         "k=$(sed -n \"${n}p\" '" << (dir / "turned.txt").string() << "')\n"
+         "[ -n \"$k\" ] && [ \"$k\" -gt 0 ] || exit 0\n"
+         "prev=; for a in \"$@\"; do [ \"$prev\" = --output_path ] && model=$a/0; prev=$a; done\n"
+         "rm -rf '" << text << "' && mkdir -p '" << text << "'\n"
+         "colmap model_converter --input_path \"$model\" --output_path '" << text << "' --output_type TXT || exit 1\n"
+         "awk -v k=$k 'BEGIN { c = 0.96592582628906831; s = 0.25881904510252074; C = 0.86602540378443865; S = 0.5 }\n"
+         "  /^#/ { print; next }\n"
+         "  { pose = !pose }\n"
+         "  pose && $1 <= k { printf \"%s %.17g %.17g %.17g %.17g %.17g %.17g %.17g\", $1, c*$2 - s*$3, c*$3 + s*$2,"
+         " c*$4 - s*$5, c*$5 + s*$4, $6, C*$7 - S*$8, S*$7 + C*$8;"
+         " for (i = 9; i <= NF; ++i) printf \" %s\", $i; print \"\"; next }\n"
+         "  { print }' '" << text << "/images.txt' > '" << text << "/turned.txt' || exit 1\n"
+         "mv '" << text << "/turned.txt' '" << text << "/images.txt'\n"
+         "exec colmap model_converter --input_path '" << text << "' --output_path \"$model\" --output_type BIN\n";
+  out.close();
+  fs::permissions(script, fs::perms::owner_all);
+  return script;
+}
+
+// A folded model is matched and mapped again; the model that disagrees least with the two-view
+// geometry stays, and nothing of the other tries is left in the folder.
+TEST_F(TempleMapTest, AFoldedModelIsMatchedAgainAndTheBestTryKept) {
+  const auto build = [&](const std::string& name, const std::vector<int>& turned, int retries,
+                         std::vector<std::string>* notes) {
+    MapBuildOptions options;
+    options.frames_spec = "0-30:2";  // 16 frames: under half the pairs to match
+    options.fold_retries = retries;
+    options.colmap = ColmapFoldingModels(scratch_ / (name + "_colmap"), turned).string();
+    MapBuildCallbacks cb;
+    cb.note = [notes](const std::string& n) { notes->push_back(n); };
+    return BuildMap(*recording_, scratch_ / name, options, cb);
+  };
+  const auto said = [](const std::vector<std::string>& notes, const std::string& text) {
+    return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+  };
+
+  // Folded, then right: the second model is kept.
+  std::vector<std::string> notes;
+  const MapBuildResult repaired = build("repaired", {4, 0}, 2, &notes);
+  EXPECT_EQ(repaired.fold_retries, 1);
+  EXPECT_FALSE(Folded(repaired.check)) << DescribeMapCheck(repaired.check);
+  EXPECT_TRUE(said(notes, "looks folded")) << ::testing::PrintToString(notes);
+  EXPECT_TRUE(said(notes, "is not folded")) << ::testing::PrintToString(notes);
+  EXPECT_FALSE(fs::exists(scratch_ / "repaired" / "fold-tries"));
+  EXPECT_FALSE(Folded(*ReadMapCheck(scratch_ / "repaired" / kMapCheckFileName)));
+  EXPECT_EQ(map::LoadMap(scratch_ / "repaired").keyframes.size(), repaired.map.keyframes.size());
+
+  // Folded less, then more, out of retries: the first is put back, with its own matches.
+  notes.clear();
+  const MapBuildResult kept = build("kept", {2, 8}, 1, &notes);
+  EXPECT_EQ(kept.fold_retries, 1);
+  EXPECT_TRUE(Folded(kept.check)) << DescribeMapCheck(kept.check);
+  EXPECT_TRUE(kept.check.flagged());
+  ASSERT_GE(notes.size(), 2u);
+  EXPECT_TRUE(said({notes.back()}, "kept the one that disagrees least")) << notes.back();
+  EXPECT_TRUE(said({notes.back()}, "the first")) << notes.back();
+  // The second try, 8 frames turned, disagreed more.
+  const std::string first = Percent(kept.check.disagreeing_fraction);
+  EXPECT_TRUE(said({notes.back()}, "disagree in " + first + ", ")) << notes.back();
+  EXPECT_FALSE(said({notes.back()}, "disagree in " + first + ", " + first + " ")) << notes.back();
+  EXPECT_FALSE(fs::exists(scratch_ / "kept" / "fold-tries"));
+  // The first try's figures, as its note gave them, are the kept model's.
+  EXPECT_TRUE(said({notes.front()}, "in " + Percent(kept.check.disagreeing_fraction) + " of " +
+                                        std::to_string(kept.check.two_view_pairs) + " pairs"))
+      << notes.front() << " / " << DescribeMapCheck(kept.check);
 }
 
 TEST_F(TempleMapTest, TruncatedModelFilesAreClearErrors) {
