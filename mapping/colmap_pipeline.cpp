@@ -296,10 +296,13 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 // A folded map (mapping/map_check.h): matching and the mapper run again, up to `retries` times,
 // until a model is not folded. Each try's database (features and matches) and model wait in
 // <out>/fold-tries/<n>/; the try that disagrees least with the two-view geometry is the one left
-// in place, and the folder is removed.
+// in place, and the folder is removed. A try that fails (a mapper that finds no initial pair on
+// other matches) ends the retries; a cancelled one puts the best try back before it stops.
+// `remember_stages` records the match and map stages as done (for the model put back).
 void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& stages, const MapBuildCallbacks& cb,
                     const std::function<void()>& match, const std::function<void()>& mapper,
-                    const std::function<void()>& read_model, MapBuildResult* result) {
+                    const std::function<void()>& read_model, const std::function<void()>& remember_stages,
+                    MapBuildResult* result) {
   const fs::path database = out_dir / "database.db";
   const fs::path sparse = out_dir / "sparse";
   const fs::path tries = out_dir / "fold-tries";
@@ -308,11 +311,20 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
   const auto disagreement = [&] {
     return Percent(result->check.disagreeing_fraction) + " of " + std::to_string(result->check.two_view_pairs) + " pairs";
   };
+  const auto put_back = [&](int k) {  // try k's matches and model in place
+    const fs::path aside = tries / std::to_string(k);
+    RemoveDatabase(database);
+    fs::rename(aside / "database.db", database);
+    fs::remove_all(sparse, ec);
+    fs::rename(aside / "sparse", sparse);
+    remember_stages();
+  };
   int best = 0;  // 0: the first model
   double best_fraction = result->check.disagreeing_fraction;
   std::string fractions = Percent(best_fraction);  // every try's, for the last note
   int tried = 0;
-  for (; tried < retries && Folded(result->check); ++tried) {
+  bool failed = false;
+  while (tried < retries && Folded(result->check)) {
     if (cb.note)
       cb.note("the model looks folded (its rotations disagree with the frames' two-view geometry in " + disagreement() +
               "): matching again, try " + std::to_string(tried + 1) + " of " + std::to_string(retries));
@@ -322,24 +334,30 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
     fs::rename(sparse, aside / "sparse");
     stages.Forget("match");
     stages.Forget("map");
-    match();
-    mapper();
-    read_model();
+    ++tried;
+    try {
+      match();
+      mapper();
+      read_model();
+    } catch (const CancelledError&) {
+      put_back(best);
+      fs::remove_all(tries, ec);
+      throw;
+    } catch (const Error& e) {
+      if (cb.note) cb.note("try " + std::to_string(tried) + " failed: " + e.what());
+      failed = true;
+      break;
+    }
     fractions += ", " + Percent(result->check.disagreeing_fraction);
     if (result->check.disagreeing_fraction < best_fraction) {
-      best = tried + 1;
+      best = tried;
       best_fraction = result->check.disagreeing_fraction;
     }
   }
   result->fold_retries = tried;
-  if (best != tried) {
-    // An earlier try disagreed least: its matches and model back in place (every try had the
-    // same stage inputs, so the stage records hold).
-    const fs::path aside = tries / std::to_string(best);
-    RemoveDatabase(database);
-    fs::rename(aside / "database.db", database);
-    fs::remove_all(sparse);
-    fs::rename(aside / "sparse", sparse);
+  if (failed || best != tried) {
+    // An earlier try disagreed least (every try had the same stage inputs).
+    put_back(best);
     read_model();
   }
   fs::remove_all(tries, ec);
@@ -516,7 +534,11 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   t0 = std::chrono::steady_clock::now();
   read_model();
   if (Folded(result.check) && options.fold_retries > 0) {
-    RetryFoldedMap(options.fold_retries, out_dir, stages, cb, match, mapper, read_model, &result);
+    const auto remember_stages = [&] {
+      stages.Save("match", match_inputs);
+      stages.Save("map", mapper_inputs);
+    };
+    RetryFoldedMap(options.fold_retries, out_dir, stages, cb, match, mapper, read_model, remember_stages, &result);
     t0 = std::chrono::steady_clock::now();
   }
   WriteMapCheck(result.check, out_dir / kMapCheckFileName);

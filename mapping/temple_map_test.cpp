@@ -279,7 +279,7 @@ TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
 
 // A COLMAP that is the real one, except that its mapper's n-th run turns the first k images (by
 // id) of the model it made by 30 degrees about their own x axis, centres kept, for the n-th entry
-// k > 0 of `turned`: a fold, as COLMAP once made on phone-fox.
+// k > 0 of `turned` (a fold, as COLMAP once made on phone-fox), and fails for k < 0.
 fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned) {
   fs::create_directories(dir);
   {
@@ -295,6 +295,7 @@ fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned
          "[ \"$1\" = mapper ] || exit 0\n"
          "n=$(cat '" << runs << "' 2>/dev/null || echo 0); n=$((n + 1)); echo $n > '" << runs << "'\n"
          "k=$(sed -n \"${n}p\" '" << (dir / "turned.txt").string() << "')\n"
+         "[ -n \"$k\" ] && [ \"$k\" -lt 0 ] && { echo 'ERROR: failed to create sparse model' >&2; exit 1; }\n"
          "[ -n \"$k\" ] && [ \"$k\" -gt 0 ] || exit 0\n"
          "prev=; for a in \"$@\"; do [ \"$prev\" = --output_path ] && model=$a/0; prev=$a; done\n"
          "rm -rf '" << text << "' && mkdir -p '" << text << "'\n"
@@ -313,52 +314,73 @@ fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned
   return script;
 }
 
-// A folded model is matched and mapped again; the model that disagrees least with the two-view
-// geometry stays, and nothing of the other tries is left in the folder.
-TEST_F(TempleMapTest, AFoldedModelIsMatchedAgainAndTheBestTryKept) {
-  const auto build = [&](const std::string& name, const std::vector<int>& turned, int retries,
-                         std::vector<std::string>* notes) {
-    MapBuildOptions options;
-    options.frames_spec = "0-30:2";  // 16 frames: under half the pairs to match
-    options.fold_retries = retries;
-    options.colmap = ColmapFoldingModels(scratch_ / (name + "_colmap"), turned).string();
-    MapBuildCallbacks cb;
-    cb.note = [notes](const std::string& n) { notes->push_back(n); };
-    return BuildMap(*recording_, scratch_ / name, options, cb);
-  };
-  const auto said = [](const std::vector<std::string>& notes, const std::string& text) {
-    return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
-  };
+// `arview map`'s pipeline on 16 of templeRing's frames (under half the pairs of the fixture's 24
+// to match) through ColmapFoldingModels(turned), with notes collected.
+MapBuildResult BuildFolding(const recordings::Recording& recording, const fs::path& out, const std::vector<int>& turned,
+                            int retries, std::vector<std::string>* notes) {
+  MapBuildOptions options;
+  options.frames_spec = "0-30:2";
+  options.fold_retries = retries;
+  options.colmap = ColmapFoldingModels(out.string() + "_colmap", turned).string();
+  MapBuildCallbacks cb;
+  cb.note = [notes](const std::string& n) { notes->push_back(n); };
+  return BuildMap(recording, out, options, cb);
+}
 
-  // Folded, then right: the second model is kept.
+bool Said(const std::vector<std::string>& notes, const std::string& text) {
+  return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+}
+
+// A folded model is matched and mapped again; the first model that is not folded is kept, and
+// nothing of the tries is left in the folder.
+TEST_F(TempleMapTest, AFoldedModelIsMatchedAgainUntilItIsNotFolded) {
   std::vector<std::string> notes;
-  const MapBuildResult repaired = build("repaired", {4, 0}, 2, &notes);
+  const fs::path out = scratch_ / "repaired";
+  const MapBuildResult repaired = BuildFolding(*recording_, out, {4, 0}, 2, &notes);
   EXPECT_EQ(repaired.fold_retries, 1);
   EXPECT_FALSE(Folded(repaired.check)) << DescribeMapCheck(repaired.check);
-  EXPECT_TRUE(said(notes, "looks folded")) << ::testing::PrintToString(notes);
-  EXPECT_TRUE(said(notes, "is not folded")) << ::testing::PrintToString(notes);
-  EXPECT_FALSE(fs::exists(scratch_ / "repaired" / "fold-tries"));
-  EXPECT_FALSE(Folded(*ReadMapCheck(scratch_ / "repaired" / kMapCheckFileName)));
-  EXPECT_EQ(map::LoadMap(scratch_ / "repaired").keyframes.size(), repaired.map.keyframes.size());
+  EXPECT_TRUE(Said(notes, "looks folded")) << ::testing::PrintToString(notes);
+  EXPECT_TRUE(Said(notes, "is not folded")) << ::testing::PrintToString(notes);
+  EXPECT_FALSE(fs::exists(out / "fold-tries"));
+  EXPECT_FALSE(Folded(*ReadMapCheck(out / kMapCheckFileName)));
+  EXPECT_EQ(map::LoadMap(out).keyframes.size(), repaired.map.keyframes.size());
+}
 
-  // Folded less, then more, out of retries: the first is put back, with its own matches.
-  notes.clear();
-  const MapBuildResult kept = build("kept", {2, 8}, 1, &notes);
+// Folded less, then more, out of retries: the first model is put back, with its own matches.
+TEST_F(TempleMapTest, AllTriesFoldedKeepsTheOneThatDisagreesLeast) {
+  std::vector<std::string> notes;
+  const fs::path out = scratch_ / "kept";
+  const MapBuildResult kept = BuildFolding(*recording_, out, {2, 8}, 1, &notes);
   EXPECT_EQ(kept.fold_retries, 1);
   EXPECT_TRUE(Folded(kept.check)) << DescribeMapCheck(kept.check);
   EXPECT_TRUE(kept.check.flagged());
   ASSERT_GE(notes.size(), 2u);
-  EXPECT_TRUE(said({notes.back()}, "kept the one that disagrees least")) << notes.back();
-  EXPECT_TRUE(said({notes.back()}, "the first")) << notes.back();
+  EXPECT_TRUE(Said({notes.back()}, "kept the one that disagrees least")) << notes.back();
+  EXPECT_TRUE(Said({notes.back()}, "the first")) << notes.back();
   // The second try, 8 frames turned, disagreed more.
   const std::string first = Percent(kept.check.disagreeing_fraction);
-  EXPECT_TRUE(said({notes.back()}, "disagree in " + first + ", ")) << notes.back();
-  EXPECT_FALSE(said({notes.back()}, "disagree in " + first + ", " + first + " ")) << notes.back();
-  EXPECT_FALSE(fs::exists(scratch_ / "kept" / "fold-tries"));
+  EXPECT_TRUE(Said({notes.back()}, "disagree in " + first + ", ")) << notes.back();
+  EXPECT_FALSE(Said({notes.back()}, "disagree in " + first + ", " + first + " ")) << notes.back();
+  EXPECT_FALSE(fs::exists(out / "fold-tries"));
   // The first try's figures, as its note gave them, are the kept model's.
-  EXPECT_TRUE(said({notes.front()}, "in " + Percent(kept.check.disagreeing_fraction) + " of " +
-                                        std::to_string(kept.check.two_view_pairs) + " pairs"))
+  EXPECT_TRUE(Said({notes.front()}, "in " + first + " of " + std::to_string(kept.check.two_view_pairs) + " pairs"))
       << notes.front() << " / " << DescribeMapCheck(kept.check);
+}
+
+// Folded, then the mapper fails on the new matches: the first model is put back, with its stages
+// recorded (a re-run skips them, then tries again).
+TEST_F(TempleMapTest, AFailedTryPutsTheFoldedModelBack) {
+  std::vector<std::string> notes;
+  const fs::path out = scratch_ / "after_failure";
+  const MapBuildResult after_failure = BuildFolding(*recording_, out, {4, -1}, 2, &notes);
+  EXPECT_EQ(after_failure.fold_retries, 1);
+  EXPECT_TRUE(Folded(after_failure.check));
+  EXPECT_TRUE(Said(notes, "try 1 failed: COLMAP mapper")) << ::testing::PrintToString(notes);
+  EXPECT_TRUE(Said({notes.back()}, "the first")) << notes.back();
+  EXPECT_FALSE(fs::exists(out / "fold-tries"));
+  EXPECT_TRUE(fs::exists(out / "stages" / "match.inputs"));
+  EXPECT_TRUE(fs::exists(out / "stages" / "map.inputs"));
+  EXPECT_EQ(map::LoadMap(out).keyframes.size(), after_failure.map.keyframes.size());
 }
 
 TEST_F(TempleMapTest, TruncatedModelFilesAreClearErrors) {
