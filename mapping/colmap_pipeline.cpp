@@ -323,7 +323,6 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
   double best_fraction = result->check.disagreeing_fraction;
   std::string fractions = Percent(best_fraction);  // every try's, for the last note
   int tried = 0;
-  bool failed = false;
   while (tried < retries && Folded(result->check)) {
     if (cb.note)
       cb.note("the model looks folded (its rotations disagree with the frames' two-view geometry in " + disagreement() +
@@ -345,8 +344,7 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
       throw;
     } catch (const Error& e) {
       if (cb.note) cb.note("try " + std::to_string(tried) + " failed: " + e.what());
-      failed = true;
-      break;
+      break;  // best < tried: put back below
     }
     fractions += ", " + Percent(result->check.disagreeing_fraction);
     if (result->check.disagreeing_fraction < best_fraction) {
@@ -355,7 +353,7 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
     }
   }
   result->fold_retries = tried;
-  if (failed || best != tried) {
+  if (best != tried) {
     // An earlier try disagreed least (every try had the same stage inputs).
     put_back(best);
     read_model();
