@@ -284,11 +284,14 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
   cmd->add_option("--max-features", a->max_features,
                   "SIFT keypoints relocalization extracts (strongest kept) on frames SIFT sees at their own size "
-                  "(--sift-size does not reduce them)")
+                  "(--sift-size does not reduce them) and that have no prior pose: a set of photos, a video's first "
+                  "frame and those after a loss")
       ->capture_default_str()->check(CLI::Range(50, 100000));
   cmd->add_option("--sift-contrast", a->sift_contrast,
-                  "SIFT contrast threshold (OpenCV's definition) on frames SIFT sees at their own size; 0.02 is the "
-                  "test of COLMAP's default peak threshold, with which the map's features were extracted")
+                  "SIFT contrast threshold (OpenCV's definition) of relocalization on frames SIFT sees at their own "
+                  "size; 0.02 is the test of COLMAP's default peak threshold, with which the map's features were "
+                  "extracted (OpenCV's default: 0.04). Below --guided-sift-contrast, flow does not follow a "
+                  "relocalization's keypoints: the next frame starts from guided matching")
       ->capture_default_str()->check(CLI::Range(0.001, 0.5));
   cmd->add_option("--reduced-max-features", a->reduced_max_features,
                   "SIFT keypoints relocalization uses when --sift-size reduces the working frame (its own SIFT "
@@ -318,7 +321,7 @@ void AddTrackCommand(CLI::App& app) {
   cmd->add_option("--prefetch-lag", a->prefetch_lag, "Frames after which features extracted ahead are used")
       ->capture_default_str()->check(CLI::Range(1, 1000));
   cmd->add_option("--guided-sift-contrast", a->guided_sift_contrast,
-                  "SIFT contrast threshold of guided matching (any working size)")
+                  "SIFT contrast threshold of guided matching and the wide search (any working size)")
       ->capture_default_str()->check(CLI::Range(0.001, 0.5));
   cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
       ->capture_default_str()->check(CLI::Range(1.0, 200.0));

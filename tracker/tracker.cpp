@@ -101,6 +101,8 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
   guided_features.max_features = options.tracking.guided_max_features;
   guided_features.contrast_threshold = options.tracking.guided_contrast_threshold;
   guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
+  relocalization_keypoints_followed_ = ActiveFeatures(resolution_.work(), options.relocalization).contrast_threshold >=
+                                       options.tracking.guided_contrast_threshold;
   prefetch_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   point_stamp_.assign(map.points.size(), 0);
   point_keyframes_.resize(map.points.size());
@@ -545,9 +547,10 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   const calib::Pose predicted = Predict(timestamp);
   if (!*extracted) {
     const auto extract_start = std::chrono::steady_clock::now();
-    // The relocalizer's own features, so that a fallback to it matches exactly what it would
-    // have extracted itself.
-    extracted->emplace(relocalizer_->Extract(gray, relocalizer_->extractor()));
+    // Guided matching's features (a relocalization that follows reuses them): the wide search
+    // is guided matching over a wider radius, and has a prior. Relocalization's own SIFT at the
+    // frame's own size is tuned for frames without one (RelocalizerOptions::features).
+    extracted->emplace(relocalizer_->Extract(gray, *guided_extractor_));
     result->keypoints = static_cast<int>((*extracted)->keypoints.size());
     result->times.extract_ms += MillisecondsSince(extract_start);
   }
@@ -687,6 +690,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   std::string tracking_reason;
   std::optional<Features> features;
   Track2D3D inliers;
+  bool followed_by_flow = features.has_value() || relocalization_keypoints_followed_;  // whether the frame's inliers are followed into the next
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     if (!tracked) {
@@ -701,6 +705,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   } else {
     const RelocalizationResult reloc =
         features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);
+    followed_by_flow = features.has_value() || relocalization_keypoints_followed_;
     result.keypoints = reloc.keypoints;
     result.matches = reloc.matches;
     result.times.extract_ms += reloc.extract_ms;
@@ -730,7 +735,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     Reset();
   } else {
     RefineOnFullCamera(inliers, &result);
-    Remember(result, timestamp, inliers);
+    Remember(result, timestamp, followed_by_flow ? inliers : Track2D3D{});
     MaybePrefetch(gray, result);
     result.center = result.pose.Center();
     result.smoothed_center = smoother_.Filter(result.center, timestamp);

@@ -74,8 +74,9 @@ struct TrackingOptions {
   // Guided matching's SIFT contrast threshold (OpenCV's definition, FeatureOptions), at any
   // working resolution: OpenCV's default. Its matches are searched within a few pixels of the
   // projection, where the stronger keypoints suffice. Kept apart from relocalization's
-  // threshold (RelocalizerOptions::features), which COLMAP's lower one can help on a set of
-  // photos; applied here too, it made the rendered room's blurred lap worse (docs/tracker.md).
+  // threshold (RelocalizerOptions::features: COLMAP's lower one, which helps frames without a
+  // prior); applied here too, it made the rendered room's blurred lap worse (docs/tracker.md).
+  // The wide search extracts these features too.
   double guided_contrast_threshold = 0.04;
   // Guided matching's SIFT, extracted ahead on a worker thread: when a tracked frame keeps fewer
   // flow tracks than `prefetch_below`, its SIFT is extracted in the background while the next
@@ -279,6 +280,12 @@ class Tracker {
   map::DescriptorIndex index_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<SiftExtractor> guided_extractor_;
+  // Whether the inliers of a relocalization on its own SIFT are followed by flow into the next
+  // frame: only when that SIFT keeps no weaker keypoints than guided matching's. Flow follows a
+  // keypoint's image patch, so the keypoint's localization error stays with the track for as long
+  // as it lives; a weak keypoint (COLMAP's contrast threshold) is placed less exactly. Otherwise
+  // the next frame starts from guided matching around the relocalised pose.
+  bool relocalization_keypoints_followed_ = true;
   std::unique_ptr<SiftExtractor> prefetch_extractor_;  // the worker's own, the same settings
   std::unique_ptr<Prefetch> prefetch_;                 // an extraction ahead, pending or done
   std::int64_t frames_tracked_ = 0;                    // Track() calls, for the prefetch's lag

@@ -193,6 +193,29 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   ExpectNear(r, far, 0.003, 0.2);
 }
 
+// A relocalization without a prior pose extracts COLMAP's weaker keypoints (contrast 0.02);
+// flow would carry their localization error along, so the next frame starts from guided
+// matching around the relocalised pose. With relocalization at guided matching's threshold its
+// inliers are followed by flow.
+TEST_F(PlanarTrackerTest, FlowFollowsARelocalizationOnlyOnKeypointsAsStrongAsGuidedMatchings) {
+  for (const double contrast : {0.02, 0.04}) {
+    TrackerOptions options;
+    options.relocalization.features.contrast_threshold = contrast;
+    Tracker tracker(*map_, options);
+    const FrameResult first = tracker.Track(world_->Render(PathPose(0)), 0.0);
+    ASSERT_EQ(first.status, TrackStatus::kRelocalized) << first.reason;
+    const FrameResult next = tracker.Track(world_->Render(PathPose(1)), 1 / 30.0);
+    ASSERT_EQ(next.status, TrackStatus::kTracking) << next.reason;
+    ExpectNear(next, PathPose(1), 0.003, 0.2);
+    if (contrast < options.tracking.guided_contrast_threshold) {
+      EXPECT_EQ(next.flow_tracks, 0) << "contrast " << contrast;
+      EXPECT_GE(next.guided_matches, options.tracking.min_inliers) << "contrast " << contrast;
+    } else {
+      EXPECT_GT(next.flow_tracks, options.tracking.min_inliers) << "contrast " << contrast;
+    }
+  }
+}
+
 // WarmUp runs each step on a blank frame and must leave nothing behind: the same poses, bit for
 // bit, as a tracker that did not warm up, from the first frame (a relocalization) on.
 TEST_F(PlanarTrackerTest, WarmUpChangesNoResult) {
