@@ -690,7 +690,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   std::string tracking_reason;
   std::optional<Features> features;
   Track2D3D inliers;
-  bool followed_by_flow = features.has_value() || relocalization_keypoints_followed_;  // whether the frame's inliers are followed into the next
+  bool followed_by_flow = true;  // whether the frame's inliers are followed into the next
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     if (!tracked) {

@@ -213,6 +213,13 @@ TEST_F(PlanarTrackerTest, FlowFollowsARelocalizationOnlyOnKeypointsAsStrongAsGui
     } else {
       EXPECT_GT(next.flow_tracks, options.tracking.min_inliers) << "contrast " << contrast;
     }
+    // Tracked frames are followed by flow either way: no further SIFT.
+    for (int i = 2; i < 6; ++i) {
+      const FrameResult r = tracker.Track(world_->Render(PathPose(i)), i / 30.0);
+      ASSERT_EQ(r.status, TrackStatus::kTracking) << r.reason;
+      EXPECT_GT(r.flow_tracks, options.tracking.min_inliers) << "contrast " << contrast << ", frame " << i;
+      EXPECT_EQ(r.keypoints, 0) << "contrast " << contrast << ", frame " << i;
+    }
   }
 }
 
