@@ -42,7 +42,9 @@ struct TrackArgs {
   double reduced_sift_contrast = tracker::RelocalizerOptions{}.reduced_features.contrast_threshold;
   double guided_sift_contrast = tracker::TrackingOptions{}.guided_contrast_threshold;
   double ratio = 0.8;
-  double ransac_threshold_px = 4.0;
+  double ransac_threshold_px = tracker::RelocalizerOptions{}.pose.ransac_threshold_px;
+  double inlier_threshold_px = tracker::RelocalizerOptions{}.pose.inlier_threshold_px;
+  double tracking_ransac_threshold_px = tracker::TrackingOptions{}.ransac_threshold_px;
   int ransac_iterations = 1000;
   int min_inliers = 12;
   double max_rms_px = 2.5;
@@ -77,7 +79,8 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.relocalization.reduced_features.contrast_threshold = a.reduced_sift_contrast;
   o.relocalization.matching.ratio = a.ratio;
   o.relocalization.pose.ransac_threshold_px = a.ransac_threshold_px;
-  o.relocalization.pose.inlier_threshold_px = a.ransac_threshold_px;
+  o.relocalization.pose.inlier_threshold_px = a.inlier_threshold_px;
+  o.tracking.ransac_threshold_px = a.tracking_ransac_threshold_px;
   o.relocalization.pose.ransac_max_iterations = a.ransac_iterations;
   o.relocalization.pose.min_inliers = a.min_inliers;
   o.relocalization.pose.max_rms_px = a.max_rms_px;
@@ -302,7 +305,14 @@ void AddTrackCommand(CLI::App& app) {
                   "(OpenCV's default 0.04: fewer, stronger keypoints, quicker)")
       ->capture_default_str()->check(CLI::Range(0.001, 0.5));
   cmd->add_option("--ratio", a->ratio, "Ratio test of global matching")->capture_default_str()->check(CLI::Range(0.1, 1.0));
-  cmd->add_option("--ransac-threshold", a->ransac_threshold_px, "Inlier threshold, pixels")
+  cmd->add_option("--ransac-threshold", a->ransac_threshold_px,
+                  "RANSAC's inlier threshold when relocalising, working pixels (the pose is refined on its inliers)")
+      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
+  cmd->add_option("--tracking-ransac-threshold", a->tracking_ransac_threshold_px,
+                  "RANSAC's inlier threshold when tracking and in the wide search, working pixels")
+      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
+  cmd->add_option("--inlier-threshold", a->inlier_threshold_px,
+                  "Inlier threshold after refinement (the inliers counted, followed and gated), working pixels")
       ->capture_default_str()->check(CLI::Range(0.1, 50.0));
   cmd->add_option("--ransac-iterations", a->ransac_iterations, "RANSAC iterations when relocalising")
       ->capture_default_str()->check(CLI::Range(1, 1000000));

@@ -175,6 +175,10 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
   } cases[] = {
       {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--ratio", "nan"}, "--ratio"},
       {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--max-rms", "inf"}, "--max-rms"},
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--tracking-ransac-threshold", "nan"},
+       "--tracking-ransac-threshold"},
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--inlier-threshold", "-1"},
+       "--inlier-threshold"},
       {{"render", "--scene", "s.yaml", "--camera", "c.yaml", "--pose", "0 0 0 0 0 0 1", "--out", tmp + "/o.png", "--time",
         "nan"},
        "--time"},

@@ -417,6 +417,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
 
   AbsolutePoseOptions pose_options = options_.relocalization.pose;
   pose_options.ransac_max_iterations = opt.ransac_max_iterations;
+  pose_options.ransac_threshold_px = opt.ransac_threshold_px;
   pose_options.min_inliers = opt.min_inliers;
   pose_options.max_rms_px = rms_gate_.Gate();
   pose_options.seed += frame_counter_;
@@ -589,6 +590,7 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   GatherCorrespondences(features, map_, matches, &pixels, &points);
   AbsolutePoseOptions pose_options = options_.relocalization.pose;
   pose_options.ransac_max_iterations = opt.wide_ransac_iterations;
+  pose_options.ransac_threshold_px = opt.ransac_threshold_px;
   pose_options.min_inliers = opt.min_inliers;
   pose_options.max_rms_px = rms_gate_.Gate();
   pose_options.seed += frame_counter_;

@@ -96,6 +96,10 @@ struct TrackingOptions {
   // are at least this fraction of the correspondences, else a short RANSAC runs.
   double prior_min_inlier_ratio = 0.5;
   int ransac_max_iterations = 50;  // the inlier ratio is high when tracking
+  // RANSAC's inlier threshold of tracking and the wide search (relocalization has its own,
+  // RelocalizerOptions::pose): a tracked frame's correspondences come from flow and guided
+  // matching on a moving, often blurred camera.
+  double ransac_threshold_px = 4.0;
   // A RANSAC pose turned further than this from the prediction is refused (a P3P solution
   // mirrored on a nearly planar patch explains the points almost as well as the true one).
   double max_rotation_from_prediction_deg = 20;
