@@ -415,12 +415,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   result->flow_tracks = static_cast<int>(pixels.size());
   result->times.flow_ms = MillisecondsSince(flow_start);
 
-  AbsolutePoseOptions pose_options = options_.relocalization.pose;
-  pose_options.ransac_max_iterations = opt.ransac_max_iterations;
-  pose_options.ransac_threshold_px = opt.ransac_threshold_px;
-  pose_options.min_inliers = opt.min_inliers;
-  pose_options.max_rms_px = rms_gate_.Gate();
-  pose_options.seed += frame_counter_;
+  AbsolutePoseOptions pose_options = TrackedPoseOptions(opt.ransac_max_iterations);
   pose_options.prior = predicted;
   result->rms_gate_px = rms_gate_.Gate();
 
@@ -540,6 +535,17 @@ bool Tracker::TrackByAlignment(const std::vector<cv::Mat>& reference_pyramid, co
   return true;
 }
 
+AbsolutePoseOptions Tracker::TrackedPoseOptions(int ransac_iterations) const {
+  const TrackingOptions& opt = options_.tracking;
+  AbsolutePoseOptions pose_options = options_.relocalization.pose;
+  pose_options.ransac_max_iterations = ransac_iterations;
+  pose_options.ransac_threshold_px = opt.ransac_threshold_px;
+  pose_options.min_inliers = opt.min_inliers;
+  pose_options.max_rms_px = rms_gate_.Gate();
+  pose_options.seed += frame_counter_;
+  return pose_options;
+}
+
 bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                         std::optional<Features>* extracted, Track2D3D* tracked_inliers) {
   const TrackingOptions& opt = options_.tracking;
@@ -588,12 +594,7 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Vector3d> points;
   GatherCorrespondences(features, map_, matches, &pixels, &points);
-  AbsolutePoseOptions pose_options = options_.relocalization.pose;
-  pose_options.ransac_max_iterations = opt.wide_ransac_iterations;
-  pose_options.ransac_threshold_px = opt.ransac_threshold_px;
-  pose_options.min_inliers = opt.min_inliers;
-  pose_options.max_rms_px = rms_gate_.Gate();
-  pose_options.seed += frame_counter_;
+  const AbsolutePoseOptions pose_options = TrackedPoseOptions(opt.wide_ransac_iterations);
   const AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
   CopyStats(pose, result);
   if (!pose.ok) {
@@ -692,7 +693,6 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   std::string tracking_reason;
   std::optional<Features> features;
   Track2D3D inliers;
-  bool followed_by_flow = true;  // whether the frame's inliers are followed into the next
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     if (!tracked) {
@@ -707,7 +707,6 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   } else {
     const RelocalizationResult reloc =
         features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);
-    followed_by_flow = features.has_value() || relocalization_keypoints_followed_;
     result.keypoints = reloc.keypoints;
     result.matches = reloc.matches;
     result.times.extract_ms += reloc.extract_ms;
@@ -737,6 +736,10 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     Reset();
   } else {
     RefineOnFullCamera(inliers, &result);
+    // A relocalization on its own SIFT (no features were extracted before it) may hold weaker
+    // keypoints than flow should follow (relocalization_keypoints_followed_).
+    const bool followed_by_flow =
+        result.status != TrackStatus::kRelocalized || features.has_value() || relocalization_keypoints_followed_;
     Remember(result, timestamp, followed_by_flow ? inliers : Track2D3D{});
     MaybePrefetch(gray, result);
     result.center = result.pose.Center();

@@ -253,6 +253,10 @@ class Tracker {
                         FrameResult* result) const;
   calib::Pose Predict(double timestamp) const;
   void RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const;
+  // The pose solver's options for a tracked frame (flow and guided matching, the wide search):
+  // relocalization's, with tracking's RANSAC threshold, inlier count and RMS gate, and a seed
+  // that changes with frame_counter_.
+  AbsolutePoseOptions TrackedPoseOptions(int ransac_iterations) const;
   void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
   // Starts extracting this frame's guided features on a worker thread when its flow tracks are
   // thinning (TrackingOptions::prefetch_below).
