@@ -7,6 +7,7 @@
 #include "app/commands.h"
 #include "app/numeric_flags.h"
 #include "base/cancellation.h"
+#include "base/heap_reuse.h"
 #include "figure/humanoid.h"
 
 namespace arview::app {
@@ -45,6 +46,7 @@ std::string OneLine(const std::string& text) {
 
 int main(int argc, char** argv) {
   using namespace arview::app;
+  arview::KeepFreedHeapForReuse();  // SIFT's scale space reused from frame to frame (base/heap_reuse.h)
   arview::figure::RegisterBuiltinCharacters();  // "builtin:figure" wherever an asset is named
   CLI::App app{"arview: marker-less augmented reality with view-adaptive characters", "arview"};
   app.require_subcommand(1);

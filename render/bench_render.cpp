@@ -27,6 +27,7 @@
 
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
+#include "base/heap_reuse.h"
 #include "render/ar_renderer.h"
 #include "render/synth_room.h"
 #include "tests/support/test_data.h"
@@ -312,6 +313,7 @@ BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 }  // namespace arview::render
 
 int main(int argc, char** argv) {
+  arview::KeepFreedHeapForReuse();  // as app/main.cpp does, so that the figures are the app's
   // Our own flags first (Google Benchmark rejects unknown ones).
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {

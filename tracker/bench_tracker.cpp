@@ -26,6 +26,7 @@
 #include "map/map_file.h"
 #include "recordings/accuracy.h"
 #include "recordings/recording.h"
+#include "base/heap_reuse.h"
 #include "base/stats.h"
 #include "tracker/refine_pose_ceres_reference.h"
 #include "tracker/test_planar_scene.h"
@@ -506,6 +507,7 @@ BENCHMARK(BM_RealCorrespondences_OpenCV_RansacRefineLM)->Arg(cv::SOLVEPNP_P3P)->
 
 int main(int argc, char** argv) {
   cv::setNumThreads(1);
+  arview::KeepFreedHeapForReuse();  // as app/main.cpp does, so that the figures are the app's
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     const std::string arg = argv[i];
