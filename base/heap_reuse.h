@@ -3,14 +3,16 @@
 // the kernel and faulted in again.
 //
 // Why: OpenCV's SIFT allocates its scale space afresh on every call (the doubled image and
-// two pyramids of float images: ~100 MB for a 360x640 frame) and frees it on return. glibc's
-// defaults serve blocks above a threshold (128 KiB, raised dynamically to the largest block
-// freed) by mmap and trim the heap's top once more than twice that is free, so every
-// extraction touched ~100 MB of fresh pages again: on phone-fox (1080x1920) a guided-matching
-// frame cost ~140 ms CPU, of which ~95 ms were page faults and zeroing, and the frame after it
-// ~10 ms instead of ~3 ms (docs/tracker.md, "2026-12-04 (night): the heap kept for the next frame").
-// With the heap kept, the memory at the process's peak stays mapped: peak resident memory is
-// unchanged (170 against 162 MB on phone-fox), only no longer returned between frames.
+// two pyramids of float images, tens of MB for a 360x640 frame) and frees it on return.
+// glibc's defaults serve blocks above a threshold (128 KiB, raised dynamically to the largest
+// block freed) by mmap and trim the heap's top once more than twice that is free, so an
+// extraction could fault all of it in again. It did in `arview track` on phone-fox
+// (1080x1920; the tracker on the main thread): ~7 000 minor page faults an extraction, and a
+// guided-matching frame cost 153 ms CPU instead of 50, a relocalization 88-98 ms instead of
+// 41, the frame after a guided one ~10 ms instead of ~3 (docs/tracker.md, "2026-12-04
+// (night)"). With the heap kept, memory up to the process's peak stays mapped: the peak
+// itself is unchanged (184 against 177 MB on phone-fox), it is only no longer returned
+// between frames.
 //
 // Called once at the start of the programs that process frames (app/main.cpp, the frame
 // benchmarks). Under AddressSanitizer, whose allocator ignores mallopt, it does nothing.
