@@ -48,6 +48,8 @@ struct AnimatorOptions {
   std::vector<DistanceWeight> distance_weights;
 };
 
+// The one description of an animated frame, from the animator (or PlacedCharacter::Update) to the
+// renderer, the overlay and the statistics.
 struct AnimatorFrame {
   std::span<const Eigen::Matrix4f> skinning_matrices;
   std::span<const DualQuatf> skinning_dual_quats;
@@ -57,7 +59,12 @@ struct AnimatorFrame {
   double view_gain = 0;                       // the view-adaptive action's gain now (0..1)
   Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // the one used (held while lost)
   bool converged = true;                      // DIB converged on every joint
+  int max_iterations = 0;                     // DIB, the worst joint (PlacedCharacter::Update)
   int triggered = 0;                          // distance triggers fired this frame
+
+  // The weight of the layers below the view-adaptive action (the idle): 0 while the viewer is
+  // tracked, 1 once the view-adaptive action has faded out (or where there is none).
+  double idle_weight() const { return 1.0 - view_gain; }
 };
 
 class Animator {

@@ -1,5 +1,5 @@
 #pragma once
-// Balance shifts (thesis §3.3, PAPERS.md §3): the idle layer's slow part. A person standing
+// Balance shifts (thesis §3.3, docs/method.md §3): the idle layer's slow part. A person standing
 // rests with the weight on the left foot, on the right, or on both, and now and then shifts it.
 // The model (learned by anim_authoring/balance.h from a recording of a person standing, never
 // invented) holds, in the idle model's posture layout (idle.h):

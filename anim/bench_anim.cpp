@@ -12,6 +12,7 @@
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
+#include "anim_authoring/character_builder.h"
 #include "anim/pose.h"
 #include "anim/animator.h"
 #include "anim_authoring/scene.h"
@@ -191,7 +192,7 @@ void BM_FoxUpdate(benchmark::State& state) {
   double t = 0;
   for (auto _ : state) {
     t += 1.0 / 60;
-    const FrameOutput& out = ch.Update(DirectionFromAzimuthElevation(100 * t, 0), t);
+    const AnimatorFrame& out = ch.Update(DirectionFromAzimuthElevation(100 * t, 0), t);
     benchmark::DoNotOptimize(out.skinning_matrices.data());
   }
   state.SetLabel(std::string(state.range(0) ? "DIB" : "DLB") + (state.range(1) ? " nlerp" : " slerp"));

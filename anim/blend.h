@@ -1,5 +1,5 @@
 #pragma once
-// Blending of K unit dual quaternions with convex weights (PAPERS.md §1, Eq. 4 and Algorithm 1).
+// Blending of K unit dual quaternions with convex weights (docs/method.md §1, Eq. 4 and Algorithm 1).
 //
 //   DualQuatd b = Dlb<double>(qs, ws);                      // closed form, one normalisation
 //   DibResult<double> r = Dib<double>(qs, ws, {1e-3, 32});   // iterative, exact blend

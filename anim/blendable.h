@@ -1,5 +1,5 @@
 #pragma once
-// Blendable objects of the MIRAnim engine (thesis §4.2.1, PAPERS.md §2): anything that maps a
+// Blendable objects of the MIRAnim engine (thesis §4.2.1, docs/method.md §2): anything that maps a
 // time to a pose of one skeleton, with or without a fixed duration. Clips, static poses, the
 // view-adaptive blend (view_adaptive.h), the idle synthesizer (idle.h) and schedules
 // (schedule.h) are blendable; modifiers wrap a blendable and are blendable again.

@@ -1,5 +1,5 @@
 #pragma once
-// Blending parameters of the MIRAnim engine (thesis §4.2.2, PAPERS.md §2): how much of an
+// Blending parameters of the MIRAnim engine (thesis §4.2.2, docs/method.md §2): how much of an
 // action enters the blend, per joint and over time.
 //
 //   Curve fade = Curve::CosineFade(0.2, 0.2);        // in and out over 20% of the action each

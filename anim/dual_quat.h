@@ -1,5 +1,5 @@
 #pragma once
-// Unit dual quaternions for rigid transforms (PAPERS.md §1, Eq. 1), header-only, for float and
+// Unit dual quaternions for rigid transforms (docs/method.md §1, Eq. 1), header-only, for float and
 // double: q̂ = r + ε d with r the rotation and d = ½ (0, t) r.
 //
 //   DualQuatd q = DualQuatd::FromRotationTranslation(R, t);

@@ -1,5 +1,5 @@
 #pragma once
-// Idle motion (thesis chapter 3, PAPERS.md §3): small posture variations synthesised on the
+// Idle motion (thesis chapter 3, docs/method.md §3): small posture variations synthesised on the
 // principal components of standing postures, so that joints vary together as in the data.
 //
 // A posture is a vector: per animated joint the exponential map of its rotation relative to the

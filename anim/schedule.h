@@ -1,5 +1,5 @@
 #pragma once
-// The blending schedule and frame blender of the MIRAnim engine (thesis §4.2.2, PAPERS.md §2).
+// The blending schedule and frame blender of the MIRAnim engine (thesis §4.2.2, docs/method.md §2).
 //
 //   Schedule s(skeleton, {BlendMethod::kDlb});
 //   int idle = s.Add({idle_synth, {}, 0.0, /*keep_rendering=*/true, "idle"});

@@ -1,5 +1,5 @@
 #pragma once
-// The view-adaptive blend (PAPERS.md §1, Algorithm 2) as a runtime object: K key clips tied to
+// The view-adaptive blend (docs/method.md §1, Algorithm 2) as a runtime object: K key clips tied to
 // key viewpoints, weighted by the current viewpoint (view_sphere.h) and blended joint by joint
 // (DLB or DIB). Built once from clips already prepared (anim_authoring/ loads assets and
 // generates look-at and gesture keys); sampled every frame without allocating. It is a

@@ -1,5 +1,5 @@
 #pragma once
-// Weights of the key viewpoints for the current viewpoint (PAPERS.md §1, Eq. 2), and a
+// Weights of the key viewpoints for the current viewpoint (docs/method.md §1, Eq. 2), and a
 // local-support alternative.
 //
 //   ViewSphere sphere(key_directions, {WeightingMode::kInverseDistance, DistanceKind::kGeodesic, 3.0});

@@ -1,5 +1,5 @@
 #pragma once
-// What a recording holds for balance shifts (thesis §3.3, PAPERS.md §3): the thesis learns
+// What a recording holds for balance shifts (thesis §3.3, docs/method.md §3): the thesis learns
 // resting-posture categories (weight on the left foot, on the right foot, on both), the
 // recorded transitions between them, transition probabilities and dwell times, from a person
 // standing. Before any of that can be learned the data must hold such standing: this measures,

@@ -5,6 +5,7 @@
 // option; and what every recording on this machine holds (printed as [balance] lines;
 // docs/anim.md quotes them): no transition, so the learner refuses each with its reason.
 
+#include "anim_authoring/animator_builder.h"
 #include "anim_authoring/balance.h"
 #include "anim/schedule.h"
 #include "anim_authoring/import.h"

@@ -1,6 +1,7 @@
 // The paper's claim, checked on real rigs: with key animations that look toward 8 viewpoints
 // around the horizon, the blended character's head points at viewpoints between the keys.
 
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
@@ -32,7 +33,7 @@ GazeStats MeasureGaze(const fs::path& asset, const std::string& method, const st
     for (double offset : {10.0, 22.5, 35.0})
       for (double t : {0.0, 0.37, 0.81, 1.6, 2.9}) {
         const Eigen::Vector3d v = DirectionFromAzimuthElevation(45 * k + offset, elevation);
-        const FrameOutput& out = ch.Update(v, t);
+        const AnimatorFrame& out = ch.Update(v, t);
         EXPECT_TRUE(out.converged);
         const Eigen::Vector3d f = HeadForward(chain, out.model);
         angles.push_back(std::atan2(f.cross(v).norm(), f.dot(v)) * 180 / M_PI);

@@ -20,6 +20,7 @@
 //   Eigen::Vector3d d = GestureDirection(arm, Gesture::kPoint, model_pose);   // for checks
 
 #include "anim/character.h"
+#include "anim/chains.h"
 #include "anim/pose.h"
 #include "anim_authoring/lookat.h"
 #include "base/enum_table.h"
@@ -37,21 +38,6 @@ constexpr auto EnumNames(Gesture) {
 
 enum class ArmSide { kRight, kLeft };
 constexpr auto EnumNames(ArmSide) { return EnumTable<ArmSide, 2>{{{ArmSide::kRight, "right"}, {ArmSide::kLeft, "left"}}}; }
-
-struct ArmLimits {
-  double elbow_min_deg = 0, elbow_max_deg = 150;  // bend: 0 = straight
-  double shoulder_cone_deg = 100;                 // half-angle, (0, 180]
-  double point_bend_deg = 10, reach_bend_deg = 40;
-};
-
-struct ArmChain {
-  int upper = -1, fore = -1, hand = -1;  // joints: shoulder (upper arm), elbow (forearm), wrist (hand)
-  ArmLimits limits;
-  // In the frame of the upper arm's parent joint (the skeleton's root_parent if none), fixed at
-  // the rest pose: the shoulder cone's axis and the direction the elbow drops toward.
-  Eigen::Vector3d cone_axis_parent = Eigen::Vector3d::UnitZ();
-  Eigen::Vector3d pole_parent = -Eigen::Vector3d::UnitY();
-};
 
 // Upper arm, forearm and hand of one side found by name in common rigs: the wrist (CMU's
 // "rwrist") or else hand joint ("RightHand", "mixamorig:RightHand", "B_Hand_Right", "hand_r")

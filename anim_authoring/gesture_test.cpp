@@ -3,6 +3,7 @@
 // a direction the shoulder cannot reach is clamped toward it, not flipped; a rig without arms
 // is refused with a clear message.
 
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/gesture.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
@@ -52,8 +53,8 @@ GestureStats Measure(const std::string& asset, const std::string& gesture, const
     const Eigen::Vector3d v = scene.characters[0].keys[0].viewpoint;
     // On the key clip's 30 Hz samples and between them (interpolated).
     for (double t : {0.0, 0.4, 0.37, 1.1, 1.23, 1.9}) {
-      const FrameOutput& out = ch.Update(v, t);
-      EXPECT_NEAR(out.weights[0], 1.0, 1e-9);
+      const AnimatorFrame& out = ch.Update(v, t);
+      EXPECT_NEAR(out.key_weights[0], 1.0, 1e-9);
       const double deg = AngleDeg(GestureDirection(arm, g, out.model), v);
       const double elbow = ElbowBendDeg(arm, out.model);
       const double cone = ShoulderConeAngleDeg(ch.character().skeleton, arm, out.model);

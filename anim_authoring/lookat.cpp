@@ -109,10 +109,6 @@ LookAtChain MakeLookAtChain(const Skeleton& sk, const std::vector<std::string>& 
   return chain;
 }
 
-Eigen::Vector3d HeadForward(const LookAtChain& chain, std::span<const Eigen::Matrix4d> model) {
-  return RotationOf(model[chain.joints.back()]) * chain.head_forward_local;
-}
-
 namespace {
 
 // Refreshes the model transforms of joint j and everything below it (children follow parents).

@@ -17,6 +17,7 @@
 //   Eigen::Vector3d f = HeadForward(chain, model_pose);   // for checks
 
 #include "anim/character.h"
+#include "anim/chains.h"
 #include "anim/pose.h"
 
 #include <span>
@@ -25,13 +26,6 @@
 #include <vector>
 
 namespace arview::anim {
-
-struct LookAtChain {
-  std::vector<int> joints;              // root-most first; the last is the head
-  std::vector<double> limits_rad;       // per joint, > 0
-  Eigen::Vector3d head_forward_local = Eigen::Vector3d::UnitZ();  // in the head joint's frame
-  Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // model space: turns are yaw about it first
-};
 
 // Names of a body → spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH,
 // Fox, BCN_Epileptic, CesiumMan, Unreal/Unity humanoids): the head (or, without one, the deepest
@@ -72,8 +66,5 @@ void RotateInModel(const Skeleton& skeleton, int j, const Eigen::Quaterniond& de
 // Turns the chain toward `target` (unit, model space).
 void ApplyLookAt(const Skeleton& skeleton, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
                  std::vector<Eigen::Matrix4d>& model);
-
-// The head's forward axis in model space for a pose given as model-space joint matrices.
-Eigen::Vector3d HeadForward(const LookAtChain& chain, std::span<const Eigen::Matrix4d> model);
 
 }  // namespace arview::anim

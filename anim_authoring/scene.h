@@ -1,18 +1,11 @@
 #pragma once
-// Scene files (YAML) describing view-adaptive characters, and the runtime that animates one.
-//
-// For render/ and app/:
+// Scene files (YAML) describing view-adaptive characters: the reader (scene_reader.cpp). The
+// characters are built from them by character_builder.h, their animators by animator_builder.h.
 //
 //   Scene scene = LoadScene("scene.yaml");               // throws anim::Error (file:line: why)
 //   const CharacterSpec& spec = scene.characters[0];
-//   AnimatedCharacter fox(spec);                          // loads the asset, builds key clips
-//   const Character& c = fox.character();                 // meshes, materials, skeleton
-//   Eigen::Matrix4d model_to_map = spec.ModelToMap();     // place it in the map
-//   // every frame, with C the camera centre in map coordinates (C = −Rᵀt):
-//   Eigen::Vector3d v = spec.ViewpointFromCamera(C);      // direction in the character's frame
-//   const FrameOutput& out = fox.Update(v, time_seconds); // no allocation
-//   out.skinning_matrices[j] (Matrix4f, model space) or out.skinning_dual_quats[j] → shader;
-//   v_map = model_to_map · Σ w_i · skinning_matrices[joint_i] · v_mesh
+//   AnimatedCharacter fox(spec);                          // character_builder.h: the asset, the keys
+//   anim::Placement placement = spec.placement();         // where it stands in the map
 //
 // The scene format (paths are relative to the scene file; angles in degrees):
 //
@@ -53,6 +46,7 @@
 // Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
 
 #include "anim/character.h"
+#include "anim/placement.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
@@ -201,11 +195,8 @@ struct CharacterSpec {
   IdleSpec idle;           // `idle:`
   ScheduleSpec schedule;   // `schedule:`
 
-  // model space → map: translate(position) · rotation · uniform scale (anchor.scale · scale).
-  Eigen::Matrix4d ModelToMap() const;
-  // Unit direction from the character to a camera centre given in map coordinates, in the
-  // character's frame; zero vector if the camera sits on the anchor.
-  Eigen::Vector3d ViewpointFromCamera(const Eigen::Vector3d& camera_center_map) const;
+  // Where it stands, as the per-frame path takes it (anim/placement.h): anchor, scale, forward, up.
+  anim::Placement placement() const;
 };
 
 struct Scene {
@@ -221,92 +212,8 @@ Scene ParseScene(const std::string& text, const std::filesystem::path& file_for_
 // the text is not three finite numbers or the vector has zero length.
 Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what = "viewpoint");
 
-struct FrameOutput {
-  std::span<const double> weights;                  // one per key
-  std::span<const Eigen::Matrix4d> model;           // joint model-space transforms
-  std::span<const Eigen::Matrix4f> skinning_matrices;
-  std::span<const DualQuatf> skinning_dual_quats;   // rigid part of skinning_matrices
-  bool converged = true;                            // DIB converged on every joint
-  int max_iterations = 0;                           // DIB, worst joint
-};
-
-// A scene's character: the asset loaded, its keys built (clips from the asset, generated
-// look-at keys, static poses), and the runtime view-adaptive blend over them, with local-to-model
-// and skinning after it.
-class AnimatedCharacter {
- public:
-  // Loads spec.asset and prepares one clip per key (from the asset, generated, or static).
-  // Throws Error naming the scene/asset and the problem (e.g. a clip that does not exist).
-  explicit AnimatedCharacter(const CharacterSpec& spec);
-  AnimatedCharacter(std::shared_ptr<const Character> character, const CharacterSpec& spec);
-
-  const Character& character() const { return *character_; }
-  std::shared_ptr<const Character> shared_character() const { return character_; }
-  std::shared_ptr<const Skeleton> shared_skeleton() const { return {character_, &character_->skeleton}; }
-  const CharacterSpec& spec() const { return spec_; }
-  const ViewSphere& view_sphere() const { return blend_->view_sphere(); }
-  // One clip per key (shared between keys that name the same clip).
-  const Clip& key_clip(int key) const { return *blend_->key(key).clip; }
-  // The look-at chain used for generated keys (empty joints if none).
-  const LookAtChain& lookat_chain() const { return chain_; }
-  // The arm chain used for gesture keys (joints −1 if none).
-  const ArmChain& arm_chain() const { return arm_; }
-  // The runtime blend, to schedule it as an action (anim/schedule.h).
-  std::shared_ptr<ViewAdaptiveBlend> view_adaptive() const { return blend_; }
-
-  // Weights for `viewpoint` (character frame), then every key clip sampled at `time_seconds`,
-  // blended, and converted to skinning transforms. Valid until the next call.
-  const FrameOutput& Update(const Eigen::Vector3d& viewpoint, double time_seconds);
-
- private:
-  std::vector<ViewAdaptiveKey> BuildKeys();
-
-  std::shared_ptr<const Character> character_;
-  CharacterSpec spec_;
-  LookAtChain chain_;
-  ArmChain arm_;
-  std::shared_ptr<ViewAdaptiveBlend> blend_;
-  // Per-frame buffers.
-  LocalPose blended_;
-  std::vector<Eigen::Matrix4d> model_;
-  std::vector<Eigen::Matrix4f> skin_;
-  std::vector<DualQuatf> skin_dq_;
-  FrameOutput out_;
-};
-
-// What the appliance may override in the scene's schedule.
-struct AnimatorOverrides {
-  std::string idle_clip;                  // the default schedule's idle layer: this clip (looped)
-  std::optional<double> hold_seconds, fade_seconds;  // tracking loss
-};
-
-// The character's animator (anim/animator.h): its scene `schedule:` built (objects, modifiers,
-// curves, masks with scopes resolved on its skeleton, distance triggers and weights), or by
-// default the idle underneath (the `idle:` synthesizer if given, else the look-at base clip
-// looped, else the first clip, else the rest pose) and the view-adaptive action "view" on top.
-// `character` must outlive the animator. Throws Error "scene:line: why". `notes` (if given)
-// receive what the appliance should tell its user: a layer the scene asked for that the data
-// cannot support (see BuildIdleLayer).
-std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {},
-                                        std::vector<std::string>* notes = nullptr);
-
-// The idle synthesizer of the character's `idle:` section (learned here), with what was learned.
-std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& character, std::string* summary = nullptr);
-
-// What BuildIdleLayer learned: the idle synthesizer's summary, the balance learner's (empty
-// without `idle.balance:`), and notes for the user: "scene:line: idle.balance: <recording>: what
-// it holds; 0 transitions: ..." when the balance layer was asked for and not built.
-struct IdleLayerReport {
-  std::string idle, balance;
-  bool balance_built = false;  // the balance-shift layer runs under the synthesizer's variations
-  std::vector<std::string> notes;
-};
-
-// The character's idle layer (`idle: true` objects and the default schedule's idle action): the
-// idle synthesizer, under which, when the scene enables `idle.balance:` and its recording holds
-// balance shifts, the balance-shift layer runs (anim/balance_shift.h: the synthesizer's
-// variations on top of the shifts). A recording without a transition gives the synthesizer alone
-// and a note: nothing is invented. Throws Error "scene:line: idle...: why" for bad data.
-BlendablePtr BuildIdleLayer(const AnimatedCharacter& character, IdleLayerReport* report = nullptr);
+// What a key plays, for the overlay and `arview view`: the clip's name, "lookat", "rest", or
+// "<clip>@<seconds>".
+std::string KeySourceLabel(const KeySpec& key);
 
 }  // namespace arview::anim

@@ -1,3 +1,4 @@
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 
@@ -72,10 +73,10 @@ TEST(Scene, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(c.keys[2].pose_time, 0.25);
   EXPECT_EQ(c.keys[3].source, KeySpec::Source::kRestPose);
   // Anchor: model → map, and the camera direction back in the character's frame.
-  const Eigen::Matrix4d m = c.ModelToMap();
+  const Eigen::Matrix4d m = c.placement().ModelToMap();
   const Eigen::Vector4d p = m * Eigen::Vector4d(0, 0, 100, 1);  // 1 m in front, scaled by 2
   EXPECT_LT((p.head<3>() - Eigen::Vector3d(3, 2, 3)).norm(), 1e-9);
-  EXPECT_LT((c.ViewpointFromCamera(Eigen::Vector3d(5, 2, 3)) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  EXPECT_LT((c.placement().ViewpointFromCamera(Eigen::Vector3d(5, 2, 3)) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
 }
 
 void ExpectSceneError(const std::string& text, const std::string& message) {
@@ -154,8 +155,8 @@ TEST(Scene, RuntimeOnAKeyPlaysThatClip) {
         "fox.yaml");
     AnimatedCharacter fox(s.characters[0]);
     const Character& c = fox.character();
-    const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(120, 0), 0.3);
-    EXPECT_DOUBLE_EQ(out.weights[1], 1.0);
+    const AnimatorFrame& out = fox.Update(DirectionFromAzimuthElevation(120, 0), 0.3);
+    EXPECT_DOUBLE_EQ(out.key_weights[1], 1.0);
     LocalPose walk(c.skeleton.size());
     ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run()));
     std::vector<Eigen::Matrix4d> model(c.skeleton.size());
@@ -163,7 +164,7 @@ TEST(Scene, RuntimeOnAKeyPlaysThatClip) {
     for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
     EXPECT_TRUE(out.converged);
     // Between keys every joint is a proper blend, and DIB converges.
-    const FrameOutput& mid = fox.Update(DirectionFromAzimuthElevation(60, 20), 1.0);
+    const AnimatorFrame& mid = fox.Update(DirectionFromAzimuthElevation(60, 20), 1.0);
     EXPECT_TRUE(mid.converged);
     for (const auto& m : mid.skinning_matrices) EXPECT_TRUE(m.allFinite());
     EXPECT_TRUE(RigidSkinning(mid.skinning_matrices));
@@ -179,7 +180,7 @@ TEST(Scene, SharedPhaseStretchesKeyClips) {
   const double walk = c.FindClip("Walk")->duration, run = c.FindClip("Run")->duration;
   const double period = 0.5 * (walk + run);
   // A quarter of the shared period plays a quarter of the Run clip.
-  const FrameOutput& out = fox.Update(DirectionFromAzimuthElevation(180, 0), 0.25 * period);
+  const AnimatorFrame& out = fox.Update(DirectionFromAzimuthElevation(180, 0), 0.25 * period);
   LocalPose expect(c.skeleton.size());
   ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run()));
   std::vector<Eigen::Matrix4d> model(c.skeleton.size());

@@ -1,6 +1,7 @@
 // Scene `schedule:` sections and the animator built from them, on the Fox and BCN_Epileptic:
 // the thesis's appendix C examples, distance triggers and weights, tracking loss and recovery.
 
+#include "anim_authoring/animator_builder.h"
 #include "anim_authoring/scene.h"
 #include "tests/support/test_data.h"
 

@@ -7,6 +7,7 @@
 // only that they repeat within a build:
 //   anim_authoring_tests --gtest_filter='StreamHash.*' | grep '\[hash\]'   (before and after)
 
+#include "anim_authoring/animator_builder.h"
 #include "anim_authoring/idle_learning.h"
 #include "base/hash.h"
 #include "anim_authoring/import.h"

@@ -2,7 +2,7 @@
 // Cancellation: one scoped handler turns SIGINT and SIGTERM into a token, and the token is
 // handed to everything that runs long (child processes, the pipeline, the tracker loop, the
 // recorder, V4L2 capture, readers of big files). Work polls the token at its natural steps
-// (a frame, a chunk, a poll() round) and stops by throwing CancelledError; app/main.cpp turns
+// (a frame, a chunk, a poll() round) and stops by throwing CancelledError; app/cli/main.cpp turns
 // that into one line and exit status 128 + signal (130 for SIGINT, 143 for SIGTERM).
 //
 // Like COLMAP's util/ threads (Stop() sets a flag that long loops check), nothing is killed

@@ -1,7 +1,7 @@
 #pragma once
 // One error base for every module. Library code throws an arview::Error (or a subclass) whose
 // what() is the whole user-facing line: it names the file, device or flag and says what is
-// wrong. Only app/main.cpp catches, prints it and exits non-zero.
+// wrong. Only app/cli/main.cpp catches, prints it and exits non-zero.
 
 #include <stdexcept>
 #include <string>

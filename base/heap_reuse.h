@@ -14,7 +14,7 @@
 // grows little (phone-fox: 184 against 177 MB; a replay of the 1920x1080 room: 433 against
 // 408 MB, flat over repeated loops), it is only no longer returned between frames.
 //
-// Called once at the start of the programs that process frames (app/main.cpp, the frame
+// Called once at the start of the programs that process frames (app/cli/main.cpp, the frame
 // benchmarks). Under AddressSanitizer, whose allocator ignores mallopt, it does nothing.
 
 #include <cstddef>

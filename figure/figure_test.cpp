@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
 #include "anim/pose.h"
@@ -193,7 +194,7 @@ TEST(Figure, LoadsAsABuiltinAssetInScenes) {
   EXPECT_EQ(scene.characters[0].name, "figure");
   anim::AnimatedCharacter figure(scene.characters[0]);
   // The key at azimuth 90 turns the head toward +X (the viewer at the figure's left).
-  const anim::FrameOutput& out = figure.Update(Eigen::Vector3d::UnitX(), 1.0);
+  const anim::AnimatorFrame& out = figure.Update(Eigen::Vector3d::UnitX(), 1.0);
   const Eigen::Vector3d forward = anim::HeadForward(figure.lookat_chain(), out.model);
   EXPECT_LT(AngleDeg(forward, Eigen::Vector3d::UnitX()), 20.0);
 }
@@ -218,7 +219,7 @@ TEST(Figure, GestureKeysPointTheRightArmAtTheViewpoint) {
       anim::AnimatedCharacter figure(scene.characters[0]);
       const anim::KeySpec& key = scene.characters[0].keys[0];
       for (double t : {0.0, 0.37, 1.5, 2.9}) {
-        const anim::FrameOutput& out = figure.Update(key.viewpoint, t);
+        const anim::AnimatorFrame& out = figure.Update(key.viewpoint, t);
         const double deg = AngleDeg(anim::GestureDirection(figure.arm_chain(), key.gesture, out.model), key.viewpoint);
         EXPECT_LE(deg, 15.0) << gesture << " azimuth " << azimuth << " elevation " << elevation << " t " << t;
         const double elbow = anim::ElbowBendDeg(figure.arm_chain(), out.model);

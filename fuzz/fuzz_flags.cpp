@@ -1,5 +1,5 @@
 // Values given on the command line: the frame spec (--frames), the viewpoint (--viewpoint),
-// and numeric flags through CLI11 with app/numeric_flags.h's guard (as main() installs it).
+// and numeric flags through CLI11 with app/cli/numeric_flags.h's guard (as main() installs it).
 // The input's first byte picks the parser; the rest is the text.
 #include <cstdint>
 #include <exception>
@@ -9,7 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "anim_authoring/scene.h"
-#include "app/numeric_flags.h"
+#include "app/cli/numeric_flags.h"
 #include "recordings/recording.h"
 
 namespace {

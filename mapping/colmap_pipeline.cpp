@@ -228,7 +228,7 @@ ImageSet PrepareStillImages(const recordings::Recording& rec, const MapBuildOpti
 }
 
 std::vector<double> ColmapCameraParams(const calib::Camera& c, bool* full_opencv) {
-  // COLMAP's pixel centres are at +0.5 (DESIGN.md, "Pixel coordinates").
+  // COLMAP's pixel centres are at +0.5 (docs/architecture.md, "Pixel coordinates").
   std::vector<double> p{c.fx, c.fy, c.cx + 0.5, c.cy + 0.5, c.dist[0], c.dist[1], c.dist[2], c.dist[3]};
   *full_opencv = c.dist[4] != 0.0;
   if (*full_opencv) p.insert(p.end(), {c.dist[4], 0.0, 0.0, 0.0});

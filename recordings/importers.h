@@ -1,6 +1,6 @@
 #pragma once
 // Importers: public datasets and plain image folders / videos turned into recording folders
-// (../shared/DESIGN.md, "The recording folder"). Still-image datasets get timestamp = frame
+// (docs/architecture.md, "The recording folder"). Still-image datasets get timestamp = frame
 // index in seconds and frames in name order; ground truth becomes groundtruth.txt (TUM,
 // camera-to-world). Malformed input throws RecordingError naming the file (and line).
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The recording folder (../shared/DESIGN.md, "The recording folder"):
+// The recording folder (docs/architecture.md, "The recording folder"):
 //   camera.yaml, frames/ (images, or one video file), frames.txt ("timestamp relative/path"),
 //   groundtruth.txt (optional, TUM, camera-to-world).
 // For a video, every line of frames.txt names the same video file and frames are read in order.

@@ -30,8 +30,8 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
   }
 }
 
-int ArRenderer::AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec) {
-  characters_.push_back({&character, &spec, std::make_unique<CharacterRenderer>(context_->gl(), character),
+int ArRenderer::AddCharacter(const anim::Character& character, const anim::Placement& placement) {
+  characters_.push_back({&character, placement, std::make_unique<CharacterRenderer>(context_->gl(), character),
                          FitShadowCapsules(character), false, LightView{}, cv::Mat()});
   if (options_.lighting == LightingMode::kShShadowed) {
     const PrtCacheResult prt = ShadowedTransferCached(character, options_.prt, options_.prt_cache_folder);
@@ -43,11 +43,11 @@ int ArRenderer::AddCharacter(const anim::Character& character, const anim::Chara
   return static_cast<int>(characters_.size()) - 1;
 }
 
-void ArRenderer::SetRoomLight(const RoomLight& light) {
+void ArRenderer::SetRoomLight(const room::RoomLight& light) {
   room_light_ = light;
   has_room_light_ = true;
   current_sh_ = light.sh;
-  follower_ = std::make_unique<ExposureFollower>(light.thumbnails, light.scene_triangles, camera_, options_.exposure_smoothing);
+  follower_ = std::make_unique<room::ExposureFollower>(light.thumbnails, light.scene_triangles, camera_, options_.exposure_smoothing);
   frames_since_exposure_ = 0;
   SetOccluders(light.occluder_triangles);
 }
@@ -71,10 +71,10 @@ void ArRenderer::FollowExposure(const cv::Mat& background, const calib::Pose& po
   // thumbnail and its rays, is then spread; cameras change exposure over several frames).
   const bool due = frames_since_exposure_++ % kExposureEvery == 0;
   const Eigen::Vector3d gain = background.empty() || !due ? follower_->gain() : follower_->Update(background, pose);
-  current_sh_ = Scaled(room_light_.sh, gain);
+  current_sh_ = room::Scaled(room_light_.sh, gain);
 }
 
-void ArRenderer::UpdateCastShadows(std::span<const anim::FrameOutput* const> frames) {
+void ArRenderer::UpdateCastShadows(std::span<const anim::AnimatorFrame* const> frames) {
   if (frames.size() != characters_.size()) {
     throw RenderError("AR render: " + std::to_string(characters_.size()) + " characters but " +
                       std::to_string(frames.size()) + " animation frames");
@@ -85,11 +85,11 @@ void ArRenderer::UpdateCastShadows(std::span<const anim::FrameOutput* const> fra
   }
 }
 
-bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view,
+bool ArRenderer::CastShadowView(const Placed& placed, const anim::AnimatorFrame& frame, LightView* view,
                                 cv::Mat* coverage) const {
   if (!options_.cast_shadow || !has_room_light_ || frame.model.empty() || placed.capsules.empty()) return false;
-  const anim::CharacterSpec& spec = *placed.spec;
-  const Eigen::Matrix4d model_to_map = spec.ModelToMap();
+  const anim::Placement& placement = placed.placement;
+  const Eigen::Matrix4d model_to_map = placement.ModelToMap();
   std::vector<Eigen::Matrix4d> joint_to_map(frame.model.size());
   for (size_t j = 0; j < frame.model.size(); ++j) joint_to_map[j] = model_to_map * frame.model[j];
   const std::vector<ShadowCapsule> posed = PoseShadowCapsules(placed.capsules, joint_to_map);
@@ -99,9 +99,9 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& f
   double radius = 0;
   CapsuleBounds(posed, &centre, &radius);
   const double soft = options_.cast_shadow_softness * 2 * radius;
-  const Eigen::Vector3d normal = (spec.anchor.rotation.normalized() * spec.up).normalized();
+  const Eigen::Vector3d normal = (placement.anchor.rotation.normalized() * placement.up).normalized();
   // Below 15 degrees of elevation the shadow would stretch across the room: none.
-  if (!MakeLightView(room_light_.dominant.direction, centre, radius + soft, spec.anchor.position, normal, 15.0, view)) {
+  if (!MakeLightView(room_light_.dominant.direction, centre, radius + soft, placement.anchor.position, normal, 15.0, view)) {
     return false;
   }
   cv::Rect support;
@@ -117,9 +117,9 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::FrameOutput& f
 
 float ArRenderer::CastShadowStrength(const Placed& placed) const {
   // The share of the floor's irradiance the dominant light brings: what the character's shadow removes.
-  const Eigen::Vector3d normal = (placed.spec->anchor.rotation.normalized() * placed.spec->up).normalized();
-  const Eigen::Vector3d w = LuminanceWeights();
-  const double total = IrradianceSh(room_light_.sh, normal).dot(w);
+  const Eigen::Vector3d normal = (placed.placement.anchor.rotation.normalized() * placed.placement.up).normalized();
+  const Eigen::Vector3d w = room::LuminanceWeights();
+  const double total = room::IrradianceSh(room_light_.sh, normal).dot(w);
   const double direct = room_light_.dominant.color.dot(w) * std::max(0.0, room_light_.dominant.direction.dot(normal));
   if (!(total > 0)) return 0.f;
   return static_cast<float>(std::clamp(direct / total, 0.0, double(options_.cast_shadow_max_strength)));
@@ -143,13 +143,13 @@ cv::Mat ArRenderer::PrepareBackground(const cv::Mat& background) {
   return undistorted;
 }
 
-bool ArRenderer::Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const {
-  const anim::CharacterSpec& spec = *placed.spec;
-  const Eigen::Matrix4d model_to_map = spec.ModelToMap();
-  const Eigen::Matrix3d rotation = spec.anchor.rotation.normalized().toRotationMatrix();
-  const Eigen::Vector3d origin = spec.anchor.position;
-  const Eigen::Vector3d normal = (rotation * spec.up).normalized();
-  Eigen::Vector3d u = rotation * spec.forward;
+bool ArRenderer::Shadow(const Placed& placed, const anim::AnimatorFrame& frame, ShadowEllipse* ellipse) const {
+  const anim::Placement& placement = placed.placement;
+  const Eigen::Matrix4d model_to_map = placement.ModelToMap();
+  const Eigen::Matrix3d rotation = placement.anchor.rotation.normalized().toRotationMatrix();
+  const Eigen::Vector3d origin = placement.anchor.position;
+  const Eigen::Vector3d normal = (rotation * placement.up).normalized();
+  Eigen::Vector3d u = rotation * placement.forward;
   u = (u - u.dot(normal) * normal);
   if (u.norm() < 1e-9) u = normal.unitOrthogonal();
   u.normalize();
@@ -170,7 +170,7 @@ bool ArRenderer::Shadow(const Placed& placed, const anim::FrameOutput& frame, Sh
   return true;
 }
 
-cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames,
                                   double* farthest) const {
   const cv::Rect full(0, 0, camera_.width, camera_.height);
   *farthest = std::numeric_limits<double>::infinity();
@@ -206,8 +206,8 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
   };
   for (size_t i = 0; i < characters_.size(); ++i) {
     const Placed& placed = characters_[i];
-    const anim::FrameOutput& frame = *frames[i];
-    const Eigen::Matrix4d model_to_map = placed.spec->ModelToMap();
+    const anim::AnimatorFrame& frame = *frames[i];
+    const Eigen::Matrix4d model_to_map = placed.placement.ModelToMap();
     const std::vector<float>& radii = placed.renderer->joint_radii();
     for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
       if (radii[j] <= 0) continue;
@@ -241,7 +241,7 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
   return box & full;
 }
 
-void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames) {
+void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames) {
   used_linear_fallback_ = false;
   double farthest = 0;
   const cv::Rect rect = ScreenBounds(eye, frames, &farthest);
@@ -271,13 +271,13 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   }
 }
 
-void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames,
                            double farthest) {
   const GlApi& gl = context_->gl();
-  auto character_draw = [&](const Placed& placed, const anim::FrameOutput& out) {
-    const Eigen::Matrix3d rotation = placed.spec->anchor.rotation.normalized().toRotationMatrix();
+  auto character_draw = [&](const Placed& placed, const anim::AnimatorFrame& out) {
+    const Eigen::Matrix3d rotation = placed.placement.anchor.rotation.normalized().toRotationMatrix();
     CharacterDraw draw;
-    draw.model_to_map = placed.spec->ModelToMap();
+    draw.model_to_map = placed.placement.ModelToMap();
     draw.skinning_matrices = out.skinning_matrices;
     draw.skinning_dual_quats = out.skinning_dual_quats;
     draw.method = options_.skinning;
@@ -285,7 +285,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
     // Key light from above and in front of the character, so that its face is lit and the
     // contact shadow straight below it is plausible.
     draw.light_direction_map =
-        (rotation * (placed.spec->up.normalized() + 0.6 * placed.spec->forward.normalized())).normalized();
+        (rotation * (placed.placement.up.normalized() + 0.6 * placed.placement.forward.normalized())).normalized();
     draw.lighting = options_.lighting;
     draw.sh = current_sh_;
     return draw;
@@ -297,7 +297,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
   if (options_.occlusion && occluders_) occluders_->Draw(projection, view, farthest);
   for (size_t i = 0; i < characters_.size(); ++i) {
     Placed& placed = characters_[i];
-    const anim::FrameOutput& out = *frames[i];
+    const anim::AnimatorFrame& out = *frames[i];
     ShadowEllipse e;
     if (options_.shadow && Shadow(placed, out, &e)) {
       shadow_.Draw(projection, view, e.center, e.axis_u, e.axis_v, options_.shadow_strength);
@@ -309,7 +309,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
 }
 
 cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
-                           std::span<const anim::FrameOutput* const> frames) {
+                           std::span<const anim::AnimatorFrame* const> frames) {
   FollowExposure(background, pose);
   UpdateCastShadows(frames);
   cv::Mat frame = PrepareBackground(background);
@@ -318,7 +318,7 @@ cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
 }
 
 cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
-                                     std::span<const anim::FrameOutput* const> frames, double ipd_m) {
+                                     std::span<const anim::AnimatorFrame* const> frames, double ipd_m) {
   if (!(ipd_m >= 0 && ipd_m < 0.5)) throw RenderError("interpupillary distance must be in [0, 0.5) m");
   FollowExposure(background, pose);
   UpdateCastShadows(frames);

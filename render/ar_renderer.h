@@ -20,13 +20,15 @@
 #include <span>
 #include <vector>
 
-#include "anim_authoring/scene.h"
+#include "anim/animator.h"
+#include "anim/character.h"
+#include "anim/placement.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "render/character_renderer.h"
 #include "render/offscreen.h"
 #include "render/projection.h"
-#include "render/room_light.h"
+#include "room/room_light.h"
 #include "render/scene_depth.h"
 #include "render/shadow_capsules.h"
 
@@ -58,7 +60,7 @@ struct ArOptions {
   bool occlusion = true;        // the room light's occluder triangles in the depth buffer first
   float cast_shadow_softness = 0.03f;  // blur radius, share of the character's bounding diameter
   float cast_shadow_max_strength = 0.8f;
-  double exposure_smoothing = 0.5;     // ExposureFollower's share per update (every 4th frame)
+  double exposure_smoothing = 0.5;     // room::ExposureFollower's share per update (every 4th frame)
   PrtOptions prt;
   // Where AddCharacter keeps and finds the PRT transfer (render/prt_cache.h); empty: computed
   // every time. The app passes DefaultPrtCacheFolder().
@@ -72,26 +74,26 @@ class ArRenderer {
   ArRenderer(const ArRenderer&) = delete;
   ArRenderer& operator=(const ArRenderer&) = delete;
 
-  // The character and spec must outlive the renderer. Returns its index for Render's frames.
-  int AddCharacter(const anim::Character& character, const anim::CharacterSpec& spec);
+  // The character must outlive the renderer; its placement is copied. Returns its index for Render's frames.
+  int AddCharacter(const anim::Character& character, const anim::Placement& placement);
 
   // One augmented frame, BGR at the camera's size. `background`: the camera image (8-bit BGR or
   // grey, the camera's size) or empty; `pose`: the camera, world → camera; `frames[i]`: the
-  // animation output (anim::AnimatedCharacter::Update) of character i.
+  // animation output (anim::Animator::Update, anim::PlacedCharacter::Update) of character i.
   cv::Mat Render(const cv::Mat& background, const calib::Pose& pose,
-                 std::span<const anim::FrameOutput* const> frames);
+                 std::span<const anim::AnimatorFrame* const> frames);
   // HMD mode: the two eyes ±ipd/2 along the camera's x axis, each over the same video frame,
   // side by side (left eye on the left): 2W x H.
   cv::Mat RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
-                           std::span<const anim::FrameOutput* const> frames, double ipd_m);
+                           std::span<const anim::AnimatorFrame* const> frames, double ipd_m);
 
   // The room's light: SH and dominant light for the SH lighting modes and the cast shadow, the
   // keyframe thumbnails the live exposure is followed against, the occluder triangles.
-  void SetRoomLight(const RoomLight& light);
+  void SetRoomLight(const room::RoomLight& light);
   // Replaces the depth-only occluders (map frame, 3 corners a triangle); empty: none.
   void SetOccluders(const std::vector<Eigen::Vector3f>& triangles);
   // The SH light of the last frame (the room light times the followed exposure gain).
-  const ShRgb& current_sh() const { return current_sh_; }
+  const room::ShRgb& current_sh() const { return current_sh_; }
   Eigen::Vector3d exposure_gain() const { return follower_ ? follower_->gain() : Eigen::Vector3d::Ones(); }
   // Total PRT precomputation time of the characters added so far, seconds.
   double prt_seconds() const { return prt_seconds_; }
@@ -108,7 +110,7 @@ class ArRenderer {
  private:
   struct Placed {
     const anim::Character* character;
-    const anim::CharacterSpec* spec;
+    anim::Placement placement;
     std::unique_ptr<CharacterRenderer> renderer;
     std::vector<ShadowCapsule> capsules;  // the cast shadow's occluder, bind pose
     bool casts = false;                   // this frame's cast shadow (UpdateCastShadows):
@@ -121,23 +123,23 @@ class ArRenderer {
   cv::Mat PrepareBackground(const cv::Mat& background);
   // Draws the characters seen from `eye` and blends them over `frame` (in place), after
   // UpdateCastShadows of the same frames.
-  void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames);
+  void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames);
   // Draws the characters' layer (occluders, contact shadows, characters) into `rect` of the
   // region target, to be read back.
-  void DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames,
+  void DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames,
                  double farthest);
-  bool Shadow(const Placed& placed, const anim::FrameOutput& frame, ShadowEllipse* ellipse) const;
+  bool Shadow(const Placed& placed, const anim::AnimatorFrame& frame, ShadowEllipse* ellipse) const;
   // Each character's cast shadow for this frame (kept in Placed for Compose, which darkens the
   // camera image with it); throws when `frames` is not one per character.
-  void UpdateCastShadows(std::span<const anim::FrameOutput* const> frames);
+  void UpdateCastShadows(std::span<const anim::AnimatorFrame* const> frames);
   // The cast shadow's light view and soft coverage for this frame (false: no cast shadow).
-  bool CastShadowView(const Placed& placed, const anim::FrameOutput& frame, LightView* view, cv::Mat* coverage) const;
+  bool CastShadowView(const Placed& placed, const anim::AnimatorFrame& frame, LightView* view, cv::Mat* coverage) const;
   float CastShadowStrength(const Placed& placed) const;
   void FollowExposure(const cv::Mat& background, const calib::Pose& pose);
   // The screen rectangle that contains everything drawn (empty when nothing is in view), and
   // the farthest distance along the view axis of what is drawn (bounding boxes; infinity when
   // not known): occluders wholly behind it are not drawn.
-  cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::FrameOutput* const> frames, double* farthest) const;
+  cv::Rect ScreenBounds(const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames, double* farthest) const;
 
   OffscreenContext* context_;
   calib::Camera camera_, pinhole_;
@@ -148,9 +150,9 @@ class ArRenderer {
   std::vector<Placed> characters_;
   bool used_linear_fallback_ = false;
   bool has_room_light_ = false;
-  RoomLight room_light_;
-  ShRgb current_sh_{};
-  std::unique_ptr<ExposureFollower> follower_;
+  room::RoomLight room_light_;
+  room::ShRgb current_sh_{};
+  std::unique_ptr<room::ExposureFollower> follower_;
   std::unique_ptr<DepthProxy> occluders_;
   std::vector<Eigen::Vector3f> occluder_triangles_;  // the same, for the cast shadow on the CPU
   double prt_seconds_ = 0;

@@ -25,14 +25,17 @@
 #include <cstring>
 #include <map>
 
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
 #include "base/heap_reuse.h"
 #include "render/ar_renderer.h"
-#include "render/synth_room.h"
+#include "synth/synth_room.h"
 #include "tests/support/test_data.h"
 
 namespace arview::render {
+using namespace arview::room;  // the room's light and proxy, tested here with the renderer
+using namespace arview::synth;  // the rendered room the light is measured in
 namespace {
 
 OffscreenOptions g_gl{GlBackend::kAuto, 1};
@@ -207,7 +210,7 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   options.cast_shadow = without != LitPart::kCastShadow;
   options.occlusion = without != LitPart::kOcclusion;
   ArRenderer renderer(Context(), BenchCamera(), options);
-  renderer.AddCharacter(subject->animated->character(), subject->spec);
+  renderer.AddCharacter(subject->animated->character(), subject->spec.placement());
   const cv::Mat background = Background();
   if (lit) {
     RoomLight light = BenchRoomLight(background, subject->camera_pose);
@@ -215,17 +218,17 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
     renderer.SetRoomLight(light);
     state.counters["prt_precompute_s"] = renderer.prt_seconds();
   }
-  const Eigen::Vector3d viewpoint = subject->spec.ViewpointFromCamera(subject->camera_pose.Center());
+  const Eigen::Vector3d viewpoint = subject->spec.placement().ViewpointFromCamera(subject->camera_pose.Center());
   double time = 0;
   cv::Mat frame;
   // Warm-up outside the timing: llvmpipe compiles each new pipeline state at its first draw.
   for (int i = 0; i < 3; ++i) {
-    const anim::FrameOutput* out = &subject->animated->Update(viewpoint, time);
+    const anim::AnimatorFrame* out = &subject->animated->Update(viewpoint, time);
     frame = renderer.Render(background, subject->camera_pose, {&out, 1});
   }
   const double cpu_start = ProcessCpuSeconds();
   for (auto _ : state) {
-    const anim::FrameOutput* out = &subject->animated->Update(viewpoint, time);
+    const anim::AnimatorFrame* out = &subject->animated->Update(viewpoint, time);
     frame = renderer.Render(background, subject->camera_pose, {&out, 1});
     benchmark::DoNotOptimize(frame.data);
     time += 1.0 / 30;
@@ -313,7 +316,7 @@ BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 }  // namespace arview::render
 
 int main(int argc, char** argv) {
-  arview::KeepFreedHeapForReuse();  // as app/main.cpp does, so that the figures are the app's
+  arview::KeepFreedHeapForReuse();  // as app/cli/main.cpp does, so that the figures are the app's
   // Our own flags first (Google Benchmark rejects unknown ones).
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {

@@ -15,7 +15,7 @@
 #include "anim/pose.h"
 #include "render/gl_objects.h"
 #include "render/prt.h"
-#include "render/sh.h"
+#include "room/sh.h"
 
 namespace arview::render {
 
@@ -39,7 +39,7 @@ struct CharacterDraw {
   // rasterisation for closed meshes; off for assets with open, single-sided parts.
   bool cull_back_faces = true;
   LightingMode lighting = LightingMode::kFixed;
-  ShRgb sh{};  // the room's incident radiance (map frame, RGB) for the SH modes
+  room::ShRgb sh{};  // the room's incident radiance (map frame, RGB) for the SH modes
 };
 
 class CharacterRenderer {

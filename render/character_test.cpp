@@ -5,6 +5,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/test_scene.h"
@@ -49,10 +50,10 @@ cv::Mat NotBackground(const cv::Mat& image, const cv::Scalar& background) {
 
 // The silhouette of anim/'s CPU-skinned meshes, projected with OpenCV and filled per triangle.
 cv::Mat CpuSilhouette(const anim::Character& character, const anim::CharacterSpec& spec,
-                      const anim::FrameOutput& frame, anim::SkinningMethod method, const calib::Camera& camera,
+                      const anim::AnimatorFrame& frame, anim::SkinningMethod method, const calib::Camera& camera,
                       const calib::Pose& pose) {
   cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8U);
-  const Eigen::Matrix4d model_to_map = spec.ModelToMap();
+  const Eigen::Matrix4d model_to_map = spec.placement().ModelToMap();
   constexpr int kShift = 8;
   for (const anim::Mesh& mesh : character.meshes) {
     std::vector<Eigen::Vector3f> skinned(mesh.positions.size());
@@ -91,7 +92,7 @@ struct Silhouettes {
   double iou = 0;
 };
 
-Silhouettes Compare(ArRenderer& renderer, const anim::AnimatedCharacter& c, const anim::FrameOutput* frame,
+Silhouettes Compare(ArRenderer& renderer, const anim::AnimatedCharacter& c, const anim::AnimatorFrame* frame,
                     anim::SkinningMethod method, const calib::Camera& camera, const calib::Pose& pose) {
   Silhouettes s;
   s.rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
@@ -107,8 +108,8 @@ class FoxTest : public ::testing::Test {
     scene_ = FoxScene();
     fox_ = std::make_unique<anim::AnimatedCharacter>(scene_.characters[0]);
   }
-  const anim::FrameOutput& Frame(double time, const calib::Pose& pose) {
-    return fox_->Update(fox_->spec().ViewpointFromCamera(pose.Center()), time);
+  const anim::AnimatorFrame& Frame(double time, const calib::Pose& pose) {
+    return fox_->Update(fox_->spec().placement().ViewpointFromCamera(pose.Center()), time);
   }
   anim::Scene scene_;
   std::unique_ptr<anim::AnimatedCharacter> fox_;
@@ -119,7 +120,7 @@ TEST_F(FoxTest, GpuSkinningMatchesCpuSkinningForBothMethods) {
   const calib::Pose pose = LookingAtFox();
   for (auto method : {anim::SkinningMethod::kDualQuaternion, anim::SkinningMethod::kLinear}) {
     ArRenderer renderer(testing::SharedContext(), camera, SilhouetteOptions(method));
-    renderer.AddCharacter(fox_->character(), fox_->spec());
+    renderer.AddCharacter(fox_->character(), fox_->spec().placement());
     for (double time : {0.0, 0.37, 0.71}) {
       const Silhouettes s = Compare(renderer, *fox_, &Frame(time, pose), method, camera, pose);
       const cv::Mat& expected = s.expected;
@@ -139,8 +140,8 @@ TEST_F(FoxTest, CompositesOverTheBackgroundWithAShadowBelow) {
   cv::Mat background(camera.height, camera.width, CV_8UC3);
   cv::randu(background, cv::Scalar::all(0), cv::Scalar::all(255));
   ArRenderer renderer(testing::SharedContext(), camera, {});
-  renderer.AddCharacter(fox_->character(), fox_->spec());
-  const anim::FrameOutput* frame = &Frame(0.2, pose);
+  renderer.AddCharacter(fox_->character(), fox_->spec().placement());
+  const anim::AnimatorFrame* frame = &Frame(0.2, pose);
   const cv::Mat out = renderer.Render(background, pose, {&frame, 1});
   ASSERT_EQ(out.size(), background.size());
 
@@ -148,7 +149,7 @@ TEST_F(FoxTest, CompositesOverTheBackgroundWithAShadowBelow) {
   bare.shadow = false;
   bare.empty_background = kMagenta;
   ArRenderer silhouette_renderer(testing::SharedContext(), camera, bare);
-  silhouette_renderer.AddCharacter(fox_->character(), fox_->spec());
+  silhouette_renderer.AddCharacter(fox_->character(), fox_->spec().placement());
   const cv::Mat fox = NotBackground(silhouette_renderer.Render({}, pose, {&frame, 1}), kMagenta);
 
   // Far from the character and its shadow, the video pixels are untouched.
@@ -178,8 +179,8 @@ TEST_F(FoxTest, SideBySideEyesSeeTheCharacterWithDisparity) {
   const calib::Camera camera = TestCamera();
   const calib::Pose pose = LookingAtFox();
   ArRenderer renderer(testing::SharedContext(), camera, SilhouetteOptions(anim::SkinningMethod::kDualQuaternion));
-  renderer.AddCharacter(fox_->character(), fox_->spec());
-  const anim::FrameOutput* frame = &Frame(0.0, pose);
+  renderer.AddCharacter(fox_->character(), fox_->spec().placement());
+  const anim::AnimatorFrame* frame = &Frame(0.0, pose);
   const cv::Mat both = renderer.RenderSideBySide({}, pose, {&frame, 1}, 0.064);
   ASSERT_EQ(both.size(), cv::Size(2 * camera.width, camera.height));
   const cv::Moments left = cv::moments(NotBackground(both(cv::Rect(0, 0, camera.width, camera.height)), kMagenta), true);
@@ -199,8 +200,8 @@ TEST_F(FoxTest, RejectsMismatchedInputs) {
   const calib::Camera camera = TestCamera();
   const calib::Pose pose = LookingAtFox();
   ArRenderer renderer(testing::SharedContext(), camera, {});
-  renderer.AddCharacter(fox_->character(), fox_->spec());
-  const anim::FrameOutput* frame = &Frame(0.0, pose);
+  renderer.AddCharacter(fox_->character(), fox_->spec().placement());
+  const anim::AnimatorFrame* frame = &Frame(0.0, pose);
   EXPECT_THROW(renderer.Render(cv::Mat(100, 100, CV_8UC3), pose, {&frame, 1}), RenderError);
   EXPECT_THROW(renderer.Render({}, pose, {}), RenderError);
 }
@@ -221,14 +222,14 @@ TEST_F(FoxTest, BoundedRenderEqualsFullFrameRender) {
   full_options.full_frame = true;
   ArRenderer bounded(testing::SharedContext(), camera, bounded_options);
   ArRenderer full(testing::SharedContext(), camera, full_options);
-  bounded.AddCharacter(fox_->character(), fox_->spec());
-  full.AddCharacter(fox_->character(), fox_->spec());
+  bounded.AddCharacter(fox_->character(), fox_->spec().placement());
+  full.AddCharacter(fox_->character(), fox_->spec().placement());
   const calib::Pose base = LookingAtFox();
   for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.6, 0, 1.2), Eigen::Vector3d(-0.3, 0.2, 1.6)}) {
     calib::Pose pose = base;
     pose.t_cw -= shift;  // moves the camera along its own axes: closer, off to one side
     for (double time : {0.1, 0.6}) {
-      const anim::FrameOutput* frame = &Frame(time, pose);
+      const anim::AnimatorFrame* frame = &Frame(time, pose);
       const cv::Mat a = bounded.Render(background, pose, {&frame, 1});
       const cv::Mat b = full.Render(background, pose, {&frame, 1});
       cv::Mat diff;
@@ -315,8 +316,8 @@ TEST(ArRenderer, DrawsUntexturedMeshesInTheirColourAndTexturedOnesWithTheirTextu
   ArOptions options = SilhouetteOptions(anim::SkinningMethod::kDualQuaternion);
   options.cull_back_faces = false;
   ArRenderer renderer(testing::SharedContext(), camera, options);
-  renderer.AddCharacter(quads.character(), quads.spec());
-  const anim::FrameOutput* frame = &quads.Update(front.Center(), 0.0);
+  renderer.AddCharacter(quads.character(), quads.spec().placement());
+  const anim::AnimatorFrame* frame = &quads.Update(front.Center(), 0.0);
   const cv::Mat out = renderer.Render({}, front, {&frame, 1});
   for (const double x : {-0.35, 0.35}) {
     const Eigen::Vector2d px = camera.Project(front.ToCamera(Eigen::Vector3d(x, 0, 1.0)));
@@ -359,9 +360,9 @@ TEST(CesiumMan, GpuSilhouetteMatchesCpuSkinningWithBackFacesCulled) {
   for (auto method : {anim::SkinningMethod::kDualQuaternion, anim::SkinningMethod::kLinear}) {
     const ArOptions options = SilhouetteOptions(method);
     ArRenderer renderer(testing::SharedContext(), camera, options);
-    renderer.AddCharacter(man.character(), man.spec());
+    renderer.AddCharacter(man.character(), man.spec().placement());
     for (const auto& [pose, time] : {std::pair{front, 0.0}, std::pair{back, 0.9}}) {
-      const anim::FrameOutput* frame = &man.Update(man.spec().ViewpointFromCamera(pose.Center()), time);
+      const anim::AnimatorFrame* frame = &man.Update(man.spec().placement().ViewpointFromCamera(pose.Center()), time);
       const Silhouettes s = Compare(renderer, man, frame, method, camera, pose);
       const cv::Mat& expected = s.expected;
       const double iou = s.iou;
@@ -374,7 +375,7 @@ TEST(CesiumMan, GpuSilhouetteMatchesCpuSkinningWithBackFacesCulled) {
       ArOptions all_faces = options;
       all_faces.cull_back_faces = false;
       ArRenderer reference(testing::SharedContext(), camera, all_faces);
-      reference.AddCharacter(man.character(), man.spec());
+      reference.AddCharacter(man.character(), man.spec().placement());
       cv::Mat diff, grey;
       cv::absdiff(renderer.Render({}, pose, {&frame, 1}), reference.Render({}, pose, {&frame, 1}), diff);
       cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);

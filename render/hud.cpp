@@ -203,4 +203,27 @@ void DrawHud(cv::Mat& frame, const calib::Camera& camera, const calib::Pose& pos
   DrawLines(frame, text.help, true, style);
 }
 
+HudSphere HudSphereFor(const anim::Placement& placement, const std::string& name,
+                       std::span<const Eigen::Vector3d> key_directions, std::span<const std::string> key_labels,
+                       std::span<const double> weights, const Eigen::Vector3d& viewpoint, double height,
+                       int highlighted_key) {
+  HudSphere s;
+  s.name = name;
+  s.centre = placement.anchor.position;
+  s.rotation = placement.anchor.rotation.normalized();
+  s.forward = placement.forward;
+  s.up = placement.up;
+  s.radius = 1.1 * height;
+  s.viewpoint = viewpoint;
+  for (size_t k = 0; k < key_directions.size(); ++k) {
+    HudKey key;
+    key.direction = key_directions[k];
+    key.weight = k < weights.size() ? weights[k] : 0;
+    key.label = k < key_labels.size() ? key_labels[k] : std::string();
+    key.highlighted = static_cast<int>(k) == highlighted_key;
+    s.keys.push_back(key);
+  }
+  return s;
+}
+
 }  // namespace arview::render

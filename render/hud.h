@@ -11,9 +11,11 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include <span>
 #include <string>
 #include <vector>
 
+#include "anim/placement.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
 
@@ -41,6 +43,15 @@ struct HudText {
   std::vector<std::string> status;  // top left
   std::vector<std::string> help;    // bottom left (empty: none)
 };
+
+// What the overlay shows for a character: its view sphere centred on its anchor and sized 1.1x
+// `height` (its rest height in map units), its keys (directions in the character's frame, with
+// what each plays) with their weights this frame, and the viewpoint the animation used. Shared
+// by the AR pipeline's `--hud` and `arview view`.
+HudSphere HudSphereFor(const anim::Placement& placement, const std::string& name,
+                       std::span<const Eigen::Vector3d> key_directions, std::span<const std::string> key_labels,
+                       std::span<const double> weights, const Eigen::Vector3d& viewpoint, double height,
+                       int highlighted_key = -1);
 
 // BGR colour for a weight in [0, 1].
 cv::Scalar WeightColour(double weight);

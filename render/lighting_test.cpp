@@ -16,19 +16,22 @@
 #include <map>
 #include <random>
 
+#include "anim_authoring/character_builder.h"
 #include "anim/pose.h"
 #include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/prt.h"
 #include "render/prt_cache.h"
-#include "render/room_light.h"
-#include "render/scene_proxy.h"
+#include "room/room_light.h"
+#include "room/scene_proxy.h"
 #include "render/shadow_capsules.h"
-#include "render/synth_room.h"
+#include "synth/synth_room.h"
 #include "render/test_scene.h"
 #include "tests/support/test_data.h"
 
 namespace arview::render {
+using namespace arview::room;  // the room's light and proxy, tested here with the renderer
+using namespace arview::synth;  // the rendered room the light is measured in
 namespace {
 
 namespace fs = std::filesystem;
@@ -527,9 +530,9 @@ TEST(Prt, ShaderRotatesTheTransferWithTheSkinning) {
     options.shadow = false;
     options.cast_shadow = false;
     ArRenderer renderer(SharedContext(), camera, options);
-    renderer.AddCharacter(animated.character(), animated.spec());
+    renderer.AddCharacter(animated.character(), animated.spec().placement());
     renderer.SetRoomLight(light);
-    const anim::FrameOutput* out = &animated.Update(spec.ViewpointFromCamera(pose.Center()), 0);
+    const anim::AnimatorFrame* out = &animated.Update(spec.placement().ViewpointFromCamera(pose.Center()), 0);
     images[mode] = renderer.Render(cv::Mat(), pose, {&out, 1});
   }
   cv::Mat diff, grey;
@@ -579,10 +582,10 @@ struct PostScene {
     options.cast_shadow = cast_shadow;
     options.full_frame = true;
     ArRenderer renderer(SharedContext(), camera, options);
-    renderer.AddCharacter(animated->character(), animated->spec());
+    renderer.AddCharacter(animated->character(), animated->spec().placement());
     renderer.SetRoomLight(AnalyticEstimate());
     renderer.SetOccluders(occluders);
-    const anim::FrameOutput* out = &animated->Update(spec.ViewpointFromCamera(pose.Center()), 0);
+    const anim::AnimatorFrame* out = &animated->Update(spec.placement().ViewpointFromCamera(pose.Center()), 0);
     return renderer.Render(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(200)), pose, {&out, 1});
   }
 };
@@ -680,11 +683,11 @@ TEST(CastShadow, IsNotSeenFromBelowTheFloor) {
 // The capsules against the mesh they stand for, seen from the light: the skinned mesh's outline
 // (anim/'s CPU skinning, filled triangle by triangle) and the capsules' coverage with a hard edge,
 // in the same orthographic view at 256 x 256 (the cast shadow's coverage has 64 x 64).
-double CapsuleOutlineIoU(const anim::AnimatedCharacter& animated, const anim::FrameOutput& frame,
+double CapsuleOutlineIoU(const anim::AnimatedCharacter& animated, const anim::AnimatorFrame& frame,
                          const Eigen::Vector3d& towards_light, cv::Mat* mesh_mask, cv::Mat* capsule_mask) {
   constexpr int kSize = 256;
   const anim::Character& character = animated.character();
-  const Eigen::Matrix4d model_to_map = animated.spec().ModelToMap();
+  const Eigen::Matrix4d model_to_map = animated.spec().placement().ModelToMap();
   std::vector<Eigen::Matrix4d> joint_to_map;
   for (const Eigen::Matrix4d& m : frame.model) joint_to_map.push_back(model_to_map * m);
   const std::vector<ShadowCapsule> posed = PoseShadowCapsules(FitShadowCapsules(character), joint_to_map);
@@ -738,7 +741,7 @@ TEST(CastShadow, CapsulesCoverTheSkinnedMeshSeenFromTheLight) {
                                                "capsule_test.yaml");
     anim::AnimatedCharacter animated(scene.characters[0]);
     for (double t : {0.0, 0.4, 0.8}) {
-      const anim::FrameOutput& frame = animated.Update(Eigen::Vector3d::UnitZ(), t);
+      const anim::AnimatorFrame& frame = animated.Update(Eigen::Vector3d::UnitZ(), t);
       cv::Mat mesh, capsules;
       const double iou = CapsuleOutlineIoU(animated, frame, light, &mesh, &capsules);
       std::printf("%s %s t=%.1f: capsules (%d texels) against the skinned mesh (%d texels) seen from the light: IoU %.3f, "
@@ -759,7 +762,7 @@ TEST(CastShadow, CapsulesCoverTheSkinnedMeshSeenFromTheLight) {
 
 // ---------------------------------------------------------------- occlusion
 
-cv::Mat CoveredMask(ArRenderer& renderer, const calib::Pose& pose, const anim::FrameOutput* out, const cv::Size& size) {
+cv::Mat CoveredMask(ArRenderer& renderer, const calib::Pose& pose, const anim::AnimatorFrame* out, const cv::Size& size) {
   const cv::Mat black = renderer.Render(cv::Mat(size, CV_8UC3, cv::Scalar::all(0)), pose, {&out, 1});
   const cv::Mat white = renderer.Render(cv::Mat(size, CV_8UC3, cv::Scalar::all(255)), pose, {&out, 1});
   cv::Mat diff, grey;
@@ -789,13 +792,13 @@ TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
   SceneProxy proxy = BuildPlaneProxy(points);
   proxy.RemovePlane(Eigen::Vector3d::UnitZ(), 0, 10, 0.05);  // the floor the Fox stands on
   const std::vector<Eigen::Vector3f> proxy_triangles = proxy.Triangles();
-  const anim::FrameOutput* out = &fox.Update(fox.spec().ViewpointFromCamera(pose.Center()), 0.5);
+  const anim::AnimatorFrame* out = &fox.Update(fox.spec().placement().ViewpointFromCamera(pose.Center()), 0.5);
   cv::Mat masks[3];
   for (int which = 0; which < 3; ++which) {
     ArOptions options;
     options.shadow = false;
     ArRenderer renderer(SharedContext(), camera, options);
-    renderer.AddCharacter(fox.character(), fox.spec());
+    renderer.AddCharacter(fox.character(), fox.spec().placement());
     if (which == 1) renderer.SetOccluders(proxy_triangles);
     if (which == 2) renderer.SetOccluders(pillar);
     masks[which] = CoveredMask(renderer, pose, out, camera.Size());
@@ -815,7 +818,7 @@ TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
   full.shadow = false;
   full.full_frame = true;
   ArRenderer all_drawn(SharedContext(), camera, full);
-  all_drawn.AddCharacter(fox.character(), fox.spec());
+  all_drawn.AddCharacter(fox.character(), fox.spec().placement());
   all_drawn.SetOccluders(proxy_triangles);
   cv::Mat differ;
   cv::bitwise_xor(CoveredMask(all_drawn, pose, out, camera.Size()), masks[1], differ);
@@ -887,13 +890,13 @@ TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
   // Between keyframes 7 and 8: the live view is none of the keyframes'.
   const calib::Pose live_pose = path.At(100.0 / 30);
   const cv::Mat live_render = camera_view.Render(live_pose);
-  const anim::FrameOutput* out = &fox.Update(fox.spec().ViewpointFromCamera(live_pose.Center()), 1.0);
+  const anim::AnimatorFrame* out = &fox.Update(fox.spec().placement().ViewpointFromCamera(live_pose.Center()), 1.0);
   cv::Mat fox_mask, card_mask = cv::Mat::zeros(480, 640, CV_8U);
   {
     ArOptions options;
     options.shadow = false;
     ArRenderer renderer(context, RoomCamera(), options);
-    renderer.AddCharacter(fox.character(), fox.spec());
+    renderer.AddCharacter(fox.character(), fox.spec().placement());
     fox_mask = CoveredMask(renderer, live_pose, out, {640, 480});
     std::vector<cv::Point> polygon;
     for (const auto& c : corners) {
@@ -926,7 +929,7 @@ TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
       options.cast_shadow = false;
       options.exposure_smoothing = 1.0;
       ArRenderer renderer(context, RoomCamera(), options);
-      renderer.AddCharacter(fox.character(), fox.spec());
+      renderer.AddCharacter(fox.character(), fox.spec().placement());
       renderer.SetRoomLight(light);
       const cv::Mat live = Film(live_render, tint, exposures[e]);
       const cv::Mat frame = renderer.Render(live, live_pose, {&out, 1});
@@ -974,7 +977,7 @@ TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
       options.lighting = way == 0 ? LightingMode::kFixed : LightingMode::kShShadowed;
       options.exposure_smoothing = 1.0;
       ArRenderer renderer(context, RoomCamera(), options);
-      renderer.AddCharacter(fox.character(), fox.spec());
+      renderer.AddCharacter(fox.character(), fox.spec().placement());
       if (way == 1) {
         renderer.SetRoomLight(light);
         renderer.SetOccluders({});

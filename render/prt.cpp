@@ -7,14 +7,14 @@
 #include <map>
 #include <thread>
 
-#include "render/ray_caster.h"
+#include "room/ray_caster.h"
 #include <Eigen/Geometry>
 
 namespace arview::render {
 
-Sh9 UnshadowedTransfer(const Eigen::Vector3d& n) {
+room::Sh9 UnshadowedTransfer(const Eigen::Vector3d& n) {
   const double band[3] = {M_PI, 2 * M_PI / 3, M_PI / 4};
-  Sh9 t = ShBasis(n);
+  room::Sh9 t = room::ShBasis(n);
   for (int k = 0; k < 9; ++k) t[k] *= band[k == 0 ? 0 : (k < 4 ? 1 : 2)];
   return t;
 }
@@ -61,17 +61,17 @@ CharacterTransfer ComputeShadowedTransfer(const anim::Character& character, cons
       }
     }
   }
-  const TriangleBvh bvh(std::move(corners));
+  const room::TriangleBvh bvh(std::move(corners));
 
   std::vector<Eigen::Vector3f> directions(options.directions);
-  std::vector<Sh9> basis(options.directions);
+  std::vector<room::Sh9> basis(options.directions);
   const double golden = M_PI * (3 - std::sqrt(5.0));
   for (int i = 0; i < options.directions; ++i) {
     const double z = 1 - (2 * i + 1.0) / options.directions;
     const double r = std::sqrt(std::max(0.0, 1 - z * z));
     const Eigen::Vector3d d(r * std::cos(golden * i), r * std::sin(golden * i), z);
     directions[i] = d.cast<float>();
-    basis[i] = ShBasis(d);
+    basis[i] = room::ShBasis(d);
   }
   const double weight = 4 * M_PI / options.directions;
 
@@ -91,7 +91,7 @@ CharacterTransfer ComputeShadowedTransfer(const anim::Character& character, cons
       Eigen::Vector3f n = mesh.normals[v];
       if (n.norm() < 1e-6f) n = Eigen::Vector3f::UnitY();
       n.normalize();
-      Sh9 t = UnshadowedTransfer(n.cast<double>());
+      room::Sh9 t = UnshadowedTransfer(n.cast<double>());
       const std::vector<int>& s = skip[mesh_first_vertex[m] + v];
       for (int i = 0; i < options.directions; ++i) {
         const float c = n.dot(directions[i]);

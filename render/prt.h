@@ -1,9 +1,9 @@
 #pragma once
 // Per-vertex precomputed radiance transfer for a skinned character (the seed paper's dynamic
-// PRT, §6.1, PAPERS.md §4): for every vertex, the 9 SH coefficients of V(l)·max(n·l, 0), the
+// PRT, §6.1, docs/method.md §4): for every vertex, the 9 SH coefficients of V(l)·max(n·l, 0), the
 // cosine lobe times visibility, ray cast once in the bind pose. At run time the vertex shader
 // rotates each vertex's transfer by its skinning rotation (band 1 as a vector, band 2 as a
-// symmetric matrix, render/sh.h), so the precomputed self-shadowing follows the limbs, and
+// symmetric matrix, room/sh.h), so the precomputed self-shadowing follows the limbs, and
 // dots it with the room's light.
 //
 // The character's meshes are its segments; rays are cast against all of them together (the
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "anim/character.h"
-#include "render/sh.h"
+#include "room/sh.h"
 
 namespace arview::render {
 
@@ -42,7 +42,7 @@ struct CharacterTransfer {
 };
 
 // Â_l Y_lm(n): the cosine lobe about n (no visibility).
-Sh9 UnshadowedTransfer(const Eigen::Vector3d& unit_normal);
+room::Sh9 UnshadowedTransfer(const Eigen::Vector3d& unit_normal);
 
 CharacterTransfer ComputeShadowedTransfer(const anim::Character& character, const PrtOptions& options = {});
 

@@ -5,7 +5,7 @@
 //    bounding sphere; render/shadow_capsules.h: the posed capsules, evaluated on the CPU) is
 //    mapped onto the floor and darkens the camera image directly (DarkenCastShadow), where no
 //    occluder stands between the camera and the floor, before the character layer goes over it.
-//  - DepthProxy: the scene proxy's triangles (render/scene_proxy.h) drawn into the depth buffer
+//  - DepthProxy: the scene proxy's triangles (room/scene_proxy.h) drawn into the depth buffer
 //    only, before the character, so real things in front of the character hide it.
 
 #include <Eigen/Core>

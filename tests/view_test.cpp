@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using testing::RunArview;
 
-constexpr double kDegPerPixel = 0.4;  // app/view_camera.h OrbitCamera::kDegPerPixel
+constexpr double kDegPerPixel = 0.4;  // app/view/view_camera.h OrbitCamera::kDegPerPixel
 
 bool OnPath(const std::string& program) {
   return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;

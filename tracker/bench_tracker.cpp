@@ -507,7 +507,7 @@ BENCHMARK(BM_RealCorrespondences_OpenCV_RansacRefineLM)->Arg(cv::SOLVEPNP_P3P)->
 
 int main(int argc, char** argv) {
   cv::setNumThreads(1);
-  arview::KeepFreedHeapForReuse();  // as app/main.cpp does, so that the figures are the app's
+  arview::KeepFreedHeapForReuse();  // as app/cli/main.cpp does, so that the figures are the app's
   std::vector<char*> rest;
   for (int i = 0; i < argc; ++i) {
     const std::string arg = argv[i];

@@ -1,4 +1,5 @@
 #include "tracker/tracker.h"
+#include "tracker/tracker_internal.h"
 
 #include <opencv2/video/tracking.hpp>
 
@@ -73,7 +74,7 @@ Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const c
   return out;
 }
 
-void ValidateMap(const map::Map& map, int min_points) {
+void CheckTrackable(const map::Map& map, int min_points) {
   if (static_cast<int>(map.points.size()) < min_points) {
     std::ostringstream msg;
     msg << "map has " << map.points.size() << " points, at least " << min_points
@@ -94,7 +95,7 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
       resolution_(map.camera, options.working_long_side),
       rms_gate_(options.tracking.rms_gate),
       smoother_(options.smoothing) {
-  ValidateMap(map, options.min_map_points);
+  CheckTrackable(map, options.min_map_points);
   index_ = map::DescriptorIndex(map.descriptors, options.index);
   relocalizer_ = std::make_unique<Relocalizer>(map_, resolution_.work(), index_, options.relocalization);
   FeatureOptions guided_features = options.relocalization.features;
@@ -132,27 +133,6 @@ std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& p
   std::vector<int> best;
   for (size_t i = 0; i < n; ++i) best.push_back(ranked[i].second);
   return best;
-}
-
-void CentreFitter::Add(double timestamp, const Eigen::Vector3d& centre) {
-  samples_.emplace_back(timestamp, centre);
-  while (!samples_.empty() && (static_cast<int>(samples_.size()) > max_count_ ||
-                               !(timestamp - samples_.front().first <= max_span_s_)))
-    samples_.erase(samples_.begin());
-}
-
-Eigen::Vector3d CentreFitter::At(double timestamp) const {
-  if (samples_.empty()) return Eigen::Vector3d::Zero();
-  double mean_t = 0;
-  Eigen::Vector3d mean_c = Eigen::Vector3d::Zero();
-  for (const auto& [t, c] : samples_) mean_t += t, mean_c += c;
-  mean_t /= static_cast<double>(samples_.size());
-  mean_c /= static_cast<double>(samples_.size());
-  double stt = 0;
-  Eigen::Vector3d stc = Eigen::Vector3d::Zero();
-  for (const auto& [t, c] : samples_) stt += (t - mean_t) * (t - mean_t), stc += (t - mean_t) * (c - mean_c);
-  if (stt < 1e-12) return mean_c;
-  return mean_c + stc / stt * (timestamp - mean_t);
 }
 
 void Tracker::Reset() {

@@ -17,6 +17,7 @@
 #include "base/error.h"
 #include "map/descriptor_index.h"
 #include "map/map.h"
+#include "tracker/centre_fitter.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
 #include "tracker/residual_gate.h"
@@ -189,25 +190,6 @@ struct FrameResult {
   StageTimes times;
 };
 
-// The camera centre extrapolated along a straight line (constant velocity in the world) fitted by
-// least squares to the last few centres: a head or a phone keeps walking while it turns, which
-// the per-frame relative motion (a velocity in the camera's turning frame) would bend, and the
-// fit damps one noisy pose (a relocalization in a blurred frame).
-class CentreFitter {
- public:
-  explicit CentreFitter(int max_count = 64, double max_span_s = 0.5) : max_count_(max_count), max_span_s_(max_span_s) {}
-  void Add(double timestamp, const Eigen::Vector3d& centre);
-  void Clear() { samples_.clear(); }
-  bool empty() const { return samples_.empty(); }
-  // The fitted line at `timestamp` (the one centre when only one is known).
-  Eigen::Vector3d At(double timestamp) const;
-
- private:
-  int max_count_;
-  double max_span_s_;
-  std::vector<std::pair<double, Eigen::Vector3d>> samples_;  // oldest first
-};
-
 class Tracker {
  public:
   // Validates the map and builds its descriptor index. `map` must outlive the tracker.
@@ -314,20 +296,4 @@ class Tracker {
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
 };
-
-// At most `max_count` of `tracks`, spread evenly over a grid of `cell` pixel squares (round
-// robin over the cells, in input order within a cell).
-Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size);
-
-// Throws TrackerError naming the problem when `map` cannot be tracked against.
-void ValidateMap(const map::Map& map, int min_points);
-
-// Constant-velocity prediction: apply the last inter-frame motion once more.
-calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity);
-// `motion` scaled by `ratio` (rotation angle and translation multiplied): the motion over
-// ratio times the interval it was measured on.
-calib::Pose ScaleMotion(const calib::Pose& motion, double ratio);
-// velocity such that PredictConstantVelocity(previous, velocity) == last.
-calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last);
-
 }  // namespace arview::tracker

@@ -1,4 +1,5 @@
 #include "tracker/tracker.h"
+#include "tracker/tracker_internal.h"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -389,7 +390,7 @@ TEST_F(PlanarTrackerTest, InconsistentMapIsRefusedWithTheReason) {
   } catch (const TrackerError& e) {
     EXPECT_NE(std::string(e.what()).find("descriptor"), std::string::npos) << e.what();
   }
-  ValidateMap(*map_, 30);
+  CheckTrackable(*map_, 30);
 }
 
 TEST(ConstantVelocity, PredictionRepeatsTheLastMotion) {

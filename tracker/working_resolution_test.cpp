@@ -5,6 +5,7 @@
 
 #include "tracker/residual_gate.h"
 #include "tracker/tracker.h"
+#include "tracker/tracker_internal.h"
 
 namespace arview::tracker {
 namespace {

@@ -13,6 +13,7 @@
 //   FourActionSchedule s(FourActionSchedule::Gesture::kPoint, /*dib=*/false);
 //   for (...) { const anim::AnimatorFrame& f = s.Step(1.0 / 60); ... }
 
+#include "anim_authoring/animator_builder.h"
 #include "anim_authoring/gesture.h"
 #include "anim_authoring/scene.h"
 

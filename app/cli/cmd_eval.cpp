@@ -1,0 +1,105 @@
+// arview eval <estimate.txt> <groundtruth.txt> [--align sim3|se3|none] [--align-with <poses.txt>]
+//             [--plot plot.png] [--json] [--max-dt S] [--rpe-delta N]
+
+#include <iostream>
+#include <optional>
+
+#include "app/cli/commands.h"
+#include "base/geometry.h"
+#include "recordings/accuracy.h"
+
+namespace arview::app {
+
+namespace {
+
+struct EvalArgs {
+  std::string estimate;
+  std::string groundtruth;
+  std::string align = "sim3";
+  std::string align_with;
+  std::string plot;
+  bool json = false;
+  double max_dt = 0.02;
+  int rpe_delta = 1;
+};
+
+// An alignment needs positions that span at least a plane (base/geometry.h EstimateSim3). Each
+// trajectory the alignment is fitted on is checked by itself first, so that the error names
+// the file whose camera centres are degenerate (all at one point, or on one line).
+void RequireAlignablePositions(const recordings::Trajectory& trajectory, const std::string& file) {
+  std::vector<Eigen::Vector3d> centres;
+  centres.reserve(trajectory.size());
+  for (const auto& stamped : trajectory) centres.push_back(stamped.pose.Center());
+  if (centres.size() < 3) return;  // the association's own error says how many are needed
+  try {
+    (void)EstimateSim3(centres, centres, false, "alignment");
+  } catch (const Error& e) {
+    throw CommandError(file + ": " + e.what());
+  }
+}
+
+void RunEval(const EvalArgs& args) {
+  try {
+    const recordings::Trajectory estimate = recordings::ReadTum(args.estimate);
+    const recordings::Trajectory groundtruth = recordings::ReadTum(args.groundtruth);
+    if (estimate.empty()) throw CommandError(args.estimate + ": holds no poses");
+    if (groundtruth.empty()) throw CommandError(args.groundtruth + ": holds no poses");
+    std::optional<recordings::Trajectory> align_with;
+    recordings::AccuracyOptions options;
+    options.align = recordings::ParseAlignMode(args.align);
+    options.max_dt = args.max_dt;
+    options.rpe_delta = args.rpe_delta;
+    if (!args.align_with.empty()) {
+      if (options.align == recordings::AlignMode::kNone) {
+        throw CommandError("--align-with needs --align se3 or sim3");
+      }
+      align_with = recordings::ReadTum(args.align_with);
+      options.align_with = &*align_with;
+    }
+    if (options.align != recordings::AlignMode::kNone) {
+      RequireAlignablePositions(groundtruth, args.groundtruth);
+      RequireAlignablePositions(align_with ? *align_with : estimate, align_with ? args.align_with : args.estimate);
+    }
+    const recordings::AccuracyReport report = recordings::EvaluateTrajectory(estimate, groundtruth, options);
+    if (!args.plot.empty()) recordings::PlotTrajectories(report, groundtruth, args.plot);
+    if (args.json) {
+      std::cout << recordings::ReportToJson(report);
+    } else {
+      std::cout << recordings::ReportToText(report);
+      if (!args.plot.empty()) std::cout << "plot        " << args.plot << "\n";
+    }
+  } catch (const recordings::RecordingError& e) {
+    // The alignment's and association's errors concern the pair: both files are named.
+    const std::string message = e.what();
+    if (message.rfind("alignment", 0) == 0 || message.rfind("evaluation", 0) == 0) {
+      throw CommandError(args.estimate + " against " + args.groundtruth + ": " + message);
+    }
+    throw CommandError(message);
+  }
+}
+
+}  // namespace
+
+void AddEvalCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("eval", "Compare a trajectory with ground truth (ATE, RPE, alignment, plot)");
+  auto args = std::make_shared<EvalArgs>();
+  cmd->add_option("estimate", args->estimate, "Estimated trajectory (TUM: timestamp tx ty tz qx qy qz qw, camera-to-world)")
+      ->required();
+  cmd->add_option("groundtruth", args->groundtruth, "Ground-truth trajectory (TUM)")->required();
+  cmd->add_option("--align", args->align, "Alignment of the estimate to the ground truth")
+      ->check(CLI::IsMember({"sim3", "se3", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--align-with", args->align_with,
+                  "Fit the alignment on this trajectory (e.g. the map's keyframe poses) instead of the estimate");
+  cmd->add_option("--plot", args->plot, "Write a PNG: top and side view, error by colour");
+  cmd->add_flag("--json", args->json, "Print the report as one JSON object");
+  cmd->add_option("--max-dt", args->max_dt, "Timestamp association tolerance, seconds")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  cmd->add_option("--rpe-delta", args->rpe_delta, "RPE interval, in associated poses")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  cmd->callback([args] { RunEval(*args); });
+}
+
+}  // namespace arview::app

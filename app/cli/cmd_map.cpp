@@ -1,0 +1,238 @@
+// arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive]
+//            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
+//            [--fold-retries N]
+// arview map info <map-dir>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "app/cli/commands.h"
+#include "base/cancellation.h"
+#include "base/process.h"
+#include "map/map_file.h"
+#include "mapping/colmap_pipeline.h"
+#include "mapping/map_check.h"
+
+namespace arview::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct MapArgs {
+  std::string recording;
+  std::string out;
+  std::string frames;
+  std::string matcher = "auto";
+  int max_frames = 300;
+  bool refine_intrinsics = false;
+  int threads = 2;
+  std::string colmap = "colmap";
+  std::string preset = "quality";
+  int max_features = 0;  // 0: the preset's
+  int fold_retries = mapping::MapBuildOptions().fold_retries;
+  std::string info_dir;
+  bool info_recheck = false;
+};
+
+// One progress line per stage on stderr: redrawn in place on a terminal, printed at every
+// 25% otherwise (logs stay short).
+class ProgressBar {
+ public:
+  ProgressBar() : tty_(::isatty(STDERR_FILENO) != 0) {}
+  ~ProgressBar() { Finish(); }
+  void Update(const std::string& stage, int done, int total) {
+    if (stage != stage_) {
+      Finish();
+      stage_ = stage;
+      last_quarter_ = -1;
+    }
+    if (tty_) {
+      const int width = 30;
+      const int filled = total > 0 ? std::min(width, done * width / total) : 0;
+      std::cerr << "\r" << std::left << std::setw(8) << stage << " [" << std::string(static_cast<size_t>(filled), '#')
+                << std::string(static_cast<size_t>(width - filled), ' ') << "] " << done << "/" << total << std::flush;
+      open_ = true;
+    } else if (total > 0) {
+      const int quarter = done * 4 / total;
+      if (quarter != last_quarter_) {
+        std::cerr << stage << ": " << done << "/" << total << "\n";
+        last_quarter_ = quarter;
+      }
+    }
+  }
+  void Finish() {
+    if (open_) std::cerr << "\n";
+    open_ = false;
+  }
+
+ private:
+  bool tty_;
+  bool open_ = false;
+  std::string stage_;
+  int last_quarter_ = -1;
+};
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream ss;
+  ss << std::fixed << std::setprecision(digits) << v;
+  return ss.str();
+}
+
+void RunMap(const MapArgs& args) {
+  if (args.recording.empty()) throw CommandError("map: the recording folder is required (arview map <recording> --out <map-dir>)", 2);
+  if (args.out.empty()) throw CommandError("map: --out <map-dir> is required", 2);
+  mapping::MapBuildOptions options;
+  options.frames_spec = args.frames;
+  options.max_frames = args.max_frames;
+  options.refine_intrinsics = args.refine_intrinsics;
+  options.threads = args.threads;
+  options.colmap = args.colmap;
+  if (args.preset == "fast") options.UseFastPreset();
+  if (args.max_features > 0) options.max_num_features = args.max_features;
+  options.fold_retries = args.fold_retries;
+  const ScopedSignalCancellation signals;
+  options.cancel = signals.token();
+  ProgressBar bar;
+  mapping::MapBuildCallbacks callbacks;
+  callbacks.progress = [&](const std::string& stage, int done, int total) {
+    if (!signals.token().IsCancelled()) bar.Update(stage, done, total);  // after a Ctrl-C: only the one line
+  };
+  callbacks.note = [&](const std::string& message) {
+    bar.Finish();
+    std::cerr << "note: " << message << "\n";
+  };
+  callbacks.warning = [&](const std::string& message) {
+    bar.Finish();
+    std::cerr << "warning: the map " << message << "\n";
+  };
+  try {
+    options.matcher = mapping::ParseMatcherKind(args.matcher);
+    const recordings::Recording recording = recordings::LoadRecording(args.recording);
+    const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
+    bar.Finish();
+    const auto stats = map::ComputeStats(result.map);
+    std::cout << "registered " << result.map.keyframes.size() << " of " << result.selected_frames.size()
+              << " frames; " << stats.points << " points, mean track length " << Fixed(stats.mean_track_length, 2)
+              << ", mean reprojection error " << Fixed(stats.mean_reprojection_error, 3) << " px\n";
+    double total = 0;
+    std::cout << "stages:";
+    for (const auto& t : result.timings) {
+      std::cout << " " << t.stage << " " << (t.skipped ? "skipped" : Fixed(t.seconds, 1) + " s");
+      total += t.seconds;
+    }
+    std::cout << " (total " << Fixed(total, 1) << " s)\n";
+    std::cout << "check: " << mapping::DescribeMapCheck(result.check) << "\n";
+    std::cout << "wrote " << args.out << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
+              << ", keyframes.txt, map.png, database.db}, COLMAP model " << result.model_dir.string() << "\n";
+  } catch (const mapping::ColmapStageError& e) {
+    bar.Finish();
+    std::cerr << "last lines of COLMAP's output (" << e.log.string() << "):\n";
+    for (const auto& line : e.log_tail) std::cerr << "  | " << line << "\n";
+    throw CommandError(e.what());
+  } catch (const CancelledError&) {
+    bar.Finish();
+    throw;  // its message says which stage stopped and what was kept
+  } catch (const ProcessError& e) {
+    throw CommandError(e.what());
+  } catch (const map::MapError& e) {
+    throw CommandError(e.what());
+  } catch (const recordings::RecordingError& e) {
+    throw CommandError(e.what());
+  }
+}
+
+void RunInfo(const std::string& dir, bool recheck) {
+  try {
+    // Before anything is printed, so that a folder without COLMAP's model fails with one line.
+    if (recheck) mapping::RecheckMap(fs::is_regular_file(dir) ? fs::path(dir).parent_path() : fs::path(dir));
+    const auto start = std::chrono::steady_clock::now();
+    const map::Map map = map::LoadMap(dir);
+    const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const auto s = map::ComputeStats(map);
+    int first = -1, last = -1;
+    for (const auto& k : map.keyframes) {
+      if (first < 0 || k.frame_index < first) first = k.frame_index;
+      last = std::max(last, k.frame_index);
+    }
+    const auto& c = map.camera;
+    std::cout << "map:                 " << dir << "\n"
+              << "camera:              " << c.width << "x" << c.height << ", fx " << c.fx << ", fy " << c.fy << ", cx "
+              << c.cx << ", cy " << c.cy << "\n"
+              << "keyframes:           " << s.keyframes << " (frames " << first << " to " << last << ")\n"
+              << "points:              " << s.points << "\n"
+              << "mean track length:   " << Fixed(s.mean_track_length, 2) << "\n"
+              << "observations:        " << s.observations << "\n"
+              << "reprojection error:  mean " << Fixed(s.mean_reprojection_error, 3) << " px, median "
+              << Fixed(s.median_reprojection_error, 3) << " px (COLMAP's mean point error "
+              << Fixed(s.mean_colmap_point_error, 3) << " px)\n"
+              << "descriptors:         " << s.descriptors << " (128 x uint8, "
+              << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
+              << "load time:           " << Fixed(load_ms, 1) << " ms\n";
+    const fs::path folder = fs::is_directory(dir) ? fs::path(dir) : fs::path(dir).parent_path();
+    if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
+      std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
+      for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
+      if (!check->flagged()) std::cout << "                     (nothing flagged)\n";
+    } else {
+      std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
+                << " is written by arview map since issue 17)\n";
+    }
+  } catch (const map::MapError& e) {
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
+void AddMapCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("map", "Build the map of a scene from a recording with COLMAP ('map info' describes one)");
+  auto args = std::make_shared<MapArgs>();
+  cmd->add_option("recording", args->recording, "Recording folder (see 'arview import')");
+  cmd->add_option("--out", args->out, "Map directory to write (created; a re-run skips unchanged stages)");
+  cmd->add_option("--frames", args->frames, "Frames to use, e.g. 0-46:2 or 1,5,9-12 (default: all)");
+  cmd->add_option("--matcher", args->matcher, "auto (exhaustive up to 100 frames, else sequential), sequential or exhaustive")
+      ->capture_default_str();
+  cmd->add_option("--max-frames", args->max_frames, "At most this many frames go to COLMAP (0: no cap)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--refine-intrinsics", args->refine_intrinsics, "Let COLMAP refine the recording's camera");
+  cmd->add_option("--threads", args->threads, "Threads COLMAP uses per stage (-1: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 256));
+  cmd->add_option("--colmap", args->colmap, "The COLMAP executable")->capture_default_str();
+  cmd->add_option("--max-features", args->max_features,
+                  "SIFT features per image (COLMAP's SiftExtraction.max_num_features; default: the preset's, "
+                  "quality 8192, fast 850): fewer map faster")
+      ->check(CLI::Range(64, 100000));
+  cmd->add_option("--preset", args->preset,
+                  "quality: COLMAP's own feature and bundle-adjustment settings; fast: 850 features, one "
+                  "orientation, fewer bundle adjustments (about a third less time, about twice the error)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"quality", "fast"}));
+  cmd->add_option("--fold-retries", args->fold_retries,
+                  "When the self-check finds part of the path registered at wrong rotations (a fold), match and "
+                  "map again up to this many times and keep the model that agrees best with the frames' two-view "
+                  "geometry (COLMAP's matches differ from run to run; 0: keep the first model)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10));
+
+  auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
+  info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();
+  info->add_flag("--recheck", args->info_recheck,
+                 "Run the map's self-check again from the COLMAP model and database in its folder and rewrite "
+                 "check.json (maps built before a check existed)");
+  info->callback([args] { RunInfo(args->info_dir, args->info_recheck); });
+  cmd->callback([args, info] {
+    if (info->parsed()) return;
+    RunMap(*args);
+  });
+}
+
+}  // namespace arview::app

@@ -1,0 +1,81 @@
+// arview place: put a character on the dominant plane of a map and write its scene file.
+
+#include <cstdio>
+
+#include "anim_authoring/import.h"
+#include "app/cli/commands.h"
+#include "app/placement/place_character.h"
+#include "app/placement/scene_lighting.h"
+#include "map/map_file.h"
+
+namespace arview::app {
+
+namespace {
+
+struct PlaceArgs {
+  std::string map_dir;
+  std::string character;
+  std::string out;
+  PlaceCharacterOptions options;
+  std::optional<double> elevation;
+  std::string recording;  // where still keyframe images are (video maps keep theirs in <map>/images)
+  bool no_light = false;
+};
+
+// A --base-clip the asset lacks is refused before the map is read and before a scene naming it
+// is written (the scene would only fail when loaded, far from the command that made it).
+void RequireBaseClip(const std::string& asset, const std::string& clip) {
+  if (clip.empty() || clip == "rest") return;
+  const anim::Character character = anim::LoadCharacter(asset);
+  std::string names;
+  for (const auto& c : character.clips) {
+    if (c.name == clip) return;
+    names += (names.empty() ? "" : ", ") + c.name;
+  }
+  throw CommandError("--base-clip: '" + clip + "' is not a clip of " + asset + " (clips: " +
+                     (names.empty() ? "none; use 'rest'" : names + ", or 'rest'") + ")");
+}
+
+}  // namespace
+
+void AddPlaceCommand(CLI::App& app) {
+  auto a = std::make_shared<PlaceArgs>();
+  auto* cmd = app.add_subcommand("place", "Place a character on the dominant plane of a map and write a scene file");
+  cmd->add_option("map-dir", a->map_dir, "Map folder written by 'arview map'")->required();
+  cmd->add_option("--character", a->character, "Character asset (glTF, FBX, Collada, .X, BVH)")->required();
+  cmd->add_option("--out", a->out, "Scene file to write (YAML)")->required();
+  cmd->add_option("--keys", a->options.keys, "Look-at key animations generated around the character")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 64));
+  cmd->add_option("--height", a->options.height_fraction,
+                  "Character height as a fraction of the median camera distance to it")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 10.0));
+  cmd->add_option("--base-clip", a->options.base_clip,
+                  "Clip the look-at keys are built on, or 'rest' for the rest pose (default: the first clip)");
+  cmd->add_option("--elevation", a->elevation,
+                  "Elevation of the keys in degrees (default: the median elevation of the map's cameras)")
+      ->check(CLI::Range(-89.0, 89.0));
+  cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
+  cmd->add_option("--recording", a->recording,
+                  "Recording the map was built from, for its keyframe images (the room's light; video maps need none)");
+  cmd->add_flag("--no-light", a->no_light, "Do not estimate the room's light (no <scene>.light.yml)");
+  cmd->callback([a] {
+    if (a->elevation) a->options.key_elevation_deg = *a->elevation;
+    RequireBaseClip(a->character, a->options.base_clip);
+    const map::Map map = map::LoadMap(a->map_dir);
+    ScenePlacement placed = PlaceCharacter(map, a->character, a->options);
+    placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
+    WriteSceneFile(placed, a->out);
+    const Anchor& anchor = placed.anchor;
+    const Eigen::Vector3d up = anchor.rotation * Eigen::Vector3d::UnitY();
+    std::printf("placed %s at (%.4f, %.4f, %.4f), up (%.3f, %.3f, %.3f), scale %.5g (rest height %.4g units)\n",
+                placed.name.c_str(), anchor.position.x(), anchor.position.y(), anchor.position.z(),
+                up.x(), up.y(), up.z(), anchor.scale, placed.rest_height);
+    std::printf("wrote %s with %d look-at keys at %.1f deg elevation\n", a->out.c_str(), placed.key_count,
+                placed.key_elevation_deg);
+    if (!a->no_light) WritePlacedLight(map, a->map_dir, a->recording, placed, a->out);
+  });
+}
+
+}  // namespace arview::app

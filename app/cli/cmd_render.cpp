@@ -1,0 +1,165 @@
+// arview render --scene scene.yaml --camera camera.yaml --pose "tx ty tz qx qy qz qw"
+
+#include "anim_authoring/character_builder.h"
+#include "base/image_file.h"
+//               [--background image.png] [--time s] [--hmd --ipd m] --out out.png
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "anim_authoring/scene.h"
+#include "app/cli/commands.h"
+#include "app/placement/scene_lighting.h"
+#include "calib/camera.h"
+#include "render/ar_renderer.h"
+#include "render/prt_cache.h"
+
+namespace arview::app {
+
+namespace {
+
+struct RenderArgs {
+  std::string scene, camera, pose, background, out;
+  double time = 0;
+  std::string skinning = "dq";
+  bool hmd = false;
+  double ipd = 0.064;
+  std::string antialiasing = "msaa";
+  bool no_shadow = false;
+  std::string lighting = "auto", light;
+  bool no_cast_shadow = false, no_occlusion = false;
+  std::string backend = "auto";
+  int threads = 1;
+};
+
+// "tx ty tz qx qy qz qw", camera-to-world as in TUM trajectories.
+calib::Pose ParsePose(const std::string& text) {
+  std::istringstream in(text);
+  double v[7];
+  for (double& x : v) {
+    if (!(in >> x)) throw CommandError("--pose needs 7 numbers \"tx ty tz qx qy qz qw\" (TUM, camera-to-world), got \"" + text + "\"");
+  }
+  std::string rest;
+  if (in >> rest) throw CommandError("--pose has more than 7 numbers: \"" + text + "\"");
+  const Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+  if (!std::isfinite(q.norm()) || std::abs(q.norm() - 1.0) > 1e-3) {
+    throw CommandError("--pose quaternion (qx qy qz qw) is not of unit length: \"" + text + "\"");
+  }
+  for (double x : v) {
+    if (!std::isfinite(x)) throw CommandError("--pose has a non-finite number: \"" + text + "\"");
+  }
+  return calib::Pose::FromCameraToWorld(q.normalized(), {v[0], v[1], v[2]});
+}
+
+std::string Fixed3(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", x);
+  return text;
+}
+
+void RunRender(const RenderArgs& args) {
+  const calib::Pose pose = ParsePose(args.pose);
+  calib::Camera camera;
+  try {
+    camera = calib::LoadCamera(args.camera);
+  } catch (const calib::CameraError& e) {
+    throw CommandError(e.what());
+  }
+  cv::Mat background;
+  if (!args.background.empty()) {
+    try {
+      background = ReadImageFile(args.background, cv::IMREAD_COLOR);
+    } catch (const Error& e) {
+      throw CommandError(e.what());
+    }
+  }
+  const std::string ext = std::filesystem::path(args.out).extension().string();
+  if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") throw CommandError(args.out + ": --out must end in .png or .jpg");
+  try {
+    const anim::Scene scene = anim::LoadScene(args.scene);
+    if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
+    const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
+    std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
+    for (const anim::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
+
+    render::OffscreenOptions gl;
+    gl.backend = render::ParseGlBackend(args.backend);
+    gl.threads = args.threads;
+    auto context = render::OffscreenContext::Create(gl);
+    render::ArOptions options;
+    options.antialiasing = render::ParseAntialiasing(args.antialiasing);
+    options.shadow = !args.no_shadow;
+    options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
+    options.lighting = lighting.mode;
+    options.prt_cache_folder = render::DefaultPrtCacheFolder();
+    options.cast_shadow = !args.no_cast_shadow;
+    options.occlusion = !args.no_occlusion;
+    options.exposure_smoothing = 1.0;  // one frame: its own exposure
+    render::ArRenderer renderer(*context, camera, options);
+    if (lighting.light) renderer.SetRoomLight(*lighting.light);
+    std::vector<const anim::AnimatorFrame*> frames;
+    for (auto& c : characters) {
+      renderer.AddCharacter(c->character(), c->spec().placement());
+      frames.push_back(&c->Update(c->spec().placement().ViewpointFromCamera(pose.Center()), args.time));
+    }
+    const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
+                                   : renderer.Render(background, pose, frames);
+    WriteImageAtomically(args.out, image);
+    std::cout << "wrote " << args.out << " (" << image.cols << "x" << image.rows << ", "
+              << characters.size() << " character" << (characters.size() == 1 ? "" : "s")
+              << (camera.HasDistortion() ? ", undistorted view" : "")
+              << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ", lighting "
+              << render::LightingModeName(lighting.mode)
+              << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s" + (renderer.prt_from_cache() > 0 ? ", from its cache" : "") + ")" : "")
+              << ") ["
+              << context->Description() << "]\n";
+  } catch (const anim::Error& e) {
+    throw CommandError(e.what());
+  } catch (const render::RenderError& e) {
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
+void AddRenderCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("render", "Render one frame of a scene from a given camera pose");
+  auto args = std::make_shared<RenderArgs>();
+  cmd->add_option("--scene", args->scene, "Scene file (YAML, see docs/anim.md)")->required();
+  cmd->add_option("--camera", args->camera, "camera.yaml (OpenCV FileStorage)")->required();
+  cmd->add_option("--pose", args->pose, "Camera pose \"tx ty tz qx qy qz qw\": camera-to-world, as a TUM trajectory line without its timestamp")
+      ->required();
+  cmd->add_option("--background", args->background, "Camera image to draw over (the camera's size); default: grey");
+  cmd->add_option("--out", args->out, "Output image (.png or .jpg)")->required();
+  cmd->add_option("--time", args->time, "Animation time, seconds")->default_val(args->time);
+  cmd->add_option("--skinning", args->skinning, "dq (dual quaternion) or lbs (linear blend)")
+      ->default_val(args->skinning)
+      ->check(CLI::IsMember({"dq", "lbs"}));
+  cmd->add_flag("--hmd", args->hmd, "Side-by-side stereo for a head-mounted display (2W x H)");
+  cmd->add_option("--ipd", args->ipd, "Interpupillary distance for --hmd, metres")->default_val(args->ipd)->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--aa", args->antialiasing, "Antialiasing: msaa (4x multisampling) or none")
+      ->default_val(args->antialiasing)
+      ->check(CLI::IsMember({"msaa", "none"}));
+  cmd->add_flag("--no-shadow", args->no_shadow, "No contact shadow");
+  cmd->add_option("--lighting", args->lighting,
+                  "auto (prt when the scene has a .light.yml), fixed (key + ambient), sh (room SH, unshadowed) or prt "
+                  "(room SH through self-shadowed PRT)")
+      ->default_val(args->lighting)
+      ->check(CLI::IsMember({"auto", "fixed", "sh", "prt"}));
+  cmd->add_option("--light", args->light, "Room light file (default: the scene's <scene>.light.yml)");
+  cmd->add_flag("--no-cast-shadow", args->no_cast_shadow, "No shadow from the room's dominant light");
+  cmd->add_flag("--no-occlusion", args->no_occlusion, "Do not let the scene proxy hide the character");
+  cmd->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
+      ->default_val(args->backend)
+      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
+  cmd->add_option("--gl-threads", args->threads, "llvmpipe rasterizer threads (LP_NUM_THREADS)")
+      ->default_val(args->threads)
+      ->check(CLI::Range(0, 32));
+  cmd->callback([args] { RunRender(*args); });
+}
+
+}  // namespace arview::app

@@ -1,0 +1,84 @@
+// arview replay: the whole pipeline on a recording (track, animate, render, composite).
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "app/session/ar_session.h"
+#include "app/cli/commands.h"
+#include "base/atomic_file.h"
+#include "app/cli/session_flags.h"
+#include "base/cancellation.h"
+#include "app/pipeline/pipeline_report.h"
+#include "map/map_file.h"
+#include "recordings/recording.h"
+#include "render/offscreen.h"
+
+namespace arview::app {
+
+namespace {
+
+struct ReplayArgs {
+  std::string recording, map_dir, out, frames;
+  bool paced = false;
+  long loop = 1;
+  SessionFlags session;
+};
+
+}  // namespace
+
+void AddReplayCommand(CLI::App& app) {
+  auto a = std::make_shared<ReplayArgs>();
+  auto* cmd = app.add_subcommand("replay", "Run the whole pipeline on a recording: track, animate, render, composite");
+  cmd->add_option("recording", a->recording, "Recording folder")->required();
+  cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map'")->required();
+  cmd->add_option("--out", a->out, "Output: a video file (.mp4, .avi, .mkv), a PNG folder, 'window', or 'null' (frames discarded)")->required();
+  cmd->add_option("--frames", a->frames, "Frames to replay, e.g. 1-46:2 (default: all)");
+  cmd->add_flag("--paced", a->paced, "Deliver frames at the recorded rate, dropping frames when a stage is slower");
+  cmd->add_option("--loop", a->loop,
+                  "Replay the frames this many times in a row (timestamps keep increasing; a soak test: "
+                  "--loop 100 --out null)")
+      ->capture_default_str()
+      ->check(CLI::Range(1L, 100000000L));
+  AddSessionFlags(cmd, a->session);
+  cmd->callback([a] {
+    const ScopedSignalCancellation signals;
+    const recordings::Recording recording = recordings::LoadRecording(a->recording);
+    recordings::ReplayOptions replay;
+    replay.paced = a->paced;
+    replay.loop = a->loop > 1;
+    replay.passes = a->loop;
+    if (!a->frames.empty()) replay.frames = recordings::ParseFrameSpec(a->frames, static_cast<int>(recording.frames.size()));
+    const long expected = a->loop * (replay.frames.empty() ? static_cast<long>(recording.frames.size())
+                                                           : static_cast<long>(replay.frames.size()));
+
+    SessionOptions o;
+    ApplySessionFlags(a->session, o);
+    // Per-frame records only for the files that need them: a long run's memory stays flat.
+    o.pipeline.keep_frame_logs = !o.stats_out.empty();
+    o.pipeline.keep_trajectory = !o.trajectory_out.empty();
+    o.pipeline.drop_frames = a->paced;
+    o.expected_frames = expected;
+    o.sink_fps = MedianFrameRate(recording.frames);
+    o.cancel = signals.token();
+    o.output_name = a->out;
+
+    // A video or a PNG folder is written under a temporary name and renamed when complete.
+    const bool to_file = a->out != "window" && a->out.rfind("window:", 0) != 0 && a->out != "null";
+    std::unique_ptr<PendingOutput> pending;
+    if (to_file) {
+      pending = std::make_unique<PendingOutput>(a->out);
+      o.sink = pending->sink_target();
+    } else {
+      o.sink = a->out;
+    }
+    recordings::RecordingSource source(recording, replay);
+    const map::Map map = map::LoadMap(a->map_dir);
+    const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
+    if (pending) pending->Commit();
+    std::printf("%s", PipelineReportText(result.report).c_str());
+    std::printf("renderer: %s\nwrote %s\n", result.renderer.c_str(), a->out.c_str());
+  });
+}
+
+}  // namespace arview::app

@@ -1,0 +1,61 @@
+// arview run: the whole pipeline live on a V4L2 camera (a webcam, or an HMD's camera).
+
+#include <cstdio>
+
+#include "app/session/ar_session.h"
+#include "app/cli/commands.h"
+#include "app/pipeline/pipeline_report.h"
+#include "app/cli/session_flags.h"
+#include "base/cancellation.h"
+#include "map/map_file.h"
+#include "recordings/v4l2_source.h"
+#include "render/offscreen.h"
+
+namespace arview::app {
+
+namespace {
+
+struct RunArgs {
+  std::string device = "/dev/video0", map_dir, out = "window", format = "auto";
+  SessionFlags session;
+};
+
+}  // namespace
+
+void AddRunCommand(CLI::App& app) {
+  auto a = std::make_shared<RunArgs>();
+  auto* cmd = app.add_subcommand("run", "Run the whole pipeline live on a V4L2 camera or HMD");
+  cmd->add_option("--device", a->device, "V4L2 capture device")->capture_default_str();
+  cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (made with this camera)")->required();
+  cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
+  cmd->add_option("--format", a->format, "Camera pixel format: auto, yuyv or mjpeg")->capture_default_str();
+  AddSessionFlags(cmd, a->session);
+  cmd->callback([a] {
+    SessionOptions o;
+    ApplySessionFlags(a->session, o);
+    // Per-frame records only for the files that need them: a long run's memory stays flat.
+    o.pipeline.keep_frame_logs = !o.stats_out.empty();
+    o.pipeline.keep_trajectory = !o.trajectory_out.empty();
+    o.sink = a->out;
+    o.pipeline.drop_frames = true;  // live: never fall behind the camera
+    const ScopedSignalCancellation signals;
+    o.cancel = signals.token();
+    o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends
+
+    // The camera must deliver the map camera's size; the map is read first to know it.
+    recordings::V4l2Options v4l2;
+    v4l2.format = a->format;
+    v4l2.cancel = signals.token();
+    const map::Map map = map::LoadMap(a->map_dir);
+    v4l2.width = map.camera.width;
+    v4l2.height = map.camera.height;
+    recordings::V4l2Source source(a->device, v4l2);
+    std::fprintf(stderr, "%s: %s, %dx%d %s (Ctrl-C stops)\n", a->device.c_str(), source.CardName().c_str(),
+                 source.size().width, source.size().height, source.FormatName().c_str());
+    const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
+    std::printf("%s", PipelineReportText(result.report).c_str());
+    std::printf("renderer: %s\n", result.renderer.c_str());
+  });
+}
+
+}  // namespace arview::app

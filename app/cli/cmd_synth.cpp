@@ -1,0 +1,104 @@
+// arview synth room --out <recording> [--frames N] [--seed S] [--motion-blur N] [--noise sigma] ...
+
+#include <chrono>
+#include <iostream>
+#include <map>
+
+#include "app/cli/commands.h"
+#include "app/cli/numeric_flags.h"
+#include "synth/synth_room.h"
+
+namespace arview::app {
+
+namespace {
+
+struct SynthArgs {
+  synth::SynthRoomOptions options;
+  std::string out;
+  std::string data_dir = synth::kOpenCvDocData;
+  std::string backend = "auto";
+  std::string size = "640x480";
+  bool quiet = false;
+};
+
+void RunSynthRoom(SynthArgs& args) {
+  synth::SynthRoomOptions& o = args.options;
+  o.out = args.out;
+  o.data_dir = args.data_dir;
+  const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
+  o.width = size.width;
+  o.height = size.height;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    o.gl.backend = render::ParseGlBackend(args.backend);
+    const synth::SynthRoomReport report = synth::SynthesizeRoom(o, [&](int done, int total) {
+      if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
+    });
+    if (!args.quiet) std::cerr << "\n";
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "wrote " << report.frames << " frames (" << o.width << "x" << o.height << ", " << o.fps << " fps, seed " << o.seed
+              << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
+  } catch (const std::exception& e) {
+    throw CommandError(e.what());
+  }
+}
+
+}  // namespace
+
+void AddSynthCommand(CLI::App& app) {
+  auto* synth = app.add_subcommand("synth", "Render synthetic recordings with exact ground truth ('synth room')");
+  synth->require_subcommand(1);
+  auto* room = synth->add_subcommand(
+      "room", "A room textured with opencv-doc photos, filmed along a hand-held-like path (640x480, 30 fps)");
+  auto args = std::make_shared<SynthArgs>();
+  synth::SynthRoomOptions& o = args->options;
+  room->add_option("--out", args->out, "Recording folder to create")->required();
+  room->add_option("--frames", o.frames, "Number of frames (30 per second)")->default_val(o.frames)->check(CLI::Range(1, 1000000));
+  room->add_option("--seed", o.seed, "Seed of the camera path and the noise")->default_val(o.seed);
+  room->add_option("--motion-blur", o.motion_blur_samples, "Renders averaged over the exposure per frame (0 = off)")
+      ->default_val(o.motion_blur_samples)
+      ->check(CLI::Range(0, 64));
+  room->add_option("--exposure", o.exposure_s, "Exposure time spanned by motion blur, seconds")->default_val(o.exposure_s);
+  room->add_option("--noise", o.noise_sigma, "Gaussian sensor noise, standard deviation in grey levels (0 = off)")
+      ->default_val(o.noise_sigma);
+  room->add_option("--size", args->size, "Frame size WxH, e.g. 1280x720 or 1920x1080 (field of view kept)")
+      ->default_val(args->size)
+      ->check(FrameSizeCheck({64, 48}, {7680, 4320}));
+  room->add_option("--subset", o.frames_subset,
+                   "Render only these frames of the --frames-long walk, e.g. 0-649:8,650-949 (a sparse lap to map, a "
+                   "dense stretch to track); each exactly as in the whole recording");
+  room->add_option("--jpeg", o.jpeg_quality, "Write frames as JPEG at this quality, 1..100 (0 = PNG)")
+      ->default_val(o.jpeg_quality)
+      ->check(CLI::Range(0, 100));
+  room->add_option("--gain-drift", o.gain_drift,
+                   "Exposure/gain change over time: brightness x (1 + A sin(2 pi t / 7 s)), A in [0, 1) (0 = off)")
+      ->default_val(o.gain_drift);
+  room->add_option("--rolling-shutter", o.rolling_shutter_s,
+                   "Rolling-shutter readout time top to bottom, seconds (0 = global shutter)")
+      ->default_val(o.rolling_shutter_s);
+  room->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
+      ->default_val(args->backend)
+      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
+  room->add_option("--gl-threads", o.gl.threads, "llvmpipe rasterizer threads (LP_NUM_THREADS)")
+      ->default_val(2)
+      ->check(CLI::Range(0, 32));
+  o.gl.threads = 2;
+  room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
+  room->add_option("--path", o.walk,
+                   "Camera walk: room (round the room's centre, looking at the walls) or orbit (two laps round the "
+                   "demo's character spot: the first looking across the room, the second at the character)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, synth::RoomWalk>{{"room", synth::RoomWalk::kRoom},
+                                                                                   {"orbit", synth::RoomWalk::kOrbit}}))
+      ->default_str("room");
+  room->add_option("--light", o.light,
+                   "How the room is lit: even (from all round, a light floor) or window (daylight through a window, a "
+                   "dark floor: a light with a direction, as the demo uses)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, synth::SynthLighting>{{"even", synth::SynthLighting::kEven},
+                                                                                    {"window", synth::SynthLighting::kWindow}}))
+      ->default_str("even");
+  room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
+  room->add_flag("--quiet", args->quiet, "No progress on stderr");
+  room->callback([args] { RunSynthRoom(*args); });
+}
+
+}  // namespace arview::app

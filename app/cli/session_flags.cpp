@@ -1,0 +1,70 @@
+#include "app/cli/session_flags.h"
+
+#include "app/placement/scene_lighting.h"
+#include "render/offscreen.h"
+#include "render/prt_cache.h"
+
+namespace arview::app {
+
+void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
+  cmd->add_option("--align-max-seconds", seconds,
+                  "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
+                  "frame before, for at most this long after the last pose from features (0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+}
+
+void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
+  cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
+  cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)");
+  cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON");
+  cmd->add_flag("--hmd", f.hmd, "Head-mounted display: side-by-side stereo, one render per eye");
+  cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--hud", f.hud, "Draw the view-sphere overlay: key viewpoints coloured by weight, the current viewpoint");
+  cmd->add_option("--gl", f.gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
+  cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16));
+  cmd->add_option("--prefetch-below", f.prefetch_below,
+                  "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive, so "
+                  "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  AddAlignMaxSecondsOption(cmd, f.align_max_seconds);
+  cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"msaa", "none"}));
+  cmd->add_option("--lighting", f.lighting, "auto (prt when the scene has a .light.yml), fixed, sh or prt")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "fixed", "sh", "prt"}));
+  cmd->add_option("--light", f.light, "Room light file (default: the scene's <scene>.light.yml)");
+  cmd->add_option("--hold", f.hold, "Seconds the character holds its last view after tracking is lost")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  cmd->add_option("--fade", f.fade, "Seconds to fade to the idle clip, and back after relocalization")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+}
+
+void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
+  o.scene_file = f.scene;
+  o.trajectory_out = f.trajectory;
+  o.stats_out = f.stats;
+  o.compositor.gl.backend = render::ParseGlBackend(f.gl);
+  o.compositor.gl.threads = f.gl_threads;
+  o.compositor.hmd = f.hmd;
+  o.compositor.ipd_m = f.ipd;
+  o.compositor.hud = f.hud;
+  o.tracker.tracking.prefetch_below = f.prefetch_below;
+  o.tracker.tracking.align_max_seconds = f.align_max_seconds;
+  o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
+  o.fade = {f.hold, f.fade};
+  const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
+  o.compositor.ar.lighting = lighting.mode;
+  o.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();
+  o.compositor.room_light = lighting.light;
+}
+
+}  // namespace arview::app

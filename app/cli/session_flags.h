@@ -1,0 +1,27 @@
+#pragma once
+// The flags `arview replay` and `arview run` share: what is drawn, how, and where the results go.
+
+#include <string>
+
+#include "app/session/ar_session.h"
+#include "app/cli/commands.h"
+
+namespace arview::app {
+
+struct SessionFlags {
+  std::string scene, trajectory, stats, gl = "auto", aa = "msaa";
+  std::string lighting = "auto", light;  // see app/placement/scene_lighting.h
+  bool hmd = false, hud = false;
+  double ipd = 0.064, hold = 0.5, fade = 1.0;
+  int gl_threads = 1;
+  int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below
+  double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
+};
+
+void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
+// --align-max-seconds (tracker::TrackingOptions::align_max_seconds), shared with `arview track`.
+void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds);
+// Fills the session options these flags control (throws on a bad --gl value).
+void ApplySessionFlags(const SessionFlags& flags, SessionOptions& options);
+
+}  // namespace arview::app

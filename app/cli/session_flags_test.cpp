@@ -1,0 +1,41 @@
+#include "app/cli/session_flags.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace arview::app {
+namespace {
+
+// Parses `args` (without the program name) as `arview replay` would its session flags.
+SessionOptions Parse(std::vector<std::string> args) {
+  CLI::App cmd;
+  SessionFlags flags;
+  AddSessionFlags(&cmd, flags);
+  args.insert(args.begin(), "replay");
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  cmd.parse(static_cast<int>(argv.size()), argv.data());
+  SessionOptions options;
+  ApplySessionFlags(flags, options);
+  return options;
+}
+
+TEST(SessionFlags, TrackerFlagsReachTheTrackerOptions) {
+  const SessionOptions defaults = Parse({});
+  EXPECT_EQ(defaults.tracker.tracking.prefetch_below, 0);
+  EXPECT_EQ(defaults.tracker.tracking.align_max_seconds, tracker::TrackingOptions{}.align_max_seconds);
+  const SessionOptions set = Parse({"--prefetch-below", "190", "--align-max-seconds", "0"});
+  EXPECT_EQ(set.tracker.tracking.prefetch_below, 190);
+  EXPECT_EQ(set.tracker.tracking.align_max_seconds, 0.0);
+}
+
+TEST(SessionFlags, OutOfRangeTrackerFlagsAreRefused) {
+  EXPECT_THROW(Parse({"--align-max-seconds", "-1"}), CLI::ValidationError);
+  EXPECT_THROW(Parse({"--align-max-seconds", "11"}), CLI::ValidationError);
+  EXPECT_THROW(Parse({"--prefetch-below", "-5"}), CLI::ValidationError);
+}
+
+}  // namespace
+}  // namespace arview::app

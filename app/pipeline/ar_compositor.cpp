@@ -1,0 +1,124 @@
+#include "app/pipeline/ar_compositor.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdio>
+
+#include "anim/character_bounds.h"
+#include "render/hud.h"
+#include "render/projection.h"
+
+namespace arview::app {
+
+ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
+                           const CompositorOptions& options)
+    : camera_(camera), characters_(std::move(characters)), options_(options) {
+  // Created here, before the pipeline's threads start: creating a context sets LP_NUM_THREADS
+  // in the environment, which must not race with other threads.
+  context_ = render::OffscreenContext::Create(options_.gl);
+  renderer_ = std::make_unique<render::ArRenderer>(*context_, camera_, options_.ar);
+  if (options_.room_light) renderer_->SetRoomLight(*options_.room_light);
+  for (const anim::PlacedCharacter* c : characters_) {
+    renderer_->AddCharacter(c->character(), c->placement());
+    heights_.push_back(anim::RestHeight(c->character(), c->placement().up) * c->placement().scale * c->placement().anchor.scale);
+  }
+  if (options_.ar.lighting == render::LightingMode::kShShadowed && !characters_.empty()) {
+    char line[96];
+    std::snprintf(line, sizeof line, "PRT transfer: %s in %.2f s", renderer_->prt_from_cache() > 0 ? "read from its cache" : "computed",
+                  renderer_->prt_seconds());
+    load_notes_.push_back(line);
+    if (!renderer_->prt_cache_note().empty()) load_notes_.push_back(renderer_->prt_cache_note());
+  }
+  description_ = context_->Description();
+}
+
+void ArCompositor::NoteFrameComposed() {
+  const auto now = std::chrono::steady_clock::now();
+  composed_at_.push_back(now);
+  while (composed_at_.size() > 2 && now - composed_at_.front() > std::chrono::seconds(1)) composed_at_.pop_front();
+}
+
+double ArCompositor::OutputRate() const {
+  if (composed_at_.size() < 2) return 0;
+  const double seconds = std::chrono::duration<double>(composed_at_.back() - composed_at_.front()).count();
+  return seconds > 0 ? (composed_at_.size() - 1) / seconds : 0;
+}
+
+std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) const {
+  char line[128];
+  std::snprintf(line, sizeof line, "frame %lld   %s   %.0f frames/s", static_cast<long long>(input.frame->index),
+                ToString(input.track->status).c_str(), OutputRate());
+  std::vector<std::string> status = {line};
+  if (input.track->status == tracker::TrackStatus::kLost) {
+    status.push_back("lost: the character is hidden until the camera is found again");
+  } else if (!input.animations.empty()) {
+    std::snprintf(line, sizeof line, "idle weight %.2f", input.animations.front()->idle_weight());
+    status.push_back(line);
+  }
+  return status;
+}
+
+std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose& input) {
+  if (!options_.hud || characters_.empty()) return {};
+  // Everything the drawing needs is copied now: the animations' frames change with the next one.
+  std::vector<render::HudSphere> spheres;
+  const bool localized = input.track->status != tracker::TrackStatus::kLost;
+  for (size_t i = 0; localized && i < characters_.size() && i < input.animations.size(); ++i) {
+    const anim::AnimatorFrame& a = *input.animations[i];
+    const anim::PlacedCharacter& c = *characters_[i];
+    spheres.push_back(render::HudSphereFor(c.placement(), c.name(), c.key_viewpoints(), c.key_labels(), a.key_weights,
+                                           a.viewpoint, heights_[i]));
+  }
+  render::HudText text;
+  text.status = HudStatus(input);
+  const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
+  return [spheres = std::move(spheres), text = std::move(text), pose, camera = renderer_->pinhole(), hmd = options_.hmd,
+          ipd_m = options_.ipd_m](cv::Mat& frame) {
+    if (!hmd) {
+      render::DrawHud(frame, camera, pose, spheres, text);
+      return;
+    }
+    for (int eye = 0; eye < 2; ++eye) {
+      cv::Mat half = frame(cv::Rect(eye * camera.width, 0, camera.width, camera.height));
+      render::DrawHud(half, camera, render::OffsetEye(pose, (eye == 0 ? -0.5 : 0.5) * ipd_m), spheres, text);
+    }
+  };
+}
+
+void ArCompositor::BindToThread() { context_->MakeCurrent(); }
+
+cv::Size ArCompositor::OutputSize() const {
+  return {options_.hmd ? 2 * camera_.width : camera_.width, camera_.height};
+}
+
+cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
+  NoteFrameComposed();
+  const bool localized = input.track->status != tracker::TrackStatus::kLost;
+  output_ptrs_.clear();
+  if (localized) output_ptrs_.assign(input.animations.begin(), input.animations.end());
+  if (localized || characters_.empty()) {
+    const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
+    return options_.hmd ? renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m)
+                        : renderer_->Render(input.frame->image, pose, output_ptrs_);
+  }
+  // Lost: no pose to register the characters with, so the video is shown alone, undistorted
+  // like the augmented frames (the renderer's maps: same K, pinhole output).
+  cv::Mat frame = input.frame->image;
+  if (frame.channels() == 1) cv::cvtColor(frame, frame, cv::COLOR_GRAY2BGR);
+  if (camera_.HasDistortion()) {
+    if (undistort_x_.empty()) {
+      cv::initUndistortRectifyMap(camera_.K(), camera_.DistCoeffs(), cv::noArray(), camera_.K(), camera_.Size(), CV_16SC2,
+                                  undistort_x_, undistort_y_);
+    }
+    cv::Mat undistorted;
+    cv::remap(frame, undistorted, undistort_x_, undistort_y_, cv::INTER_LINEAR);
+    frame = undistorted;
+  }
+  cv::Mat out;
+  if (options_.hmd) cv::hconcat(frame, frame, out);
+  else out = frame.clone();
+  return out;  // the HUD, drawn by DeferredOverlay, says "lost"
+}
+
+}  // namespace arview::app

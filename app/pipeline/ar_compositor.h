@@ -1,0 +1,65 @@
+#pragma once
+// The render stage of the pipeline on render::ArRenderer: the GL context is created with the
+// compositor and bound to the render thread (BindToThread); the characters are drawn where the tracker says the camera is, and
+// lost frames show the video alone.
+
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/pipeline/ar_pipeline.h"
+#include "render/ar_renderer.h"
+#include "render/offscreen.h"
+
+namespace arview::app {
+
+struct CompositorOptions {
+  render::OffscreenOptions gl;
+  render::ArOptions ar;
+  bool hmd = false;   // side-by-side stereo
+  double ipd_m = 0.064;
+  std::optional<room::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
+  bool hud = false;   // the overlay (render/hud.h): view sphere, weights, tracking status, frame rate
+};
+
+class ArCompositor : public FrameCompositor {
+ public:
+  // The characters must outlive the compositor.
+  ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
+               const CompositorOptions& options);
+  void BindToThread() override;
+  cv::Mat Compose(const FrameToCompose& input) override;
+  // The HUD (CompositorOptions::hud), drawn on the sink's thread.
+  std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& input) override;
+  // The GL context's description.
+  std::string Description() const { return description_; }
+  // What loading the characters is worth telling the user (the PRT transfer's time and its
+  // cache), for the command to print as `note:` lines.
+  const std::vector<std::string>& LoadNotes() const { return load_notes_; }
+  cv::Size OutputSize() const;
+
+ private:
+  // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
+  std::vector<std::string> HudStatus(const FrameToCompose& input) const;
+  // Composed frames per second over the last second or so of output (wall clock).
+  void NoteFrameComposed();
+  double OutputRate() const;
+
+  calib::Camera camera_;
+  std::vector<const anim::PlacedCharacter*> characters_;
+  CompositorOptions options_;
+  std::unique_ptr<render::OffscreenContext> context_;
+  std::unique_ptr<render::ArRenderer> renderer_;
+  std::vector<const anim::AnimatorFrame*> output_ptrs_;
+  std::string description_;
+  std::vector<std::string> load_notes_;
+  std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
+  cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
+  std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
+};
+
+}  // namespace arview::app

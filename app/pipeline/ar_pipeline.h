@@ -1,0 +1,107 @@
+#pragma once
+// The real-time pipeline: capture → track → animate → render + composite → sink, each on its
+// own thread, joined by bounded queues. Live sources drop the oldest waiting frame when a stage
+// falls behind (and count it); replays of a recording may instead process every frame.
+// Per-stage times and the end-to-end latency (frame arrival to output) are measured.
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "app/pipeline/layered_animator.h"
+#include "app/pipeline/stage_stats.h"
+#include "recordings/frame_source.h"
+#include "recordings/trajectory.h"
+#include "video/sinks.h"
+#include "tracker/tracker.h"
+
+namespace arview::app {
+
+using Clock = std::chrono::steady_clock;
+
+// What the render stage gets for one frame.
+struct FrameToCompose {
+  const recordings::Frame* frame = nullptr;
+  const tracker::FrameResult* track = nullptr;
+  std::vector<const anim::AnimatorFrame*> animations;  // one per character (none: no character)
+};
+
+class FrameCompositor {
+ public:
+  virtual ~FrameCompositor() = default;
+  // Called once on the render thread before the first frame (e.g. to bind a GL context).
+  virtual void BindToThread() {}
+  // The output picture: the video frame, with the character drawn over it when tracked.
+  virtual cv::Mat Compose(const FrameToCompose& input) = 0;
+  // Drawing over the composed picture that can wait for the sink's thread (the HUD), called on
+  // the render thread right after Compose: what it returns holds copies of what it draws, and
+  // runs on the sink's thread before the frame is written. The render stage limits the frame
+  // rate on a CPU renderer, and ~1 ms of drawing text and circles need not hold it up. Empty:
+  // nothing to draw.
+  virtual std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& /*input*/) { return {}; }
+};
+
+struct PipelineOptions {
+  // Live sources: a slower stage makes the oldest waiting frame drop. Replays: every frame.
+  bool drop_frames = false;
+  size_t queue_capacity = 2;
+  // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for --stats and the
+  // demo's figures) and `trajectory` (80 bytes a localized frame). A long run that writes
+  // neither turns them off, so that its memory stays flat (the soak test, docs/reliability.md);
+  // `briefs` (12 bytes a frame, for the text summary) are always kept.
+  bool keep_frame_logs = true;
+  bool keep_trajectory = true;
+};
+
+// What the text summary needs of each frame.
+struct FrameBrief {
+  float track_ms = 0;
+  float gaze_error_deg = -1;  // < 0: none
+  tracker::TrackStatus status = tracker::TrackStatus::kLost;
+};
+
+struct FrameLog {
+  int64_t index = 0;
+  double timestamp = 0;
+  tracker::FrameResult track;
+  double idle_weight = 0;
+  std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
+  int actions_triggered = 0;  // first character: distance-triggered actions started (a greeting)
+};
+
+struct PipelineReport {
+  size_t frames_read = 0;
+  size_t frames_processed = 0;  // reached the sink
+  size_t frames_dropped = 0;
+  size_t frames_localized = 0;
+  double wall_seconds = 0;
+  double fps = 0;  // frames processed per wall-clock second
+  // CPU time of the whole process (every thread: the stages, llvmpipe's, the encoder's) per
+  // frame processed, over the run. On a shared machine this is steadier than the frame rate,
+  // and it bounds it: two cores give at most 2000 / cpu_ms_per_frame frames per second.
+  double cpu_ms_per_frame = 0;
+  std::map<std::string, TimingSummary> stages;  // track, animate, render, sink (with the deferred overlay), latency
+  std::vector<FrameLog> frames;                 // in processing order (PipelineOptions::keep_frame_logs)
+  std::vector<FrameBrief> briefs;               // in processing order, always
+  recordings::Trajectory trajectory;            // raw poses of localized frames
+};
+
+// Runs until the source ends (or `stop()` returns true, checked by every stage between frames:
+// a stopped run drains nothing). Rethrows on the
+// caller's thread the first error any stage raised, after every thread has stopped.
+PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
+                           FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,
+                           const std::function<void(const PipelineReport&)>& on_frame = {},
+                           const std::function<bool()>& stop = {});
+
+// Angle in degrees between the head's forward axis and the direction from the head to the camera
+// centre, in map coordinates. Nothing when the character has no look-at chain.
+std::optional<double> GazeErrorDeg(const anim::PlacedCharacter& character, std::span<const Eigen::Matrix4d> model,
+                                   const Eigen::Vector3d& camera_center_map);
+
+}  // namespace arview::app

@@ -1,0 +1,24 @@
+#include "app/pipeline/layered_animator.h"
+
+#include <utility>
+
+namespace arview::app {
+
+LayeredAnimator::LayeredAnimator(const anim::PlacedCharacter& character, std::unique_ptr<anim::Animator> animator,
+                                 const anim::Clip* idle_clip, std::vector<std::string> notes)
+    : character_(character), idle_(idle_clip), animator_(std::move(animator)), notes_(std::move(notes)) {}
+
+const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d>& camera_center, double time) {
+  const anim::Placement& placement = character_.placement();
+  anim::FrameInputs inputs;
+  inputs.tracking = camera_center.has_value();
+  if (camera_center) {
+    inputs.viewpoint = placement.ViewpointFromCamera(*camera_center);
+    inputs.distance = placement.FloorDistance(*camera_center);
+  } else {
+    inputs.viewpoint = Eigen::Vector3d::Zero();  // held by the animator
+  }
+  return animator_->Update(time, inputs);
+}
+
+}  // namespace arview::app

@@ -1,0 +1,61 @@
+// One median definition: the same numbers give the same median whether they go through
+// stats.json (the pipeline's stage timings and gaze errors) or `arview eval` (trajectory errors).
+// Before base/stats.h, stats.json quoted the lower middle sample and eval the mean of the two
+// middle ones, so an even count gave two different "medians".
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "app/pipeline/pipeline_report.h"
+#include "app/pipeline/stage_stats.h"
+#include "recordings/accuracy.h"
+
+namespace arview::app {
+namespace {
+
+// An even count, so that the median definitions in use before differed: 0.25 + 0.5 over 2.
+const std::vector<double> kNumbers{0.75, 0.1, 0.5, 2.0, 0.25, 0.05};
+constexpr double kMedian = 0.375;
+
+double StatsJsonStageMedian() {
+  StageStats stats;
+  for (double v : kNumbers) stats.Record("track", v);
+  PipelineReport report;
+  report.stages = stats.Summaries();
+  for (double v : kNumbers) {
+    FrameLog f;
+    f.gaze_error_deg = v;
+    report.frames.push_back(f);
+  }
+  const nlohmann::json j = nlohmann::json::parse(PipelineReportJson(report, "test"));
+  EXPECT_DOUBLE_EQ(j["gaze"]["median_error_deg"].get<double>(), j["stages"]["track"]["median_ms"].get<double>());
+  return j["stages"]["track"]["median_ms"].get<double>();
+}
+
+double EvalMedian() {
+  // Ground truth at the origin; each estimate off by one of the numbers along x.
+  recordings::Trajectory groundtruth, estimate;
+  for (size_t i = 0; i < kNumbers.size(); ++i) {
+    const double t = static_cast<double>(i);
+    groundtruth.push_back({t, calib::Pose{}});
+    estimate.push_back({t, calib::Pose::FromCameraToWorld(Eigen::Quaterniond::Identity(), {kNumbers[i], 0, 0})});
+  }
+  recordings::AccuracyOptions options;
+  options.align = recordings::AlignMode::kNone;
+  const recordings::AccuracyReport report = recordings::EvaluateTrajectory(estimate, groundtruth, options);
+  const nlohmann::json j = nlohmann::json::parse(recordings::ReportToJson(report));
+  EXPECT_DOUBLE_EQ(j["ate"]["median"].get<double>(), report.ate.median);
+  return report.ate.median;
+}
+
+TEST(OneMedian, StatsJsonAndEvalGiveTheSameMedianOfTheSameNumbers) {
+  const double from_stats = StatsJsonStageMedian();
+  const double from_eval = EvalMedian();
+  EXPECT_DOUBLE_EQ(from_stats, kMedian);
+  EXPECT_DOUBLE_EQ(from_eval, kMedian);
+  EXPECT_DOUBLE_EQ(from_stats, from_eval);
+}
+
+}  // namespace
+}  // namespace arview::app

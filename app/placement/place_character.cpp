@@ -1,0 +1,64 @@
+#include "app/placement/place_character.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "anim_authoring/import.h"
+#include "anim/character_bounds.h"
+#include "base/stats.h"
+
+namespace arview::app {
+
+ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& asset_path,
+                               const PlaceCharacterOptions& o) {
+  // A built-in asset ("builtin:figure") is a name, not a file.
+  const std::filesystem::path asset =
+      anim::IsBuiltinAsset(asset_path) ? asset_path : std::filesystem::absolute(asset_path);
+  const anim::Character character = anim::LoadCharacter(asset);
+  const double height = anim::RestHeight(character, Eigen::Vector3d::UnitY());
+
+  std::vector<Eigen::Vector3d> points, centres, up_axes;
+  points.reserve(map.points.size());
+  for (const auto& p : map.points) points.push_back(p.xyz);
+  // The first keyframe (lowest frame index) goes first: the character faces it.
+  const map::Keyframe* first = nullptr;
+  for (const auto& k : map.keyframes) {
+    if (!first || k.frame_index < first->frame_index) first = &k;
+  }
+  if (first) centres.push_back(first->pose.Center());
+  for (const auto& k : map.keyframes) {
+    if (&k != first) centres.push_back(k.pose.Center());
+    up_axes.push_back(-(k.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitY()));
+  }
+  PlacementOptions options;
+  options.height_fraction = o.height_fraction;
+  options.plane.seed = o.seed;
+
+  ScenePlacement placed;
+  placed.name = anim::IsBuiltinAsset(asset) ? asset.string().substr(std::string(anim::kBuiltinAssetPrefix).size())
+                                            : asset.stem().string();
+  placed.asset = asset;
+  placed.anchor = o.anchor ? *o.anchor : PlaceOnDominantPlane(points, centres, up_axes, height, options);
+  placed.rest_height = height;
+  // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
+  // seen from the character's eyes (a character on a table is looked at from above; a tall one
+  // looks down at cameras held lower than its head). Eyes: 93% of the rest height.
+  std::vector<double> elevations;
+  const Eigen::Vector3d up = placed.anchor.rotation * Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d eyes = placed.anchor.position + 0.93 * height * placed.anchor.scale * up;
+  for (const auto& c : centres) {
+    const Eigen::Vector3d d = c - eyes;
+    if (d.norm() > 0) elevations.push_back(std::asin(std::clamp(up.dot(d.normalized()), -1.0, 1.0)) * 180 / M_PI);
+  }
+  if (!elevations.empty() && o.key_elevation_deg.has_value() == false) {
+    placed.key_elevation_deg = std::clamp(Median(elevations), -60.0, 60.0);
+  } else {
+    placed.key_elevation_deg = o.key_elevation_deg.value_or(0.0);
+  }
+  placed.key_count = o.keys;
+  placed.base_clip = o.base_clip;
+  if (placed.base_clip.empty() && !character.clips.empty()) placed.base_clip = character.clips.front().name;
+  return placed;
+}
+
+}  // namespace arview::app

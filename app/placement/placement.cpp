@@ -1,0 +1,77 @@
+#include "app/placement/placement.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+
+namespace arview::app {
+
+Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const std::vector<Eigen::Vector3d>& up_axes) {
+  Eigen::Vector3d mean_up = Eigen::Vector3d::Zero();
+  for (const auto& u : up_axes) mean_up += u.normalized();
+  Eigen::Vector3d up = mean_up;
+  if (centres.size() >= 3) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& c : centres) mean += c;
+    mean /= centres.size();
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& c : centres) cov += (c - mean) * (c - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    // A plane of centres: the two larger spreads are comparable, the third much smaller.
+    if (eig.eigenvalues()(1) > 0.05 * eig.eigenvalues()(2) && eig.eigenvalues()(0) < 0.3 * eig.eigenvalues()(1)) {
+      up = eig.eigenvectors().col(0);
+      if (up.dot(mean_up) < 0) up = -up;
+    }
+  }
+  if (up.norm() < 1e-9) throw PlacementError("cannot tell which way is up from the map's cameras");
+  return up.normalized();
+}
+
+Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
+                            const std::vector<Eigen::Vector3d>& camera_centres,
+                            const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
+                            const PlacementOptions& o) {
+  if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
+  if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
+  PlaneFitOptions plane_options = o.plane;
+  if (!plane_options.up_prior) plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
+  Plane plane = FitDominantPlane(points, plane_options);
+
+  // Up is the side of the plane the cameras are on.
+  double side = 0;
+  for (const auto& c : camera_centres) side += plane.Distance(c);
+  if (side < 0) {
+    plane.normal = -plane.normal;
+    plane.offset = -plane.offset;
+  }
+  // Stand at the median of the plane's inliers near the middle, projected onto the plane.
+  const Eigen::Vector3d middle = ComponentMedian(points);
+  const double limit = o.plane.inlier_distance > 0 ? o.plane.inlier_distance : 0.01 * 2 * MedianDistance(points, middle);
+  std::vector<Eigen::Vector3d> on_plane;
+  for (const auto& p : points) {
+    if (std::abs(plane.Distance(p)) < limit) on_plane.push_back(p);
+  }
+  Eigen::Vector3d position = on_plane.empty() ? middle : ComponentMedian(on_plane);
+  position -= plane.Distance(position) * plane.normal;
+
+  // Face the first keyframe: its direction projected onto the plane (any perpendicular if above).
+  // Stand upright in the viewers' world: up is the cameras' up (signed like the floor's normal);
+  // the floor gives the footing. On a level floor the two agree within the RANSAC noise.
+  Eigen::Vector3d up = *plane_options.up_prior;
+  if (up.dot(plane.normal) < 0) up = -up;
+  Eigen::Vector3d forward = camera_centres.front() - position;
+  forward -= forward.dot(up) * up;
+  if (forward.norm() < 1e-9) forward = up.unitOrthogonal();
+  forward.normalize();
+  const Eigen::Vector3d right = up.cross(forward);  // glTF: +X = up × forward (character's left)
+
+  Eigen::Matrix3d rotation;
+  rotation << right, up, forward;
+  Anchor anchor;
+  anchor.position = position;
+  anchor.rotation = Eigen::Quaterniond(rotation).normalized();
+  anchor.scale = o.height_fraction * MedianDistance(camera_centres, position) / character_height;
+  return anchor;
+}
+
+}  // namespace arview::app

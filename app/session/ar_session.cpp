@@ -1,0 +1,98 @@
+#include "app/session/ar_session.h"
+
+#include "anim_authoring/character_builder.h"
+#include "app/session/character_setup.h"
+#include "base/stats.h"
+
+#include <cstdio>
+#include <algorithm>
+#include <memory>
+#include <iostream>
+
+#include "base/atomic_file.h"
+#include "app/pipeline/pipeline_report.h"
+#include "base/progress.h"
+#include "video/sinks.h"
+#include "tracker/tracker.h"
+
+namespace arview::app {
+
+double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames) {
+  std::vector<double> dt;
+  for (size_t i = 1; i < frames.size(); ++i) dt.push_back(frames[i].timestamp - frames[i - 1].timestamp);
+  if (dt.empty()) return 30;
+  const double median = Median(dt);
+  // Still-photo datasets are stamped one second apart; a 1 fps video of them would be a slide show.
+  if (median >= 0.5) return 10;
+  return median > 0 ? 1.0 / median : 30;
+}
+
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
+                         const std::string& map_name, const SessionOptions& o) {
+  if (source_size != map.camera.Size()) {
+    throw Error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
+                             std::to_string(source_size.height) + " but the map " + map_name +
+                             " was built for a " + std::to_string(map.camera.width) + "x" +
+                             std::to_string(map.camera.height) + " camera");
+  }
+  tracker::Tracker tracker(map, o.tracker);
+  tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
+
+  std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
+  std::vector<std::unique_ptr<LayeredAnimator>> animators;
+  std::vector<LayeredAnimator*> animator_ptrs;
+  std::vector<const anim::PlacedCharacter*> character_ptrs;
+  if (!o.scene_file.empty()) {
+    const anim::Scene scene = anim::LoadScene(o.scene_file);
+    for (const anim::CharacterSpec& spec : scene.characters) {
+      characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
+      animators.push_back(MakeLayeredAnimator(*characters.back(), "", o.fade));
+      for (const std::string& note : animators.back()->notes()) std::cerr << "note: " << note << "\n";
+      animator_ptrs.push_back(animators.back().get());
+      character_ptrs.push_back(characters.back().get());
+    }
+  }
+
+  ArCompositor compositor(map.camera, character_ptrs, o.compositor);
+  for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
+  std::unique_ptr<video::FrameSink> sink = video::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
+
+  Progress progress("augmenting frames");
+  double rss_mib = -1;
+  std::size_t rss_read_at = 0;
+  PipelineReport report = RunPipeline(
+      source, tracker, animator_ptrs, compositor, *sink, o.pipeline,
+      [&](const PipelineReport& r) {
+        if (o.quiet || o.cancel.IsCancelled()) return;  // after a Ctrl-C: only the one line
+        // Resident memory, read every 100 frames (a soak test follows it on these lines).
+        if (r.frames_processed >= rss_read_at + 100 || rss_mib < 0) {
+          rss_mib = ResidentMemoryMiB();
+          rss_read_at = r.frames_processed;
+        }
+        char detail[128];
+        std::snprintf(detail, sizeof(detail), "%zu localized, %zu dropped, resident %.1f MiB", r.frames_localized,
+                      r.frames_dropped, rss_mib);
+        progress.Update(static_cast<long>(r.frames_processed), o.expected_frames > 0 ? o.expected_frames
+                                                                                      : static_cast<long>(r.frames_processed),
+                        detail);
+      },
+      [&o] { return o.cancel.IsCancelled(); });
+  progress.Finish();
+  if (o.cancel.IsCancelled() && !o.cancel_ends_normally) {
+    std::string unwritten = o.output_name.empty() ? std::string() : o.output_name;
+    for (const auto& file : {o.trajectory_out, o.stats_out}) {
+      if (!file.empty()) unwritten += (unwritten.empty() ? "" : ", ") + file.string();
+    }
+    o.cancel.ThrowIfCancelled("stopped after " + std::to_string(report.frames_processed) + " frames; " +
+                              (unwritten.empty() ? std::string("nothing to keep") : "not written: " + unwritten));
+  }
+
+  SessionResult result{std::move(report), compositor.Description()};
+  if (!o.trajectory_out.empty()) {
+    recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
+  }
+  if (!o.stats_out.empty()) WriteFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer));
+  return result;
+}
+
+}  // namespace arview::app

@@ -1,0 +1,56 @@
+#pragma once
+// One augmented-reality session, shared by `arview replay`, `arview run` and `arview demo`:
+// load the map and the scene, build the tracker, the characters' animators and the compositor,
+// run the pipeline from a frame source into a sink, and write the trajectory and stats.
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "app/pipeline/ar_compositor.h"
+#include "base/cancellation.h"
+#include "app/pipeline/ar_pipeline.h"
+#include "app/pipeline/layered_animator.h"
+#include "map/map.h"
+#include "recordings/frame_source.h"
+#include "recordings/recording.h"
+
+namespace arview::app {
+
+struct SessionOptions {
+  std::filesystem::path scene_file;          // empty: no character (tracking + video only)
+  std::string sink = "window";               // video::OpenSink target
+  double sink_fps = 30;
+  std::filesystem::path trajectory_out;      // optional TUM file
+  std::filesystem::path stats_out;           // optional stats.json
+  CompositorOptions compositor;
+  FadeOptions fade;
+  PipelineOptions pipeline;
+  tracker::TrackerOptions tracker;
+  long expected_frames = 0;                  // for the progress line (0: unknown)
+  // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory, no stats) and
+  // RunSession throws CancelledError saying so; the caller removes its partial video.
+  CancellationToken cancel;
+  std::string output_name;                   // what the sink's output is called, for that message
+  // Live sessions (`arview run`) end by Ctrl-C: then a cancellation is the normal end, and the
+  // outputs are written.
+  bool cancel_ends_normally = false;
+  bool quiet = false;
+};
+
+struct SessionResult {
+  PipelineReport report;
+  std::string renderer;
+};
+
+// Frames per second of a recording from its median frame interval: 30 for a single frame, 10
+// for still-photo datasets (stamped a second apart), so that their videos are watchable.
+double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
+
+// `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
+// names the map in messages. Throws CancelledError when options.cancel was cancelled.
+SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
+                         const std::string& map_name, const SessionOptions& options);
+
+}  // namespace arview::app

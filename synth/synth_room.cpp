@@ -1,0 +1,461 @@
+#include "synth/synth_room.h"
+
+#include "base/image_file.h"
+
+#include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <array>
+#include <map>
+#include <cmath>
+#include <future>
+#include <random>
+#include <string_view>
+
+#include "recordings/recording.h"
+#include "recordings/trajectory.h"
+#include "render/projection.h"
+
+namespace arview::synth {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kHalfX = 3.5, kHalfY = 2.5, kHeight = 2.8;
+// Trilinear mipmaps plus 4x anisotropic filtering: oblique walls and floor stay sharp (more
+// features) without aliasing; 16x costs llvmpipe ~20% more per frame for little visible gain.
+constexpr float kRoomAnisotropy = 4.f;
+// Panels stand this far in front of the paint they hang on, so depth never fights.
+constexpr double kPanelOffset = 0.004;
+
+struct Wall {
+  Eigen::Vector3d facing;  // viewing direction of someone looking at the wall from inside
+  double distance;         // from the room's vertical axis
+  double length;
+  Eigen::Vector3f shade;
+  std::vector<const char*> images;
+};
+
+// Photos chosen for dense, distinct texture (many SIFT features, no repeated patterns, no two
+// views of the same scene), so that every part of the room is recognisable.
+const std::array<Wall, 4>& Walls() {
+  static const std::array<Wall, 4> walls = {{
+      {{0, 1, 0}, kHalfY, 2 * kHalfX, {0.95f, 0.95f, 0.93f}, {"building.jpg", "graf1.png", "home.jpg", "leuvenA.jpg"}},
+      {{0, -1, 0}, kHalfY, 2 * kHalfX, {0.85f, 0.85f, 0.84f}, {"aero1.jpg", "fruits.jpg", "baboon.jpg", "messi5.jpg"}},
+      {{1, 0, 0}, kHalfX, 2 * kHalfY, {0.9f, 0.9f, 0.88f}, {"box_in_scene.png", "rubberwhale1.png", "starry_night.jpg"}},
+      {{-1, 0, 0}, kHalfX, 2 * kHalfY, {0.8f, 0.8f, 0.8f}, {"squirrel_cls.jpg", "smarties.png", "left.jpg"}},
+  }};
+  return walls;
+}
+
+const char* kFloorImages[4] = {"aloeL.jpg", "board.jpg", "licenseplate_motion.jpg", "text_defocus.jpg"};
+const char* kCeilingImages[2] = {"Blender_Suzanne1.jpg", "sudoku.png"};
+
+struct BoxSpec {
+  Eigen::Vector2d center;
+  double yaw;
+  Eigen::Vector3d size;
+  std::array<const char*, 5> images;  // four sides, then the top
+};
+
+const std::array<BoxSpec, 3>& Boxes() {
+  static const std::array<BoxSpec, 3> boxes = {{
+      {{2.1, 1.3}, 0.35, {0.8, 0.8, 0.9},
+       {"basketball1.png", "ela_original.jpg", "butterfly.jpg", "pca_test1.jpg", "orange.jpg"}},
+      {{-2.3, -1.1}, -0.25, {1.0, 0.6, 0.6},
+       {"blox.jpg", "chicky_512.png", "HappyFish.jpg", "cards.png", "apple.jpg"}},
+      {{0.9, -1.8}, 0.7, {0.6, 0.6, 1.2},
+       {"stuff.jpg", "imageTextN.png", "detect_blob.png", "text_motion.jpg", "LinuxLogo.jpg"}},
+  }};
+  return boxes;
+}
+
+// Resamples a photo to power-of-two sides (nearest in log scale). With odd sizes down the mip
+// chain, Mesa's mipmap generation shifts levels by up to half a texel, which would move
+// texture content by a few tenths of a pixel against the exact geometry.
+cv::Mat PowerOfTwo(const cv::Mat& image) {
+  auto side = [](int n) { return 1 << std::clamp(static_cast<int>(std::lround(std::log2(n))), 6, 11); };
+  cv::Mat out;
+  cv::resize(image, out, {side(image.cols), side(image.rows)}, 0, 0, cv::INTER_AREA);
+  return out;
+}
+
+class SceneBuilder {
+ public:
+  explicit SceneBuilder(const fs::path& data_dir) : data_dir_(data_dir) {
+    scene_.textures.push_back(cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(255)));
+    paint_.texture = 0;
+  }
+
+  // A rectangle centred at `center` spanned by unit `right` and `up`.
+  void Panel(const char* image, const Eigen::Vector3d& center, const Eigen::Vector3d& right,
+             const Eigen::Vector3d& up, double width, double height, const Eigen::Vector3f& shade) {
+    RoomPanel panel{image, {}, Texture(image)};
+    panel.corners[0] = center - right * width / 2 + up * height / 2;
+    panel.corners[1] = center + right * width / 2 + up * height / 2;
+    panel.corners[2] = center + right * width / 2 - up * height / 2;
+    panel.corners[3] = center - right * width / 2 - up * height / 2;
+    render::TriangleBatch batch;
+    batch.texture = panel.texture;
+    render::AppendQuad(batch, panel.corners, Eigen::Vector4f(0, 0, 1, 1), shade);
+    scene_.batches.push_back(std::move(batch));
+    scene_.panels.push_back(std::move(panel));
+  }
+
+  void Paint(const Eigen::Vector3d corners[4], const Eigen::Vector3f& colour) {
+    render::AppendQuad(paint_, corners, Eigen::Vector4f(0, 0, 1, 1), colour);
+  }
+
+  double Aspect(const char* image) {
+    Texture(image);
+    return aspect_.at(image);
+  }
+
+  RoomScene Finish() {
+    scene_.batches.push_back(std::move(paint_));
+    return std::move(scene_);
+  }
+
+ private:
+  int Texture(const char* name) {
+    if (auto it = loaded_.find(name); it != loaded_.end()) return it->second;
+    const fs::path path = data_dir_ / name;
+    cv::Mat image;
+    try {
+      image = ReadImageFile(path, cv::IMREAD_COLOR);  // a cut or damaged photo: one line naming it
+    } catch (const Error& e) {
+      throw render::RenderError(std::string(e.what()) + " (the room's photos come from Debian package opencv-doc)");
+    }
+    aspect_[name] = static_cast<double>(image.cols) / image.rows;
+    scene_.textures.push_back(PowerOfTwo(image));
+    return loaded_[name] = static_cast<int>(scene_.textures.size()) - 1;
+  }
+
+  fs::path data_dir_;
+  RoomScene scene_;
+  render::TriangleBatch paint_;
+  std::map<std::string, int> loaded_;
+  std::map<std::string, double> aspect_;
+};
+
+// The window of SynthLighting::kWindow takes this photo's place on its wall.
+constexpr const char* kWindowReplaces = "graf1.png";
+
+// A window seen from inside: panes clipped white by the daylight behind them, in a dark frame
+// with a mullion and a transom (their corners give the tracker something to hold on to).
+void AddWindow(SceneBuilder& builder, const Eigen::Vector3d& center, const Eigen::Vector3d& right,
+               const Eigen::Vector3d& up, const Eigen::Vector3d& inward, double width, double height) {
+  auto rectangle = [&](const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double offset, const Eigen::Vector3f& colour) {
+    const Eigen::Vector3d o = center + inward * offset;
+    const Eigen::Vector3d corners[4] = {o + right * lo.x() + up * hi.y(), o + right * hi.x() + up * hi.y(),
+                                        o + right * hi.x() + up * lo.y(), o + right * lo.x() + up * lo.y()};
+    builder.Paint(corners, colour);
+  };
+  const double w = width / 2, h = height / 2, bar = 0.06;
+  const Eigen::Vector3f pane(1.f, 1.f, 1.f), frame(0.3f, 0.27f, 0.24f);
+  rectangle({-w, -h}, {w, h}, kPanelOffset, pane);
+  const double in_front = 2 * kPanelOffset;
+  rectangle({-w, -h}, {-w + bar, h}, in_front, frame);
+  rectangle({w - bar, -h}, {w, h}, in_front, frame);
+  rectangle({-w, h - bar}, {w, h}, in_front, frame);
+  rectangle({-w, -h}, {w, -h + bar}, in_front, frame);
+  rectangle({-bar / 2, -h}, {bar / 2, h}, in_front, frame);              // mullion
+  rectangle({-w, 0.25 * h - bar / 2}, {w, 0.25 * h + bar / 2}, in_front, frame);  // transom
+}
+
+void AddWalls(SceneBuilder& builder, SynthLighting light) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  for (const Wall& wall : Walls()) {
+    const Eigen::Vector3d right = wall.facing.cross(up);
+    const Eigen::Vector3d base = wall.facing * wall.distance;
+    const Eigen::Vector3d paint[4] = {base - right * wall.length / 2 + up * kHeight,
+                                      base + right * wall.length / 2 + up * kHeight,
+                                      base + right * wall.length / 2, base - right * wall.length / 2};
+    builder.Paint(paint, wall.shade.cwiseProduct(Eigen::Vector3f(0.86f, 0.83f, 0.78f)));
+    const int n = static_cast<int>(wall.images.size());
+    const double spacing = wall.length / n;
+    for (int i = 0; i < n; ++i) {
+      const double along = -wall.length / 2 + spacing * (i + 0.5);
+      if (light == SynthLighting::kWindow && std::string_view(wall.images[i]) == kWindowReplaces) {
+        AddWindow(builder, base + right * along + up * 1.7, right, up, -wall.facing, 1.4, 1.6);
+        continue;
+      }
+      const double height = 1.6;
+      const double width = std::min(height * builder.Aspect(wall.images[i]), spacing - 0.2);
+      const Eigen::Vector3d center = base - wall.facing * kPanelOffset + right * along + up * 1.4;
+      builder.Panel(wall.images[i], center, right, up, width, height, wall.shade);
+    }
+  }
+}
+
+void AddFloorAndCeiling(SceneBuilder& builder, SynthLighting light) {
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitX(), y = Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d floor[4] = {{-kHalfX, kHalfY, 0}, {kHalfX, kHalfY, 0}, {kHalfX, -kHalfY, 0}, {-kHalfX, -kHalfY, 0}};
+  // Under a window the floor is the dark side of the room (the light comes from the side and
+  // above); evenly lit, it is as bright as the walls.
+  const float floor_light = light == SynthLighting::kWindow ? 0.6f : 1.f;
+  builder.Paint(floor, Eigen::Vector3f(0.55f, 0.5f, 0.45f) * floor_light);
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector3d center((i % 2 ? 0.5 : -0.5) * kHalfX, (i / 2 ? 0.5 : -0.5) * kHalfY, kPanelOffset);
+    builder.Panel(kFloorImages[i], center, x, y, kHalfX - 0.1, kHalfY - 0.1, Eigen::Vector3f::Constant(0.9f * floor_light));
+  }
+  Eigen::Vector3d ceiling[4];
+  for (int i = 0; i < 4; ++i) ceiling[i] = floor[i] + Eigen::Vector3d(0, 0, kHeight);
+  builder.Paint(ceiling, {0.7f, 0.7f, 0.7f});
+  for (int i = 0; i < 2; ++i) {
+    const Eigen::Vector3d center((i ? 0.5 : -0.5) * kHalfX, 0, kHeight - kPanelOffset);
+    builder.Panel(kCeilingImages[i], center, x, -y, kHalfX - 0.3, 2 * kHalfY - 0.6, {0.75f, 0.75f, 0.75f});
+  }
+}
+
+void AddBoxes(SceneBuilder& builder) {
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d light = Eigen::Vector3d(0.5, 0.3, 0).normalized();
+  for (const BoxSpec& box : Boxes()) {
+    const Eigen::Matrix3d r = Eigen::AngleAxisd(box.yaw, up).toRotationMatrix();
+    const Eigen::Vector3d center(box.center.x(), box.center.y(), box.size.z() / 2);
+    for (int side = 0; side < 4; ++side) {
+      // Outward normals +x, +y, −x, −y of the box frame; widths follow.
+      const double angle = side * M_PI / 2;
+      const Eigen::Vector3d normal = r * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0);
+      const double depth = (side % 2 ? box.size.y() : box.size.x()) / 2;
+      const double width = side % 2 ? box.size.x() : box.size.y();
+      const Eigen::Vector3d right = (-normal).cross(up);
+      const float shade = static_cast<float>(0.72 + 0.25 * std::max(0.0, normal.dot(light)));
+      builder.Panel(box.images[side], center + normal * depth, right, up, width, box.size.z(),
+                    {shade, shade, shade});
+    }
+    builder.Panel(box.images[4], center + up * box.size.z() / 2, r.col(0), r.col(1), box.size.x(), box.size.y(),
+                  {1.f, 1.f, 1.f});
+  }
+}
+
+// Uniform in [0, 1) from the engine's raw bits: the standard distributions are not specified
+// bit-exactly across standard libraries, and the path must be the same everywhere for a seed.
+double Unit(std::mt19937_64& engine) { return static_cast<double>(engine() >> 11) * 0x1.0p-53; }
+
+double SmootherStep(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return s * s * s * (s * (6 * s - 15) + 10);
+}
+
+}  // namespace
+
+RoomScene MakeRoomScene(const fs::path& data_dir, SynthLighting light) {
+  SceneBuilder builder(data_dir);
+  AddWalls(builder, light);
+  AddFloorAndCeiling(builder, light);
+  AddBoxes(builder);
+  return builder.Finish();
+}
+
+calib::Camera RoomCamera(int width, int height) {
+  const double s = width / 640.0;
+  // The 640x480 camera's principal point offset from the image centre, scaled (pixel centres:
+  // the image centre is at (W − 1) / 2).
+  const double cx = (width - 1) / 2.0 + (321.5 - 319.5) * s;
+  const double cy = (height - 1) / 2.0 + (238.5 - 239.5) * s;
+  return calib::Camera::Pinhole(width, height, 525.0 * s, 525.0 * s, cx, cy);
+}
+
+RoomPath::RoomPath(double duration, uint64_t seed) : duration_(duration) {
+  std::mt19937_64 engine(seed);
+  angle0_ = 2 * M_PI * Unit(engine);
+  direction_ = Unit(engine) < 0.5 ? -1.0 : 1.0;
+  pan_phase_ = 2 * M_PI * Unit(engine);
+  pitch_phase_ = 2 * M_PI * Unit(engine);
+  roll_phase_ = 2 * M_PI * Unit(engine);
+  bob_phase_ = 2 * M_PI * Unit(engine);
+  turn_sign_ = Unit(engine) < 0.5 ? -1.0 : 1.0;
+  for (double& phase : shake_phase_) phase = 2 * M_PI * Unit(engine);
+}
+
+calib::Pose RoomPath::At(double t) const {
+  constexpr double kTwoPi = 2 * M_PI;
+  // Walk: an ellipse round the room's centre at about 0.2 m/s, clear of the boxes, far enough
+  // from the walls that the floor in front of them is in view.
+  const double angle = angle0_ + direction_ * kTwoPi * 0.045 * t;
+  auto shake = [&](int i, double amplitude) {
+    return amplitude * (std::sin(kTwoPi * 6.1 * t + shake_phase_[i]) + 0.6 * std::sin(kTwoPi * 9.7 * t + shake_phase_[5 - i]));
+  };
+  Eigen::Vector3d center(0.9 * std::cos(angle), 0.55 * std::sin(angle), 1.5);
+  center.z() += 0.015 * std::sin(kTwoPi * 1.7 * t + bob_phase_);  // steps
+  center += Eigen::Vector3d(shake(3, 0.0015), shake(4, 0.0015), shake(5, 0.0015));
+
+  // Look outwards at the walls, panning; one fast 90° turn that the path then keeps.
+  const double turn_start = 0.55 * duration_;
+  const double turn = turn_sign_ * (M_PI / 2) * SmootherStep((t - turn_start) / 0.6);
+  const double yaw = angle + 0.45 * std::sin(kTwoPi * t / 6.5 + pan_phase_) + turn + shake(0, 0.002);
+  const double pitch = -0.28 + 0.06 * std::sin(kTwoPi * t / 5.3 + pitch_phase_) + shake(1, 0.002);
+  const double roll = 0.03 * std::sin(kTwoPi * t / 4.1 + roll_phase_) + shake(2, 0.0015);
+
+  return HandHeldCameraPose(center, yaw, pitch, roll);
+}
+
+RoomRenderer::RoomRenderer(render::OffscreenContext& context, const RoomScene& scene, const calib::Camera& camera, int samples)
+    : context_(&context),
+      camera_(camera),
+      scene_(context.gl(), scene.textures, scene.batches, render::TextureOptions{true, kRoomAnisotropy, false}),
+      target_(context.gl(), camera.width, camera.height, samples) {}
+
+cv::Mat RoomRenderer::Render(const calib::Pose& pose) {
+  const render::GlApi& gl = context_->gl();
+  target_.Bind();
+  gl.ClearColor(0, 0, 0, 1);
+  gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  scene_.Draw(render::ProjectionMatrix(camera_, {0.05, 20.0}), render::ViewMatrix(pose));
+  return target_.ReadBgr();
+}
+
+namespace {
+
+void ValidateOptions(const SynthRoomOptions& o) {
+  auto fail = [](const std::string& what) { throw render::RenderError("synth room: " + what); };
+  if (o.out.empty()) fail("an output folder is required");
+  if (o.frames < 1 || o.frames > 1000000) fail("--frames must be in 1..1000000, got " + std::to_string(o.frames));
+  if (!(o.fps > 0 && o.fps <= 1000)) fail("frame rate must be in (0, 1000]");
+  if (o.motion_blur_samples < 0 || o.motion_blur_samples > 64) fail("--motion-blur must be in 0..64 samples");
+  if (!(o.exposure_s >= 0 && o.exposure_s <= 1.0 / o.fps)) fail("--exposure must be in [0, 1/fps] seconds");
+  if (!(o.noise_sigma >= 0 && o.noise_sigma <= 64)) fail("--noise must be in [0, 64] grey levels");
+  if (o.width < 64 || o.height < 48 || o.width > 7680 || o.height > 4320)
+    fail("--size must be between 64x48 and 7680x4320, got " + std::to_string(o.width) + "x" + std::to_string(o.height));
+  if (o.jpeg_quality < 0 || o.jpeg_quality > 100) fail("--jpeg must be in 0..100 (0: PNG)");
+  if (!(o.gain_drift >= 0 && o.gain_drift < 1)) fail("--gain-drift must be in [0, 1)");
+  if (!(o.rolling_shutter_s >= 0 && o.rolling_shutter_s <= 1.0 / o.fps))
+    fail("--rolling-shutter must be in [0, 1/fps] seconds");
+}
+
+// The walk's frames to render, in order: every one, or the --subset's.
+std::vector<int> FramesToRender(const SynthRoomOptions& o) {
+  if (o.frames_subset.empty()) {
+    std::vector<int> every(o.frames);
+    for (int i = 0; i < o.frames; ++i) every[i] = i;
+    return every;
+  }
+  try {
+    return recordings::ParseFrameSpec(o.frames_subset, o.frames);
+  } catch (const Error& e) {
+    throw render::RenderError(std::string("synth room: --subset: ") + e.what());
+  }
+}
+
+void PrepareFolder(const SynthRoomOptions& o) {
+  std::error_code ec;
+  if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) {
+    throw render::RenderError(o.out.string() + ": exists and is not a folder");
+  }
+  if (fs::exists(o.out, ec) && !fs::is_empty(o.out, ec)) {
+    if (!o.overwrite) throw render::RenderError(o.out.string() + ": folder exists and is not empty (--force replaces the recording)");
+    // Only what a recording consists of, never anything else the user keeps there.
+    fs::remove_all(o.out / "frames", ec);
+    for (const char* file : {"frames.txt", "groundtruth.txt", "camera.yaml"}) fs::remove(o.out / file, ec);
+  }
+  fs::create_directories(o.out / "frames", ec);
+  if (ec) throw render::RenderError(o.out.string() + ": cannot create the recording folder (" + ec.message() + ")");
+}
+
+using PoseAt = std::function<calib::Pose(double)>;
+
+cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const PoseAt& path, double t, const SynthRoomOptions& o) {
+  if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path(t));
+  cv::Mat sum;
+  for (int k = 0; k < o.motion_blur_samples; ++k) {
+    const double offset = o.exposure_s * (static_cast<double>(k) / (o.motion_blur_samples - 1) - 0.5);
+    cv::Mat frame;
+    renderer.Render(path(t + offset)).convertTo(frame, CV_32FC3);
+    if (sum.empty()) sum = frame;
+    else sum += frame;
+  }
+  cv::Mat out;
+  sum.convertTo(out, CV_8UC3, 1.0 / o.motion_blur_samples);
+  return out;
+}
+
+// A rolling shutter reads row y at t + (y / H − 1/2)·readout: 16 horizontal bands, each rendered
+// (with its motion blur) at its middle row's time.
+cv::Mat RenderExposure(RoomRenderer& renderer, const PoseAt& path, double t, const SynthRoomOptions& o) {
+  if (o.rolling_shutter_s <= 0) return RenderGlobalExposure(renderer, path, t, o);
+  constexpr int kBands = 16;
+  cv::Mat out(o.height, o.width, CV_8UC3);
+  for (int b = 0; b < kBands; ++b) {
+    const int y0 = o.height * b / kBands, y1 = o.height * (b + 1) / kBands;
+    const double row_time = t + ((y0 + y1) / 2.0 / o.height - 0.5) * o.rolling_shutter_s;
+    RenderGlobalExposure(renderer, path, row_time, o).rowRange(y0, y1).copyTo(out.rowRange(y0, y1));
+  }
+  return out;
+}
+
+void ApplyGain(cv::Mat& image, double drift, double t) {
+  if (drift <= 0) return;
+  image.convertTo(image, CV_8UC3, 1.0 + drift * std::sin(2 * M_PI * t / 7.0));  // saturating
+}
+
+void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
+  if (sigma <= 0) return;
+  cv::RNG rng(seed * 0x9E3779B97F4A7C15ULL + static_cast<uint64_t>(frame) + 1);
+  cv::Mat noise(image.size(), CV_32FC3), noisy;
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, sigma);
+  image.convertTo(noisy, CV_32FC3);
+  noisy += noise;
+  noisy.convertTo(image, CV_8UC3);  // saturating
+}
+
+}  // namespace
+
+SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
+  ValidateOptions(o);
+  const std::vector<int> indices = FramesToRender(o);
+  const RoomScene scene = MakeRoomScene(o.data_dir, o.light);
+  std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.gl);
+  PrepareFolder(o);
+  const calib::Camera camera = RoomCamera(o.width, o.height);
+  RoomRenderer renderer(*context, scene, camera, o.samples);
+  const RoomPath room_path(o.frames / o.fps, o.seed);
+  const OrbitWalk orbit_walk(o.frames / o.fps, o.seed, o.orbit);
+  const PoseAt path = [&](double t) { return o.walk == RoomWalk::kOrbit ? orbit_walk.At(t) : room_path.At(t); };
+
+  std::vector<recordings::FrameEntry> entries;
+  recordings::Trajectory groundtruth;
+  // PNG encoding of frame i overlaps the rendering of frame i + 1.
+  std::future<bool> pending_write;
+  std::string pending_name;
+  auto finish_write = [&] {
+    if (pending_write.valid() && !pending_write.get()) {
+      throw render::RenderError((o.out / pending_name).string() + ": cannot write the frame");
+    }
+  };
+  for (size_t n = 0; n < indices.size(); ++n) {
+    const int i = indices[n];
+    const double t = i / o.fps;
+    cv::Mat image = RenderExposure(renderer, path, t, o);
+    ApplyGain(image, o.gain_drift, t);
+    AddNoise(image, o.noise_sigma, o.seed, i);
+    char name[32];
+    std::snprintf(name, sizeof name, "frames/%06d.%s", i, o.jpeg_quality > 0 ? "jpg" : "png");
+    finish_write();
+    pending_name = name;
+    const std::vector<int> params = o.jpeg_quality > 0 ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality}
+                                                       : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
+    pending_write = std::async(std::launch::async, [file = (o.out / name).string(), image, params] {
+      try {
+        WriteImageAtomically(file, image, params);
+        return true;
+      } catch (const Error&) {
+        return false;
+      }
+    });
+    entries.push_back({t, name});
+    groundtruth.push_back({t, path(t)});
+    if (progress) progress(static_cast<int>(n) + 1, static_cast<int>(indices.size()));
+  }
+  finish_write();
+  calib::SaveCamera(camera, o.out / "camera.yaml");
+  recordings::WriteFramesTxt(o.out, entries);
+  recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
+                       "arview synth room, seed " + std::to_string(o.seed) + (o.light == SynthLighting::kWindow ? ", window light" : "") +
+                           ", world: metres, z up, floor z = 0");
+  return {context->Description(), static_cast<int>(indices.size())};
+}
+
+}  // namespace arview::synth

@@ -1,0 +1,134 @@
+#pragma once
+// A rendered room with exact ground truth (`arview synth room`): the inside of a 7 x 5 x 2.8 m
+// room whose walls, floor, ceiling and three boxes carry real photos from Debian's opencv-doc
+// package, filmed at 640x480 and 30 fps along a smooth hand-held-like path (a walk round the
+// room looking at the walls, panning, a little shake and one fast turn).
+//
+// World frame: metres, z up, floor at z = 0, room centred on the origin (x in [−3.5, 3.5],
+// y in [−2.5, 2.5], z in [0, 2.8]).
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "calib/camera.h"
+#include "calib/pose.h"
+#include "render/offscreen.h"
+#include "synth/orbit_walk.h"
+#include "render/textured_scene.h"
+
+namespace arview::synth {
+
+inline const char* kOpenCvDocData = "/usr/share/doc/opencv-doc/examples/data";
+
+// One textured rectangle of the room, kept for tests and tools: its corners in the world
+// (top-left, top-right, bottom-right, bottom-left of the upright texture) and its image.
+struct RoomPanel {
+  std::string image_name;
+  Eigen::Vector3d corners[4];
+  int texture = 0;
+};
+
+struct RoomScene {
+  std::vector<cv::Mat> textures;       // textures[0] is plain white (wall paint)
+  std::vector<render::TriangleBatch> batches;  // everything drawn
+  std::vector<RoomPanel> panels;       // the photo rectangles only
+};
+
+// How the room is lit; the light is baked into the surfaces' shades (nothing is lit at render
+// time), so a frame's brightness depends only on what it sees.
+//   kEven:   evenly from all round, a light floor (the tracking tests' room).
+//   kWindow: daylight through a window in the +y wall (x in [−1.575, −0.175], z in [0.9, 2.5]), the
+//            pane clipped white, a dark floor under light walls: the light has a direction that
+//            a camera in the room sees, so `arview place` finds a dominant light above the floor
+//            and the character casts a shadow (`arview demo`). One wall photo (graf1) gives way
+//            to the window.
+enum class SynthLighting { kEven, kWindow };
+
+// Loads the photos from `data_dir`; throws RenderError naming a missing or unreadable file.
+RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData, SynthLighting light = SynthLighting::kEven);
+
+// The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
+// Other sizes keep the horizontal field of view (f and the principal point offset scale with
+// width / 640, pixel centres in OpenCV's convention); a wider aspect crops top and bottom.
+calib::Camera RoomCamera(int width = 640, int height = 480);
+
+// The hand-held path: camera pose (world → camera) at time t (seconds) for a sequence of
+// `duration` seconds; deterministic for a seed. The fast turn (90° in 0.6 s) starts at 55% of
+// the duration.
+class RoomPath {
+ public:
+  RoomPath(double duration, uint64_t seed);
+  calib::Pose At(double t) const;
+
+ private:
+  double duration_;
+  double angle0_, direction_, pan_phase_, pitch_phase_, roll_phase_, bob_phase_, turn_sign_;
+  double shake_phase_[6];
+};
+
+// The camera's walk: RoomPath (round the room's centre, looking at the walls), or OrbitWalk
+// (two laps round a spot where a character stands, for `arview demo`).
+enum class RoomWalk { kRoom, kOrbit };
+
+struct SynthRoomOptions {
+  std::filesystem::path out;
+  RoomWalk walk = RoomWalk::kRoom;
+  SynthLighting light = SynthLighting::kEven;
+  OrbitWalkOptions orbit;        // for RoomWalk::kOrbit
+  int frames = 300;
+  uint64_t seed = 1;
+  double fps = 30.0;
+  int motion_blur_samples = 0;   // 0 or 1: none; N > 1: average N renders over the exposure
+  double exposure_s = 1.0 / 60;  // shutter time spanned by motion blur
+  double noise_sigma = 0.0;      // additive Gaussian sensor noise, grey levels (8-bit)
+  int width = 640, height = 480; // frame size (e.g. 1280x720, 1920x1080)
+  int jpeg_quality = 0;          // 0: frames as PNG; 1..100: JPEG at this quality
+  // Exposure/gain change over time: brightness multiplied by 1 + gain_drift·sin(2πt / 7 s)
+  // (auto-exposure hunting); 0: off.
+  double gain_drift = 0.0;
+  // Rolling shutter: rows are read out over this time, top to bottom (each of 16 bands is
+  // rendered at its own time); 0: global shutter.
+  double rolling_shutter_s = 0.0;
+  int samples = 4;               // MSAA samples
+  // Only these frames of the `frames`-long walk are rendered and listed (recordings::
+  // ParseFrameSpec syntax, e.g. "0-649:8,650-949"); empty: every frame. The walk, the noise
+  // and every rendered frame are exactly those of the full recording: a subset makes sizes
+  // whose frames take seconds each affordable (a sparse first lap to map, a dense stretch to track).
+  std::string frames_subset;
+  bool overwrite = false;        // replace an existing recording in `out`
+  std::filesystem::path data_dir = kOpenCvDocData;
+  render::OffscreenOptions gl;
+};
+
+struct SynthRoomReport {
+  std::string gl_description;
+  int frames = 0;
+};
+
+// Renders and writes the recording: frames/NNNNNN.png (or .jpg), frames.txt, camera.yaml and
+// groundtruth.txt (TUM, camera-to-world, pose at the middle of each exposure; with a rolling
+// shutter, of the middle row's exposure).
+// `progress(done, total)` is called after every frame when given.
+SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options,
+                               const std::function<void(int, int)>& progress = nullptr);
+
+// Renders one frame of the room (no noise), for tests and previews.
+class RoomRenderer {
+ public:
+  RoomRenderer(render::OffscreenContext& context, const RoomScene& scene, const calib::Camera& camera, int samples);
+  cv::Mat Render(const calib::Pose& pose);
+
+ private:
+  render::OffscreenContext* context_;
+  calib::Camera camera_;
+  render::TexturedScene scene_;
+  render::RenderTarget target_;
+};
+
+}  // namespace arview::synth

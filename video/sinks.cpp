@@ -1,0 +1,190 @@
+#include "video/sinks.h"
+
+#include "base/image_file.h"
+
+#include <opencv2/highgui.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "video/h264_writer.h"
+#include "render/offscreen.h"
+
+namespace arview::video {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+
+void CheckFrame(const cv::Mat& frame, cv::Size size, const std::string& target) {
+  if (frame.size() != size || frame.type() != CV_8UC3) {
+    throw render::RenderError(target + ": frame is " + SizeText(frame.size()) + " type " + std::to_string(frame.type()) +
+                      ", the sink was opened for " + SizeText(size) + " BGR");
+  }
+}
+
+class WindowSink final : public FrameSink {
+ public:
+  WindowSink(std::string title, cv::Size size) : title_(std::move(title)), size_(size) {
+    if (!HasDisplay()) {
+      throw render::RenderError("window output needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set; "
+                        "write to a file instead (e.g. --out out.mp4)");
+    }
+    try {
+      cv::namedWindow(title_, cv::WINDOW_AUTOSIZE);
+    } catch (const cv::Exception& e) {
+      throw render::RenderError("cannot open a window: " + std::string(e.what()));
+    }
+  }
+  ~WindowSink() override { Close(); }
+  void Write(const cv::Mat& bgr) override {
+    CheckFrame(bgr, size_, "window");
+    cv::imshow(title_, bgr);
+    const int key = cv::waitKey(1);
+    if (key == 27 || key == 'q') stop_ = true;
+    if (cv::getWindowProperty(title_, cv::WND_PROP_VISIBLE) < 1) stop_ = true;
+  }
+  void Close() override {
+    if (open_) {
+      open_ = false;
+      try {
+        cv::destroyWindow(title_);
+      } catch (const cv::Exception&) {
+      }
+    }
+  }
+  bool StopRequested() const override { return stop_; }
+  std::string Describe() const override { return "window \"" + title_ + "\""; }
+
+ private:
+  std::string title_;
+  cv::Size size_;
+  bool open_ = true;
+  bool stop_ = false;
+};
+
+class VideoSink final : public FrameSink {
+ public:
+  VideoSink(const fs::path& path, cv::Size size, double fps) : path_(path), size_(size) {
+    if (!(fps > 0 && fps <= 1000)) throw render::RenderError(path.string() + ": frame rate must be in (0, 1000]");
+    if (path.has_parent_path() && !fs::is_directory(path.parent_path())) {
+      throw render::RenderError(path.string() + ": folder " + path.parent_path().string() + " does not exist");
+    }
+    // H.264 through libx264 at a fast preset (video/h264_writer.h says why not OpenCV's writer);
+    // without libx264, OpenCV's writer: H.264 if its FFmpeg has another encoder for it, else
+    // MPEG-4 part 2, which every FFmpeg build has.
+    h264_ = H264Writer::Open(path, size, fps);
+    if (h264_) {
+      codec_ = "H.264, libx264 " + H264Options{}.preset;
+      return;
+    }
+    for (const char* codec : {"avc1", "mp4v"}) {
+      writer_.open(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps,
+                   size, true);
+      if (writer_.isOpened()) {
+        codec_ = codec;
+        break;
+      }
+    }
+    if (!writer_.isOpened()) throw render::RenderError(path.string() + ": OpenCV's FFmpeg writer cannot open this file");
+  }
+  ~VideoSink() override {
+    h264_.reset();
+    writer_.release();
+  }
+  void Write(const cv::Mat& bgr) override {
+    CheckFrame(bgr, size_, path_.string());
+    if (h264_) h264_->Write(bgr);
+    else writer_.write(bgr);
+  }
+  void Close() override {
+    if (h264_) h264_->Close();
+    writer_.release();
+    std::error_code ec;
+    if (!closed_ && (!fs::exists(path_, ec) || fs::file_size(path_, ec) == 0)) {
+      closed_ = true;
+      throw render::RenderError(path_.string() + ": the video file was not written");
+    }
+    closed_ = true;
+  }
+  std::string Describe() const override { return path_.string() + " (" + codec_ + ")"; }
+
+ private:
+  fs::path path_;
+  cv::Size size_;
+  std::unique_ptr<H264Writer> h264_;
+  cv::VideoWriter writer_;
+  std::string codec_;
+  bool closed_ = false;
+};
+
+class PngSequenceSink final : public FrameSink {
+ public:
+  PngSequenceSink(const fs::path& folder, cv::Size size) : folder_(folder), size_(size) {
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (ec || !fs::is_directory(folder)) throw render::RenderError(folder.string() + ": cannot create the PNG folder");
+  }
+  void Write(const cv::Mat& bgr) override {
+    CheckFrame(bgr, size_, folder_.string());
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", index_++);
+    const fs::path file = folder_ / name;
+    WriteImageAtomically(file, bgr, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  }
+  void Close() override {}
+  std::string Describe() const override { return folder_.string() + "/NNNNNN.png"; }
+
+ private:
+  fs::path folder_;
+  cv::Size size_;
+  int index_ = 0;
+};
+
+// Counts the frames and keeps none (`--out null`: soak runs and timing without an encoder).
+class NullSink final : public FrameSink {
+ public:
+  explicit NullSink(cv::Size size) : size_(size) {}
+  void Write(const cv::Mat& bgr) override {
+    CheckFrame(bgr, size_, "null");
+    ++frames_;
+  }
+  void Close() override {}
+  std::string Describe() const override { return "null (" + std::to_string(frames_) + " frames discarded)"; }
+
+ private:
+  cv::Size size_;
+  long frames_ = 0;
+};
+
+}  // namespace
+
+bool HasDisplay() {
+  for (const char* name : {"DISPLAY", "WAYLAND_DISPLAY"}) {
+    const char* value = std::getenv(name);
+    if (value != nullptr && *value != '\0') return true;
+  }
+  return false;
+}
+
+std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps) {
+  if (frame_size.width <= 0 || frame_size.height <= 0) throw render::RenderError("sink: frame size must be positive");
+  if (target == "window" || target.rfind("window:", 0) == 0) {
+    return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size);
+  }
+  if (target == "null") return std::make_unique<NullSink>(frame_size);
+  if (target.empty()) throw render::RenderError("sink: no output given");
+  const fs::path path(target);
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".mp4" || ext == ".avi" || ext == ".mkv") return std::make_unique<VideoSink>(path, frame_size, fps);
+  if (target.back() == '/' || ext.empty() || fs::is_directory(path)) {
+    return std::make_unique<PngSequenceSink>(path, frame_size);
+  }
+  throw render::RenderError(target + ": unknown output (expected window, null, a .mp4/.avi/.mkv file, or a folder for PNGs)");
+}
+
+}  // namespace arview::video
