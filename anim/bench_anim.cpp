@@ -188,7 +188,7 @@ void BM_FoxUpdate(benchmark::State& state) {
                      (state.range(0) ? "dib" : "dlb") + "}\n    sampling: " + (state.range(1) ? "nlerp" : "slerp") +
                      "\n    keys:\n";
   for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
-  AnimatedCharacter ch(ParseScene(text, "bench.yaml").characters[0]);
+  authoring::AnimatedCharacter ch(authoring::ParseScene(text, "bench.yaml").characters[0]);
   double t = 0;
   for (auto _ : state) {
     t += 1.0 / 60;

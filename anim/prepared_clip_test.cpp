@@ -154,7 +154,7 @@ TEST(PreparedClip, SamplesAsSamplingJobOnTheTestAssets) {
   ARVIEW_REQUIRE_DATA_PATH(bvh, "Debian package assimp-testmodels");
   for (const std::filesystem::path& asset :
        {testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"), testing::SharedData("characters/CesiumMan.glb"), bcn, bvh}) {
-    const Character c = LoadCharacter(asset);
+    const Character c = authoring::LoadCharacter(asset);
     double slerp = 0, nlerp = 0;
     for (const Clip& clip : c.clips) {
       std::vector<double> times;

@@ -8,7 +8,7 @@
 #include <set>
 #include <sstream>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 namespace {
 
@@ -23,39 +23,39 @@ class AnimatorBuilder {
   // After Build: notes for the user about layers built without what the scene asked for.
   const std::vector<std::string>& notes() const { return notes_; }
 
-  std::unique_ptr<Animator> Build() {
-    FrameBlenderOptions blender;
+  std::unique_ptr<anim::Animator> Build() {
+    anim::FrameBlenderOptions blender;
     blender.method = spec_.blend;
     blender.dib = spec_.dib;
     blender.rest_threshold = spec_.schedule.rest_threshold;
     std::vector<ActionSpec> actions = spec_.schedule.given ? spec_.schedule.actions : DefaultActions();
     int triggers = 0;
     for (const ActionSpec& a : actions) triggers += a.has_trigger;
-    auto schedule = std::make_shared<Schedule>(sk_, blender, std::min<int>(60, static_cast<int>(actions.size()) + 4 * triggers + 4));
-    AnimatorOptions options;
+    auto schedule = std::make_shared<anim::Schedule>(sk_, blender, std::min<int>(60, static_cast<int>(actions.size()) + 4 * triggers + 4));
+    anim::AnimatorOptions options;
     options.view_action = spec_.schedule.view_action;
     options.hold_seconds = overrides_.hold_seconds.value_or(spec_.schedule.hold_seconds);
     options.fade_seconds = overrides_.fade_seconds.value_or(spec_.schedule.fade_seconds);
     for (std::size_t i = 0; i < actions.size(); ++i) {
       ActionSpec a = actions[i];
       if (a.name.empty()) a.name = "action" + std::to_string(i + 1);
-      Action action = MakeAction(a);
+      anim::Action action = MakeAction(a);
       if (a.has_trigger) {
         options.triggers.push_back({a.trigger_near, a.trigger_far, std::move(action)});
         continue;
       }
       try {
         schedule->Add(std::move(action));
-      } catch (const Error& e) {
-        throw Error(At(a.line) + e.what());
+      } catch (const anim::Error& e) {
+        throw anim::Error(At(a.line) + e.what());
       }
       if (!a.distance_weight.empty()) options.distance_weights.push_back({a.name, a.distance_weight});
     }
     if (!options.view_action.empty() && schedule->FindByName(options.view_action) < 0) options.view_action.clear();
     try {
-      return std::make_unique<Animator>(sk_, schedule, std::move(options), ch_.view_adaptive());
-    } catch (const Error& e) {
-      throw Error(spec_.where + ": " + e.what());
+      return std::make_unique<anim::Animator>(sk_, schedule, std::move(options), ch_.view_adaptive());
+    } catch (const anim::Error& e) {
+      throw anim::Error(spec_.where + ": " + e.what());
     }
   }
 
@@ -67,7 +67,7 @@ class AnimatorBuilder {
     idle.name = "idle";
     idle.keep_rendering = true;
     idle.line = 0;
-    const Character& c = ch_.character();
+    const anim::Character& c = ch_.character();
     std::string clip = overrides_.idle_clip;
     if (clip.empty() && spec_.lookat.base_clip != "rest") {
       clip = spec_.lookat.base_clip;
@@ -90,32 +90,32 @@ class AnimatorBuilder {
     return {idle, view};
   }
 
-  const Clip& FindClip(const std::string& name, int line) const {
-    const Clip* clip = ch_.character().FindClip(name);
+  const anim::Clip& FindClip(const std::string& name, int line) const {
+    const anim::Clip* clip = ch_.character().FindClip(name);
     if (!clip)
-      throw Error((line ? At(line) : spec_.where + ": ") + "clip '" + name + "' does not exist in " + ch_.character().source +
+      throw anim::Error((line ? At(line) : spec_.where + ": ") + "clip '" + name + "' does not exist in " + ch_.character().source +
                   " (clips: " + ClipList(ch_.character()) + ")");
     return *clip;
   }
 
-  BlendablePtr Object(const ObjectSpec& o) {
-    BlendablePtr b;
+  anim::BlendablePtr Object(const ObjectSpec& o) {
+    anim::BlendablePtr b;
     switch (o.kind) {
       case ObjectSpec::Kind::kClip:
-        b = std::make_shared<ClipSource>(sk_, std::shared_ptr<const Clip>(ch_.shared_character(), &FindClip(o.clip, o.line)),
+        b = std::make_shared<anim::ClipSource>(sk_, std::shared_ptr<const anim::Clip>(ch_.shared_character(), &FindClip(o.clip, o.line)),
                                          spec_.nlerp_sampling);
         break;
       case ObjectSpec::Kind::kPose: {
-        LocalPose pose = LocalPose::Rest(*sk_);
-        if (!o.clip.empty()) MustRun(SamplingJob{sk_.get(), &FindClip(o.clip, o.line), o.pose_time, false, &pose}, "pose");
-        b = std::make_shared<StaticPose>(std::move(pose));
+        anim::LocalPose pose = anim::LocalPose::Rest(*sk_);
+        if (!o.clip.empty()) anim::MustRun(anim::SamplingJob{sk_.get(), &FindClip(o.clip, o.line), o.pose_time, false, &pose}, "pose");
+        b = std::make_shared<anim::StaticPose>(std::move(pose));
         break;
       }
       case ObjectSpec::Kind::kViewAdaptive:
         b = ch_.view_adaptive();
         break;
       case ObjectSpec::Kind::kIdle:
-        if (!spec_.idle.given) throw Error(At(o.line) + "'idle: true' needs the character's 'idle:' section");
+        if (!spec_.idle.given) throw anim::Error(At(o.line) + "'idle: true' needs the character's 'idle:' section");
         if (!idle_) {
           IdleLayerReport report;
           idle_ = BuildIdleLayer(ch_, &report);
@@ -124,18 +124,18 @@ class AnimatorBuilder {
         b = idle_;
         break;
       case ObjectSpec::Kind::kSchedule: {
-        FrameBlenderOptions blender;
+        anim::FrameBlenderOptions blender;
         blender.method = spec_.blend;
         blender.dib = spec_.dib;
         blender.rest_threshold = spec_.schedule.rest_threshold;
-        auto nested = std::make_shared<Schedule>(sk_, blender, std::min<int>(60, static_cast<int>(o.actions.size()) + 1));
+        auto nested = std::make_shared<anim::Schedule>(sk_, blender, std::min<int>(60, static_cast<int>(o.actions.size()) + 1));
         for (const ActionSpec& a : o.actions) {
           if (a.has_trigger || !a.distance_weight.empty())
-            throw Error(At(a.line) + "distance triggers and weights belong to the top-level schedule");
+            throw anim::Error(At(a.line) + "distance triggers and weights belong to the top-level schedule");
           try {
             nested->Add(MakeAction(a));
-          } catch (const Error& e) {
-            throw Error(At(a.line) + e.what());
+          } catch (const anim::Error& e) {
+            throw anim::Error(At(a.line) + e.what());
           }
         }
         b = nested;
@@ -143,26 +143,26 @@ class AnimatorBuilder {
       }
     }
     try {
-      if (o.has_window) b = std::make_shared<Window>(b, o.window_from, o.window_to);
-      if (o.stretch > 0) b = std::make_shared<TimeStretch>(b, o.stretch);
-      if (o.loop >= 0) b = std::make_shared<Loop>(b, o.loop);
-      if (o.mirror) b = std::make_shared<Mirror>(b, sk_, spec_.up.cross(spec_.forward));
+      if (o.has_window) b = std::make_shared<anim::Window>(b, o.window_from, o.window_to);
+      if (o.stretch > 0) b = std::make_shared<anim::TimeStretch>(b, o.stretch);
+      if (o.loop >= 0) b = std::make_shared<anim::Loop>(b, o.loop);
+      if (o.mirror) b = std::make_shared<anim::Mirror>(b, sk_, spec_.up.cross(spec_.forward));
       if (o.has_transform)
-        b = std::make_shared<GlobalTransform>(b, sk_, DualQuatd::FromRotationTranslation(o.transform.rotation, o.transform.position));
-    } catch (const Error& e) {
-      throw Error(At(o.line) + e.what());
+        b = std::make_shared<anim::GlobalTransform>(b, sk_, anim::DualQuatd::FromRotationTranslation(o.transform.rotation, o.transform.position));
+    } catch (const anim::Error& e) {
+      throw anim::Error(At(o.line) + e.what());
     }
     return b;
   }
 
-  JointMask Mask(const MaskSpec& m) const {
-    JointMask mask{std::vector<double>(sk_->size(), m.default_rotation), std::vector<double>(sk_->size(), m.default_translation)};
+  anim::JointMask Mask(const MaskSpec& m) const {
+    anim::JointMask mask{std::vector<double>(sk_->size(), m.default_rotation), std::vector<double>(sk_->size(), m.default_translation)};
     for (const MaskSpec::Scope& s : m.scopes) {
       std::vector<int> joints;
       try {
-        joints = ResolveScope(*sk_, s.name, spec_.scopes);
-      } catch (const Error& e) {
-        throw Error(At(m.line) + e.what());
+        joints = anim::ResolveScope(*sk_, s.name, spec_.scopes);
+      } catch (const anim::Error& e) {
+        throw anim::Error(At(m.line) + e.what());
       }
       mask.SetRotation(joints, s.rotation);
       mask.SetTranslation(joints, s.translation);
@@ -170,8 +170,8 @@ class AnimatorBuilder {
     return mask;
   }
 
-  Action MakeAction(const ActionSpec& a) {
-    Action action;
+  anim::Action MakeAction(const ActionSpec& a) {
+    anim::Action action;
     action.object = Object(a.object);
     action.name = a.name;
     action.start = a.start;
@@ -186,10 +186,10 @@ class AnimatorBuilder {
 
   const AnimatedCharacter& ch_;
   const CharacterSpec& spec_;
-  std::shared_ptr<const Skeleton> sk_;
+  std::shared_ptr<const anim::Skeleton> sk_;
   AnimatorOverrides overrides_;
   std::string file_;
-  BlendablePtr idle_;
+  anim::BlendablePtr idle_;
   std::vector<std::string> notes_;  // what the user should be told (IdleLayerReport::notes)
 };
 
@@ -200,7 +200,7 @@ std::string IdleWhere(const CharacterSpec& spec, int line, const std::string& wh
 
 // The idle section's learning options and sources (the loaded motion files kept in `motion`).
 struct IdleLearningInput {
-  std::vector<Character> motion;
+  std::vector<anim::Character> motion;
   std::vector<IdleSource> sources;
   IdleLearningOptions options;
 };
@@ -211,16 +211,16 @@ std::unique_ptr<IdleLearningInput> IdleInput(const AnimatedCharacter& ch) {
   auto in = std::make_unique<IdleLearningInput>();
   in->motion.reserve(spec.idle.motion.size());
   for (const auto& f : spec.idle.motion) in->motion.push_back(LoadCharacter(f));
-  for (const Character& m : in->motion) {
+  for (const anim::Character& m : in->motion) {
     IdleSource s{&m, {}, false};
-    for (const Clip& c : m.clips) s.clips.push_back(&c);
+    for (const anim::Clip& c : m.clips) s.clips.push_back(&c);
     in->sources.push_back(s);
   }
   if (!spec.idle.clips.empty()) {
     IdleSource own{&ch.character(), {}, true};
     for (const std::string& name : spec.idle.clips) {
-      const Clip* c = ch.character().FindClip(name);
-      if (!c) throw Error(where + "clip '" + name + "' does not exist in " + ch.character().source);
+      const anim::Clip* c = ch.character().FindClip(name);
+      if (!c) throw anim::Error(where + "clip '" + name + "' does not exist in " + ch.character().source);
       own.clips.push_back(c);
     }
     in->sources.push_back(own);
@@ -232,14 +232,14 @@ std::unique_ptr<IdleLearningInput> IdleInput(const AnimatedCharacter& ch) {
   return in;
 }
 
-std::shared_ptr<IdleModel> LearnIdle(const AnimatedCharacter& ch, const IdleLearningInput& in, std::string* summary) {
+std::shared_ptr<anim::IdleModel> LearnIdle(const AnimatedCharacter& ch, const IdleLearningInput& in, std::string* summary) {
   const CharacterSpec& spec = ch.spec();
   IdleLearningReport report;
-  std::shared_ptr<IdleModel> model;
+  std::shared_ptr<anim::IdleModel> model;
   try {
-    model = std::make_shared<IdleModel>(LearnIdleModel(ch.character().skeleton, in.sources, in.options, &report));
-  } catch (const Error& e) {
-    throw Error(IdleWhere(spec, spec.idle.line, "idle") + e.what());
+    model = std::make_shared<anim::IdleModel>(LearnIdleModel(ch.character().skeleton, in.sources, in.options, &report));
+  } catch (const anim::Error& e) {
+    throw anim::Error(IdleWhere(spec, spec.idle.line, "idle") + e.what());
   }
   if (summary) *summary = report.Summary();
   return model;
@@ -247,13 +247,13 @@ std::shared_ptr<IdleModel> LearnIdle(const AnimatedCharacter& ch, const IdleLear
 
 // The balance-shift model of `idle.balance:` (nothing when its recording holds no transition),
 // in the idle model's posture layout.
-std::shared_ptr<const BalanceModel> LearnBalance(const AnimatedCharacter& ch, const IdleModel& idle, const IdleLearningInput& in,
+std::shared_ptr<const anim::BalanceModel> LearnBalance(const AnimatedCharacter& ch, const anim::IdleModel& idle, const IdleLearningInput& in,
                                                  BalanceLearningReport& report) {
   const CharacterSpec& spec = ch.spec();
   const BalanceSpec& b = spec.idle.balance;
   const std::string where = IdleWhere(spec, b.line, "idle.balance");
   try {
-    std::optional<Character> recording;
+    std::optional<anim::Character> recording;
     IdleSource source{&ch.character(), {}, true};
     BalanceLearningOptions options;
     options.components = b.components;
@@ -261,41 +261,41 @@ std::shared_ptr<const BalanceModel> LearnBalance(const AnimatedCharacter& ch, co
     if (!b.motion.empty()) {
       recording = LoadCharacter(b.motion);
       source = {&*recording, {}, false};
-      for (const Clip& c : recording->clips) source.clips.push_back(&c);
+      for (const anim::Clip& c : recording->clips) source.clips.push_back(&c);
       options.analysis.up = Eigen::Vector3d::UnitY();  // motion capture's up, as the idle learner reads it
     } else {
-      const Clip* c = ch.character().FindClip(b.clip);
+      const anim::Clip* c = ch.character().FindClip(b.clip);
       if (!c)
-        throw Error("clip '" + b.clip + "' does not exist in " + ch.character().source + " (clips: " + ClipList(ch.character()) +
+        throw anim::Error("clip '" + b.clip + "' does not exist in " + ch.character().source + " (clips: " + ClipList(ch.character()) +
                     ")");
       source.clips.push_back(c);
     }
-    std::optional<BalanceModel> model =
+    std::optional<anim::BalanceModel> model =
         LearnBalanceModel(ch.character().skeleton, source, idle, in.options, options, &report);
-    return model ? std::make_shared<const BalanceModel>(std::move(*model)) : nullptr;
-  } catch (const Error& e) {
-    throw Error(where + e.what());
+    return model ? std::make_shared<const anim::BalanceModel>(std::move(*model)) : nullptr;
+  } catch (const anim::Error& e) {
+    throw anim::Error(where + e.what());
   }
 }
 
 }  // namespace
 
-std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& ch, std::string* summary) {
+std::shared_ptr<anim::IdleSynthesizer> BuildIdle(const AnimatedCharacter& ch, std::string* summary) {
   const auto in = IdleInput(ch);
-  return std::make_shared<IdleSynthesizer>(ch.shared_skeleton(), LearnIdle(ch, *in, summary), ch.spec().idle.seed);
+  return std::make_shared<anim::IdleSynthesizer>(ch.shared_skeleton(), LearnIdle(ch, *in, summary), ch.spec().idle.seed);
 }
 
-BlendablePtr BuildIdleLayer(const AnimatedCharacter& ch, IdleLayerReport* report) {
+anim::BlendablePtr BuildIdleLayer(const AnimatedCharacter& ch, IdleLayerReport* report) {
   IdleLayerReport rep;
   const auto in = IdleInput(ch);
-  const std::shared_ptr<IdleModel> idle_model = LearnIdle(ch, *in, &rep.idle);
-  auto idle = std::make_shared<IdleSynthesizer>(ch.shared_skeleton(), idle_model, ch.spec().idle.seed);
-  BlendablePtr layer = idle;
+  const std::shared_ptr<anim::IdleModel> idle_model = LearnIdle(ch, *in, &rep.idle);
+  auto idle = std::make_shared<anim::IdleSynthesizer>(ch.shared_skeleton(), idle_model, ch.spec().idle.seed);
+  anim::BlendablePtr layer = idle;
   const BalanceSpec& b = ch.spec().idle.balance;
   if (b.given) {
     BalanceLearningReport balance;
     if (auto model = LearnBalance(ch, *idle_model, *in, balance)) {
-      layer = std::make_shared<BalanceShifter>(ch.shared_skeleton(), model, b.seed, idle);
+      layer = std::make_shared<anim::BalanceShifter>(ch.shared_skeleton(), model, b.seed, idle);
       rep.balance_built = true;
     } else {
       rep.notes.push_back(IdleWhere(ch.spec(), b.line, "idle.balance") + balance.Summary() +
@@ -307,12 +307,12 @@ BlendablePtr BuildIdleLayer(const AnimatedCharacter& ch, IdleLayerReport* report
   return layer;
 }
 
-std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides,
+std::unique_ptr<anim::Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides,
                                         std::vector<std::string>* notes) {
   AnimatorBuilder builder(character, overrides);
-  std::unique_ptr<Animator> animator = builder.Build();
+  std::unique_ptr<anim::Animator> animator = builder.Build();
   if (notes) *notes = builder.notes();
   return animator;
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

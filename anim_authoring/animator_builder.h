@@ -12,7 +12,7 @@
 #include "anim/idle.h"
 #include "anim_authoring/character_builder.h"
 
-namespace arview::anim {
+namespace arview::authoring {
 
 // What the appliance may override in the scene's schedule.
 struct AnimatorOverrides {
@@ -27,11 +27,11 @@ struct AnimatorOverrides {
 // `character` must outlive the animator. Throws Error "scene:line: why". `notes` (if given)
 // receive what the appliance should tell its user: a layer the scene asked for that the data
 // cannot support (see BuildIdleLayer).
-std::unique_ptr<Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {},
+std::unique_ptr<anim::Animator> BuildAnimator(const AnimatedCharacter& character, const AnimatorOverrides& overrides = {},
                                         std::vector<std::string>* notes = nullptr);
 
 // The idle synthesizer of the character's `idle:` section (learned here), with what was learned.
-std::shared_ptr<IdleSynthesizer> BuildIdle(const AnimatedCharacter& character, std::string* summary = nullptr);
+std::shared_ptr<anim::IdleSynthesizer> BuildIdle(const AnimatedCharacter& character, std::string* summary = nullptr);
 
 // What BuildIdleLayer learned: the idle synthesizer's summary, the balance learner's (empty
 // without `idle.balance:`), and notes for the user: "scene:line: idle.balance: <recording>: what
@@ -47,6 +47,6 @@ struct IdleLayerReport {
 // balance shifts, the balance-shift layer runs (anim/balance_shift.h: the synthesizer's
 // variations on top of the shifts). A recording without a transition gives the synthesizer alone
 // and a note: nothing is invented. Throws Error "scene:line: idle...: why" for bad data.
-BlendablePtr BuildIdleLayer(const AnimatedCharacter& character, IdleLayerReport* report = nullptr);
+anim::BlendablePtr BuildIdleLayer(const AnimatedCharacter& character, IdleLayerReport* report = nullptr);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

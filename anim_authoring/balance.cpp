@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 std::string Lower(std::string s) {
@@ -17,10 +17,10 @@ std::string Lower(std::string s) {
 
 // The side's ankle (or foot) joint: the first joint below the leg's root named like one, else
 // two joints below the leg's root (hip → knee → ankle). −1 without a leg.
-int FootJoint(const Skeleton& sk, bool left) {
-  const int leg = LegRoot(sk, left);
+int FootJoint(const anim::Skeleton& sk, bool left) {
+  const int leg = anim::LegRoot(sk, left);
   if (leg < 0) return -1;
-  for (int j : Subtree(sk, leg)) {
+  for (int j : anim::Subtree(sk, leg)) {
     const std::string n = Lower(sk.names[j]);
     if (n.find("ankle") != std::string::npos || n.find("foot") != std::string::npos) return j;
   }
@@ -36,7 +36,7 @@ int FootJoint(const Skeleton& sk, bool left) {
 }
 
 // The nearest common ancestor of two joints (the pelvis above both legs), or a if none.
-int CommonAncestor(const Skeleton& sk, int a, int b) {
+int CommonAncestor(const anim::Skeleton& sk, int a, int b) {
   for (int x = a; x >= 0; x = sk.parents[x])
     for (int y = b; y >= 0; y = sk.parents[y])
       if (x == y) return x;
@@ -70,19 +70,19 @@ std::string BalanceAnalysis::Summary() const {
   return buf;
 }
 
-BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const BalanceOptions& o, const std::string& source) {
+BalanceAnalysis AnalyseBalance(const anim::Skeleton& sk, const anim::Clip& clip, const BalanceOptions& o, const std::string& source) {
   auto named = [&](const std::string& name) {
     const int j = sk.Find(name);
-    if (j < 0) throw Error(source + ": no joint '" + name + "'");
+    if (j < 0) throw anim::Error(source + ": no joint '" + name + "'");
     return j;
   };
   const int left = o.left_foot.empty() ? FootJoint(sk, true) : named(o.left_foot);
   const int right = o.right_foot.empty() ? FootJoint(sk, false) : named(o.right_foot);
   if (left < 0 || right < 0)
-    throw Error(source + ": no left and right foot found by name (balance needs both legs)");
+    throw anim::Error(source + ": no left and right foot found by name (balance needs both legs)");
   std::vector<int> pelvis;
   for (const std::string& n : o.pelvis) pelvis.push_back(named(n));
-  if (pelvis.empty()) pelvis.push_back(CommonAncestor(sk, LegRoot(sk, true), LegRoot(sk, false)));
+  if (pelvis.empty()) pelvis.push_back(CommonAncestor(sk, anim::LegRoot(sk, true), anim::LegRoot(sk, false)));
   const Eigen::Vector3d up = o.up.normalized();
   BalanceAnalysis a;
   a.source = source;
@@ -91,13 +91,13 @@ BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const Balan
   a.frames = std::max(1, static_cast<int>(std::floor(clip.duration * o.rate)) + 1);
   // Per frame: feet and pelvis positions, and the body's extent along up (its height: the
   // median over the frames, so that marker data without a rest pose is measured too).
-  LocalPose pose = LocalPose::Rest(sk);
+  anim::LocalPose pose = anim::LocalPose::Rest(sk);
   std::vector<Eigen::Matrix4d> model(sk.size());
   std::vector<Eigen::Vector3d> lf(a.frames), rf(a.frames), pv(a.frames);
   std::vector<double> extent(a.frames);
   for (int f = 0; f < a.frames; ++f) {
-    MustRun(SamplingJob{&sk, &clip, f / o.rate, false, &pose}, "balance");
-    MustRun(LocalToModelJob{&sk, &pose, model}, "balance");
+    anim::MustRun(anim::SamplingJob{&sk, &clip, f / o.rate, false, &pose}, "balance");
+    anim::MustRun(anim::LocalToModelJob{&sk, &pose, model}, "balance");
     lf[f] = model[left].block<3, 1>(0, 3);
     rf[f] = model[right].block<3, 1>(0, 3);
     pv[f].setZero();
@@ -113,14 +113,14 @@ BalanceAnalysis AnalyseBalance(const Skeleton& sk, const Clip& clip, const Balan
   a.height = extent[a.frames / 2] > 0 ? extent[a.frames / 2] : 1.0;
   const double dt = 1.0 / o.rate;
   std::vector<bool> planted(a.frames, false), resting(a.frames, false);
-  std::vector<Support> support(a.frames, Support::kBoth);
+  std::vector<anim::Support> support(a.frames, anim::Support::kBoth);
   double run = 0;
   for (int f = 1; f < a.frames; ++f) {
     const double foot_speed = std::max((lf[f] - lf[f - 1]).norm(), (rf[f] - rf[f - 1]).norm()) * o.rate / a.height;
     const double pelvis_speed = Horizontal(pv[f] - pv[f - 1], up).norm() * o.rate / a.height;
     const Eigen::Vector3d d = Horizontal(rf[f] - lf[f], up);
     const double s = d.squaredNorm() > 0 ? Horizontal(pv[f] - lf[f], up).dot(d) / d.squaredNorm() : 0.5;
-    support[f] = s < o.one_foot ? Support::kLeft : s > 1 - o.one_foot ? Support::kRight : Support::kBoth;
+    support[f] = s < o.one_foot ? anim::Support::kLeft : s > 1 - o.one_foot ? anim::Support::kRight : anim::Support::kBoth;
     planted[f] = foot_speed < o.max_foot_speed;
     resting[f] = planted[f] && pelvis_speed < o.max_rest_speed;
     if (planted[f]) {
@@ -165,12 +165,12 @@ namespace {
 
 // Keeps the transitions after which the walk can always go on: a transition into a category
 // with no recorded way out is dropped, and so on until nothing changes.
-void KeepLeavable(BalanceModel& m) {
+void KeepLeavable(anim::BalanceModel& m) {
   for (bool changed = true; changed;) {
     changed = false;
-    for (int s = 0; s < kSupports; ++s) {
-      if (m.CanLeave(static_cast<Support>(s))) continue;
-      for (int c = 0; c < kSupports; ++c)
+    for (int s = 0; s < anim::kSupports; ++s) {
+      if (m.CanLeave(static_cast<anim::Support>(s))) continue;
+      for (int c = 0; c < anim::kSupports; ++c)
         if (m.counts[c][s] > 0) {
           m.counts[c][s] = 0;
           changed = true;
@@ -181,10 +181,10 @@ void KeepLeavable(BalanceModel& m) {
 
 // The recording's transitions as segments (postures from the end of one rest to the start of
 // the next), with the dwell before each (the rest it leaves) per category.
-void AddTransitions(const BalanceAnalysis& a, const std::vector<Eigen::VectorXd>& postures, double rate, BalanceModel& m,
-                    std::array<std::vector<double>, kSupports>& dwell) {
+void AddTransitions(const BalanceAnalysis& a, const std::vector<Eigen::VectorXd>& postures, double rate, anim::BalanceModel& m,
+                    std::array<std::vector<double>, anim::kSupports>& dwell) {
   for (const BalanceAnalysis::Transition& t : a.transitions) {
-    BalanceModel::Segment segment;
+    anim::BalanceModel::Segment segment;
     segment.from = t.from_support;
     segment.to = t.to_support;
     segment.rate = rate;
@@ -206,16 +206,16 @@ std::string Seconds(double s) {
 
 }  // namespace
 
-std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const IdleSource& source, const IdleModel& idle,
+std::optional<anim::BalanceModel> LearnBalanceModel(const anim::Skeleton& character, const IdleSource& source, const anim::IdleModel& idle,
                                               const IdleLearningOptions& idle_options, const BalanceLearningOptions& options,
                                               BalanceLearningReport* report) {
   BalanceLearningReport rep;
   rep.source = source.data->source;
-  BalanceModel m;
-  std::array<std::vector<double>, kSupports> dwell;
+  anim::BalanceModel m;
+  std::array<std::vector<double>, anim::kSupports> dwell;
   const double rate = options.analysis.rate;
   // What each clip holds first: a recording without a transition needs no postures.
-  for (const Clip* clip : source.clips) {
+  for (const anim::Clip* clip : source.clips) {
     BalanceAnalysis a = AnalyseBalance(source.data->skeleton, *clip, options.analysis, source.data->source + " " + clip->name);
     for (const BalanceAnalysis::Rest& r : a.rests) ++rep.rests[static_cast<int>(r.support)];
     rep.transitions += static_cast<int>(a.transitions.size());
@@ -226,19 +226,19 @@ std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const I
     std::vector<int> joints;
     const std::vector<Eigen::VectorXd> postures = ClipPostures(character, source, *source.clips[i], idle_options, rate, &joints);
     if (joints != idle.joints)
-      throw Error(rep.clips[i].source + ": maps onto other joints than the idle model's sources; learn both from one kind of rig");
+      throw anim::Error(rep.clips[i].source + ": maps onto other joints than the idle model's sources; learn both from one kind of rig");
     AddTransitions(rep.clips[i], postures, rate, m, dwell);
   }
   KeepLeavable(m);
-  std::erase_if(m.segments, [&](const BalanceModel::Segment& s) {
+  std::erase_if(m.segments, [&](const anim::BalanceModel::Segment& s) {
     return m.counts[static_cast<int>(s.from)][static_cast<int>(s.to)] == 0;
   });
-  for (const BalanceModel::Segment& s : m.segments) {
+  for (const anim::BalanceModel::Segment& s : m.segments) {
     m.rests[static_cast<int>(s.from)].push_back(s.frames.front());
     m.rests[static_cast<int>(s.to)].push_back(s.frames.back());
   }
-  for (int c = 0; c < kSupports; ++c)
-    if (m.CanLeave(static_cast<Support>(c))) {
+  for (int c = 0; c < anim::kSupports; ++c)
+    if (m.CanLeave(static_cast<anim::Support>(c))) {
       m.dwell_min[c] = *std::min_element(dwell[c].begin(), dwell[c].end());
       m.dwell_max[c] = *std::max_element(dwell[c].begin(), dwell[c].end());
     }
@@ -272,18 +272,18 @@ std::string BalanceLearningReport::Summary() const {
                                  : ": none leads to a category the recording also leaves, so no walk can go on");
   }
   s += "; learned " + std::to_string(segments) + " segments:";
-  for (int c = 0; c < kSupports; ++c) {
+  for (int c = 0; c < anim::kSupports; ++c) {
     const int total = counts[c][0] + counts[c][1] + counts[c][2];
     if (total == 0) continue;
-    s += std::string(" ") + SupportName(static_cast<Support>(c)) + " (dwell " + Seconds(dwell_min[c]) + "-" +
+    s += std::string(" ") + anim::SupportName(static_cast<anim::Support>(c)) + " (dwell " + Seconds(dwell_min[c]) + "-" +
          Seconds(dwell_max[c]) + " s) to";
-    for (int t = 0; t < kSupports; ++t)
+    for (int t = 0; t < anim::kSupports; ++t)
       if (counts[c][t] > 0)
-        s += std::string(" ") + SupportName(static_cast<Support>(t)) + " " + std::to_string(counts[c][t]) + "/" +
+        s += std::string(" ") + anim::SupportName(static_cast<anim::Support>(t)) + " " + std::to_string(counts[c][t]) + "/" +
              std::to_string(total);
     s += ";";
   }
   return s + " distance over " + std::to_string(components) + " components";
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 struct BalanceOptions {
   double rate = 30;
@@ -50,11 +50,11 @@ struct BalanceOptions {
 
 struct BalanceAnalysis {
   struct Rest {
-    Support support = Support::kBoth;
+    anim::Support support = anim::Support::kBoth;
     double from = 0, to = 0;  // seconds
   };
   struct Transition {
-    Support from_support = Support::kBoth, to_support = Support::kBoth;
+    anim::Support from_support = anim::Support::kBoth, to_support = anim::Support::kBoth;
     double from = 0, to = 0;  // seconds: the end of one rest to the start of the next
     int rest = -1;            // the index of the rest it leaves
   };
@@ -76,7 +76,7 @@ struct BalanceAnalysis {
 };
 
 // Throws Error when the skeleton has no left and right leg with a foot found by name.
-BalanceAnalysis AnalyseBalance(const Skeleton& skeleton, const Clip& clip, const BalanceOptions& options,
+BalanceAnalysis AnalyseBalance(const anim::Skeleton& skeleton, const anim::Clip& clip, const BalanceOptions& options,
                                const std::string& source = "");
 
 struct BalanceLearningOptions {
@@ -87,13 +87,13 @@ struct BalanceLearningOptions {
 struct BalanceLearningReport {
   std::string source;                      // the recording
   std::vector<BalanceAnalysis> clips;      // what each clip holds
-  std::array<int, kSupports> rests{};      // rests found, per category
+  std::array<int, anim::kSupports> rests{};      // rests found, per category
   int transitions = 0;                     // transitions found
   // Learned (model given): categories that can be left, segments kept, dwell ranges.
   bool learned = false;
   int segments = 0;
-  std::array<std::array<int, kSupports>, kSupports> counts{};
-  std::array<double, kSupports> dwell_min{}, dwell_max{};
+  std::array<std::array<int, anim::kSupports>, anim::kSupports> counts{};
+  std::array<double, anim::kSupports> dwell_min{}, dwell_max{};
   int components = 0;
   // One line: what was found, and what was learned or why nothing was.
   std::string Summary() const;
@@ -107,8 +107,8 @@ struct BalanceLearningReport {
 // the report says what the recording held (a recording without a transition is only analysed:
 // `idle` is not read then). Throws Error when the source maps onto other joints than the idle
 // model, or has no feet found by name.
-std::optional<BalanceModel> LearnBalanceModel(const Skeleton& character, const IdleSource& source, const IdleModel& idle,
+std::optional<anim::BalanceModel> LearnBalanceModel(const anim::Skeleton& character, const IdleSource& source, const anim::IdleModel& idle,
                                               const IdleLearningOptions& idle_options, const BalanceLearningOptions& options,
                                               BalanceLearningReport* report = nullptr);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

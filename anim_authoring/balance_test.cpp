@@ -19,17 +19,17 @@
 #include <cstdio>
 #include <optional>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
 
-Skeleton Stance() { return testing::StandingSkeleton(false); }
+anim::Skeleton Stance() { return testing::StandingSkeleton(false); }
 
 // The pelvis rests over the left foot, shifts (cosine, `shift` s) over the right foot, rests,
 // and keeps the feet where they are: the hips move by x and the legs move back by −x.
-Clip WeightShift(double rest, double shift, bool step) {
-  Clip c;
+anim::Clip WeightShift(double rest, double shift, bool step) {
+  anim::Clip c;
   c.name = "shift";
   c.duration = 2 * rest + shift;
   c.tracks.resize(7);
@@ -47,16 +47,16 @@ Clip WeightShift(double rest, double shift, bool step) {
 }
 
 TEST(Balance, FindsTheConstructedShift) {
-  const Skeleton sk = Stance();
+  const anim::Skeleton sk = Stance();
   const BalanceAnalysis a = AnalyseBalance(sk, WeightShift(1.5, 0.8, false), {}, "stance");
   std::printf("[balance] %s\n", a.Summary().c_str());
   ASSERT_EQ(a.rests.size(), 2u);
-  EXPECT_EQ(a.rests[0].support, Support::kLeft);
-  EXPECT_EQ(a.rests[1].support, Support::kRight);
+  EXPECT_EQ(a.rests[0].support, anim::Support::kLeft);
+  EXPECT_EQ(a.rests[1].support, anim::Support::kRight);
   EXPECT_NEAR(a.rests[0].to - a.rests[0].from, 1.5, 0.1);
   ASSERT_EQ(a.transitions.size(), 1u);
-  EXPECT_EQ(a.transitions[0].from_support, Support::kLeft);
-  EXPECT_EQ(a.transitions[0].to_support, Support::kRight);
+  EXPECT_EQ(a.transitions[0].from_support, anim::Support::kLeft);
+  EXPECT_EQ(a.transitions[0].to_support, anim::Support::kRight);
   EXPECT_EQ(a.TransitionPairs(), 1);
   EXPECT_NEAR(a.planted_seconds, a.seconds, 0.05);
 }
@@ -69,12 +69,12 @@ TEST(Balance, AStepIsNotABalanceShift) {
 }
 
 TEST(Balance, NoLegsIsAnError) {
-  Skeleton sk = Stance();
+  anim::Skeleton sk = Stance();
   sk.names = {"a", "b", "c", "d", "e", "f", "g"};
   try {
     AnalyseBalance(sk, WeightShift(1, 1, false), {}, "legless");
     FAIL() << "no error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("legless: no left and right foot"), std::string::npos) << e.what();
   }
 }
@@ -83,23 +83,23 @@ TEST(Balance, NoLegsIsAnError) {
 // learns only from recordings the user gives it). ---
 
 using testing::Stay;
-constexpr Support kL = Support::kLeft, kB = Support::kBoth, kR = Support::kRight;
+constexpr anim::Support kL = anim::Support::kLeft, kB = anim::Support::kBoth, kR = anim::Support::kRight;
 
 using testing::LearnFromStanding;
 using testing::LongStanding;
 
-int Index(Support s) { return static_cast<int>(s); }
+int Index(anim::Support s) { return static_cast<int>(s); }
 
 TEST(BalanceLearning, TheGraphIsWhatWasConstructed) {
   const std::vector<Stay> stays = LongStanding();
   const auto l = LearnFromStanding(stays);
   std::printf("[balance] %s\n", l->report.Summary().c_str());
   ASSERT_TRUE(l->balance);
-  const BalanceModel& m = *l->balance;
+  const anim::BalanceModel& m = *l->balance;
   // What was constructed: rests per category, transitions per pair, the dwell before each.
-  std::array<int, kSupports> rests{};
-  std::array<std::array<int, kSupports>, kSupports> counts{};
-  std::array<double, kSupports> shortest{1e9, 1e9, 1e9}, longest{};
+  std::array<int, anim::kSupports> rests{};
+  std::array<std::array<int, anim::kSupports>, anim::kSupports> counts{};
+  std::array<double, anim::kSupports> shortest{1e9, 1e9, 1e9}, longest{};
   for (std::size_t i = 0; i < stays.size(); ++i) {
     const int c = Index(stays[i].support);
     ++rests[c];
@@ -111,16 +111,16 @@ TEST(BalanceLearning, TheGraphIsWhatWasConstructed) {
   EXPECT_EQ(l->report.rests, rests);
   EXPECT_EQ(l->report.transitions, 10);
   EXPECT_EQ(m.counts, counts);
-  for (int c = 0; c < kSupports; ++c) {
+  for (int c = 0; c < anim::kSupports; ++c) {
     const int total = counts[c][0] + counts[c][1] + counts[c][2];
-    for (int t = 0; t < kSupports; ++t)
-      EXPECT_DOUBLE_EQ(m.Probability(static_cast<Support>(c), static_cast<Support>(t)), double(counts[c][t]) / total);
+    for (int t = 0; t < anim::kSupports; ++t)
+      EXPECT_DOUBLE_EQ(m.Probability(static_cast<anim::Support>(c), static_cast<anim::Support>(t)), double(counts[c][t]) / total);
     // A rest as measured takes in the slow ends of the cosine shifts beside it (the pelvis is
     // slower than the rest limit, 0.05 body heights/s, for the first and last 0.054 s of a 0.6 s
     // shift), to a frame at 30 Hz.
     for (auto [measured, constructed] : {std::pair{m.dwell_min[c], shortest[c]}, std::pair{m.dwell_max[c], longest[c]}}) {
-      EXPECT_GE(measured, constructed - 1 / 30.0 - 1e-9) << SupportName(static_cast<Support>(c));
-      EXPECT_LE(measured, constructed + 2 * 0.054 + 1 / 30.0) << SupportName(static_cast<Support>(c));
+      EXPECT_GE(measured, constructed - 1 / 30.0 - 1e-9) << anim::SupportName(static_cast<anim::Support>(c));
+      EXPECT_LE(measured, constructed + 2 * 0.054 + 1 / 30.0) << anim::SupportName(static_cast<anim::Support>(c));
     }
   }
   ASSERT_EQ(m.segments.size(), stays.size() - 1);
@@ -155,13 +155,13 @@ TEST(BalanceLearning, KeepsOnlyTransitionsTheWalkCanGoOnFrom) {
 }
 
 TEST(BalanceLearning, AStepTeachesNothing) {
-  Character person;
+  anim::Character person;
   person.source = "step";
   person.skeleton = Stance();
   person.clips = {WeightShift(1.5, 0.8, true)};
   const IdleSource own{&person, {&person.clips[0]}, true};
   const IdleLearningOptions options;
-  const IdleModel idle = LearnIdleModel(person.skeleton, {own}, options);
+  const anim::IdleModel idle = LearnIdleModel(person.skeleton, {own}, options);
   BalanceLearningReport report;
   EXPECT_FALSE(LearnBalanceModel(person.skeleton, own, idle, options, {}, &report));
   EXPECT_EQ(report.Summary(),
@@ -172,10 +172,10 @@ TEST(BalanceLearning, AStepTeachesNothing) {
 // Every state the walk enters over `seconds`, sampled at 30 Hz, with the resting postures it
 // holds or joins.
 struct Visit {
-  BalanceShifter::State state;
+  anim::BalanceShifter::State state;
   Eigen::VectorXd from, to;
 };
-std::vector<Visit> Walk(BalanceShifter& b, double seconds) {
+std::vector<Visit> Walk(anim::BalanceShifter& b, double seconds) {
   std::vector<Visit> visits;
   for (int f = 0; f <= static_cast<int>(seconds * 30); ++f) {
     b.Posture(f / 30.0);
@@ -187,9 +187,9 @@ std::vector<Visit> Walk(BalanceShifter& b, double seconds) {
 TEST(BalanceShift, SameSeedSameStreamOtherSeedOtherStream) {
   const auto l = LearnFromStanding(LongStanding());
   ASSERT_TRUE(l->balance);
-  const auto model = std::make_shared<const BalanceModel>(*l->balance);
-  BalanceShifter a(l->skeleton(), model, 7), b(l->skeleton(), model, 7), other(l->skeleton(), model, 8);
-  LocalPose pa(l->person.skeleton.size()), pb(pa), po(pa);
+  const auto model = std::make_shared<const anim::BalanceModel>(*l->balance);
+  anim::BalanceShifter a(l->skeleton(), model, 7), b(l->skeleton(), model, 7), other(l->skeleton(), model, 8);
+  anim::LocalPose pa(l->person.skeleton.size()), pb(pa), po(pa);
   int differing = 0;
   Eigen::VectorXd at_10;
   for (int f = 0; f <= 120 * 30; ++f) {
@@ -206,15 +206,15 @@ TEST(BalanceShift, SameSeedSameStreamOtherSeedOtherStream) {
 TEST(BalanceShift, TenMinutesStayOnTheLearnedGraph) {
   const auto l = LearnFromStanding(LongStanding());
   ASSERT_TRUE(l->balance);
-  const BalanceModel& m = *l->balance;
-  BalanceShifter b(l->skeleton(), std::make_shared<const BalanceModel>(m), 3);
+  const anim::BalanceModel& m = *l->balance;
+  anim::BalanceShifter b(l->skeleton(), std::make_shared<const anim::BalanceModel>(m), 3);
   const std::vector<Visit> visits = Walk(b, 600);
-  std::array<std::array<int, kSupports>, kSupports> drawn{};
-  std::array<double, kSupports> shortest{1e9, 1e9, 1e9}, longest{};
+  std::array<std::array<int, anim::kSupports>, anim::kSupports> drawn{};
+  std::array<double, anim::kSupports> shortest{1e9, 1e9, 1e9}, longest{};
   int rests = 0;
   // The first rest starts at a seeded phase and the last is unfinished: the ones between.
   for (std::size_t k = 1; k + 1 < visits.size(); ++k) {
-    const BalanceShifter::State& s = visits[k].state;
+    const anim::BalanceShifter::State& s = visits[k].state;
     if (s.segment < 0) {
       const int c = Index(s.from);
       EXPECT_GE(s.t1 - s.t0, m.dwell_min[c] - 1e-9);
@@ -224,7 +224,7 @@ TEST(BalanceShift, TenMinutesStayOnTheLearnedGraph) {
       ++rests;
       continue;
     }
-    const BalanceModel::Segment& a = m.segments[s.segment];
+    const anim::BalanceModel::Segment& a = m.segments[s.segment];
     EXPECT_EQ(a.from, s.from);
     EXPECT_EQ(a.to, s.to);
     EXPECT_NEAR(s.t1 - s.t0, a.Seconds(), 1e-9);  // played at its recorded length
@@ -232,12 +232,12 @@ TEST(BalanceShift, TenMinutesStayOnTheLearnedGraph) {
   }
   EXPECT_GT(rests, 100);
   std::printf("[balance] 10 min, seed 3: %d rests; transitions drawn", rests);
-  for (int c = 0; c < kSupports; ++c) {
+  for (int c = 0; c < anim::kSupports; ++c) {
     const int total = drawn[c][0] + drawn[c][1] + drawn[c][2];
-    ASSERT_GT(total, 20) << SupportName(static_cast<Support>(c));
-    for (int t = 0; t < kSupports; ++t) {
-      const double p = m.Probability(static_cast<Support>(c), static_cast<Support>(t));
-      std::printf(" %s>%s %.2f (P %.2f)", SupportName(static_cast<Support>(c)), SupportName(static_cast<Support>(t)),
+    ASSERT_GT(total, 20) << anim::SupportName(static_cast<anim::Support>(c));
+    for (int t = 0; t < anim::kSupports; ++t) {
+      const double p = m.Probability(static_cast<anim::Support>(c), static_cast<anim::Support>(t));
+      std::printf(" %s>%s %.2f (P %.2f)", anim::SupportName(static_cast<anim::Support>(c)), anim::SupportName(static_cast<anim::Support>(t)),
                   double(drawn[c][t]) / total, p);
       EXPECT_NEAR(double(drawn[c][t]) / total, p, 0.15);
     }
@@ -264,9 +264,9 @@ double LargestJointStep(const std::vector<Eigen::VectorXd>& postures, int joints
 TEST(BalanceShift, FittedSegmentsJoinTheRestsWithoutAJump) {
   const auto l = LearnFromStanding(LongStanding());
   ASSERT_TRUE(l->balance);
-  const BalanceModel& m = *l->balance;
+  const anim::BalanceModel& m = *l->balance;
   const int joints = static_cast<int>(m.joints.size());
-  BalanceShifter walk(l->skeleton(), std::make_shared<const BalanceModel>(m), 5);
+  anim::BalanceShifter walk(l->skeleton(), std::make_shared<const anim::BalanceModel>(m), 5);
   const std::vector<Visit> visits = Walk(walk, 300);
   double largest_offset = 0, worst_ratio = 0;
   int transitions = 0;
@@ -274,18 +274,18 @@ TEST(BalanceShift, FittedSegmentsJoinTheRestsWithoutAJump) {
     const Visit& v = visits[k];
     if (v.state.segment < 0) continue;
     ++transitions;
-    const BalanceModel::Segment& a = m.segments[v.state.segment];
+    const anim::BalanceModel::Segment& a = m.segments[v.state.segment];
     // It leaves the posture the rest before held, and the rest after holds the one it reaches.
     EXPECT_EQ(visits[k - 1].from, v.from);
     EXPECT_EQ(visits[k + 1].from, v.to);
     // The recorded segment nearest both by the eigenvalue-weighted distance.
-    EXPECT_EQ(v.state.segment, ChooseSegment(m, v.state.from, v.state.to, v.from, v.to));
+    EXPECT_EQ(v.state.segment, anim::ChooseSegment(m, v.state.from, v.state.to, v.from, v.to));
     largest_offset = std::max({largest_offset, m.Distance(v.from, a.frames.front()), m.Distance(v.to, a.frames.back())});
     // Fitted, frame by frame at its own rate: from exactly p to exactly q, no step more than
     // twice the recording's own largest.
     std::vector<Eigen::VectorXd> fitted(a.frames.size());
     for (std::size_t f = 0; f < a.frames.size(); ++f)
-      FittedPosture(a, v.from, v.to, double(f) / double(a.frames.size() - 1), fitted[f]);
+      anim::FittedPosture(a, v.from, v.to, double(f) / double(a.frames.size() - 1), fitted[f]);
     EXPECT_LT((fitted.front() - v.from).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LT((fitted.back() - v.to).cwiseAbs().maxCoeff(), 1e-12);
     const double recorded = LargestJointStep(a.frames, joints);
@@ -298,7 +298,7 @@ TEST(BalanceShift, FittedSegmentsJoinTheRestsWithoutAJump) {
   EXPECT_GT(largest_offset, 1e-3);  // the ends did need fitting
   EXPECT_LE(worst_ratio, 2.0);
   // No jump where a transition begins or ends: the posture just before each boundary and at it.
-  BalanceShifter again(l->skeleton(), std::make_shared<const BalanceModel>(m), 5);
+  anim::BalanceShifter again(l->skeleton(), std::make_shared<const anim::BalanceModel>(m), 5);
   for (std::size_t k = 1; k + 1 < visits.size(); ++k) {
     const double boundary = visits[k].state.t0;
     const Eigen::VectorXd before = again.Posture(boundary - 1e-7);
@@ -312,9 +312,9 @@ TEST(BalanceShift, UnderAMaskedActionTheLegsStayOnTheBalanceLayer) {
   const auto l = LearnFromStanding(LongStanding());
   ASSERT_TRUE(l->balance);
   const auto sk = l->skeleton();
-  const auto model = std::make_shared<const BalanceModel>(*l->balance);
+  const auto model = std::make_shared<const anim::BalanceModel>(*l->balance);
   const int n = sk->size();
-  auto gesture = std::make_shared<Clip>();
+  auto gesture = std::make_shared<anim::Clip>();
   gesture->name = "wave";
   gesture->duration = 3;
   gesture->tracks.resize(n);
@@ -322,23 +322,23 @@ TEST(BalanceShift, UnderAMaskedActionTheLegsStayOnTheBalanceLayer) {
     for (const char* joint : {"Chest", "LeftArm"})
       gesture->tracks[sk->Find(joint)].rotation.push_back(
           {k / 30.0, Eigen::Quaterniond(Eigen::AngleAxisd(0.6 * std::sin(k / 10.0), Eigen::Vector3d::UnitX()))});
-  BlendingParams torso_only;
-  JointMask mask = JointMask::Uniform(n, 0.0);
-  mask.Set(ResolveScope(*sk, "torso"), 1.0);
+  anim::BlendingParams torso_only;
+  anim::JointMask mask = anim::JointMask::Uniform(n, 0.0);
+  mask.Set(anim::ResolveScope(*sk, "torso"), 1.0);
   torso_only.masks = {mask};
-  Schedule s(sk);
-  s.Add({std::make_shared<BalanceShifter>(sk, model, 11), {}, 0.0, true, "idle", 0});
-  s.Add({std::make_shared<ClipSource>(sk, gesture), torso_only, 1.0, false, "wave", 1});
-  BalanceShifter alone(sk, model, 11);
-  ClipSource wave(sk, gesture);
-  LocalPose out(n), below(n), above(n);
-  const std::vector<int> torso = ResolveScope(*sk, "torso");
+  anim::Schedule s(sk);
+  s.Add({std::make_shared<anim::BalanceShifter>(sk, model, 11), {}, 0.0, true, "idle", 0});
+  s.Add({std::make_shared<anim::ClipSource>(sk, gesture), torso_only, 1.0, false, "wave", 1});
+  anim::BalanceShifter alone(sk, model, 11);
+  anim::ClipSource wave(sk, gesture);
+  anim::LocalPose out(n), below(n), above(n);
+  const std::vector<int> torso = anim::ResolveScope(*sk, "torso");
   for (double t : {0.5, 1.2, 2.05, 3.9, 5.0}) {
     ASSERT_TRUE(s.Sample(t, {}, out) && alone.Sample(t, {}, below) && wave.Sample(t - 1.0, {}, above));
     const bool waving = t >= 1.0 && t <= 4.0;
     for (int j = 0; j < n; ++j) {
       const bool in_torso = std::find(torso.begin(), torso.end(), j) != torso.end();
-      const DualQuatd& expect = waving && in_torso ? above.rigid[j] : below.rigid[j];
+      const anim::DualQuatd& expect = waving && in_torso ? above.rigid[j] : below.rigid[j];
       if (!in_torso) {  // exactly the layer below, bit for bit
         EXPECT_EQ(out.rigid[j].real().coeffs(), expect.real().coeffs()) << sk->names[j] << " at " << t;
         EXPECT_EQ(out.rigid[j].dual().coeffs(), expect.dual().coeffs()) << sk->names[j] << " at " << t;
@@ -362,7 +362,7 @@ const char* kSceneHead =
 std::string SceneError(const std::string& balance_line) {
   try {
     ParseScene(kSceneHead + balance_line, "/s/scene.yaml");
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     return e.what();
   }
   return "no error";
@@ -401,46 +401,46 @@ TEST(BalanceScene, TheOptionIsReadAndBadValuesAreNamed) {
 // The constructed recording as the character's own clip, named by the scene: the idle layer is
 // the balance shifter with the idle synthesizer's variations on top, also in the default schedule.
 TEST(BalanceScene, BuiltFromTheClipTheSceneNames) {
-  auto person = std::make_shared<Character>();
+  auto person = std::make_shared<anim::Character>();
   person->source = "person.glb";
   person->skeleton = testing::StandingSkeleton(true);
   person->clips = {testing::StandingRecording(LongStanding())};
   const Scene s = ParseScene(std::string(kSceneHead) + "      balance: {clip: standing, seed: 2}\n", "/s/scene.yaml");
   const AnimatedCharacter ch(person, s.characters[0]);
   IdleLayerReport report;
-  const BlendablePtr layer = BuildIdleLayer(ch, &report);
+  const anim::BlendablePtr layer = BuildIdleLayer(ch, &report);
   std::printf("[balance] idle: %s\n[balance] balance: %s\n", report.idle.c_str(), report.balance.c_str());
   EXPECT_TRUE(report.balance_built);
   EXPECT_TRUE(report.notes.empty());
   EXPECT_NE(report.balance.find("10 transitions; learned 10 segments"), std::string::npos) << report.balance;
-  auto* shifter = dynamic_cast<BalanceShifter*>(layer.get());
+  auto* shifter = dynamic_cast<anim::BalanceShifter*>(layer.get());
   ASSERT_NE(shifter, nullptr);
   // The pose is the balance posture plus the synthesizer's variations (its own stream, same seed).
-  const std::shared_ptr<IdleSynthesizer> idle = BuildIdle(ch);
-  const IdleModel& im = idle->model();
-  const LocalPose rest = LocalPose::Rest(person->skeleton);
-  LocalPose out(person->skeleton.size()), expect(out);
+  const std::shared_ptr<anim::IdleSynthesizer> idle = BuildIdle(ch);
+  const anim::IdleModel& im = idle->model();
+  const anim::LocalPose rest = anim::LocalPose::Rest(person->skeleton);
+  anim::LocalPose out(person->skeleton.size()), expect(out);
   for (double t : {0.0, 3.3, 17.9, 42.0}) {
     ASSERT_TRUE(layer->Sample(t, {}, out));
     const Eigen::VectorXd posture = shifter->Posture(t) + idle->Posture(t) - im.mean;
-    PoseFromPosture(person->skeleton, rest, im.joints, im.root, posture, expect);
+    anim::PoseFromPosture(person->skeleton, rest, im.joints, im.root, posture, expect);
     for (int j = 0; j < out.size(); ++j) {
       EXPECT_LT(out.rigid[j].Rotation().angularDistance(expect.rigid[j].Rotation()), 1e-12) << t;
       EXPECT_LT((out.rigid[j].Translation() - expect.rigid[j].Translation()).norm(), 1e-12) << t;
     }
   }
   std::vector<std::string> notes;
-  const std::unique_ptr<Animator> animator = BuildAnimator(ch, {}, &notes);
+  const std::unique_ptr<anim::Animator> animator = BuildAnimator(ch, {}, &notes);
   EXPECT_TRUE(notes.empty());
-  const Action* idle_action = animator->schedule().Find(animator->schedule().FindByName("idle"));
+  const anim::Action* idle_action = animator->schedule().Find(animator->schedule().FindByName("idle"));
   ASSERT_NE(idle_action, nullptr);
-  EXPECT_NE(dynamic_cast<BalanceShifter*>(idle_action->object.get()), nullptr);
+  EXPECT_NE(dynamic_cast<anim::BalanceShifter*>(idle_action->object.get()), nullptr);
   // A clip the character does not have: one message naming the scene line and the option.
   const Scene missing = ParseScene(std::string(kSceneHead) + "      balance: {clip: sway}\n", "/s/scene.yaml");
   try {
     BuildIdleLayer(AnimatedCharacter(person, missing.characters[0]));
     FAIL() << "no error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_STREQ(e.what(), "/s/scene.yaml:6: idle.balance: clip 'sway' does not exist in person.glb (clips: standing)");
   }
   // A recording that is not there: the same, with the loader's reason.
@@ -448,7 +448,7 @@ TEST(BalanceScene, BuiltFromTheClipTheSceneNames) {
   try {
     BuildIdleLayer(AnimatedCharacter(person, absent.characters[0]));
     FAIL() << "no error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_EQ(std::string(e.what()).rfind("/s/scene.yaml:6: idle.balance: /s/no_such.bvh", 0), 0u) << e.what();
   }
 }
@@ -464,8 +464,8 @@ TEST(BalanceScene, ARecordingWithoutATransitionGivesANoteAndNoLayer) {
                              "/s/bcn.yaml");
   const AnimatedCharacter ch(s.characters[0]);
   IdleLayerReport report;
-  const BlendablePtr layer = BuildIdleLayer(ch, &report);
-  EXPECT_NE(dynamic_cast<IdleSynthesizer*>(layer.get()), nullptr);
+  const anim::BlendablePtr layer = BuildIdleLayer(ch, &report);
+  EXPECT_NE(dynamic_cast<anim::IdleSynthesizer*>(layer.get()), nullptr);
   EXPECT_FALSE(report.balance_built);
   ASSERT_EQ(report.notes.size(), 1u);
   std::printf("[balance] note: %s\n", report.notes[0].c_str());
@@ -476,7 +476,7 @@ TEST(BalanceScene, ARecordingWithoutATransitionGivesANoteAndNoLayer) {
             std::string::npos)
       << note;
   std::vector<std::string> notes;
-  const std::unique_ptr<Animator> animator = BuildAnimator(ch, {}, &notes);
+  const std::unique_ptr<anim::Animator> animator = BuildAnimator(ch, {}, &notes);
   EXPECT_EQ(notes, report.notes);
   for (double t : {0.0, 0.5, 1.0}) animator->Update(t, {});
 }
@@ -493,8 +493,8 @@ TEST(Balance, WhatTheRecordingsHold) {
       testing::SharedData("characters/CesiumMan.glb").string()};
   int transitions = 0, loose_transitions = 0;
   for (const std::string& f : files) {
-    const Character c = LoadCharacter(f);
-    for (const Clip& clip : c.clips) {
+    const anim::Character c = LoadCharacter(f);
+    for (const anim::Clip& clip : c.clips) {
       if (clip.duration < 1) continue;
       try {
         BalanceOptions o;
@@ -514,7 +514,7 @@ TEST(Balance, WhatTheRecordingsHold) {
         learning.analysis = o;
         BalanceLearningReport report;
         const IdleSource own{&c, {&clip}, true};
-        EXPECT_FALSE(LearnBalanceModel(c.skeleton, own, IdleModel{}, {}, learning, &report)) << name;
+        EXPECT_FALSE(LearnBalanceModel(c.skeleton, own, anim::IdleModel{}, {}, learning, &report)) << name;
         EXPECT_NE(report.Summary().find("; 0 transitions: nothing to learn balance shifts from"), std::string::npos)
             << report.Summary();
         // Twice as tolerant (feet and pelvis speeds doubled, rests from 0.25 s): the conclusion
@@ -525,7 +525,7 @@ TEST(Balance, WhatTheRecordingsHold) {
         const BalanceAnalysis loose = AnalyseBalance(c.skeleton, clip, o, name + " (tolerant)");
         std::printf("[balance] %s\n", loose.Summary().c_str());
         loose_transitions += static_cast<int>(loose.transitions.size());
-      } catch (const Error& e) {
+      } catch (const anim::Error& e) {
         std::printf("[balance] %s\n", e.what());
       }
     }
@@ -539,4 +539,4 @@ TEST(Balance, WhatTheRecordingsHold) {
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

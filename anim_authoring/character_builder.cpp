@@ -8,47 +8,47 @@
 #include "anim_authoring/import.h"
 #include "anim_authoring/lookat.h"
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 struct BuiltKeys {
-  std::vector<ViewAdaptiveKey> keys;
-  LookAtChain lookat;
-  ArmChain arm;
+  std::vector<anim::ViewAdaptiveKey> keys;
+  anim::LookAtChain lookat;
+  anim::ArmChain arm;
 };
 
 // The key clips of `spec` on `character`: from the asset, generated (look-at, gesture), or static,
 // with the chains the generated ones turn.
-BuiltKeys BuildKeys(const std::shared_ptr<const Character>& character, const CharacterSpec& spec) {
+BuiltKeys BuildKeys(const std::shared_ptr<const anim::Character>& character, const CharacterSpec& spec) {
   BuiltKeys built;
-  const Character& c = *character;
-  const Skeleton& sk = c.skeleton;
+  const anim::Character& c = *character;
+  const anim::Skeleton& sk = c.skeleton;
   const std::string where = spec.where.empty() ? spec.asset.string() : spec.where;
   auto key_where = [&](const KeySpec& k) {
     return k.line > 0 && !spec.where.empty() ? spec.where.substr(0, spec.where.rfind(':')) + ":" + std::to_string(k.line)
                                               : where;
   };
-  auto find_clip = [&](const KeySpec& k, const std::string& name) -> const Clip& {
-    const Clip* clip = c.FindClip(name);
+  auto find_clip = [&](const KeySpec& k, const std::string& name) -> const anim::Clip& {
+    const anim::Clip* clip = c.FindClip(name);
     if (!clip)
-      throw Error(key_where(k) + ": clip '" + name + "' does not exist in " + c.source + " (clips: " + ClipList(c) + ")");
+      throw anim::Error(key_where(k) + ": clip '" + name + "' does not exist in " + c.source + " (clips: " + ClipList(c) + ")");
     return *clip;
   };
   const bool any_lookat = std::any_of(spec.keys.begin(), spec.keys.end(),
                                       [](const KeySpec& k) { return k.source == KeySpec::Source::kLookAt; });
-  const Clip* lookat_base = nullptr;
+  const anim::Clip* lookat_base = nullptr;
   if (any_lookat) {
     try {
       built.lookat = MakeLookAtChain(sk, spec.lookat.chain, spec.lookat.limits_deg, spec.forward, spec.up);
-    } catch (const Error& e) {
-      throw Error(where + ": " + e.what());
+    } catch (const anim::Error& e) {
+      throw anim::Error(where + ": " + e.what());
     }
     if (spec.lookat.base_clip == "rest" && !c.FindClip("rest")) {
       lookat_base = nullptr;  // a static look from the rest pose
     } else if (!spec.lookat.base_clip.empty()) {
       lookat_base = c.FindClip(spec.lookat.base_clip);
       if (!lookat_base)
-        throw Error(where + ": lookat.base_clip '" + spec.lookat.base_clip + "' does not exist in " + c.source +
+        throw anim::Error(where + ": lookat.base_clip '" + spec.lookat.base_clip + "' does not exist in " + c.source +
                     " (clips: " + ClipList(c) + ")");
     } else if (!c.clips.empty()) {
       lookat_base = &c.clips.front();
@@ -59,36 +59,36 @@ BuiltKeys BuildKeys(const std::shared_ptr<const Character>& character, const Cha
   if (any_gesture) {
     try {
       built.arm = MakeArmChain(sk, spec.gesture.chain, spec.gesture.side, spec.gesture.limits, spec.forward, spec.up);
-    } catch (const Error& e) {
-      throw Error(where + ": " + e.what());
+    } catch (const anim::Error& e) {
+      throw anim::Error(where + ": " + e.what());
     }
   }
-  std::vector<std::shared_ptr<const Clip>> key_clips;
+  std::vector<std::shared_ptr<const anim::Clip>> key_clips;
   for (const KeySpec& k : spec.keys) {
     switch (k.source) {
       case KeySpec::Source::kClip:
         // Alias into the character: no copy.
-        key_clips.push_back(std::shared_ptr<const Clip>(character, &find_clip(k, k.clip)));
+        key_clips.push_back(std::shared_ptr<const anim::Clip>(character, &find_clip(k, k.clip)));
         break;
       case KeySpec::Source::kLookAt:
         if (k.gesture != Gesture::kNone)
           key_clips.push_back(
-              std::make_shared<const Clip>(GenerateGestureClip(sk, lookat_base, &built.lookat, built.arm, k.gesture, k.viewpoint)));
+              std::make_shared<const anim::Clip>(GenerateGestureClip(sk, lookat_base, &built.lookat, built.arm, k.gesture, k.viewpoint)));
         else
-          key_clips.push_back(std::make_shared<const Clip>(GenerateLookAtClip(sk, lookat_base, built.lookat, k.viewpoint)));
+          key_clips.push_back(std::make_shared<const anim::Clip>(GenerateLookAtClip(sk, lookat_base, built.lookat, k.viewpoint)));
         break;
       case KeySpec::Source::kRestPose: {
-        Clip rest;
+        anim::Clip rest;
         rest.name = "rest";
         rest.tracks.resize(sk.size());
-        key_clips.push_back(std::make_shared<const Clip>(std::move(rest)));
+        key_clips.push_back(std::make_shared<const anim::Clip>(std::move(rest)));
         break;
       }
       case KeySpec::Source::kStaticPose: {
-        const Clip& from = find_clip(k, k.clip);
-        LocalPose pose(sk.size());
-        MustRun(SamplingJob{&sk, &from, k.pose_time, false, &pose}, "static pose key");
-        Clip still;
+        const anim::Clip& from = find_clip(k, k.clip);
+        anim::LocalPose pose(sk.size());
+        anim::MustRun(anim::SamplingJob{&sk, &from, k.pose_time, false, &pose}, "static pose key");
+        anim::Clip still;
         still.name = k.clip + "@" + std::to_string(k.pose_time);
         still.tracks.resize(sk.size());
         for (int j = 0; j < sk.size(); ++j) {
@@ -96,7 +96,7 @@ BuiltKeys BuildKeys(const std::shared_ptr<const Character>& character, const Cha
           still.tracks[j].translation.push_back({0.0, pose.rigid[j].Translation()});
           still.tracks[j].scale.push_back({0.0, pose.scale[j]});
         }
-        key_clips.push_back(std::make_shared<const Clip>(std::move(still)));
+        key_clips.push_back(std::make_shared<const anim::Clip>(std::move(still)));
         break;
       }
     }
@@ -105,21 +105,21 @@ BuiltKeys BuildKeys(const std::shared_ptr<const Character>& character, const Cha
   return built;
 }
 
-PlacedCharacterParts BuildParts(std::shared_ptr<const Character> character, const CharacterSpec& spec) {
+anim::PlacedCharacterParts BuildParts(std::shared_ptr<const anim::Character> character, const CharacterSpec& spec) {
   const std::string where = spec.where.empty() ? spec.asset.string() : spec.where;
-  ViewAdaptiveOptions options;
+  anim::ViewAdaptiveOptions options;
   options.weights = spec.weights;
   options.blend = spec.blend;
   options.dib = spec.dib;
   options.phase = spec.phase;
   options.nlerp_sampling = spec.nlerp_sampling;
   BuiltKeys built = BuildKeys(character, spec);
-  PlacedCharacterParts parts;
+  anim::PlacedCharacterParts parts;
   try {
-    parts.blend = std::make_shared<ViewAdaptiveBlend>(std::shared_ptr<const Skeleton>(character, &character->skeleton),
+    parts.blend = std::make_shared<anim::ViewAdaptiveBlend>(std::shared_ptr<const anim::Skeleton>(character, &character->skeleton),
                                                       std::move(built.keys), options);
-  } catch (const Error& e) {
-    throw Error(where + ": " + e.what());
+  } catch (const anim::Error& e) {
+    throw anim::Error(where + ": " + e.what());
   }
   parts.character = std::move(character);
   parts.placement = spec.placement();
@@ -136,17 +136,17 @@ PlacedCharacterParts BuildParts(std::shared_ptr<const Character> character, cons
 
 }  // namespace
 
-std::string ClipList(const Character& c) {
+std::string ClipList(const anim::Character& c) {
   std::string s;
-  for (const Clip& clip : c.clips) s += (s.empty() ? "" : ", ") + clip.name;
+  for (const anim::Clip& clip : c.clips) s += (s.empty() ? "" : ", ") + clip.name;
   return s.empty() ? "none" : s;
 }
 
 
 AnimatedCharacter::AnimatedCharacter(const CharacterSpec& spec)
-    : AnimatedCharacter(std::make_shared<const Character>(LoadCharacter(spec.asset)), spec) {}
+    : AnimatedCharacter(std::make_shared<const anim::Character>(LoadCharacter(spec.asset)), spec) {}
 
-AnimatedCharacter::AnimatedCharacter(std::shared_ptr<const Character> character, const CharacterSpec& spec)
-    : PlacedCharacter(BuildParts(std::move(character), spec)), spec_(spec) {}
+AnimatedCharacter::AnimatedCharacter(std::shared_ptr<const anim::Character> character, const CharacterSpec& spec)
+    : anim::PlacedCharacter(BuildParts(std::move(character), spec)), spec_(spec) {}
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -14,14 +14,14 @@
 #include "anim/placed_character.h"
 #include "anim_authoring/scene.h"
 
-namespace arview::anim {
+namespace arview::authoring {
 
-class AnimatedCharacter : public PlacedCharacter {
+class AnimatedCharacter : public anim::PlacedCharacter {
  public:
   // Loads spec.asset and prepares one clip per key (from the asset, generated, or static).
   // Throws Error naming the scene/asset and the problem (e.g. a clip that does not exist).
   explicit AnimatedCharacter(const CharacterSpec& spec);
-  AnimatedCharacter(std::shared_ptr<const Character> character, const CharacterSpec& spec);
+  AnimatedCharacter(std::shared_ptr<const anim::Character> character, const CharacterSpec& spec);
 
   const CharacterSpec& spec() const { return spec_; }
 
@@ -30,6 +30,6 @@ class AnimatedCharacter : public PlacedCharacter {
 };
 
 // The clip names of `character`, for messages: "Survey, Walk, Run", or "none".
-std::string ClipList(const Character& character);
+std::string ClipList(const anim::Character& character);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -27,15 +27,15 @@ GazeStats MeasureGaze(const fs::path& asset, const std::string& method, const st
   for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
   const Scene scene = ParseScene(text, "gaze.yaml");
   AnimatedCharacter ch(scene.characters[0]);
-  const LookAtChain& chain = ch.lookat_chain();
+  const anim::LookAtChain& chain = ch.lookat_chain();
   std::vector<double> angles;
   for (int k = 0; k < 8; ++k)
     for (double offset : {10.0, 22.5, 35.0})
       for (double t : {0.0, 0.37, 0.81, 1.6, 2.9}) {
-        const Eigen::Vector3d v = DirectionFromAzimuthElevation(45 * k + offset, elevation);
-        const AnimatorFrame& out = ch.Update(v, t);
+        const Eigen::Vector3d v = anim::DirectionFromAzimuthElevation(45 * k + offset, elevation);
+        const anim::AnimatorFrame& out = ch.Update(v, t);
         EXPECT_TRUE(out.converged);
-        const Eigen::Vector3d f = HeadForward(chain, out.model);
+        const Eigen::Vector3d f = anim::HeadForward(chain, out.model);
         angles.push_back(std::atan2(f.cross(v).norm(), f.dot(v)) * 180 / M_PI);
       }
   std::sort(angles.begin(), angles.end());
@@ -82,10 +82,10 @@ TEST(Gaze, KeyViewpointIsMetExactly) {
                                      "      - azimuth: 135\n        generate: lookat\n",
                                  "gaze.yaml");
   AnimatedCharacter ch(scene.characters[0]);
-  const Eigen::Vector3d v = DirectionFromAzimuthElevation(135, 0);
-  const Eigen::Vector3d f = HeadForward(ch.lookat_chain(), ch.Update(v, 0.5).model);
+  const Eigen::Vector3d v = anim::DirectionFromAzimuthElevation(135, 0);
+  const Eigen::Vector3d f = anim::HeadForward(ch.lookat_chain(), ch.Update(v, 0.5).model);
   EXPECT_GT(f.dot(v), std::cos(0.5 * M_PI / 180));
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 constexpr double kDeg = M_PI / 180;
@@ -33,7 +33,7 @@ int SideSign(ArmSide side) { return side == ArmSide::kLeft ? 1 : -1; }  // as Na
 // `words` and passes `accept`, or −1.
 // NameSide(), plus CMU's lower-case one-letter prefixes ("rwrist", "lhumerus").
 int ArmNameSide(const std::string& name) {
-  if (const int s = NameSide(name); s != 0) return s;
+  if (const int s = anim::NameSide(name); s != 0) return s;
   const std::string n = Lower(name);
   if (n.size() > 1 && (n[0] == 'l' || n[0] == 'r'))
     for (const char* part : {"clavicle", "humerus", "radius", "wrist", "hand"})
@@ -42,7 +42,7 @@ int ArmNameSide(const std::string& name) {
 }
 
 template <class Accept>
-int FirstOnSide(const Skeleton& sk, ArmSide side, std::initializer_list<const char*> words, Accept accept) {
+int FirstOnSide(const anim::Skeleton& sk, ArmSide side, std::initializer_list<const char*> words, Accept accept) {
   for (int j = 0; j < sk.size(); ++j) {
     const std::string n = Lower(sk.names[j]);
     if (Has(n, words) && ArmNameSide(sk.names[j]) == SideSign(side) && accept(n)) return j;
@@ -50,7 +50,7 @@ int FirstOnSide(const Skeleton& sk, ArmSide side, std::initializer_list<const ch
   return -1;
 }
 
-int FirstChild(const Skeleton& sk, int j) {
+int FirstChild(const anim::Skeleton& sk, int j) {
   for (int k = j + 1; k < sk.size(); ++k)
     if (sk.parents[k] == j) return k;
   return -1;
@@ -64,7 +64,7 @@ Eigen::Matrix3d RotationOf(const Eigen::Matrix4d& m) {
   return r;
 }
 
-Eigen::Matrix3d ParentRotation(const Skeleton& sk, int j, std::span<const Eigen::Matrix4d> model) {
+Eigen::Matrix3d ParentRotation(const anim::Skeleton& sk, int j, std::span<const Eigen::Matrix4d> model) {
   const int p = sk.parents[j];
   return RotationOf(p < 0 ? sk.root_parent : model[p]);
 }
@@ -79,15 +79,15 @@ Eigen::Vector3d Perpendicular(const Eigen::Vector3d& v) {
   return v.cross(other).normalized();
 }
 
-std::vector<Eigen::Matrix4d> ModelPose(const Skeleton& sk, const LocalPose& pose) {
+std::vector<Eigen::Matrix4d> ModelPose(const anim::Skeleton& sk, const anim::LocalPose& pose) {
   std::vector<Eigen::Matrix4d> model(sk.size());
-  MustRun(LocalToModelJob{&sk, &pose, model}, "gesture");
+  anim::MustRun(anim::LocalToModelJob{&sk, &pose, model}, "gesture");
   return model;
 }
 
 }  // namespace
 
-std::vector<std::string> DefaultArmChain(const Skeleton& sk, ArmSide side) {
+std::vector<std::string> DefaultArmChain(const anim::Skeleton& sk, ArmSide side) {
   auto not_finger = [](const std::string& n) { return !IsFingerOrEnd(n); };
   // The wrist before the hand: CMU's "rhand" hangs below "rwrist".
   int hand = FirstOnSide(sk, side, {"wrist"}, not_finger);
@@ -109,36 +109,36 @@ std::vector<std::string> DefaultArmChain(const Skeleton& sk, ArmSide side) {
   return {sk.names[upper], sk.names[fore], sk.names[last]};
 }
 
-ArmChain MakeArmChain(const Skeleton& sk, const std::vector<std::string>& names_in, ArmSide side,
-                      const ArmLimits& limits, const Eigen::Vector3d& forward_in, const Eigen::Vector3d& up_in) {
+anim::ArmChain MakeArmChain(const anim::Skeleton& sk, const std::vector<std::string>& names_in, ArmSide side,
+                      const anim::ArmLimits& limits, const Eigen::Vector3d& forward_in, const Eigen::Vector3d& up_in) {
   const std::string what = std::string("gesture: ") + ToString(side) + " arm";
   const std::vector<std::string> names = names_in.empty() ? DefaultArmChain(sk, side) : names_in;
   if (names.empty())
-    throw Error(what + ": no chain found by name (a wrist/hand joint with its forearm and upper arm, or an upper arm "
+    throw anim::Error(what + ": no chain found by name (a wrist/hand joint with its forearm and upper arm, or an upper arm "
                        "with two joints below it); list the upper arm, forearm and hand in the scene's gesture.chain");
   if (names.size() != 3)
-    throw Error(what + ": gesture.chain needs 3 joints (upper arm, forearm, hand), not " + std::to_string(names.size()));
+    throw anim::Error(what + ": gesture.chain needs 3 joints (upper arm, forearm, hand), not " + std::to_string(names.size()));
   int joints[3];
   for (int i = 0; i < 3; ++i) {
     joints[i] = sk.Find(names[i]);
-    if (joints[i] < 0) throw Error(what + ": the skeleton has no joint '" + names[i] + "'");
+    if (joints[i] < 0) throw anim::Error(what + ": the skeleton has no joint '" + names[i] + "'");
     if (i > 0 && sk.parents[joints[i]] != joints[i - 1])
-      throw Error(what + ": '" + names[i] + "' is not a child of '" + names[i - 1] + "'");
+      throw anim::Error(what + ": '" + names[i] + "' is not a child of '" + names[i - 1] + "'");
   }
   if (!(limits.elbow_min_deg >= 0 && limits.elbow_min_deg <= limits.elbow_max_deg && limits.elbow_max_deg <= 180))
-    throw Error(what + ": the elbow range must satisfy 0 <= min <= max <= 180 degrees");
+    throw anim::Error(what + ": the elbow range must satisfy 0 <= min <= max <= 180 degrees");
   if (!(limits.shoulder_cone_deg > 0 && limits.shoulder_cone_deg <= 180))
-    throw Error(what + ": the shoulder cone must be in (0, 180] degrees");
-  if (forward_in.norm() < 1e-9 || up_in.norm() < 1e-9) throw Error(what + ": forward and up must not be zero");
-  ArmChain arm;
+    throw anim::Error(what + ": the shoulder cone must be in (0, 180] degrees");
+  if (forward_in.norm() < 1e-9 || up_in.norm() < 1e-9) throw anim::Error(what + ": forward and up must not be zero");
+  anim::ArmChain arm;
   arm.upper = joints[0];
   arm.fore = joints[1];
   arm.hand = joints[2];
   arm.limits = limits;
-  const std::vector<Eigen::Matrix4d> rest = ModelPose(sk, LocalPose::Rest(sk));
+  const std::vector<Eigen::Matrix4d> rest = ModelPose(sk, anim::LocalPose::Rest(sk));
   const Eigen::Vector3d s = Position(rest, arm.upper), e = Position(rest, arm.fore), h = Position(rest, arm.hand);
   if ((e - s).norm() < 1e-9 || (h - e).norm() < 1e-9)
-    throw Error(what + ": '" + names[0] + "', '" + names[1] + "' and '" + names[2] + "' must not coincide at rest");
+    throw anim::Error(what + ": '" + names[0] + "', '" + names[1] + "' and '" + names[2] + "' must not coincide at rest");
   const Eigen::Vector3d up = up_in.normalized();
   const Eigen::Vector3d forward = (forward_in - forward_in.dot(up) * up).normalized();
   // The arm's side from where the shoulder is (rigs disagree on which of ±x is "left").
@@ -179,9 +179,9 @@ ArmDirections Aim(const Eigen::Vector3d& d, Gesture gesture, double l1, double l
 double Angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
 
 // One analytic solve of the arm toward `target` (see gesture.h).
-void SolveArm(const Skeleton& sk, const ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target, LocalPose& pose,
+void SolveArm(const anim::Skeleton& sk, const anim::ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target, anim::LocalPose& pose,
               std::vector<Eigen::Matrix4d>& model) {
-  const ArmLimits& lim = arm.limits;
+  const anim::ArmLimits& lim = arm.limits;
   const Eigen::Vector3d s = Position(model, arm.upper), e = Position(model, arm.fore), h = Position(model, arm.hand);
   const double l1 = (e - s).norm(), l2 = (h - e).norm();
   const Eigen::Matrix3d parent = ParentRotation(sk, arm.upper, model);
@@ -212,28 +212,28 @@ void SolveArm(const Skeleton& sk, const ArmChain& arm, Gesture gesture, const Ei
 
 }  // namespace
 
-void ApplyGesture(const Skeleton& sk, const ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target,
-                  LocalPose& pose, std::vector<Eigen::Matrix4d>& model) {
+void ApplyGesture(const anim::Skeleton& sk, const anim::ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target,
+                  anim::LocalPose& pose, std::vector<Eigen::Matrix4d>& model) {
   if (gesture == Gesture::kNone) return;
   SolveArm(sk, arm, gesture, target, pose, model);
 }
 
-Clip GenerateGestureClip(const Skeleton& sk, const Clip* base, const LookAtChain* lookat, const ArmChain& arm,
+anim::Clip GenerateGestureClip(const anim::Skeleton& sk, const anim::Clip* base, const anim::LookAtChain* lookat, const anim::ArmChain& arm,
                          Gesture gesture, const Eigen::Vector3d& viewpoint, double sample_rate) {
-  if (viewpoint.norm() < 1e-9) throw Error("gesture: the key viewpoint has zero length");
-  if (arm.upper < 0 || arm.fore < 0 || arm.hand < 0) throw Error("gesture: no arm chain");
-  if (!(sample_rate > 0)) throw Error("gesture: sample rate must be positive");
+  if (viewpoint.norm() < 1e-9) throw anim::Error("gesture: the key viewpoint has zero length");
+  if (arm.upper < 0 || arm.fore < 0 || arm.hand < 0) throw anim::Error("gesture: no arm chain");
+  if (!(sample_rate > 0)) throw anim::Error("gesture: sample rate must be positive");
   const Eigen::Vector3d target = viewpoint.normalized();
-  Clip clip = StartKeyClip(sk, base, ToString(gesture), target);
+  anim::Clip clip = StartKeyClip(sk, base, ToString(gesture), target);
   const std::vector<double> times = KeySampleTimes(base, sample_rate);
   std::vector<int> turned = lookat ? lookat->joints : std::vector<int>{};
   for (int j : {arm.upper, arm.fore})
     if (std::find(turned.begin(), turned.end(), j) == turned.end()) turned.push_back(j);
   for (int j : turned) clip.tracks[j].rotation.clear();
-  LocalPose pose(sk.size());
+  anim::LocalPose pose(sk.size());
   for (double t : times) {
-    if (base) MustRun(SamplingJob{&sk, base, t, false, &pose}, "gesture base clip");
-    else pose = LocalPose::Rest(sk);
+    if (base) anim::MustRun(anim::SamplingJob{&sk, base, t, false, &pose}, "gesture base clip");
+    else pose = anim::LocalPose::Rest(sk);
     std::vector<Eigen::Matrix4d> model = ModelPose(sk, pose);
     if (lookat && !lookat->joints.empty()) ApplyLookAt(sk, *lookat, target, pose, model);
     ApplyGesture(sk, arm, gesture, target, pose, model);
@@ -242,19 +242,19 @@ Clip GenerateGestureClip(const Skeleton& sk, const Clip* base, const LookAtChain
   return clip;
 }
 
-Eigen::Vector3d GestureDirection(const ArmChain& arm, Gesture gesture, std::span<const Eigen::Matrix4d> model) {
+Eigen::Vector3d GestureDirection(const anim::ArmChain& arm, Gesture gesture, std::span<const Eigen::Matrix4d> model) {
   const int from = gesture == Gesture::kReach ? arm.upper : arm.fore;
   return (Position(model, arm.hand) - Position(model, from)).normalized();
 }
 
-double ElbowBendDeg(const ArmChain& arm, std::span<const Eigen::Matrix4d> model) {
+double ElbowBendDeg(const anim::ArmChain& arm, std::span<const Eigen::Matrix4d> model) {
   return AngleDeg(Position(model, arm.fore) - Position(model, arm.upper),
                   Position(model, arm.hand) - Position(model, arm.fore));
 }
 
-double ShoulderConeAngleDeg(const Skeleton& sk, const ArmChain& arm, std::span<const Eigen::Matrix4d> model) {
+double ShoulderConeAngleDeg(const anim::Skeleton& sk, const anim::ArmChain& arm, std::span<const Eigen::Matrix4d> model) {
   const Eigen::Vector3d axis = ParentRotation(sk, arm.upper, model) * arm.cone_axis_parent;
   return AngleDeg(Position(model, arm.fore) - Position(model, arm.upper), axis);
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

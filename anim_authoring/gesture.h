@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 enum class Gesture { kNone, kPoint, kReach };
 constexpr auto EnumNames(Gesture) {
@@ -44,31 +44,31 @@ constexpr auto EnumNames(ArmSide) { return EnumTable<ArmSide, 2>{{{ArmSide::kRig
 // with its parent and grandparent; without either (CesiumMan's "Skeleton_arm_joint_R",
 // "..._R__2_", "..._R__3_"), the side's first joint named like an (upper) arm and the next two
 // joints below it. Empty when no such chain exists.
-std::vector<std::string> DefaultArmChain(const Skeleton& skeleton, ArmSide side);
+std::vector<std::string> DefaultArmChain(const anim::Skeleton& skeleton, ArmSide side);
 
 // Builds the chain: `names` (upper arm, forearm, hand; empty: DefaultArmChain) must form one
 // parent chain. Throws Error naming what is missing ("no right arm chain found by name ...").
-ArmChain MakeArmChain(const Skeleton& skeleton, const std::vector<std::string>& names, ArmSide side,
-                      const ArmLimits& limits, const Eigen::Vector3d& forward,
+anim::ArmChain MakeArmChain(const anim::Skeleton& skeleton, const std::vector<std::string>& names, ArmSide side,
+                      const anim::ArmLimits& limits, const Eigen::Vector3d& forward,
                       const Eigen::Vector3d& up = Eigen::Vector3d::UnitY());
 
 // Turns the arm of `pose` (model transforms in `model`, kept up to date) toward `target` (unit,
 // model space) within the limits.
-void ApplyGesture(const Skeleton& skeleton, const ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target,
-                  LocalPose& pose, std::vector<Eigen::Matrix4d>& model);
+void ApplyGesture(const anim::Skeleton& skeleton, const anim::ArmChain& arm, Gesture gesture, const Eigen::Vector3d& target,
+                  anim::LocalPose& pose, std::vector<Eigen::Matrix4d>& model);
 
 // The base clip (nullptr: the rest pose) turned toward `viewpoint` by the look-at chain
 // (nullptr: not turned), then the arm on top, at every sample (`sample_rate` Hz over the base
 // clip). The result animates the look-at and arm joints; the others keep the base clip.
-Clip GenerateGestureClip(const Skeleton& skeleton, const Clip* base, const LookAtChain* lookat, const ArmChain& arm,
+anim::Clip GenerateGestureClip(const anim::Skeleton& skeleton, const anim::Clip* base, const anim::LookAtChain* lookat, const anim::ArmChain& arm,
                          Gesture gesture, const Eigen::Vector3d& viewpoint, double sample_rate = 30.0);
 
 // Checks on a pose given as model-space joint matrices:
 // the gesture's direction (point: elbow → hand; reach: shoulder → hand), unit;
-Eigen::Vector3d GestureDirection(const ArmChain& arm, Gesture gesture, std::span<const Eigen::Matrix4d> model);
+Eigen::Vector3d GestureDirection(const anim::ArmChain& arm, Gesture gesture, std::span<const Eigen::Matrix4d> model);
 // the elbow's bend in degrees (0 = straight);
-double ElbowBendDeg(const ArmChain& arm, std::span<const Eigen::Matrix4d> model);
+double ElbowBendDeg(const anim::ArmChain& arm, std::span<const Eigen::Matrix4d> model);
 // the upper arm's angle from the shoulder cone's axis, in degrees.
-double ShoulderConeAngleDeg(const Skeleton& skeleton, const ArmChain& arm, std::span<const Eigen::Matrix4d> model);
+double ShoulderConeAngleDeg(const anim::Skeleton& skeleton, const anim::ArmChain& arm, std::span<const Eigen::Matrix4d> model);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

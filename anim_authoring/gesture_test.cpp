@@ -13,7 +13,7 @@
 #include <algorithm>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -48,12 +48,12 @@ GestureStats Measure(const std::string& asset, const std::string& gesture, const
                              "}\n      - {azimuth: " + std::to_string(k.azimuth + 90) + ", generate: lookat}\n";
     const Scene scene = ParseScene(text, "gesture.yaml");
     AnimatedCharacter ch(scene.characters[0]);
-    const ArmChain& arm = ch.arm_chain();
+    const anim::ArmChain& arm = ch.arm_chain();
     const Gesture g = scene.characters[0].keys[0].gesture;
     const Eigen::Vector3d v = scene.characters[0].keys[0].viewpoint;
     // On the key clip's 30 Hz samples and between them (interpolated).
     for (double t : {0.0, 0.4, 0.37, 1.1, 1.23, 1.9}) {
-      const AnimatorFrame& out = ch.Update(v, t);
+      const anim::AnimatorFrame& out = ch.Update(v, t);
       EXPECT_NEAR(out.key_weights[0], 1.0, 1e-9);
       const double deg = AngleDeg(GestureDirection(arm, g, out.model), v);
       const double elbow = ElbowBendDeg(arm, out.model);
@@ -79,7 +79,7 @@ GestureStats Measure(const std::string& asset, const std::string& gesture, const
 constexpr double kBetweenSamplesDeg = 0.5;
 
 void CheckCharacter(const std::string& asset, const std::string& extra = "") {
-  const ArmLimits defaults;
+  const anim::ArmLimits defaults;
   for (const char* g : {"point", "reach"}) {
     const GestureStats st = Measure(asset, g, extra);
     EXPECT_GE(st.worst_elbow_low, defaults.elbow_min_deg - kBetweenSamplesDeg) << g;
@@ -110,7 +110,7 @@ void MeasureBetweenKeys(const std::string& asset, const std::string& mode) {
   for (int k = 0; k < 8; ++k)
     for (double offset : {10.0, 22.5, 35.0})
       for (double t : {0.0, 0.37, 1.23, 1.9}) {
-        const Eigen::Vector3d v = DirectionFromAzimuthElevation(45 * k + offset, 0);
+        const Eigen::Vector3d v = anim::DirectionFromAzimuthElevation(45 * k + offset, 0);
         angles.push_back(AngleDeg(GestureDirection(ch.arm_chain(), Gesture::kPoint, ch.Update(v, t).model), v));
       }
   std::sort(angles.begin(), angles.end());
@@ -130,14 +130,14 @@ TEST(Gesture, BetweenKeysOnARing) {
 
 TEST(Gesture, DefaultArmChainsByName) {
   ARVIEW_REQUIRE_DATA_PATH(fs::path(kBcn), "Debian package assimp-testmodels");
-  const Character bcn = LoadCharacter(kBcn);
+  const anim::Character bcn = LoadCharacter(kBcn);
   EXPECT_EQ(DefaultArmChain(bcn.skeleton, ArmSide::kRight),
             (std::vector<std::string>{"B_UpperArm_Right", "B_ForeArm_Right", "B_Hand_Right"}));
   EXPECT_EQ(DefaultArmChain(bcn.skeleton, ArmSide::kLeft),
             (std::vector<std::string>{"B_UpperArm_Left", "B_ForeArm_Left", "B_Hand_Left"}));
   // Mixamo names, with and without the prefix, and CMU's wrist below the radius.
   for (const std::string prefix : {"", "mixamorig:"}) {
-    Skeleton sk;
+    anim::Skeleton sk;
     for (const std::string n : {"Hips", "Spine", "RightShoulder", "RightArm", "RightForeArm", "RightHand",
                                 "RightHandIndex1"}) {
       sk.parents.push_back(sk.names.empty() ? -1 : static_cast<int>(sk.names.size()) - 1);
@@ -147,7 +147,7 @@ TEST(Gesture, DefaultArmChainsByName) {
               (std::vector<std::string>{prefix + "RightArm", prefix + "RightForeArm", prefix + "RightHand"}));
     EXPECT_TRUE(DefaultArmChain(sk, ArmSide::kLeft).empty());
   }
-  Skeleton cmu;
+  anim::Skeleton cmu;
   for (const std::string n : {"hip", "lowerback", "rclavicle", "rhumerus", "rradius", "rwrist", "rhand"}) {
     cmu.parents.push_back(cmu.names.empty() ? -1 : static_cast<int>(cmu.names.size()) - 1);
     cmu.names.push_back(n);
@@ -158,7 +158,7 @@ TEST(Gesture, DefaultArmChainsByName) {
 TEST(Gesture, CesiumManArmChainByName) {
   const fs::path man = testing::SharedData("characters/CesiumMan.glb");
   ARVIEW_REQUIRE_DATA_PATH(man, "../shared/data");
-  const Character c = LoadCharacter(man);
+  const anim::Character c = LoadCharacter(man);
   EXPECT_EQ(DefaultArmChain(c.skeleton, ArmSide::kRight),
             (std::vector<std::string>{"Skeleton_arm_joint_R", "Skeleton_arm_joint_R__2_", "Skeleton_arm_joint_R__3_"}));
   EXPECT_EQ(DefaultArmChain(c.skeleton, ArmSide::kLeft),
@@ -169,22 +169,22 @@ TEST(Gesture, CesiumManArmChainByName) {
 // cone and is moved onto its boundary toward the target, never to the other side.
 TEST(Gesture, BehindIsClampedNotFlipped) {
   ARVIEW_REQUIRE_DATA_PATH(fs::path(kBcn), "Debian package assimp-testmodels");
-  const Character bcn = LoadCharacter(kBcn);
-  const Skeleton& sk = bcn.skeleton;
+  const anim::Character bcn = LoadCharacter(kBcn);
+  const anim::Skeleton& sk = bcn.skeleton;
   const Eigen::Vector3d forward = Eigen::Vector3d::UnitZ(), up = Eigen::Vector3d::UnitY();
   for (ArmSide side : {ArmSide::kRight, ArmSide::kLeft}) {
-    const ArmChain arm = MakeArmChain(sk, {}, side, {}, forward, up);
+    const anim::ArmChain arm = MakeArmChain(sk, {}, side, {}, forward, up);
     // The arm's side, from where its shoulder is at rest.
     std::vector<Eigen::Matrix4d> model(sk.size());
-    LocalPose rest = LocalPose::Rest(sk);
-    MustRun(LocalToModelJob{&sk, &rest, model}, "test");
+    anim::LocalPose rest = anim::LocalPose::Rest(sk);
+    anim::MustRun(anim::LocalToModelJob{&sk, &rest, model}, "test");
     const double out = model[arm.upper](0, 3) > 0 ? 1 : -1;
     for (double behind_side : {0.3, -0.3, 0.0}) {
       const Eigen::Vector3d target = Eigen::Vector3d(behind_side * out, 0.1, -1).normalized();
-      const Clip clip = GenerateGestureClip(sk, nullptr, nullptr, arm, Gesture::kPoint, target);
-      LocalPose pose(sk.size());
-      MustRun(SamplingJob{&sk, &clip, 0.0, false, &pose}, "test");
-      MustRun(LocalToModelJob{&sk, &pose, model}, "test");
+      const anim::Clip clip = GenerateGestureClip(sk, nullptr, nullptr, arm, Gesture::kPoint, target);
+      anim::LocalPose pose(sk.size());
+      anim::MustRun(anim::SamplingJob{&sk, &clip, 0.0, false, &pose}, "test");
+      anim::MustRun(anim::LocalToModelJob{&sk, &pose, model}, "test");
       EXPECT_LE(ShoulderConeAngleDeg(sk, arm, model), arm.limits.shoulder_cone_deg + 0.01);
       const Eigen::Vector3d d = GestureDirection(arm, Gesture::kPoint, model);
       // Clamped: still pointing backward-ish and out to the arm's side, not forward or across.
@@ -208,7 +208,7 @@ TEST(Gesture, ElbowRangeIsKept) {
 }
 
 TEST(Gesture, NoArmChainIsAnError) {
-  Skeleton sk;
+  anim::Skeleton sk;
   sk.names = {"Hips", "Spine", "Neck", "Head"};
   sk.parents = {-1, 0, 1, 2};
   sk.rest.resize(4);
@@ -216,18 +216,18 @@ TEST(Gesture, NoArmChainIsAnError) {
   try {
     MakeArmChain(sk, {}, ArmSide::kRight, {}, Eigen::Vector3d::UnitZ());
     ADD_FAILURE() << "expected an error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("right arm: no chain found by name"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("gesture.chain"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(MakeArmChain(sk, {"Spine", "Head", "Neck"}, ArmSide::kRight, {}, Eigen::Vector3d::UnitZ()), Error);
+  EXPECT_THROW(MakeArmChain(sk, {"Spine", "Head", "Neck"}, ArmSide::kRight, {}, Eigen::Vector3d::UnitZ()), anim::Error);
 }
 
 TEST(Gesture, SceneRefusesUnknownValuesWithTheLine) {
   auto error_of = [](const std::string& text) {
     try {
       ParseScene(text, "g.yaml");
-    } catch (const Error& e) {
+    } catch (const anim::Error& e) {
       return std::string(e.what());
     }
     return std::string("no error");
@@ -264,11 +264,11 @@ TEST(Gesture, MissingChainJointInTheSceneIsAnError) {
   try {
     AnimatedCharacter ch(scene.characters[0]);
     ADD_FAILURE() << "expected an error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("g.yaml:2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("no joint 'RightHand'"), std::string::npos) << e.what();
   }
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -23,7 +23,7 @@
 
 #include <filesystem>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 // True when the file is one this check reads: a GLB (by its magic), or a .gltf/.glb name.
 bool IsGltfAsset(const std::filesystem::path& file);
@@ -31,4 +31,4 @@ bool IsGltfAsset(const std::filesystem::path& file);
 // Throws anim::Error("<file>: <what is wrong>") unless the asset's structure is sound.
 void CheckGltfStructure(const std::filesystem::path& file);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

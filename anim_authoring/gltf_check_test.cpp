@@ -13,7 +13,7 @@
 #include "anim_authoring/import.h"
 #include "tests/support/test_data.h"
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -107,7 +107,7 @@ std::string CheckError(const std::string& bytes, const std::string& name = "asse
   try {
     CheckGltfStructure(file);
     return "";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     return e.what();
   }
 }
@@ -128,7 +128,7 @@ std::string CheckError(const std::function<void(TinySkinnedGltf&)>& mutate) {
 TEST(GltfCheck, TheTinySkinnedTriangleIsAcceptedAndLoads) {
   const fs::path file = Write("asset.glb", TinySkinnedGltf().Glb());
   EXPECT_NO_THROW(CheckGltfStructure(file));
-  const Character c = LoadCharacter(file);
+  const anim::Character c = LoadCharacter(file);
   EXPECT_EQ(c.skeleton.size(), 2);
   ASSERT_EQ(c.meshes.size(), 1u);
   EXPECT_EQ(c.meshes[0].vertex_count(), 3);
@@ -144,7 +144,7 @@ TEST(GltfCheck, ASkinWithoutInverseBindMatricesIsRefusedBeforeAssimp) {
   try {
     (void)LoadCharacter(file);
     FAIL() << "loaded";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_REFUSED(e.what(), "skins[0] has no inverseBindMatrices");
   }
 }
@@ -274,7 +274,7 @@ TEST(GltfCheck, ExternalBuffersStayInsideTheAssetsFolderAndHoldTheirLength) {
     try {
       CheckGltfStructure(file);
       return std::string();
-    } catch (const Error& e) {
+    } catch (const anim::Error& e) {
       return std::string(e.what());
     }
   };
@@ -315,11 +315,11 @@ TEST(GltfCheck, TheFuzzReproducerOnRiggedSimpleIsRefused) {
     try {
       (void)LoadCharacter(file);
       ADD_FAILURE() << "loaded";
-    } catch (const Error& e) {
+    } catch (const anim::Error& e) {
       EXPECT_REFUSED(e.what(), expected);
     }
   }
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -12,7 +12,7 @@
 #include <random>
 #include <set>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 std::string Lower(std::string s) {
@@ -20,7 +20,7 @@ std::string Lower(std::string s) {
   return s;
 }
 
-Eigen::Matrix3d RootParentLinear(const Skeleton& sk) { return sk.root_parent.block<3, 3>(0, 0); }
+Eigen::Matrix3d RootParentLinear(const anim::Skeleton& sk) { return sk.root_parent.block<3, 3>(0, 0); }
 
 // The fastest joint's angular speed (rad/s) per frame step of each training sequence, the
 // postures read as the synthesizer reads them (exponential maps of the first `joints` triples).
@@ -42,7 +42,7 @@ std::vector<double> FastestJointSpeeds(const PostureSequences& data) {
   return speeds;
 }
 
-Eigen::Quaterniond RootParentRotation(const Skeleton& sk) {
+Eigen::Quaterniond RootParentRotation(const anim::Skeleton& sk) {
   Eigen::Matrix3d r = RootParentLinear(sk);
   for (int c = 0; c < 3; ++c) r.col(c).normalize();
   return Eigen::Quaterniond(r).normalized();
@@ -55,7 +55,7 @@ Eigen::Vector3d LogMap(Eigen::Quaterniond q) {
 }
 
 // Joint → model rotations (root_parent's rotation included).
-void ModelRotations(const Skeleton& sk, const LocalPose& p, std::vector<Eigen::Quaterniond>& out) {
+void ModelRotations(const anim::Skeleton& sk, const anim::LocalPose& p, std::vector<Eigen::Quaterniond>& out) {
   const Eigen::Quaterniond rp = RootParentRotation(sk);
   out.resize(sk.size());
   for (int j = 0; j < sk.size(); ++j)
@@ -63,10 +63,10 @@ void ModelRotations(const Skeleton& sk, const LocalPose& p, std::vector<Eigen::Q
 }
 
 // Model-space extent of the rest pose along `up`.
-double RestHeight(const Skeleton& sk, const Eigen::Vector3d& up) {
-  LocalPose rest = LocalPose::Rest(sk);
+double RestHeight(const anim::Skeleton& sk, const Eigen::Vector3d& up) {
+  anim::LocalPose rest = anim::LocalPose::Rest(sk);
   std::vector<Eigen::Matrix4d> model(sk.size());
-  MustRun(LocalToModelJob{&sk, &rest, model}, "rest height");
+  anim::MustRun(anim::LocalToModelJob{&sk, &rest, model}, "rest height");
   double lo = 1e300, hi = -1e300;
   for (const auto& m : model) {
     const double h = up.dot(m.block<3, 1>(0, 3));
@@ -77,7 +77,7 @@ double RestHeight(const Skeleton& sk, const Eigen::Vector3d& up) {
 }
 
 // A chain: from `first`, following the child whose subtree is largest, up to `count` joints.
-std::vector<int> ChainFrom(const Skeleton& sk, int first, int count) {
+std::vector<int> ChainFrom(const anim::Skeleton& sk, int first, int count) {
   std::vector<int> chain;
   for (int j = first; j >= 0 && static_cast<int>(chain.size()) < count;) {
     chain.push_back(j);
@@ -85,7 +85,7 @@ std::vector<int> ChainFrom(const Skeleton& sk, int first, int count) {
     std::size_t best = 0;
     for (int c = j + 1; c < sk.size(); ++c)
       if (sk.parents[c] == j) {
-        const std::size_t size = Subtree(sk, c).size();
+        const std::size_t size = anim::Subtree(sk, c).size();
         if (next < 0 || size > best) next = c, best = size;
       }
     j = next;
@@ -98,14 +98,14 @@ struct Chains {
   std::vector<int> spine, neck, arm[2], leg[2];
 };
 
-Chains FindChains(const Skeleton& sk) {
+Chains FindChains(const anim::Skeleton& sk) {
   Chains c;
-  const int neck = NeckJoint(sk);
+  const int neck = anim::NeckJoint(sk);
   if (neck >= 0) {
     for (int j = sk.parents[neck]; j >= 0 && sk.parents[j] >= 0; j = sk.parents[j]) c.spine.insert(c.spine.begin(), j);
     // Neck to head: the path to the first descendant named head, else two joints.
     int head = -1;
-    for (int j : Subtree(sk, neck))
+    for (int j : anim::Subtree(sk, neck))
       if (Lower(sk.names[j]).find("head") != std::string::npos) {
         head = j;
         break;
@@ -120,8 +120,8 @@ Chains FindChains(const Skeleton& sk) {
   }
   for (int side = 0; side < 2; ++side) {
     const bool left = side == 0;
-    if (int a = ArmRoot(sk, left); a >= 0) c.arm[side] = ChainFrom(sk, a, 4);
-    if (int l = LegRoot(sk, left); l >= 0) {
+    if (int a = anim::ArmRoot(sk, left); a >= 0) c.arm[side] = ChainFrom(sk, a, 4);
+    if (int l = anim::LegRoot(sk, left); l >= 0) {
       if (Lower(sk.names[l]).find("hipjoint") != std::string::npos) l = ChainFrom(sk, l, 2).back();  // CMU's zero-length helper
       c.leg[side] = ChainFrom(sk, l, 4);
     }
@@ -147,7 +147,7 @@ void PairChains(const std::vector<int>& ch, const std::vector<int>& da, bool ali
 }
 
 struct Frames {
-  std::vector<LocalPose> poses;  // data poses at `rate`
+  std::vector<anim::LocalPose> poses;  // data poses at `rate`
 };
 
 // The rotation taking the data's model frame (up +Y, forward +Z, as BVH files are) to the
@@ -162,9 +162,9 @@ Eigen::Quaterniond DataToCharacter(const Eigen::Vector3d& forward, const Eigen::
 }
 
 struct Retargeter {
-  Retargeter(const Skeleton& character, const Skeleton& data) : ch(character), da(data) {}
-  const Skeleton& ch;
-  const Skeleton& da;
+  Retargeter(const anim::Skeleton& character, const anim::Skeleton& data) : ch(character), da(data) {}
+  const anim::Skeleton& ch;
+  const anim::Skeleton& da;
   std::vector<std::pair<int, int>> pairs;  // character joint, data joint
   bool identity = false;                   // the character's own clips
   Eigen::Quaterniond a = Eigen::Quaterniond::Identity();
@@ -181,7 +181,7 @@ struct Retargeter {
 
   // Posture vector of one data frame: rotations of the mapped character joints relative to
   // their rest, then the root's offset in the root's parent frame.
-  Eigen::VectorXd Posture(const LocalPose& data_pose, std::vector<Eigen::Quaterniond>& g) const {
+  Eigen::VectorXd Posture(const anim::LocalPose& data_pose, std::vector<Eigen::Quaterniond>& g) const {
     const int m = static_cast<int>(pairs.size());
     Eigen::VectorXd v(3 * m + 3);
     if (identity) {
@@ -220,7 +220,7 @@ struct Retargeter {
 using Stillest = PostureSequences::Stillest;
 
 // Standing runs of a clip sampled at `rate`: root speed and joint speed below the limits.
-std::vector<std::pair<int, int>> StandingRuns(const Skeleton& da, const std::vector<LocalPose>& poses,
+std::vector<std::pair<int, int>> StandingRuns(const anim::Skeleton& da, const std::vector<anim::LocalPose>& poses,
                                               const std::vector<int>& data_joints, double rate, double data_height,
                                               const IdleLearningOptions& o, Stillest& stillest, const std::string& name) {
   std::vector<bool> still(poses.size(), false);
@@ -263,12 +263,12 @@ std::vector<std::pair<int, int>> StandingRuns(const Skeleton& da, const std::vec
   return runs;
 }
 
-std::vector<LocalPose> Resample(const Skeleton& sk, const Clip& clip, double rate) {
-  std::vector<LocalPose> poses;
+std::vector<anim::LocalPose> Resample(const anim::Skeleton& sk, const anim::Clip& clip, double rate) {
+  std::vector<anim::LocalPose> poses;
   const int n = std::max(1, static_cast<int>(std::floor(clip.duration * rate)) + 1);
   for (int i = 0; i < n; ++i) {
     poses.emplace_back(sk.size());
-    MustRun(SamplingJob{&sk, &clip, i / rate, false, &poses.back()}, "idle learning");
+    anim::MustRun(anim::SamplingJob{&sk, &clip, i / rate, false, &poses.back()}, "idle learning");
   }
   return poses;
 }
@@ -360,7 +360,7 @@ std::vector<double> SegmentShape(const std::vector<double>& c, int from, int to)
 
 }  // namespace
 
-std::vector<std::pair<int, int>> HumanoidJointPairs(const Skeleton& character, const Skeleton& data,
+std::vector<std::pair<int, int>> HumanoidJointPairs(const anim::Skeleton& character, const anim::Skeleton& data,
                                                     const std::map<std::string, std::string>& overrides) {
   const Chains c = FindChains(character), d = FindChains(data);
   std::vector<std::pair<int, int>> pairs{{c.root, d.root}};
@@ -372,8 +372,8 @@ std::vector<std::pair<int, int>> HumanoidJointPairs(const Skeleton& character, c
   }
   for (const auto& [data_name, character_name] : overrides) {
     const int dj = data.Find(data_name), cj = character.Find(character_name);
-    if (dj < 0) throw Error("idle.joint_map: no joint '" + data_name + "' in the motion data");
-    if (cj < 0) throw Error("idle.joint_map: no joint '" + character_name + "' in the character");
+    if (dj < 0) throw anim::Error("idle.joint_map: no joint '" + data_name + "' in the motion data");
+    if (cj < 0) throw anim::Error("idle.joint_map: no joint '" + character_name + "' in the character");
     std::erase_if(pairs, [&](const auto& p) { return p.first == cj; });
     pairs.emplace_back(cj, dj);
   }
@@ -386,8 +386,8 @@ namespace {
 
 // The retargeting of one source onto the character: the humanoid joint pairs (or every joint
 // for the character's own clips), the axes and the height ratio.
-Retargeter MakeRetargeter(const Skeleton& ch, const IdleSource& src, const IdleLearningOptions& o) {
-  const Skeleton& da = src.data->skeleton;
+Retargeter MakeRetargeter(const anim::Skeleton& ch, const IdleSource& src, const IdleLearningOptions& o) {
+  const anim::Skeleton& da = src.data->skeleton;
   Retargeter r(ch, da);
   r.identity = src.is_character;
   if (r.identity) {
@@ -396,20 +396,20 @@ Retargeter MakeRetargeter(const Skeleton& ch, const IdleSource& src, const IdleL
   }
   r.pairs = HumanoidJointPairs(ch, da, o.joint_map);
   if (r.pairs.size() < 6)
-    throw Error(src.data->source + ": only " + std::to_string(r.pairs.size()) +
+    throw anim::Error(src.data->source + ": only " + std::to_string(r.pairs.size()) +
                 " joints map onto the character by name (give idle.joint_map)");
   r.a = DataToCharacter(o.forward, o.up);
   r.height_ratio = RestHeight(ch, o.up) / RestHeight(da, Eigen::Vector3d::UnitY());
-  LocalPose rest = LocalPose::Rest(ch);
+  anim::LocalPose rest = anim::LocalPose::Rest(ch);
   ModelRotations(ch, rest, r.ch_rest_model);
   return r;
 }
 
 // The postures of the frames in `runs` ([begin, end) frame ranges of `poses`), retargeted about
 // the data's mean posture over those frames, one sequence per run.
-std::vector<std::vector<Eigen::VectorXd>> RunPostures(Retargeter& r, const std::vector<LocalPose>& poses,
+std::vector<std::vector<Eigen::VectorXd>> RunPostures(Retargeter& r, const std::vector<anim::LocalPose>& poses,
                                                       const std::vector<std::pair<int, int>>& runs) {
-  const Skeleton& da = r.da;
+  const anim::Skeleton& da = r.da;
   std::vector<std::vector<Eigen::Quaterniond>> per_joint(da.size());
   Eigen::Vector3d root_sum = Eigen::Vector3d::Zero();
   int count = 0;
@@ -435,22 +435,22 @@ std::vector<std::vector<Eigen::VectorXd>> RunPostures(Retargeter& r, const std::
 
 }  // namespace
 
-PostureSequences TrainingPostures(const Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,
+PostureSequences TrainingPostures(const anim::Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,
                                   double rate) {
   PostureSequences out;
   out.rate = rate;
   out.root = 0;
   for (const IdleSource& src : sources) {
-    const Skeleton& da = src.data->skeleton;
+    const anim::Skeleton& da = src.data->skeleton;
     Retargeter r = MakeRetargeter(ch, src, o);
     if (out.joints.empty()) out.joints = r.Joints();
     else if (out.joints != r.Joints())
-      throw Error(src.data->source + ": maps onto other joints than the first motion source; learn from one kind of rig");
+      throw anim::Error(src.data->source + ": maps onto other joints than the first motion source; learn from one kind of rig");
     std::vector<int> data_joints;
     for (auto [c, d] : r.pairs) data_joints.push_back(d);
     const double data_height = RestHeight(da, Eigen::Vector3d::UnitY());
-    for (const Clip* clip : src.clips) {
-      const std::vector<LocalPose> poses = Resample(da, *clip, rate);
+    for (const anim::Clip* clip : src.clips) {
+      const std::vector<anim::LocalPose> poses = Resample(da, *clip, rate);
       // The character's own clips are taken whole: the scene names them as idle material.
       const auto runs = src.is_character ? std::vector<std::pair<int, int>>{{0, static_cast<int>(poses.size())}}
                                          : StandingRuns(da, poses, data_joints, rate, data_height, o, out.stillest, src.data->source);
@@ -461,19 +461,19 @@ PostureSequences TrainingPostures(const Skeleton& ch, const std::vector<IdleSour
   return out;
 }
 
-std::vector<Eigen::VectorXd> ClipPostures(const Skeleton& ch, const IdleSource& source, const Clip& clip,
+std::vector<Eigen::VectorXd> ClipPostures(const anim::Skeleton& ch, const IdleSource& source, const anim::Clip& clip,
                                           const IdleLearningOptions& o, double rate, std::vector<int>* joints) {
   Retargeter r = MakeRetargeter(ch, source, o);
   if (joints) *joints = r.Joints();
-  const std::vector<LocalPose> poses = Resample(source.data->skeleton, clip, rate);
+  const std::vector<anim::LocalPose> poses = Resample(source.data->skeleton, clip, rate);
   return RunPostures(r, poses, {{0, static_cast<int>(poses.size())}}).front();
 }
 
-IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,
+anim::IdleModel LearnIdleModel(const anim::Skeleton& ch, const std::vector<IdleSource>& sources, const IdleLearningOptions& o,
                          IdleLearningReport* report) {
   IdleLearningReport rep;
   for (const IdleSource& s : sources)
-    for (const Clip* c : s.clips) rep.source_seconds += c->duration;
+    for (const anim::Clip* c : s.clips) rep.source_seconds += c->duration;
   const PostureSequences data = TrainingPostures(ch, sources, o);
   std::string names;
   for (const IdleSource& s : sources) names += (names.empty() ? "" : ", ") + s.data->source;
@@ -484,7 +484,7 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
                   "motion from; the stillest is %s (root %.3g heights/s, fastest joint %.3g rad/s)",
                   o.min_segment_seconds, o.max_root_speed, o.max_joint_speed, data.stillest.where.c_str(), data.stillest.root,
                   data.stillest.joint);
-    throw Error(names + buf);
+    throw anim::Error(names + buf);
   }
   const int dims = static_cast<int>(data.segments.front().front().size());
   int frames = 0;
@@ -493,7 +493,7 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
   int row = 0;
   for (const auto& seg : data.segments)
     for (const auto& v : seg) x.row(row++) = v.transpose();
-  IdleModel m;
+  anim::IdleModel m;
   m.joints = data.joints;
   m.root = data.root;
   m.mean = x.colwise().mean().transpose();
@@ -515,7 +515,7 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
   // Per component: extrema (interval, value), k-means, transitions.
   const int window = std::max(1, static_cast<int>(std::lround(0.05 * data.rate)));  // ±50 ms
   for (int i = 0; i < k; ++i) {
-    std::vector<IdleModel::Extremum> ex;
+    std::vector<anim::IdleModel::Extremum> ex;
     std::vector<std::pair<int, int>> links;  // consecutive extrema (indices into ex)
     for (const auto& seg : data.segments) {
       std::vector<double> c(seg.size());
@@ -531,9 +531,9 @@ IdleModel LearnIdleModel(const Skeleton& ch, const std::vector<IdleSource>& sour
                       SegmentShape(c, idx[e - 1], idx[e])});
       }
     }
-    IdleModel::ComponentChain chain;
+    anim::IdleModel::ComponentChain chain;
     if (ex.empty()) {
-      throw Error(names + ": component " + std::to_string(i + 1) + " has no extrema in the standing segments");
+      throw anim::Error(names + ": component " + std::to_string(i + 1) + " has no extrema in the standing segments");
     }
     double mean_dt = 0, mean_v = 0;
     for (const auto& e : ex) mean_dt += e.dt, mean_v += e.value;
@@ -586,4 +586,4 @@ std::string IdleLearningReport::Summary() const {
   return s;
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

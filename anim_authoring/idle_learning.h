@@ -22,16 +22,16 @@
 #include <string>
 #include <vector>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 // Character joint → data joint pairs found by the humanoid chains (and `overrides`: data joint
 // name → character joint name, which replace what the chains found for that character joint).
-std::vector<std::pair<int, int>> HumanoidJointPairs(const Skeleton& character, const Skeleton& data,
+std::vector<std::pair<int, int>> HumanoidJointPairs(const anim::Skeleton& character, const anim::Skeleton& data,
                                                     const std::map<std::string, std::string>& overrides = {});
 
 struct IdleSource {
-  const Character* data = nullptr;       // motion capture, or the character itself
-  std::vector<const Clip*> clips;        // its clips to learn from
+  const anim::Character* data = nullptr;       // motion capture, or the character itself
+  std::vector<const anim::Clip*> clips;        // its clips to learn from
   bool is_character = false;             // the character's own clips: no retargeting
 };
 
@@ -58,7 +58,7 @@ struct IdleLearningReport {
 };
 
 // Throws Error (naming the source) when nothing maps, or no standing segment is found.
-IdleModel LearnIdleModel(const Skeleton& character, const std::vector<IdleSource>& sources, const IdleLearningOptions& options,
+anim::IdleModel LearnIdleModel(const anim::Skeleton& character, const std::vector<IdleSource>& sources, const IdleLearningOptions& options,
                          IdleLearningReport* report = nullptr);
 
 // The training postures (standing frames, per segment) as the learner sees them, for checks:
@@ -75,15 +75,15 @@ struct PostureSequences {
   int root = 0;
   double rate = 0;
 };
-PostureSequences TrainingPostures(const Skeleton& character, const std::vector<IdleSource>& sources,
+PostureSequences TrainingPostures(const anim::Skeleton& character, const std::vector<IdleSource>& sources,
                                   const IdleLearningOptions& options, double rate = 30.0);
 
 // Every frame of `clip` (a clip of source.data) at `rate` Hz as a posture in the layout the
 // learner gives `source` (retargeted about the clip's mean posture, or the character's own
 // rotations), with the character joints of that layout in `joints`: what the balance-shift
 // learner (balance.h) reads a recording as.
-std::vector<Eigen::VectorXd> ClipPostures(const Skeleton& character, const IdleSource& source, const Clip& clip,
+std::vector<Eigen::VectorXd> ClipPostures(const anim::Skeleton& character, const IdleSource& source, const anim::Clip& clip,
                                           const IdleLearningOptions& options, double rate,
                                           std::vector<int>* joints = nullptr);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

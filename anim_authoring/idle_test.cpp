@@ -11,17 +11,17 @@
 #include <cmath>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 const char* kBvhDir = "/usr/share/assimp/models/BVH";
 const char* kBcn = "/usr/share/assimp/models/X/BCN_Epileptic.X";
 
 struct Learned {
-  Character fox;
+  anim::Character fox;
   std::vector<IdleSource> sources;
   IdleLearningOptions options;
-  IdleModel model;
+  anim::IdleModel model;
   IdleLearningReport report;
 };
 
@@ -52,7 +52,7 @@ void Speeds(const std::vector<Eigen::VectorXd>& seq, int joints, double rate, st
 
 TEST(Idle, HumanoidMapPairsCmuWithBcnEpileptic) {
   ARVIEW_REQUIRE_DATA_PATH(kBcn, "Debian package assimp-testmodels");
-  const Character bcn = LoadCharacter(kBcn), cmu = LoadCharacter(std::string(kBvhDir) + "/01_01.bvh");
+  const anim::Character bcn = LoadCharacter(kBcn), cmu = LoadCharacter(std::string(kBvhDir) + "/01_01.bvh");
   const auto pairs = HumanoidJointPairs(bcn.skeleton, cmu.skeleton);
   std::map<std::string, std::string> named;
   for (auto [c, d] : pairs) named[bcn.skeleton.names[c]] = cmu.skeleton.names[d];
@@ -69,15 +69,15 @@ TEST(Idle, TenMinuteStreamMatchesTheData) {
   ARVIEW_REQUIRE_DATA_PATH(testing::SharedData("characters/Fox"), "../shared/data");
   const auto l = Learn();
   std::printf("[idle] Fox Survey: %s\n", l->report.Summary().c_str());
-  const IdleModel& m = l->model;
-  auto skeleton = std::make_shared<const Skeleton>(l->fox.skeleton);
-  auto model = std::make_shared<const IdleModel>(m);
-  IdleSynthesizer idle(skeleton, model, 7);
+  const anim::IdleModel& m = l->model;
+  auto skeleton = std::make_shared<const anim::Skeleton>(l->fox.skeleton);
+  auto model = std::make_shared<const anim::IdleModel>(m);
+  anim::IdleSynthesizer idle(skeleton, model, 7);
   const double rate = 30;
   const int frames = static_cast<int>(600 * rate);
   std::vector<Eigen::VectorXd> stream;
   stream.reserve(frames);
-  LocalPose pose(skeleton->size());
+  anim::LocalPose pose(skeleton->size());
   for (int f = 0; f < frames; ++f) {
     ASSERT_TRUE(idle.Sample(f / rate, {}, pose));
     stream.push_back(idle.Posture(f / rate));
@@ -86,7 +86,7 @@ TEST(Idle, TenMinuteStreamMatchesTheData) {
   // 1.5), of the synthesized component values; printed also for the clamped postures projected
   // back (clamping each value into its range leaks into the tiny components: docs/anim.md).
   std::vector<Eigen::VectorXd> coefficients;
-  IdleSynthesizer walk(skeleton, model, 7);
+  anim::IdleSynthesizer walk(skeleton, model, 7);
   for (int f = 0; f < frames; ++f) coefficients.push_back(walk.Coefficients(f / rate));
   double worst_ratio = 1;
   int within = 0;
@@ -128,7 +128,7 @@ TEST(Idle, TenMinuteStreamMatchesTheData) {
   EXPECT_NEAR(m.speed_limit, data_p99, 1e-9);
   EXPECT_LT(stream_p99, data_p99);
   // Same seed, same stream; another seed, another.
-  IdleSynthesizer again(skeleton, model, 7), other(skeleton, model, 8);
+  anim::IdleSynthesizer again(skeleton, model, 7), other(skeleton, model, 8);
   for (int f = 0; f < 300; f += 7) {
     EXPECT_EQ(again.Posture(f / rate), stream[f]);
   }
@@ -142,12 +142,12 @@ TEST(Idle, TenMinuteStreamMatchesTheData) {
 TEST(Idle, CmuCapturesHoldNoStandingSegment) {
   ARVIEW_REQUIRE_DATA_PATH(kBcn, "Debian package assimp-testmodels");
   ARVIEW_REQUIRE_DATA_PATH(std::string(kBvhDir) + "/01_03.bvh", "Debian package assimp-testmodels");
-  const Character bcn = LoadCharacter(kBcn), cmu1 = LoadCharacter(std::string(kBvhDir) + "/01_01.bvh"),
+  const anim::Character bcn = LoadCharacter(kBcn), cmu1 = LoadCharacter(std::string(kBvhDir) + "/01_01.bvh"),
                   cmu3 = LoadCharacter(std::string(kBvhDir) + "/01_03.bvh");
   try {
     LearnIdleModel(bcn.skeleton, {{&cmu1, {&cmu1.clips.front()}, false}, {&cmu3, {&cmu3.clips.front()}, false}}, {});
     FAIL() << "learned from jumping";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     std::printf("[idle] CMU 01_01 + 01_03 on BCN_Epileptic: %s\n", e.what());
     EXPECT_NE(std::string(e.what()).find("no standing segment"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("the stillest is"), std::string::npos);
@@ -155,4 +155,4 @@ TEST(Idle, CmuCapturesHoldNoStandingSegment) {
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

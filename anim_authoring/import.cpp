@@ -18,7 +18,7 @@
 #include <set>
 #include <unordered_map>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -52,7 +52,7 @@ NodeSelection SelectSkeletonNodes(const aiScene* scene, const std::set<std::stri
   std::vector<std::vector<const aiNode*>> paths;
   for (const std::string& name : names) {
     const aiNode* n = scene->mRootNode->FindNode(name.c_str());
-    if (!n) throw Error(file + ": the skin names a bone '" + name + "' that is not a node of the file");
+    if (!n) throw anim::Error(file + ": the skin names a bone '" + name + "' that is not a node of the file");
     paths.push_back(PathFromRoot(n));
   }
   std::size_t common = paths.front().size();
@@ -67,19 +67,19 @@ NodeSelection SelectSkeletonNodes(const aiScene* scene, const std::set<std::stri
   return sel;
 }
 
-void AddJoints(const aiNode* node, int parent, const NodeSelection& sel, Skeleton& sk,
+void AddJoints(const aiNode* node, int parent, const NodeSelection& sel, anim::Skeleton& sk,
                std::unordered_map<const aiNode*, int>& index) {
   if (!sel.members.count(node)) return;
   const int j = sk.size();
   index[node] = j;
   sk.names.emplace_back(node->mName.C_Str());
   sk.parents.push_back(parent);
-  sk.rest.push_back(Transform::FromMatrix(ToEigen(node->mTransformation)));
+  sk.rest.push_back(anim::Transform::FromMatrix(ToEigen(node->mTransformation)));
   sk.inverse_bind.push_back(Eigen::Matrix4d::Identity());
   for (unsigned c = 0; c < node->mNumChildren; ++c) AddJoints(node->mChildren[c], j, sel, sk, index);
 }
 
-std::vector<Eigen::Matrix4d> RestModel(const Skeleton& sk) {
+std::vector<Eigen::Matrix4d> RestModel(const anim::Skeleton& sk) {
   std::vector<Eigen::Matrix4d> g(sk.size());
   for (int j = 0; j < sk.size(); ++j)
     g[j] = (sk.parents[j] < 0 ? sk.root_parent : g[sk.parents[j]]) * sk.rest[j].ToMatrix();
@@ -92,7 +92,7 @@ struct Influence {
 };
 
 // Applies `m` to a mesh's positions and its inverse transpose to its normals.
-void BakeTransform(Mesh& mesh, const Eigen::Matrix4d& m) {
+void BakeTransform(anim::Mesh& mesh, const Eigen::Matrix4d& m) {
   if (m.isIdentity(1e-12)) return;
   const Eigen::Matrix3f a = m.block<3, 3>(0, 0).cast<float>();
   const Eigen::Vector3f t = m.block<3, 1>(0, 3).cast<float>();
@@ -101,7 +101,7 @@ void BakeTransform(Mesh& mesh, const Eigen::Matrix4d& m) {
   for (auto& v : mesh.normals) v = (n * v).normalized();
 }
 
-void FinishInfluences(Mesh& mesh, std::vector<std::vector<Influence>>& inf, int fallback_joint) {
+void FinishInfluences(anim::Mesh& mesh, std::vector<std::vector<Influence>>& inf, int fallback_joint) {
   mesh.joints.resize(mesh.positions.size());
   mesh.weights.resize(mesh.positions.size());
   for (std::size_t v = 0; v < inf.size(); ++v) {
@@ -126,8 +126,8 @@ void FinishInfluences(Mesh& mesh, std::vector<std::vector<Influence>>& inf, int 
   }
 }
 
-Mesh CopyGeometry(const aiMesh* m) {
-  Mesh mesh;
+anim::Mesh CopyGeometry(const aiMesh* m) {
+  anim::Mesh mesh;
   mesh.name = m->mName.C_Str();
   mesh.material = static_cast<int>(m->mMaterialIndex);
   mesh.positions.reserve(m->mNumVertices);
@@ -156,8 +156,8 @@ class Importer {
  public:
   Importer(const aiScene* scene, const fs::path& path) : scene_(scene), path_(path), file_(path.string()) {}
 
-  Character Run() {
-    Character c;
+  anim::Character Run() {
+    anim::Character c;
     c.source = file_;
     BuildSkeleton(c.skeleton);
     rest_model_ = RestModel(c.skeleton);
@@ -168,7 +168,7 @@ class Importer {
   }
 
  private:
-  void BuildSkeleton(Skeleton& sk) {
+  void BuildSkeleton(anim::Skeleton& sk) {
     std::set<std::string> names;
     for (unsigned i = 0; i < scene_->mNumMeshes; ++i)
       for (unsigned b = 0; b < scene_->mMeshes[i]->mNumBones; ++b)
@@ -177,15 +177,15 @@ class Importer {
       for (unsigned a = 0; a < scene_->mNumAnimations; ++a)
         for (unsigned ch = 0; ch < scene_->mAnimations[a]->mNumChannels; ++ch)
           names.insert(scene_->mAnimations[a]->mChannels[ch]->mNodeName.C_Str());
-    if (names.empty()) throw Error(file_ + ": no skeleton (no skinned mesh and no animated node)");
+    if (names.empty()) throw anim::Error(file_ + ": no skeleton (no skinned mesh and no animated node)");
     const NodeSelection sel = SelectSkeletonNodes(scene_, names, file_);
     if (sel.top->mParent) sk.root_parent = GlobalTransform(sel.top->mParent);
     AddJoints(sel.top, -1, sel, sk, index_);
-    if (sk.size() > 65535) throw Error(file_ + ": more than 65535 joints");
+    if (sk.size() > 65535) throw anim::Error(file_ + ": more than 65535 joints");
   }
 
-  void ImportMeshes(Character& c) {
-    Skeleton& sk = c.skeleton;
+  void ImportMeshes(anim::Character& c) {
+    anim::Skeleton& sk = c.skeleton;
     std::vector<bool> has_bind(sk.size(), false);
     // Skinned meshes first: they define the inverse bind matrices.
     std::vector<std::pair<const aiNode*, unsigned>> instances;
@@ -193,7 +193,7 @@ class Importer {
     for (const auto& [node, mi] : instances) {
       const aiMesh* m = scene_->mMeshes[mi];
       if (m->mNumBones == 0 || m->mNumVertices == 0) continue;
-      Mesh mesh = CopyGeometry(m);
+      anim::Mesh mesh = CopyGeometry(m);
       std::vector<std::vector<Influence>> inf(m->mNumVertices);
       const Eigen::Matrix4d place = RestPlacement(m);
       BakeTransform(mesh, place);
@@ -212,7 +212,7 @@ class Importer {
           const Eigen::Matrix4d d = sk.inverse_bind[j].inverse() * offset;
           if (!bake) bake = d;
           else if (!bake->isApprox(d, 1e-6))
-            throw Error(file_ + ": mesh '" + mesh.name + "' is bound with inconsistent bind matrices for bone '" +
+            throw anim::Error(file_ + ": mesh '" + mesh.name + "' is bound with inconsistent bind matrices for bone '" +
                         sk.names[j] + "'");
         }
         for (unsigned w = 0; w < bone->mNumWeights; ++w) {
@@ -231,7 +231,7 @@ class Importer {
       const aiMesh* m = scene_->mMeshes[mi];
       if (m->mNumBones != 0 || m->mNumVertices == 0) continue;
       const int j = NearestJoint(node);
-      Mesh mesh = CopyGeometry(m);
+      anim::Mesh mesh = CopyGeometry(m);
       // At rest: model_j · IB_j · v' = G_node · v.
       BakeTransform(mesh, sk.inverse_bind[j].inverse() * rest_model_[j].inverse() * GlobalTransform(node));
       std::vector<std::vector<Influence>> inf(m->mNumVertices, {{j, 1.0f}});
@@ -277,15 +277,15 @@ class Importer {
   int JointOf(const std::string& name) const {
     const aiNode* n = scene_->mRootNode->FindNode(name.c_str());
     auto it = index_.find(n);
-    if (it == index_.end()) throw Error(file_ + ": bone '" + name + "' is not in the skeleton");
+    if (it == index_.end()) throw anim::Error(file_ + ": bone '" + name + "' is not in the skeleton");
     return it->second;
   }
 
-  void ImportMaterials(Character& c) {
+  void ImportMaterials(anim::Character& c) {
     std::map<std::string, int> texture_index;
     for (unsigned i = 0; i < scene_->mNumMaterials; ++i) {
       const aiMaterial* mat = scene_->mMaterials[i];
-      Material m;
+      anim::Material m;
       aiString name;
       if (mat->Get(AI_MATKEY_NAME, name) == AI_SUCCESS) m.name = name.C_Str();
       aiColor4D col;
@@ -306,8 +306,8 @@ class Importer {
     }
   }
 
-  Texture LoadTexture(const std::string& key) const {
-    Texture t;
+  anim::Texture LoadTexture(const std::string& key) const {
+    anim::Texture t;
     if (const aiTexture* e = scene_->GetEmbeddedTexture(key.c_str())) {
       if (e->mHeight == 0) {
         const auto* bytes = reinterpret_cast<const std::uint8_t*>(e->pcData);
@@ -330,11 +330,11 @@ class Importer {
     return t;
   }
 
-  void ImportClips(Character& c) {
+  void ImportClips(anim::Character& c) {
     std::set<std::string> used;
     for (unsigned a = 0; a < scene_->mNumAnimations; ++a) {
       const aiAnimation* anim = scene_->mAnimations[a];
-      Clip clip;
+      anim::Clip clip;
       clip.name = anim->mName.length ? anim->mName.C_Str() : "clip" + std::to_string(a);
       for (int n = 2; used.count(clip.name); ++n) clip.name = std::string(anim->mName.C_Str()) + "#" + std::to_string(n);
       used.insert(clip.name);
@@ -347,7 +347,7 @@ class Importer {
         const aiNode* node = scene_->mRootNode->FindNode(na->mNodeName);
         auto it = index_.find(node);
         if (it == index_.end()) continue;  // animates a node outside the skeleton (e.g. a mesh node)
-        JointTrack& tr = clip.tracks[it->second];
+        anim::JointTrack& tr = clip.tracks[it->second];
         for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
           const auto& v = na->mPositionKeys[k];
           tr.translation.push_back({v.mTime / tps, Eigen::Vector3d(v.mValue.x, v.mValue.y, v.mValue.z)});
@@ -362,12 +362,12 @@ class Importer {
         }
         for (const auto* keys : {&tr.translation, &tr.scale})
           for (const auto& k : *keys)
-            if (!k.value.allFinite()) throw Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
+            if (!k.value.allFinite()) throw anim::Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
         for (const auto& k : tr.rotation)
-          if (!k.value.coeffs().allFinite()) throw Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
+          if (!k.value.coeffs().allFinite()) throw anim::Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
       }
       if (!(clip.duration >= 0) || !std::isfinite(clip.duration))
-        throw Error(file_ + ": clip '" + clip.name + "' has an invalid duration");
+        throw anim::Error(file_ + ": clip '" + clip.name + "' has an invalid duration");
       c.clips.push_back(std::move(clip));
     }
   }
@@ -389,19 +389,19 @@ bool IsBuiltinAsset(const fs::path& asset) { return asset.native().rfind(kBuilti
 
 void SetBuiltinCharacterProvider(BuiltinCharacterProvider provider) { builtin_provider = provider; }
 
-Character LoadCharacter(const fs::path& path) {
+anim::Character LoadCharacter(const fs::path& path) {
   const std::string file = path.string();
   if (IsBuiltinAsset(path)) {
     const BuiltinCharacterProvider provider = builtin_provider.load();
-    if (!provider) throw Error(file + ": built-in characters are not available in this program");
+    if (!provider) throw anim::Error(file + ": built-in characters are not available in this program");
     return provider(file.substr(std::string(kBuiltinAssetPrefix).size()));
   }
   std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(file + ": no such file");
-  if (!fs::is_regular_file(path, ec)) throw Error(file + ": not a regular file");
+  if (!fs::exists(path, ec)) throw anim::Error(file + ": no such file");
+  if (!fs::is_regular_file(path, ec)) throw anim::Error(file + ": not a regular file");
   {
     std::ifstream probe(path, std::ios::binary);
-    if (!probe) throw Error(file + ": cannot open for reading");
+    if (!probe) throw anim::Error(file + ": cannot open for reading");
   }
   // Assimp trusts a glTF's indices and byte ranges (and crashes on a skin without inverse bind
   // matrices): the structure is checked first. Other formats go to Assimp as they are.
@@ -414,9 +414,9 @@ Character LoadCharacter(const fs::path& path) {
                 aiProcess_LimitBoneWeights | aiProcess_SortByPType);
   if (!scene || !scene->mRootNode) {
     const std::string why = importer.GetErrorString();
-    throw Error(file + ": cannot read as a 3D asset" + (why.empty() ? std::string() : ": " + why));
+    throw anim::Error(file + ": cannot read as a 3D asset" + (why.empty() ? std::string() : ": " + why));
   }
   return Importer(scene, path).Run();
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <fstream>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -21,18 +21,18 @@ fs::path CesiumMan() { return testing::SharedData("characters/CesiumMan.glb"); }
 // model space, relative to the model's size.
 // Vertices weighted to a joint in `skip` are left out (bones whose rest pose is not their bind
 // pose in the file).
-double RestSkinningError(const Character& c, SkinningMethod method, const std::vector<std::string>& skip = {}) {
-  const Skeleton& sk = c.skeleton;
-  const LocalPose rest = LocalPose::Rest(sk);
+double RestSkinningError(const anim::Character& c, anim::SkinningMethod method, const std::vector<std::string>& skip = {}) {
+  const anim::Skeleton& sk = c.skeleton;
+  const anim::LocalPose rest = anim::LocalPose::Rest(sk);
   std::vector<Eigen::Matrix4d> model(sk.size());
-  EXPECT_TRUE((LocalToModelJob{&sk, &rest, model}.Run()));
+  EXPECT_TRUE((anim::LocalToModelJob{&sk, &rest, model}.Run()));
   std::vector<Eigen::Matrix4f> skin(sk.size());
-  std::vector<DualQuatf> dq(sk.size());
-  EXPECT_TRUE((SkinningMatricesJob{&sk, model, skin, dq}.Run()));
+  std::vector<anim::DualQuatf> dq(sk.size());
+  EXPECT_TRUE((anim::SkinningMatricesJob{&sk, model, skin, dq}.Run()));
   double worst = 0, extent = 0;
-  for (const Mesh& m : c.meshes) {
+  for (const anim::Mesh& m : c.meshes) {
     std::vector<Eigen::Vector3f> pos(m.vertex_count()), nrm(m.vertex_count());
-    EXPECT_TRUE((SkinningJob{&m, method, skin, dq, pos, nrm}.Run()));
+    EXPECT_TRUE((anim::SkinningJob{&m, method, skin, dq, pos, nrm}.Run()));
     for (int v = 0; v < m.vertex_count(); ++v) {
       bool skipped = false;
       for (int i = 0; i < 4; ++i)
@@ -45,8 +45,8 @@ double RestSkinningError(const Character& c, SkinningMethod method, const std::v
   return worst / std::max(extent, 1e-9);
 }
 
-void ExpectValidSkin(const Character& c) {
-  for (const Mesh& m : c.meshes) {
+void ExpectValidSkin(const anim::Character& c) {
+  for (const anim::Mesh& m : c.meshes) {
     ASSERT_EQ(m.joints.size(), m.positions.size());
     ASSERT_EQ(m.normals.size(), m.positions.size());
     ASSERT_EQ(m.indices.size() % 3, 0u);
@@ -62,7 +62,7 @@ void ExpectValidSkin(const Character& c) {
 
 TEST(Import, Fox) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const Character c = LoadCharacter(Fox());
+  const anim::Character c = LoadCharacter(Fox());
   EXPECT_EQ(c.skeleton.size(), 24);
   ASSERT_EQ(c.clips.size(), 3u);
   EXPECT_NE(c.FindClip("Survey"), nullptr);
@@ -72,45 +72,45 @@ TEST(Import, Fox) {
   ASSERT_EQ(c.meshes.size(), 1u);
   EXPECT_FALSE(c.meshes[0].uvs.empty());
   ASSERT_GE(c.meshes[0].material, 0);
-  const Material& mat = c.materials[c.meshes[0].material];
+  const anim::Material& mat = c.materials[c.meshes[0].material];
   ASSERT_GE(mat.texture, 0);
   EXPECT_EQ(c.textures[mat.texture].format_hint, "png");
   EXPECT_GT(c.textures[mat.texture].encoded.size(), 1000u);
   ExpectValidSkin(c);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-5);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-5);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-5);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kDualQuaternion), 1e-5);
 }
 
 TEST(Import, CesiumMan) {
   ARVIEW_REQUIRE_DATA_PATH(CesiumMan(), "../shared/data");
-  const Character c = LoadCharacter(CesiumMan());
+  const anim::Character c = LoadCharacter(CesiumMan());
   EXPECT_EQ(c.skeleton.size(), 19);
   EXPECT_EQ(c.clips.size(), 1u);
   ASSERT_EQ(c.meshes.size(), 1u);
   ExpectValidSkin(c);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kDualQuaternion), 1e-4);
 }
 
 TEST(Import, BcnEpilepticX) {
   ARVIEW_REQUIRE_DATA_PATH(kBcn, "Debian package assimp-testmodels");
-  const Character c = LoadCharacter(kBcn);
+  const anim::Character c = LoadCharacter(kBcn);
   EXPECT_EQ(c.skeleton.size(), 54);
   EXPECT_EQ(c.clips.size(), 1u);
   EXPECT_EQ(c.meshes.size(), 3u);
   EXPECT_GE(c.skeleton.Find("B_Neck"), 0);
   ExpectValidSkin(c);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kDualQuaternion), 1e-4);
 }
 
 TEST(Import, CmuBvh) {
   ARVIEW_REQUIRE_DATA_PATH(kBvh, "Debian package assimp-testmodels");
-  const Character c = LoadCharacter(kBvh);
+  const anim::Character c = LoadCharacter(kBvh);
   EXPECT_EQ(c.skeleton.size(), 31);
   EXPECT_TRUE(c.meshes.empty());
   ASSERT_EQ(c.clips.size(), 1u);
-  const Clip& clip = c.clips[0];
+  const anim::Clip& clip = c.clips[0];
   EXPECT_NEAR(clip.ticks_per_second, 120.0, 1e-3);
   const int hips = c.skeleton.Find("Hips");
   ASSERT_EQ(hips, 0);
@@ -123,59 +123,59 @@ TEST(Import, CmuBvh) {
 TEST(Import, FbxSkinned) {
   const fs::path fbx = "/usr/share/assimp/models/FBX/animation_with_skeleton.fbx";
   ARVIEW_REQUIRE_DATA_PATH(fbx, "Debian package assimp-testmodels");
-  const Character c = LoadCharacter(fbx);
+  const anim::Character c = LoadCharacter(fbx);
   EXPECT_EQ(c.skeleton.size(), 15);
   ASSERT_EQ(c.clips.size(), 1u);
   EXPECT_NEAR(c.clips[0].duration, 0.833, 0.01);
   ASSERT_EQ(c.meshes.size(), 1u);
   ExpectValidSkin(c);
   // In this file Bone.005 and Bone.006 rest away from their bind pose; the rest is bound as it rests.
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear, {"Bone.005", "Bone.006"}), 1e-5);
-  EXPECT_GT(RestSkinningError(c, SkinningMethod::kLinear), 1e-2);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear, {"Bone.005", "Bone.006"}), 1e-5);
+  EXPECT_GT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-2);
 }
 
 TEST(Import, ColladaSkinned) {
   const fs::path dae = "/usr/share/assimp/models/Collada/box_nested_animation.dae";
   ARVIEW_REQUIRE_DATA_PATH(dae, "Debian package assimp-testmodels");
-  const Character c = LoadCharacter(dae);
+  const anim::Character c = LoadCharacter(dae);
   EXPECT_EQ(c.skeleton.size(), 1);
   EXPECT_EQ(c.clips.size(), 1u);
   ASSERT_EQ(c.meshes.size(), 1u);
   ExpectValidSkin(c);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-5);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-5);
 }
 
 TEST(Import, ColladaRigidMeshesFollowTheirNodes) {
   // 64 animated boxes in a chain, no skin: each mesh is bound rigidly to its node.
   const fs::path dae = "/usr/share/assimp/models/Collada/anims_with_full_rotations_between_keys.DAE";
   ARVIEW_REQUIRE_DATA_PATH(dae, "Debian package assimp-testmodels");
-  const Character c = LoadCharacter(dae);
+  const anim::Character c = LoadCharacter(dae);
   EXPECT_EQ(c.skeleton.size(), 64);
   EXPECT_FALSE(c.meshes.empty());
   ExpectValidSkin(c);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kLinear), 1e-4);
-  EXPECT_LT(RestSkinningError(c, SkinningMethod::kDualQuaternion), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kLinear), 1e-4);
+  EXPECT_LT(RestSkinningError(c, anim::SkinningMethod::kDualQuaternion), 1e-4);
 }
 
 TEST(Import, SamplingInterpolatesAndLoops) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const Character c = LoadCharacter(Fox());
-  const Clip& walk = *c.FindClip("Walk");
-  const Skeleton& sk = c.skeleton;
-  LocalPose a(sk.size()), b(sk.size());
-  ASSERT_TRUE((SamplingJob{&sk, &walk, 0.1, true, &a}.Run()));
-  ASSERT_TRUE((SamplingJob{&sk, &walk, 0.1 + walk.duration, true, &b}.Run()));
+  const anim::Character c = LoadCharacter(Fox());
+  const anim::Clip& walk = *c.FindClip("Walk");
+  const anim::Skeleton& sk = c.skeleton;
+  anim::LocalPose a(sk.size()), b(sk.size());
+  ASSERT_TRUE((anim::SamplingJob{&sk, &walk, 0.1, true, &a}.Run()));
+  ASSERT_TRUE((anim::SamplingJob{&sk, &walk, 0.1 + walk.duration, true, &b}.Run()));
   for (int j = 0; j < sk.size(); ++j) EXPECT_LT((a.rigid[j].ToMatrix() - b.rigid[j].ToMatrix()).norm(), 1e-9);
   // Clamp: beyond the end holds the last key.
-  ASSERT_TRUE((SamplingJob{&sk, &walk, 100.0, false, &a}.Run()));
-  ASSERT_TRUE((SamplingJob{&sk, &walk, walk.duration, false, &b}.Run()));
+  ASSERT_TRUE((anim::SamplingJob{&sk, &walk, 100.0, false, &a}.Run()));
+  ASSERT_TRUE((anim::SamplingJob{&sk, &walk, walk.duration, false, &b}.Run()));
   for (int j = 0; j < sk.size(); ++j) EXPECT_LT((a.rigid[j].ToMatrix() - b.rigid[j].ToMatrix()).norm(), 1e-9);
   // Between two keys the rotation lies between the keys' rotations.
   const int hip = sk.Find("b_Hip_01");
   const auto& keys = walk.tracks[hip].rotation;
   ASSERT_GT(keys.size(), 2u);
   const double mid = 0.5 * (keys[0].time + keys[1].time);
-  ASSERT_TRUE((SamplingJob{&sk, &walk, mid, false, &a}.Run()));
+  ASSERT_TRUE((anim::SamplingJob{&sk, &walk, mid, false, &a}.Run()));
   const Eigen::Quaterniond r = a.rigid[hip].Rotation();
   EXPECT_NEAR(r.angularDistance(keys[0].value), 0.5 * keys[0].value.angularDistance(keys[1].value), 1e-9);
 }
@@ -187,14 +187,14 @@ TEST(Import, NlerpSamplingStaysCloseToSlerp) {
   ARVIEW_REQUIRE_DATA_PATH(kBvh, "Debian package assimp-testmodels");
   ARVIEW_REQUIRE_DATA_PATH(kBcn, "Debian package assimp-testmodels");
   for (const fs::path& asset : {Fox(), CesiumMan(), kBcn, kBvh}) {
-    const Character c = LoadCharacter(asset);
+    const anim::Character c = LoadCharacter(asset);
     double worst = 0;
-    for (const Clip& clip : c.clips) {
-      LocalPose a(c.skeleton.size()), b(c.skeleton.size());
+    for (const anim::Clip& clip : c.clips) {
+      anim::LocalPose a(c.skeleton.size()), b(c.skeleton.size());
       for (int s = 0; s < 997; ++s) {
         const double t = clip.duration * s / 997.0;
-        ASSERT_TRUE((SamplingJob{&c.skeleton, &clip, t, true, &a, false}.Run()));
-        ASSERT_TRUE((SamplingJob{&c.skeleton, &clip, t, true, &b, true}.Run()));
+        ASSERT_TRUE((anim::SamplingJob{&c.skeleton, &clip, t, true, &a, false}.Run()));
+        ASSERT_TRUE((anim::SamplingJob{&c.skeleton, &clip, t, true, &b, true}.Run()));
         for (int j = 0; j < c.skeleton.size(); ++j)
           worst = std::max(worst, a.rigid[j].Rotation().angularDistance(b.rigid[j].Rotation()));
       }
@@ -206,16 +206,16 @@ TEST(Import, NlerpSamplingStaysCloseToSlerp) {
 
 TEST(Import, JobsRejectMismatchedSizes) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const Character c = LoadCharacter(Fox());
-  LocalPose wrong(3);
-  EXPECT_FALSE((SamplingJob{&c.skeleton, &c.clips[0], 0.0, true, &wrong}.Run()));
+  const anim::Character c = LoadCharacter(Fox());
+  anim::LocalPose wrong(3);
+  EXPECT_FALSE((anim::SamplingJob{&c.skeleton, &c.clips[0], 0.0, true, &wrong}.Run()));
   std::vector<Eigen::Matrix4d> model(2);
-  LocalPose rest = LocalPose::Rest(c.skeleton);
-  EXPECT_FALSE((LocalToModelJob{&c.skeleton, &rest, model}.Run()));
-  LocalPose out(c.skeleton.size());
-  const LocalPose* inputs[] = {&rest, &rest};
+  anim::LocalPose rest = anim::LocalPose::Rest(c.skeleton);
+  EXPECT_FALSE((anim::LocalToModelJob{&c.skeleton, &rest, model}.Run()));
+  anim::LocalPose out(c.skeleton.size());
+  const anim::LocalPose* inputs[] = {&rest, &rest};
   const double zero[] = {0.0, 0.0}, nan[] = {NAN, 1.0}, fine[] = {0.5, 0.5};
-  BlendingJob blend;
+  anim::BlendingJob blend;
   blend.inputs = inputs;
   blend.output = &out;
   blend.weights = zero;
@@ -224,27 +224,27 @@ TEST(Import, JobsRejectMismatchedSizes) {
   EXPECT_FALSE(blend.Run());
   blend.weights = fine;
   EXPECT_TRUE(blend.Run());
-  const LocalPose* mismatched[] = {&rest, &wrong};
+  const anim::LocalPose* mismatched[] = {&rest, &wrong};
   blend.inputs = mismatched;
   EXPECT_FALSE(blend.Run());
 }
 
 TEST(Import, AnimatedPoseLbsAndDqsAgreeRoughly) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const Character c = LoadCharacter(Fox());
-  const Skeleton& sk = c.skeleton;
-  LocalPose p(sk.size());
-  ASSERT_TRUE((SamplingJob{&sk, c.FindClip("Run"), 0.3, true, &p}.Run()));
+  const anim::Character c = LoadCharacter(Fox());
+  const anim::Skeleton& sk = c.skeleton;
+  anim::LocalPose p(sk.size());
+  ASSERT_TRUE((anim::SamplingJob{&sk, c.FindClip("Run"), 0.3, true, &p}.Run()));
   std::vector<Eigen::Matrix4d> model(sk.size());
-  ASSERT_TRUE((LocalToModelJob{&sk, &p, model}.Run()));
+  ASSERT_TRUE((anim::LocalToModelJob{&sk, &p, model}.Run()));
   std::vector<Eigen::Matrix4f> skin(sk.size());
-  std::vector<DualQuatf> dq(sk.size());
-  ASSERT_TRUE((SkinningMatricesJob{&sk, model, skin, dq}.Run()));
-  EXPECT_TRUE(RigidSkinning(skin));
-  const Mesh& m = c.meshes[0];
+  std::vector<anim::DualQuatf> dq(sk.size());
+  ASSERT_TRUE((anim::SkinningMatricesJob{&sk, model, skin, dq}.Run()));
+  EXPECT_TRUE(anim::RigidSkinning(skin));
+  const anim::Mesh& m = c.meshes[0];
   std::vector<Eigen::Vector3f> lbs(m.vertex_count()), dqs(m.vertex_count());
-  ASSERT_TRUE((SkinningJob{&m, SkinningMethod::kLinear, skin, dq, lbs, {}}.Run()));
-  ASSERT_TRUE((SkinningJob{&m, SkinningMethod::kDualQuaternion, skin, dq, dqs, {}}.Run()));
+  ASSERT_TRUE((anim::SkinningJob{&m, anim::SkinningMethod::kLinear, skin, dq, lbs, {}}.Run()));
+  ASSERT_TRUE((anim::SkinningJob{&m, anim::SkinningMethod::kDualQuaternion, skin, dq, dqs, {}}.Run()));
   double worst = 0, moved = 0;
   for (int v = 0; v < m.vertex_count(); ++v) {
     worst = std::max(worst, double((lbs[v] - dqs[v]).norm()));
@@ -266,7 +266,7 @@ TEST(ImportErrors, MissingFile) {
   try {
     LoadCharacter("/nonexistent/dir/fox.glb");
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/fox.glb: no such file"), std::string::npos) << e.what();
   }
 }
@@ -280,7 +280,7 @@ TEST(ImportErrors, TruncatedGltf) {
   try {
     LoadCharacter(cut);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     // Refused by the structure check before Assimp (anim_authoring/gltf_check.h).
     EXPECT_NE(std::string(e.what()).find(cut.string() + ": the GLB header gives a length of"), std::string::npos)
         << e.what();
@@ -294,11 +294,11 @@ TEST(ImportErrors, NoSkeleton) {
   try {
     LoadCharacter(obj);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find(obj.string() + ": no skeleton"), std::string::npos) << e.what();
   }
   fs::remove(obj);
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 std::string Lower(std::string s) {
@@ -26,7 +26,7 @@ bool IsSpineLike(const std::string& n) {
          Contains(n, "back") || Contains(n, "head");
 }
 
-int Depth(const Skeleton& sk, int j) {
+int Depth(const anim::Skeleton& sk, int j) {
   int d = 0;
   for (; sk.parents[j] >= 0; j = sk.parents[j]) ++d;
   return d;
@@ -38,15 +38,15 @@ Eigen::Matrix3d RotationOf(const Eigen::Matrix4d& m) {
   return r;
 }
 
-std::vector<Eigen::Matrix4d> ModelPose(const Skeleton& sk, const LocalPose& pose) {
+std::vector<Eigen::Matrix4d> ModelPose(const anim::Skeleton& sk, const anim::LocalPose& pose) {
   std::vector<Eigen::Matrix4d> model(sk.size());
-  MustRun(LocalToModelJob{&sk, &pose, model}, "look-at");
+  anim::MustRun(anim::LocalToModelJob{&sk, &pose, model}, "look-at");
   return model;
 }
 
 }  // namespace
 
-std::vector<std::string> DefaultLookAtChain(const Skeleton& sk) {
+std::vector<std::string> DefaultLookAtChain(const anim::Skeleton& sk) {
   // The head: the shallowest joint named like a head (not an end marker); else the deepest
   // neck-like joint (rigs such as BCN_Epileptic and CesiumMan end their spine at the neck).
   int head = -1;
@@ -75,24 +75,24 @@ std::vector<std::string> DefaultLookAtChain(const Skeleton& sk) {
   return chain;
 }
 
-LookAtChain MakeLookAtChain(const Skeleton& sk, const std::vector<std::string>& names_in,
+anim::LookAtChain MakeLookAtChain(const anim::Skeleton& sk, const std::vector<std::string>& names_in,
                             const std::vector<double>& limits_deg, const Eigen::Vector3d& forward,
                             const Eigen::Vector3d& up) {
   const std::vector<std::string> names = names_in.empty() ? DefaultLookAtChain(sk) : names_in;
-  if (names.empty()) throw Error("look-at: no head or neck joint found by name; list the chain joints");
+  if (names.empty()) throw anim::Error("look-at: no head or neck joint found by name; list the chain joints");
   if (!limits_deg.empty() && limits_deg.size() != names.size())
-    throw Error("look-at: " + std::to_string(limits_deg.size()) + " limits for " + std::to_string(names.size()) +
+    throw anim::Error("look-at: " + std::to_string(limits_deg.size()) + " limits for " + std::to_string(names.size()) +
                 " chain joints");
-  if (forward.norm() < 1e-9 || up.norm() < 1e-9) throw Error("look-at: forward and up must not be zero");
-  LookAtChain chain;
+  if (forward.norm() < 1e-9 || up.norm() < 1e-9) throw anim::Error("look-at: forward and up must not be zero");
+  anim::LookAtChain chain;
   chain.up = up.normalized();
   for (std::size_t i = 0; i < names.size(); ++i) {
     const int j = sk.Find(names[i]);
-    if (j < 0) throw Error("look-at: the skeleton has no joint '" + names[i] + "'");
+    if (j < 0) throw anim::Error("look-at: the skeleton has no joint '" + names[i] + "'");
     if (i > 0) {
       bool descends = false;
       for (int p = sk.parents[j]; p >= 0; p = sk.parents[p]) descends = descends || p == chain.joints.back();
-      if (!descends) throw Error("look-at: '" + names[i] + "' does not descend from '" + names[i - 1] + "'");
+      if (!descends) throw anim::Error("look-at: '" + names[i] + "' does not descend from '" + names[i - 1] + "'");
     }
     chain.joints.push_back(j);
     double limit;
@@ -101,10 +101,10 @@ LookAtChain MakeLookAtChain(const Skeleton& sk, const std::vector<std::string>& 
     else if (i + 1 == names.size()) limit = 70;
     else if (i + 2 == names.size()) limit = 50;
     else limit = 45;
-    if (!(limit > 0) || limit > 180) throw Error("look-at: limit for '" + names[i] + "' must be in (0, 180] degrees");
+    if (!(limit > 0) || limit > 180) throw anim::Error("look-at: limit for '" + names[i] + "' must be in (0, 180] degrees");
     chain.limits_rad.push_back(limit * M_PI / 180);
   }
-  const std::vector<Eigen::Matrix4d> rest = ModelPose(sk, LocalPose::Rest(sk));
+  const std::vector<Eigen::Matrix4d> rest = ModelPose(sk, anim::LocalPose::Rest(sk));
   chain.head_forward_local = (RotationOf(rest[chain.joints.back()]).transpose() * forward.normalized()).normalized();
   return chain;
 }
@@ -112,7 +112,7 @@ LookAtChain MakeLookAtChain(const Skeleton& sk, const std::vector<std::string>& 
 namespace {
 
 // Refreshes the model transforms of joint j and everything below it (children follow parents).
-void RefreshBelow(const Skeleton& sk, int j, const LocalPose& pose, std::vector<Eigen::Matrix4d>& model) {
+void RefreshBelow(const anim::Skeleton& sk, int j, const anim::LocalPose& pose, std::vector<Eigen::Matrix4d>& model) {
   for (int k = j; k < sk.size(); ++k) {
     if (k != j) {
       bool below = false;
@@ -128,13 +128,13 @@ void RefreshBelow(const Skeleton& sk, int j, const LocalPose& pose, std::vector<
 
 }  // namespace
 
-void RotateInModel(const Skeleton& sk, int j, const Eigen::Quaterniond& delta, LocalPose& pose,
+void RotateInModel(const anim::Skeleton& sk, int j, const Eigen::Quaterniond& delta, anim::LocalPose& pose,
                    std::vector<Eigen::Matrix4d>& model) {
   const int p = sk.parents[j];
   const Eigen::Quaterniond parent(RotationOf(p < 0 ? sk.root_parent : model[p]));
   const Eigen::Quaterniond local = pose.rigid[j].Rotation();
   const Eigen::Vector3d t = pose.rigid[j].Translation();
-  pose.rigid[j] = DualQuatd::FromRotationTranslation((parent.conjugate() * delta * parent * local).normalized(), t);
+  pose.rigid[j] = anim::DualQuatd::FromRotationTranslation((parent.conjugate() * delta * parent * local).normalized(), t);
   RefreshBelow(sk, j, pose, model);
 }
 
@@ -153,12 +153,12 @@ double UpperYaw(double phi, double share, double limit) {
 
 }  // namespace
 
-void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
+void ApplyLookAt(const anim::Skeleton& sk, const anim::LookAtChain& chain, const Eigen::Vector3d& target, anim::LocalPose& pose,
                  std::vector<Eigen::Matrix4d>& model) {
   const std::size_t n = chain.joints.size();
   const Eigen::Vector3d& up = chain.up;
   // Yaw about the up axis, measured on the horizontal projections.
-  const Eigen::Vector3d f = HeadForward(chain, model);
+  const Eigen::Vector3d f = anim::HeadForward(chain, model);
   const Eigen::Vector3d fh = f - f.dot(up) * up, th = target - target.dot(up) * up;
   if (fh.norm() > 1e-9 && th.norm() > 1e-9) {
     const double phi = std::atan2(fh.cross(th).dot(up), fh.dot(th));
@@ -174,7 +174,7 @@ void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vect
   // The remaining tilt (elevation), spread over the upper joints within their limits.
   const std::size_t first_tilt = n > 1 ? 1 : 0;
   for (std::size_t i = first_tilt; i < n; ++i) {
-    const Eigen::Quaterniond full = Eigen::Quaterniond::FromTwoVectors(HeadForward(chain, model), target);
+    const Eigen::Quaterniond full = Eigen::Quaterniond::FromTwoVectors(anim::HeadForward(chain, model), target);
     const double angle = Eigen::AngleAxisd(full).angle();
     if (angle < 1e-12) break;
     const double share = std::min({1.0, 1.0 / double(n - i), chain.limits_rad[i] / angle});
@@ -182,7 +182,7 @@ void ApplyLookAt(const Skeleton& sk, const LookAtChain& chain, const Eigen::Vect
   }
 }
 
-std::vector<double> KeySampleTimes(const Clip* base, double sample_rate) {
+std::vector<double> KeySampleTimes(const anim::Clip* base, double sample_rate) {
   if (!base || base->duration <= 0) return {0.0};
   const int samples = std::max(2, static_cast<int>(std::ceil(base->duration * sample_rate)) + 1);
   std::vector<double> times;
@@ -190,8 +190,8 @@ std::vector<double> KeySampleTimes(const Clip* base, double sample_rate) {
   return times;
 }
 
-Clip StartKeyClip(const Skeleton& sk, const Clip* base, std::string_view tag, const Eigen::Vector3d& target) {
-  Clip clip;
+anim::Clip StartKeyClip(const anim::Skeleton& sk, const anim::Clip* base, std::string_view tag, const Eigen::Vector3d& target) {
+  anim::Clip clip;
   clip.tracks.resize(sk.size());
   if (base) clip = *base;
   char where[96];
@@ -201,19 +201,19 @@ Clip StartKeyClip(const Skeleton& sk, const Clip* base, std::string_view tag, co
   return clip;
 }
 
-Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain& chain, const Eigen::Vector3d& viewpoint,
+anim::Clip GenerateLookAtClip(const anim::Skeleton& sk, const anim::Clip* base, const anim::LookAtChain& chain, const Eigen::Vector3d& viewpoint,
                         double sample_rate) {
-  if (viewpoint.norm() < 1e-9) throw Error("look-at: the key viewpoint has zero length");
-  if (chain.joints.empty()) throw Error("look-at: empty chain");
-  if (!(sample_rate > 0)) throw Error("look-at: sample rate must be positive");
+  if (viewpoint.norm() < 1e-9) throw anim::Error("look-at: the key viewpoint has zero length");
+  if (chain.joints.empty()) throw anim::Error("look-at: empty chain");
+  if (!(sample_rate > 0)) throw anim::Error("look-at: sample rate must be positive");
   const Eigen::Vector3d target = viewpoint.normalized();
-  Clip clip = StartKeyClip(sk, base, "lookat", target);
+  anim::Clip clip = StartKeyClip(sk, base, "lookat", target);
   const std::vector<double> times = KeySampleTimes(base, sample_rate);
   for (int j : chain.joints) clip.tracks[j].rotation.clear();
-  LocalPose pose(sk.size());
+  anim::LocalPose pose(sk.size());
   for (double t : times) {
-    if (base) MustRun(SamplingJob{&sk, base, t, false, &pose}, "look-at base clip");
-    else pose = LocalPose::Rest(sk);
+    if (base) anim::MustRun(anim::SamplingJob{&sk, base, t, false, &pose}, "look-at base clip");
+    else pose = anim::LocalPose::Rest(sk);
     std::vector<Eigen::Matrix4d> model = ModelPose(sk, pose);
     ApplyLookAt(sk, chain, target, pose, model);
     for (int j : chain.joints) clip.tracks[j].rotation.push_back({t, pose.rigid[j].Rotation()});
@@ -221,4 +221,4 @@ Clip GenerateLookAtClip(const Skeleton& sk, const Clip* base, const LookAtChain&
   return clip;
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -25,13 +25,13 @@
 #include <string_view>
 #include <vector>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 // Names of a body → spine → neck → head chain found by name in common rigs (Mixamo, CMU BVH,
 // Fox, BCN_Epileptic, CesiumMan, Unreal/Unity humanoids): the head (or, without one, the deepest
 // neck joint), its spine/neck/chest/back ancestors, and the skeleton's root first.
 // Empty when no head- or neck-like joint exists.
-std::vector<std::string> DefaultLookAtChain(const Skeleton& skeleton);
+std::vector<std::string> DefaultLookAtChain(const anim::Skeleton& skeleton);
 
 // Builds the chain. Empty `names` uses DefaultLookAtChain(); empty `limits_deg` uses 180° for
 // the first joint (the body), 45° per spine joint, 50° for the joint before the head and 70°
@@ -39,32 +39,32 @@ std::vector<std::string> DefaultLookAtChain(const Skeleton& skeleton);
 // forward axis is the model-space `forward` at rest, expressed in the head's frame.
 // Throws Error when a name is missing, the joints do not form one parent chain, or the
 // counts differ.
-LookAtChain MakeLookAtChain(const Skeleton& skeleton, const std::vector<std::string>& names,
+anim::LookAtChain MakeLookAtChain(const anim::Skeleton& skeleton, const std::vector<std::string>& names,
                             const std::vector<double>& limits_deg, const Eigen::Vector3d& forward,
                             const Eigen::Vector3d& up = Eigen::Vector3d::UnitY());
 
 // The base clip with the chain turned toward `viewpoint` (character frame) at every key time of
 // the base clip (resampled at `sample_rate` Hz where the chain's parents move between keys).
 // `base` may be nullptr: the result is a static look from the rest pose.
-Clip GenerateLookAtClip(const Skeleton& skeleton, const Clip* base, const LookAtChain& chain,
+anim::Clip GenerateLookAtClip(const anim::Skeleton& skeleton, const anim::Clip* base, const anim::LookAtChain& chain,
                         const Eigen::Vector3d& viewpoint, double sample_rate = 30.0);
 
 // The times a generated key samples: the base clip's duration at `sample_rate` Hz, both ends
 // included (at least two samples); {0} for no base clip or a zero-length one.
-std::vector<double> KeySampleTimes(const Clip* base, double sample_rate);
+std::vector<double> KeySampleTimes(const anim::Clip* base, double sample_rate);
 
 // A generated key's clip before its chain is turned: a copy of `base` (or empty tracks for
 // every joint of the rest pose), named after the base and `tag`, e.g. "Idle@lookat(0.00,0.00,1.00)";
 // `target` is the key's unit viewpoint.
-Clip StartKeyClip(const Skeleton& skeleton, const Clip* base, std::string_view tag, const Eigen::Vector3d& target);
+anim::Clip StartKeyClip(const anim::Skeleton& skeleton, const anim::Clip* base, std::string_view tag, const Eigen::Vector3d& target);
 
 // The steps GenerateLookAtClip takes per sample, for keys built on top of it (gesture.h).
 // `model` holds the model-space transforms of `pose` and is kept up to date.
 // Rotates joint j by `delta` (model space) about the joint's own origin.
-void RotateInModel(const Skeleton& skeleton, int j, const Eigen::Quaterniond& delta, LocalPose& pose,
+void RotateInModel(const anim::Skeleton& skeleton, int j, const Eigen::Quaterniond& delta, anim::LocalPose& pose,
                    std::vector<Eigen::Matrix4d>& model);
 // Turns the chain toward `target` (unit, model space).
-void ApplyLookAt(const Skeleton& skeleton, const LookAtChain& chain, const Eigen::Vector3d& target, LocalPose& pose,
+void ApplyLookAt(const anim::Skeleton& skeleton, const anim::LookAtChain& chain, const Eigen::Vector3d& target, anim::LocalPose& pose,
                  std::vector<Eigen::Matrix4d>& model);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

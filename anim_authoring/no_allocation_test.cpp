@@ -48,7 +48,7 @@ void* realloc(void* p, std::size_t n) {
 #define ARVIEW_COUNTS_ALLOCATIONS 1
 #endif
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 #ifdef ARVIEW_COUNTS_ALLOCATIONS
@@ -73,7 +73,7 @@ void ExpectUpdatesAllocateNothing([[maybe_unused]] testing::FourActionSchedule::
   // idle chains step past many extrema.
   bool all_finite = true;
   for (int frame = 0; frame < 1200; ++frame) {
-    const AnimatorFrame& f = schedule.Step(1.0 / 60);
+    const anim::AnimatorFrame& f = schedule.Step(1.0 / 60);
     all_finite = all_finite && f.skinning_matrices[0].allFinite();
   }
   const long allocations = g_allocations.load() - before;
@@ -102,9 +102,9 @@ TEST(NoAllocation, BalanceLayerOverTheIdleSynthesizer) {
   const auto standing = testing::LearnFromStanding(testing::LongStanding());
   ASSERT_TRUE(standing->balance);
   const auto sk = standing->skeleton();
-  auto idle = std::make_shared<IdleSynthesizer>(sk, std::make_shared<const IdleModel>(standing->idle), 1);
-  BalanceShifter layer(sk, std::make_shared<const BalanceModel>(*standing->balance), 1, idle);
-  LocalPose pose(sk->size());
+  auto idle = std::make_shared<anim::IdleSynthesizer>(sk, std::make_shared<const anim::IdleModel>(standing->idle), 1);
+  anim::BalanceShifter layer(sk, std::make_shared<const anim::BalanceModel>(*standing->balance), 1, idle);
+  anim::LocalPose pose(sk->size());
   ASSERT_TRUE(layer.Sample(0, {}, pose));
   const long before = g_allocations.load();
   bool sampled = true;
@@ -122,4 +122,4 @@ TEST(NoAllocation, BalanceLayerOverTheIdleSynthesizer) {
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

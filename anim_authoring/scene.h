@@ -68,7 +68,7 @@
 #include <string>
 #include <vector>
 
-namespace arview::anim {
+namespace arview::authoring {
 
 // The scene file's anchor is the one arview::Anchor (base/geometry.h): the rotation a unit
 // quaternion, as the placement that writes it.
@@ -125,7 +125,7 @@ struct ActionSpec {
   bool keep_rendering = false;
   int layer = 0;
   double weight = 1;
-  std::vector<Curve> curves, scalings;
+  std::vector<anim::Curve> curves, scalings;
   std::vector<MaskSpec> masks;
   bool has_trigger = false;  // a distance trigger: added when the viewer comes within `near`
   double trigger_near = 0, trigger_far = 0;
@@ -171,7 +171,7 @@ struct LookAtSpec {
 struct GestureSpec {
   ArmSide side = ArmSide::kRight;
   std::vector<std::string> chain;    // upper arm, forearm, hand; empty: DefaultArmChain()
-  ArmLimits limits;
+  anim::ArmLimits limits;
 };
 
 struct CharacterSpec {
@@ -182,16 +182,16 @@ struct CharacterSpec {
   Anchor anchor;
   Eigen::Vector3d forward = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
-  ViewSphereOptions weights;
-  BlendMethod blend = BlendMethod::kDlb;
-  DibOptions<double> dib;
-  PhaseMode phase = PhaseMode::kShared;
+  anim::ViewSphereOptions weights;
+  anim::BlendMethod blend = anim::BlendMethod::kDlb;
+  anim::DibOptions<double> dib;
+  anim::PhaseMode phase = anim::PhaseMode::kShared;
   bool nlerp_sampling = false;  // `sampling: nlerp` (default slerp): see SamplingJob::nlerp
   bool has_lookat = false;
   LookAtSpec lookat;
   GestureSpec gesture;     // `gesture:`, for keys with `gesture: point|reach`
   std::vector<KeySpec> keys;
-  ScopeTable scopes;       // `scopes:` added to the built-in ones
+  anim::ScopeTable scopes;       // `scopes:` added to the built-in ones
   IdleSpec idle;           // `idle:`
   ScheduleSpec schedule;   // `schedule:`
 
@@ -216,4 +216,4 @@ Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what 
 // "<clip>@<seconds>".
 std::string KeySourceLabel(const KeySpec& key);
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

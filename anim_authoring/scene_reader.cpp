@@ -8,7 +8,7 @@
 #include <set>
 #include <sstream>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -19,7 +19,7 @@ class SceneReader {
   explicit SceneReader(std::string file) : file_(std::move(file)) {}
 
   [[noreturn]] void Fail(const Node& n, const std::string& what) const {
-    throw Error(file_ + ":" + std::to_string(n.line) + ": " + what);
+    throw anim::Error(file_ + ":" + std::to_string(n.line) + ": " + what);
   }
 
   void OnlyKeys(const Node& n, const std::set<std::string>& allowed, const std::string& where) const {
@@ -110,12 +110,12 @@ class SceneReader {
     if (const Node* x = n.Find("weights")) {
       OnlyKeys(*x, {"mode", "distance", "alpha"}, "weights");
       if (const Node* y = x->Find("mode"))
-        c.weights.mode = Choice<WeightingMode>(*y, "weights.mode",
-                                               {{"inverse-distance", WeightingMode::kInverseDistance},
-                                                {"local", WeightingMode::kLocalSupport}});
+        c.weights.mode = Choice<anim::WeightingMode>(*y, "weights.mode",
+                                               {{"inverse-distance", anim::WeightingMode::kInverseDistance},
+                                                {"local", anim::WeightingMode::kLocalSupport}});
       if (const Node* y = x->Find("distance"))
-        c.weights.distance = Choice<DistanceKind>(*y, "weights.distance",
-                                                  {{"geodesic", DistanceKind::kGeodesic}, {"chordal", DistanceKind::kChordal}});
+        c.weights.distance = Choice<anim::DistanceKind>(*y, "weights.distance",
+                                                  {{"geodesic", anim::DistanceKind::kGeodesic}, {"chordal", anim::DistanceKind::kChordal}});
       if (const Node* y = x->Find("alpha")) {
         c.weights.alpha = Number(*y, "weights.alpha");
         if (!(c.weights.alpha > 0)) Fail(*y, "weights.alpha must be positive");
@@ -124,7 +124,7 @@ class SceneReader {
     if (const Node* x = n.Find("blend")) {
       OnlyKeys(*x, {"method", "precision", "max_iterations"}, "blend");
       if (const Node* y = x->Find("method"))
-        c.blend = Choice<BlendMethod>(*y, "blend.method", {{"dlb", BlendMethod::kDlb}, {"dib", BlendMethod::kDib}});
+        c.blend = Choice<anim::BlendMethod>(*y, "blend.method", {{"dlb", anim::BlendMethod::kDlb}, {"dib", anim::BlendMethod::kDib}});
       if (const Node* y = x->Find("precision")) {
         c.dib.precision = Number(*y, "blend.precision");
         if (!(c.dib.precision > 0)) Fail(*y, "blend.precision must be positive");
@@ -136,7 +136,7 @@ class SceneReader {
       }
     }
     if (const Node* x = n.Find("phase"))
-      c.phase = Choice<PhaseMode>(*x, "phase", {{"shared", PhaseMode::kShared}, {"independent", PhaseMode::kIndependent}});
+      c.phase = Choice<anim::PhaseMode>(*x, "phase", {{"shared", anim::PhaseMode::kShared}, {"independent", anim::PhaseMode::kIndependent}});
     if (const Node* x = n.Find("sampling"))
       c.nlerp_sampling = Choice<bool>(*x, "sampling", {{"slerp", false}, {"nlerp", true}});
     if (const Node* x = n.Find("lookat")) {
@@ -180,11 +180,11 @@ class SceneReader {
     return x;
   }
 
-  ScopeTable Scopes(const Node& n) const {
+  anim::ScopeTable Scopes(const Node& n) const {
     if (!n.IsMapping()) Fail(n, "scopes must be a mapping of name: [joints]");
-    ScopeTable table;
+    anim::ScopeTable table;
     for (const auto& [name, v] : n.entries) {
-      ScopeSpec spec;
+      anim::ScopeSpec spec;
       const Node* joints = &v;
       if (v.IsMapping()) {
         OnlyKeys(v, {"joints", "descendants"}, "scope '" + name + "'");
@@ -255,16 +255,16 @@ class SceneReader {
     return b;
   }
 
-  Curve CurveOf(const Node& n, const std::string& what) const {
+  anim::Curve CurveOf(const Node& n, const std::string& what) const {
     OnlyKeys(n, {"shape", "in", "out", "attack", "decay", "sustain", "release", "peak", "seconds"}, what);
-    Curve c;
+    anim::Curve c;
     if (const Node* x = n.Find("shape"))
-      c.shape = Choice<Curve::Shape>(*x, what + ".shape",
-                                     {{"constant", Curve::Shape::kConstant},
-                                      {"linear-fade", Curve::Shape::kLinearFade},
-                                      {"cosine-fade", Curve::Shape::kCosineFade},
-                                      {"adsr", Curve::Shape::kAdsr},
-                                      {"cosine-adsr", Curve::Shape::kCosineAdsr}});
+      c.shape = Choice<anim::Curve::Shape>(*x, what + ".shape",
+                                     {{"constant", anim::Curve::Shape::kConstant},
+                                      {"linear-fade", anim::Curve::Shape::kLinearFade},
+                                      {"cosine-fade", anim::Curve::Shape::kCosineFade},
+                                      {"adsr", anim::Curve::Shape::kAdsr},
+                                      {"cosine-adsr", anim::Curve::Shape::kCosineAdsr}});
     if (const Node* x = n.Find("in")) c.fade_in = NonNegative(*x, what + ".in");
     if (const Node* x = n.Find("out")) c.fade_out = NonNegative(*x, what + ".out");
     if (const Node* x = n.Find("attack")) c.attack = NonNegative(*x, what + ".attack");
@@ -277,8 +277,8 @@ class SceneReader {
     return c;
   }
 
-  std::vector<Curve> Curves(const Node& n, const std::string& what) const {
-    std::vector<Curve> out;
+  std::vector<anim::Curve> Curves(const Node& n, const std::string& what) const {
+    std::vector<anim::Curve> out;
     if (n.IsSequence())
       for (const Node& c : n.items) out.push_back(CurveOf(c, what));
     else
@@ -515,7 +515,7 @@ class SceneReader {
       const double a = az ? Number(*az, "azimuth") : 0.0;
       const double e = el ? Number(*el, "elevation") : 0.0;
       if (std::abs(e) > 90) Fail(el ? *el : n, "elevation must be within [-90, 90] degrees");
-      k.viewpoint = DirectionFromAzimuthElevation(a, e, c.forward, c.up);
+      k.viewpoint = anim::DirectionFromAzimuthElevation(a, e, c.forward, c.up);
     } else {
       Fail(n, "a key needs 'viewpoint: [x, y, z]' or 'azimuth: <deg>'");
     }
@@ -557,7 +557,7 @@ class SceneReader {
     OnlyKeys(root, {"characters"}, "the scene");
     const Node* chars = root.Find("characters");
     if (!chars || !chars->IsSequence() || chars->items.empty())
-      throw Error(file_ + ": a scene needs a non-empty 'characters:' list");
+      throw anim::Error(file_ + ": a scene needs a non-empty 'characters:' list");
     Scene s;
     s.file = file;
     const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
@@ -599,14 +599,14 @@ Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what)
       }
     }
     if (!ok || used != word.size() || !std::isfinite(v[i]))
-      throw Error(what + ": expected three numbers \"x,y,z\", got \"" + text + "\"");
+      throw anim::Error(what + ": expected three numbers \"x,y,z\", got \"" + text + "\"");
   }
   std::string extra;
-  if (in >> extra) throw Error(what + ": more than three numbers in \"" + text + "\"");
+  if (in >> extra) throw anim::Error(what + ": more than three numbers in \"" + text + "\"");
   // Scaled by its largest component first: the norm of (1e308, 1e308, 1e308) overflows to
   // infinity and normalizing by it gave (0, 0, 0).
   const double largest = v.cwiseAbs().maxCoeff();
-  if (!(largest > 1e-12)) throw Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
+  if (!(largest > 1e-12)) throw anim::Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
   return (v / largest).normalized();
 }
 
@@ -626,4 +626,4 @@ std::string KeySourceLabel(const KeySpec& key) {
   return "?";
 }
 
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <fstream>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 namespace fs = std::filesystem;
@@ -55,13 +55,13 @@ TEST(Scene, ParsesEveryField) {
   EXPECT_DOUBLE_EQ(c.scale, 0.01);
   EXPECT_LT((c.anchor.position - Eigen::Vector3d(1, 2, 3)).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(c.anchor.scale, 2);
-  EXPECT_EQ(c.weights.mode, WeightingMode::kLocalSupport);
-  EXPECT_EQ(c.weights.distance, DistanceKind::kChordal);
+  EXPECT_EQ(c.weights.mode, anim::WeightingMode::kLocalSupport);
+  EXPECT_EQ(c.weights.distance, anim::DistanceKind::kChordal);
   EXPECT_DOUBLE_EQ(c.weights.alpha, 4);
-  EXPECT_EQ(c.blend, BlendMethod::kDib);
+  EXPECT_EQ(c.blend, anim::BlendMethod::kDib);
   EXPECT_DOUBLE_EQ(c.dib.precision, 1e-4);
   EXPECT_EQ(c.dib.max_iterations, 10);
-  EXPECT_EQ(c.phase, PhaseMode::kIndependent);
+  EXPECT_EQ(c.phase, anim::PhaseMode::kIndependent);
   EXPECT_TRUE(c.nlerp_sampling);
   EXPECT_EQ(c.lookat.chain, (std::vector<std::string>{"a", "b"}));
   ASSERT_EQ(c.keys.size(), 4u);
@@ -83,7 +83,7 @@ void ExpectSceneError(const std::string& text, const std::string& message) {
   try {
     ParseScene(text, "bad.yaml");
     FAIL() << "no error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
   }
 }
@@ -100,23 +100,23 @@ TEST(Scene, ParseErrors) {
                    "bad.yaml:3: scale: expected a number, got 'big'");
   ExpectSceneError("characters:\n  - keys:\n      - azimuth: 0\n        clip: x\n", "bad.yaml:2: a character needs 'asset");
   ExpectSceneError("characters: []\n", "bad.yaml: a scene needs a non-empty 'characters:' list");
-  EXPECT_THROW(LoadScene("/nonexistent/scene.yaml"), Error);
+  EXPECT_THROW(LoadScene("/nonexistent/scene.yaml"), anim::Error);
 }
 
 TEST(Scene, ParseViewpoint) {
   EXPECT_LT((ParseViewpoint("0,0,2") - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
   EXPECT_LT((ParseViewpoint(" 1, 0 ,0") - Eigen::Vector3d::UnitX()).norm(), 1e-12);
-  EXPECT_THROW(ParseViewpoint("1,2"), Error);
-  EXPECT_THROW(ParseViewpoint("1,2,3,4"), Error);
+  EXPECT_THROW(ParseViewpoint("1,2"), anim::Error);
+  EXPECT_THROW(ParseViewpoint("1,2,3,4"), anim::Error);
   // Issue 17: the norm of (1e308, 1e308, 1e308) overflowed and the direction became (0, 0, 0).
   EXPECT_LT((ParseViewpoint("1e308,1e308,1e308") - Eigen::Vector3d::Ones().normalized()).norm(), 1e-12);
   EXPECT_LT((ParseViewpoint("-1e308,0,0") + Eigen::Vector3d::UnitX()).norm(), 1e-12);
-  EXPECT_THROW(ParseViewpoint("1,x,3"), Error);
-  EXPECT_THROW(ParseViewpoint("1,nan,3"), Error);
+  EXPECT_THROW(ParseViewpoint("1,x,3"), anim::Error);
+  EXPECT_THROW(ParseViewpoint("1,nan,3"), anim::Error);
   try {
     ParseViewpoint("0,0,0", "--viewpoint");
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("--viewpoint: zero-length viewpoint"), std::string::npos) << e.what();
   }
 }
@@ -128,7 +128,7 @@ TEST(Scene, MissingClipIsAnError) {
   try {
     AnimatedCharacter c(s.characters[0]);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("fox.yaml:8: clip 'Jump' does not exist"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("Survey, Walk, Run"), std::string::npos) << e.what();
   }
@@ -140,7 +140,7 @@ TEST(Scene, MissingAssetIsAnError) {
   try {
     AnimatedCharacter c(s.characters[0]);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("/tmp/x/nowhere.glb: no such file"), std::string::npos) << e.what();
   }
 }
@@ -154,20 +154,20 @@ TEST(Scene, RuntimeOnAKeyPlaysThatClip) {
                  std::string("    phase: independent\n    blend: {method: ") + method + "}\n"),
         "fox.yaml");
     AnimatedCharacter fox(s.characters[0]);
-    const Character& c = fox.character();
-    const AnimatorFrame& out = fox.Update(DirectionFromAzimuthElevation(120, 0), 0.3);
+    const anim::Character& c = fox.character();
+    const anim::AnimatorFrame& out = fox.Update(anim::DirectionFromAzimuthElevation(120, 0), 0.3);
     EXPECT_DOUBLE_EQ(out.key_weights[1], 1.0);
-    LocalPose walk(c.skeleton.size());
-    ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run()));
+    anim::LocalPose walk(c.skeleton.size());
+    ASSERT_TRUE((anim::SamplingJob{&c.skeleton, c.FindClip("Walk"), 0.3, true, &walk}.Run()));
     std::vector<Eigen::Matrix4d> model(c.skeleton.size());
-    ASSERT_TRUE((LocalToModelJob{&c.skeleton, &walk, model}.Run()));
+    ASSERT_TRUE((anim::LocalToModelJob{&c.skeleton, &walk, model}.Run()));
     for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
     EXPECT_TRUE(out.converged);
     // Between keys every joint is a proper blend, and DIB converges.
-    const AnimatorFrame& mid = fox.Update(DirectionFromAzimuthElevation(60, 20), 1.0);
+    const anim::AnimatorFrame& mid = fox.Update(anim::DirectionFromAzimuthElevation(60, 20), 1.0);
     EXPECT_TRUE(mid.converged);
     for (const auto& m : mid.skinning_matrices) EXPECT_TRUE(m.allFinite());
-    EXPECT_TRUE(RigidSkinning(mid.skinning_matrices));
+    EXPECT_TRUE(anim::RigidSkinning(mid.skinning_matrices));
   }
 }
 
@@ -176,17 +176,17 @@ TEST(Scene, SharedPhaseStretchesKeyClips) {
   const Scene s = ParseScene(FoxScene("      - azimuth: 0\n        clip: Walk\n      - azimuth: 180\n        clip: Run\n"),
                              "fox.yaml");
   AnimatedCharacter fox(s.characters[0]);
-  const Character& c = fox.character();
+  const anim::Character& c = fox.character();
   const double walk = c.FindClip("Walk")->duration, run = c.FindClip("Run")->duration;
   const double period = 0.5 * (walk + run);
   // A quarter of the shared period plays a quarter of the Run clip.
-  const AnimatorFrame& out = fox.Update(DirectionFromAzimuthElevation(180, 0), 0.25 * period);
-  LocalPose expect(c.skeleton.size());
-  ASSERT_TRUE((SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run()));
+  const anim::AnimatorFrame& out = fox.Update(anim::DirectionFromAzimuthElevation(180, 0), 0.25 * period);
+  anim::LocalPose expect(c.skeleton.size());
+  ASSERT_TRUE((anim::SamplingJob{&c.skeleton, c.FindClip("Run"), 0.25 * run, true, &expect}.Run()));
   std::vector<Eigen::Matrix4d> model(c.skeleton.size());
-  ASSERT_TRUE((LocalToModelJob{&c.skeleton, &expect, model}.Run()));
+  ASSERT_TRUE((anim::LocalToModelJob{&c.skeleton, &expect, model}.Run()));
   for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((out.model[j] - model[j]).norm(), 1e-6) << j;
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
 std::filesystem::path Fox() { return testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
@@ -21,17 +21,17 @@ std::string Scene(const std::string& asset, const std::string& extra) {
 
 void ExpectError(const std::string& text, const std::string& message) {
   try {
-    const anim::Scene s = ParseScene(text, "bad.yaml");
+    const authoring::Scene s = ParseScene(text, "bad.yaml");
     AnimatedCharacter c(s.characters[0]);
     BuildAnimator(c);
     FAIL() << "no error";
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
   }
 }
 
 TEST(ScheduleScene, ParsesActionsObjectsCurvesMasks) {
-  const anim::Scene s = ParseScene(Scene("a.glb", R"(    scopes:
+  const authoring::Scene s = ParseScene(Scene("a.glb", R"(    scopes:
       hands: [LeftHand, RightHand]
       spine_only: {joints: [Spine], descendants: false}
     schedule:
@@ -76,8 +76,8 @@ TEST(ScheduleScene, ParsesActionsObjectsCurvesMasks) {
   EXPECT_TRUE(wave.object.mirror);
   EXPECT_EQ(wave.layer, 2);
   EXPECT_DOUBLE_EQ(wave.weight, 0.5);
-  EXPECT_EQ(wave.curves[0].shape, Curve::Shape::kCosineFade);
-  EXPECT_EQ(wave.scalings[0].shape, Curve::Shape::kAdsr);
+  EXPECT_EQ(wave.curves[0].shape, anim::Curve::Shape::kCosineFade);
+  EXPECT_EQ(wave.scalings[0].shape, anim::Curve::Shape::kAdsr);
   EXPECT_DOUBLE_EQ(wave.masks[1].default_translation, 0);
   EXPECT_TRUE(wave.has_trigger);
   EXPECT_DOUBLE_EQ(wave.trigger_far, 2);
@@ -94,7 +94,7 @@ TEST(ScheduleScene, ErrorsNameTheLine) {
     try {
       ParseScene(Scene("a.glb", extra), "bad.yaml");
       FAIL() << "no error";
-    } catch (const Error& e) {
+    } catch (const anim::Error& e) {
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
     }
   };
@@ -125,7 +125,7 @@ TEST(ScheduleScene, BuildErrorsNameTheLine) {
               "bad.yaml:23: window: needs 0 <= from < to <= the object's length");
 }
 
-double LargestRotationStep(const std::vector<LocalPose>& frames) {
+double LargestRotationStep(const std::vector<anim::LocalPose>& frames) {
   double worst = 0;
   for (std::size_t f = 1; f < frames.size(); ++f)
     for (int j = 0; j < frames[f].size(); ++j)
@@ -137,17 +137,17 @@ double LargestRotationStep(const std::vector<LocalPose>& frames) {
 // moves no joint faster than the stream itself does.
 TEST(ScheduleScene, LossAndRecoveryDoNotJump) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const anim::Scene s = ParseScene(Scene(Fox().string(), "    lookat: {base_clip: Survey}\n"), "fox.yaml");
+  const authoring::Scene s = ParseScene(Scene(Fox().string(), "    lookat: {base_clip: Survey}\n"), "fox.yaml");
   AnimatedCharacter fox(s.characters[0]);
   auto run = [&](bool with_loss) {
     auto animator = BuildAnimator(fox);
-    std::vector<LocalPose> frames;
+    std::vector<anim::LocalPose> frames;
     for (int i = 0; i < 180; ++i) {
       const double t = i / 30.0;
-      FrameInputs in;
-      in.viewpoint = DirectionFromAzimuthElevation(60 * t, 5);
+      anim::FrameInputs in;
+      in.viewpoint = anim::DirectionFromAzimuthElevation(60 * t, 5);
       in.tracking = !with_loss || i < 30 || i >= 90;
-      const AnimatorFrame& f = animator->Update(t, in);
+      const anim::AnimatorFrame& f = animator->Update(t, in);
       frames.push_back(f.local[0]);
       if (with_loss && i == 80) {
         EXPECT_DOUBLE_EQ(f.view_gain, 0.0);
@@ -164,7 +164,7 @@ TEST(ScheduleScene, LossAndRecoveryDoNotJump) {
 
 TEST(ScheduleScene, DistanceTriggersWithHysteresisAndDistanceWeights) {
   ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
-  const anim::Scene s = ParseScene(Scene(Fox().string(), R"(    schedule:
+  const authoring::Scene s = ParseScene(Scene(Fox().string(), R"(    schedule:
       actions:
         - name: idle
           object: {clip: Survey, loop: true}
@@ -183,10 +183,10 @@ TEST(ScheduleScene, DistanceTriggersWithHysteresisAndDistanceWeights) {
                                    "fox.yaml");
   AnimatedCharacter fox(s.characters[0]);
   auto animator = BuildAnimator(fox);
-  Schedule& sched = animator->schedule();
+  anim::Schedule& sched = animator->schedule();
   const int view = sched.FindByName("view");
   ASSERT_GE(view, 0);
-  FrameInputs in;
+  anim::FrameInputs in;
   int fired = 0;
   // The viewer walks in from 4 m to 1 m, back out to 2 m (inside the band: no re-arm), in to
   // 1 m (no second greeting), out to 3 m (re-armed) and in again (a second greeting).
@@ -228,20 +228,20 @@ TEST(ScheduleScene, ThesisAppendixCExamples) {
   };
   const std::string idle_section = "    idle: {clips: [Epileptisch], seed: 3}\n";
   for (std::size_t e = 0; e < examples.size(); ++e) {
-    const anim::Scene s =
+    const authoring::Scene s =
         ParseScene(Scene(kBcn, (e == 4 ? idle_section : "") + "    schedule:\n      actions:\n" + examples[e]), "example.yaml");
     AnimatedCharacter bcn(s.characters[0]);
     auto animator = BuildAnimator(bcn);
     for (double t : {0.0, 1.5, 2.5, 4.0}) {
-      const AnimatorFrame& f = animator->Update(t, {});
+      const anim::AnimatorFrame& f = animator->Update(t, {});
       for (const auto& m : f.skinning_matrices) ASSERT_TRUE(m.allFinite()) << "example " << e + 1;
     }
     if (e == 2) {
       // Example 3: legs on the idle exactly, torso mostly the mirrored gesture.
-      const Skeleton& sk = bcn.character().skeleton;
-      const AnimatorFrame& f = animator->Update(2.0, {});
-      LocalPose idle_pose(sk.size());
-      ASSERT_TRUE((SamplingJob{&sk, bcn.character().FindClip("Epileptisch"), 2.0, true, &idle_pose}.Run()));
+      const anim::Skeleton& sk = bcn.character().skeleton;
+      const anim::AnimatorFrame& f = animator->Update(2.0, {});
+      anim::LocalPose idle_pose(sk.size());
+      ASSERT_TRUE((anim::SamplingJob{&sk, bcn.character().FindClip("Epileptisch"), 2.0, true, &idle_pose}.Run()));
       for (const char* leg : {"B_Knee_Left", "B_Ankle_Right", "B_Hip_Left"}) {
         const int j = sk.Find(leg);
         EXPECT_EQ(f.local[0].rigid[j].real().coeffs(), idle_pose.rigid[j].real().coeffs()) << leg;
@@ -251,4 +251,4 @@ TEST(ScheduleScene, ThesisAppendixCExamples) {
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

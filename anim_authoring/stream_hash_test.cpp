@@ -19,12 +19,12 @@
 #include <cstdint>
 #include <cstdio>
 
-namespace arview::anim {
+namespace arview::authoring {
 namespace {
 
-std::uint64_t PostureHash(const std::shared_ptr<const Skeleton>& skeleton, const std::shared_ptr<const IdleModel>& model,
+std::uint64_t PostureHash(const std::shared_ptr<const anim::Skeleton>& skeleton, const std::shared_ptr<const anim::IdleModel>& model,
                           std::uint64_t seed) {
-  IdleSynthesizer idle(skeleton, model, seed);
+  anim::IdleSynthesizer idle(skeleton, model, seed);
   Fnv1a h;
   for (int f = 0; f < 600 * 30; ++f) {
     const Eigen::VectorXd& p = idle.Posture(f / 30.0);
@@ -36,13 +36,13 @@ std::uint64_t PostureHash(const std::shared_ptr<const Skeleton>& skeleton, const
 TEST(StreamHash, IdleStreamsAndFourActionSchedule) {
   ARVIEW_REQUIRE_DATA_PATH(testing::SharedData("characters/Fox"), "../shared/data");
   ARVIEW_REQUIRE_DATA_PATH(testing::kBcnEpileptic, "Debian package assimp-testmodels");
-  const Character fox = LoadCharacter(testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"));
+  const anim::Character fox = LoadCharacter(testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"));
   const std::vector<IdleSource> sources{{&fox, {fox.FindClip("Survey")}, true}};
-  const auto fox_skeleton = std::make_shared<const Skeleton>(fox.skeleton);
-  const auto fox_model = std::make_shared<const IdleModel>(LearnIdleModel(fox.skeleton, sources, IdleLearningOptions{}));
+  const auto fox_skeleton = std::make_shared<const anim::Skeleton>(fox.skeleton);
+  const auto fox_model = std::make_shared<const anim::IdleModel>(LearnIdleModel(fox.skeleton, sources, IdleLearningOptions{}));
   testing::FourActionSchedule schedule(testing::FourActionSchedule::Gesture::kPoint, /*dib=*/false);
   const auto bcn_skeleton = schedule.character().shared_skeleton();
-  const auto bcn_model = std::make_shared<const IdleModel>(BuildIdle(schedule.character())->model());
+  const auto bcn_model = std::make_shared<const anim::IdleModel>(BuildIdle(schedule.character())->model());
 
   Fnv1a all;
   for (int seed = 1; seed <= 12; ++seed) {
@@ -67,4 +67,4 @@ TEST(StreamHash, IdleStreamsAndFourActionSchedule) {
 }
 
 }  // namespace
-}  // namespace arview::anim
+}  // namespace arview::authoring

@@ -11,7 +11,7 @@
 #include <set>
 #include <sstream>
 
-namespace arview::anim::yaml {
+namespace arview::authoring::yaml {
 namespace {
 
 // Builds our Node tree from yaml-cpp's events, refusing what scene files do not allow.
@@ -56,7 +56,7 @@ class TreeBuilder : public YAML::EventHandler {
   void OnMapEnd() override { Close(); }
 
   [[noreturn]] void Fail(int line, const std::string& what) const {
-    throw Error(file_ + ":" + std::to_string(line) + ": " + what);
+    throw anim::Error(file_ + ":" + std::to_string(line) + ": " + what);
   }
 
  private:
@@ -201,14 +201,14 @@ const Node* Node::Find(const std::string& key) const {
 
 Node Parse(const std::string& text, const std::string& file) {
   if (text.size() > kMaxFileBytes)
-    throw Error(file + ": " + std::to_string(text.size()) + " bytes; scene files are limited to " +
+    throw anim::Error(file + ": " + std::to_string(text.size()) + " bytes; scene files are limited to " +
                 std::to_string(kMaxFileBytes) + " bytes");
   const DepthScan depth = ScanNestingDepth(text, kMaxDepth);
   if (depth.first_line_over)
-    throw Error(file + ":" + std::to_string(depth.first_line_over) + ": nested deeper than " + std::to_string(kMaxDepth) +
+    throw anim::Error(file + ":" + std::to_string(depth.first_line_over) + ": nested deeper than " + std::to_string(kMaxDepth) +
                 " levels");
   if (depth.unterminated_quote_line)
-    throw Error(file + ":" + std::to_string(depth.unterminated_quote_line) + ": unterminated quoted string");
+    throw anim::Error(file + ":" + std::to_string(depth.unterminated_quote_line) + ": unterminated quoted string");
   std::istringstream in(text);
   TreeBuilder builder(file);
   try {
@@ -227,7 +227,7 @@ Node Parse(const std::string& text, const std::string& file) {
       builder.Fail(at == std::string::npos ? 1 : line + 1, "only one YAML document is supported");
     }
   } catch (const YAML::Exception& e) {
-    throw Error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    throw anim::Error(file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   Node root = builder.TakeRoot();
   if (root.IsScalar() && root.scalar.empty() && !root.quoted) {
@@ -240,15 +240,15 @@ Node Parse(const std::string& text, const std::string& file) {
 
 Node ParseFile(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw Error(path.string() + ": no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path.string() + ": not a regular file");
+  if (!std::filesystem::exists(path, ec)) throw anim::Error(path.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) throw anim::Error(path.string() + ": not a regular file");
   const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw Error(path.string() + ": cannot read its size: " + ec.message());
+  if (ec) throw anim::Error(path.string() + ": cannot read its size: " + ec.message());
   if (size > kMaxFileBytes)
-    throw Error(path.string() + ": " + std::to_string(size) + " bytes; scene files are limited to " +
+    throw anim::Error(path.string() + ": " + std::to_string(size) + " bytes; scene files are limited to " +
                 std::to_string(kMaxFileBytes) + " bytes");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
+  if (!in) throw anim::Error(path.string() + ": cannot open for reading");
   std::stringstream ss;
   ss << in.rdbuf();
   return Parse(ss.str(), path.string());
@@ -261,4 +261,4 @@ Node& Node::operator=(const Node&) = default;
 Node& Node::operator=(Node&&) noexcept = default;
 Node::~Node() = default;
 
-}  // namespace arview::anim::yaml
+}  // namespace arview::authoring::yaml

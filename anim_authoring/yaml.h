@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-namespace arview::anim::yaml {
+namespace arview::authoring::yaml {
 
 // Deeper than any scene needs (the deepest key path today is 5 levels); far below where
 // yaml-cpp's recursion exhausts an 8 MB stack (thousands of levels).
@@ -66,4 +66,4 @@ struct DepthScan {
 };
 DepthScan ScanNestingDepth(const std::string& text, int limit = kMaxDepth);
 
-}  // namespace arview::anim::yaml
+}  // namespace arview::authoring::yaml

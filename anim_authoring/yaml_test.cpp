@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-namespace arview::anim::yaml {
+namespace arview::authoring::yaml {
 namespace {
 
 TEST(Yaml, BlockAndFlow) {
@@ -61,7 +61,7 @@ void ExpectError(const std::string& text, const std::string& message) {
   try {
     Parse(text, "bad.yaml");
     FAIL() << "no error for: " << text;
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
   }
 }
@@ -126,7 +126,7 @@ TEST(Yaml, FileLimits) {
   try {
     ParseFile(big);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("big.yaml: " + std::to_string(kMaxFileBytes + 6) + " bytes; scene files are limited"),
               std::string::npos)
         << e.what();
@@ -134,12 +134,12 @@ TEST(Yaml, FileLimits) {
   try {
     ParseFile(dir);
     FAIL();
-  } catch (const Error& e) {
+  } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(ParseFile("/dev/zero"), Error);
+  EXPECT_THROW(ParseFile("/dev/zero"), anim::Error);
   std::filesystem::remove_all(dir);
 }
 
 }  // namespace
-}  // namespace arview::anim::yaml
+}  // namespace arview::authoring::yaml

@@ -45,7 +45,7 @@ TEST(Figure, SkeletonUsesHumanoidNamesThatTheLookAtChainFinds) {
                            "LeftHand", "RightArm", "RightForeArm", "RightHand", "LeftUpLeg", "LeftLeg", "LeftFoot",
                            "RightUpLeg", "RightLeg", "RightFoot", "RightToeBase"})
     EXPECT_GE(sk.Find(name), 0) << name;
-  const std::vector<std::string> chain = anim::DefaultLookAtChain(sk);
+  const std::vector<std::string> chain = authoring::DefaultLookAtChain(sk);
   ASSERT_FALSE(chain.empty());
   EXPECT_EQ(chain.front(), "Hips");
   EXPECT_EQ(chain.back(), "Head");
@@ -174,17 +174,17 @@ TEST(Figure, WaveRaisesTheRightHandAboveTheHeadAndPointAimsAhead) {
 
 TEST(Figure, LoadsAsABuiltinAssetInScenes) {
   RegisterBuiltinCharacters();
-  const anim::Character c = anim::LoadCharacter("builtin:figure");
+  const anim::Character c = authoring::LoadCharacter("builtin:figure");
   EXPECT_EQ(c.source, "builtin:figure");
   EXPECT_EQ(c.meshes.size(), Figure().meshes.size());
   try {
-    anim::LoadCharacter("builtin:robot");
+    authoring::LoadCharacter("builtin:robot");
     FAIL() << "an unknown built-in must throw";
   } catch (const anim::Error& e) {
     EXPECT_NE(std::string(e.what()).find("builtin:robot"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("builtin:figure"), std::string::npos);
   }
-  const anim::Scene scene = anim::ParseScene(
+  const authoring::Scene scene = authoring::ParseScene(
       "characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    keys:\n"
       "      - azimuth: 0\n        generate: lookat\n      - azimuth: 90\n        generate: lookat\n"
       "      - azimuth: 200\n        clip: Wave\n",
@@ -192,7 +192,7 @@ TEST(Figure, LoadsAsABuiltinAssetInScenes) {
   ASSERT_EQ(scene.characters.size(), 1u);
   EXPECT_EQ(scene.characters[0].asset, "builtin:figure");  // not resolved against the scene's folder
   EXPECT_EQ(scene.characters[0].name, "figure");
-  anim::AnimatedCharacter figure(scene.characters[0]);
+  authoring::AnimatedCharacter figure(scene.characters[0]);
   // The key at azimuth 90 turns the head toward +X (the viewer at the figure's left).
   const anim::AnimatorFrame& out = figure.Update(Eigen::Vector3d::UnitX(), 1.0);
   const Eigen::Vector3d forward = anim::HeadForward(figure.lookat_chain(), out.model);
@@ -204,28 +204,28 @@ TEST(Figure, LoadsAsABuiltinAssetInScenes) {
 // reaches) within 15° of the viewpoint, the elbow and shoulder within their limits.
 TEST(Figure, GestureKeysPointTheRightArmAtTheViewpoint) {
   RegisterBuiltinCharacters();
-  EXPECT_EQ(anim::DefaultArmChain(Figure().skeleton, anim::ArmSide::kRight),
+  EXPECT_EQ(authoring::DefaultArmChain(Figure().skeleton, authoring::ArmSide::kRight),
             (std::vector<std::string>{"RightArm", "RightForeArm", "RightHand"}));
   const anim::ArmLimits limits;
   for (const char* gesture : {"point", "reach"}) {
     double worst = 0;
     for (const auto& [azimuth, elevation] : std::vector<std::pair<double, double>>{
              {0, 0}, {35, 0}, {-35, 0}, {70, 0}, {-70, 0}, {100, 0}, {-100, 0}, {0, 30}, {40, 25}, {-40, -20}, {180, 0}}) {
-      const anim::Scene scene = anim::ParseScene(
+      const authoring::Scene scene = authoring::ParseScene(
           "characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    keys:\n      - {azimuth: " +
               std::to_string(azimuth) + ", elevation: " + std::to_string(elevation) + ", gesture: " + gesture +
               "}\n      - {azimuth: " + std::to_string(azimuth + 90) + ", generate: lookat}\n",
           "figure.yaml");
-      anim::AnimatedCharacter figure(scene.characters[0]);
-      const anim::KeySpec& key = scene.characters[0].keys[0];
+      authoring::AnimatedCharacter figure(scene.characters[0]);
+      const authoring::KeySpec& key = scene.characters[0].keys[0];
       for (double t : {0.0, 0.37, 1.5, 2.9}) {
         const anim::AnimatorFrame& out = figure.Update(key.viewpoint, t);
-        const double deg = AngleDeg(anim::GestureDirection(figure.arm_chain(), key.gesture, out.model), key.viewpoint);
+        const double deg = AngleDeg(authoring::GestureDirection(figure.arm_chain(), key.gesture, out.model), key.viewpoint);
         EXPECT_LE(deg, 15.0) << gesture << " azimuth " << azimuth << " elevation " << elevation << " t " << t;
-        const double elbow = anim::ElbowBendDeg(figure.arm_chain(), out.model);
+        const double elbow = authoring::ElbowBendDeg(figure.arm_chain(), out.model);
         EXPECT_GE(elbow, limits.elbow_min_deg - 0.5);
         EXPECT_LE(elbow, limits.elbow_max_deg + 0.5);
-        EXPECT_LE(anim::ShoulderConeAngleDeg(figure.character().skeleton, figure.arm_chain(), out.model),
+        EXPECT_LE(authoring::ShoulderConeAngleDeg(figure.character().skeleton, figure.arm_chain(), out.model),
                   limits.shoulder_cone_deg + 0.5);
         worst = std::max(worst, deg);
       }

@@ -4,7 +4,7 @@
 // fresh machine with no downloads and no asset file in the repository.
 //
 //   figure::RegisterBuiltinCharacters();              // once, at program start
-//   anim::Character c = anim::LoadCharacter("builtin:figure");   // like any imported asset
+//   anim::Character c = authoring::LoadCharacter("builtin:figure");   // like any imported asset
 //
 // The figure ("builtin:figure"): 1.72 m tall, in metres, +Y up, facing +Z (its left is +X),
 // standing on y = 0; the bind pose is the rest pose (arms 15° from the body).
@@ -44,7 +44,7 @@ std::vector<std::string> BuiltinCharacterNames();
 // the asset and listing the known names when there is no such character.
 anim::Character MakeBuiltinCharacter(const std::string& name);
 
-// Makes anim::LoadCharacter("builtin:<name>") return MakeBuiltinCharacter(name).
+// Makes authoring::LoadCharacter("builtin:<name>") return MakeBuiltinCharacter(name).
 void RegisterBuiltinCharacters();
 
 }  // namespace arview::figure

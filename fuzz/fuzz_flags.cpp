@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)arview::recordings::ParseFrameSpec(text, 1 + data[0] / 3 * 40);
         break;
       case 1:
-        (void)arview::anim::ParseViewpoint(text, "--viewpoint");
+        (void)arview::authoring::ParseViewpoint(text, "--viewpoint");
         break;
       default:
         ParseNumericFlags(text);

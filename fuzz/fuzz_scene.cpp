@@ -1,4 +1,4 @@
-// Scene files through anim::ParseScene (the depth and duplicate-key checks, then yaml-cpp and
+// Scene files through authoring::ParseScene (the depth and duplicate-key checks, then yaml-cpp and
 // our schema). Assets are not loaded here (fuzz_gltf does that).
 #include <exception>
 #include <string>
@@ -8,7 +8,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    (void)arview::anim::ParseScene(text, "fuzz-scene.yaml");
+    (void)arview::authoring::ParseScene(text, "fuzz-scene.yaml");
   } catch (const std::exception&) {
   }
   return 0;

@@ -357,6 +357,55 @@ std::uint64_t Key(std::uint32_t image_id, std::uint32_t point2d_idx) {
   return (static_cast<std::uint64_t>(image_id) << 32) | point2d_idx;
 }
 
+// One camera for all keyframes (arview runs COLMAP with --ImageReader.single_camera 1).
+calib::Camera TheOneCamera(const std::unordered_map<std::uint32_t, calib::Camera>& cameras, const std::vector<ColmapImage>& images,
+                           const fs::path& cameras_file, const fs::path& images_file) {
+  const std::uint32_t camera_id = images.front().camera_id;
+  for (const auto& im : images) {
+    if (im.camera_id != camera_id) {
+      throw map::MapError(images_file.string() + ": images use several cameras (" + std::to_string(camera_id) + ", " +
+                     std::to_string(im.camera_id) + "); arview maps have one");
+    }
+  }
+  const auto cam = cameras.find(camera_id);
+  if (cam == cameras.end()) {
+    throw map::MapError(images_file.string() + ": camera id " + std::to_string(camera_id) + " is not in " +
+                   cameras_file.string());
+  }
+  return cam->second;
+}
+
+// Track elements must name registered images and 2D points that point back at them.
+void RequireTracksReferBack(const std::vector<ColmapPoint>& points, const std::vector<ColmapImage>& images,
+                            const std::unordered_map<std::uint32_t, std::uint32_t>& keyframe_of_image,
+                            const fs::path& points_file, const fs::path& images_file) {
+  for (const auto& p : points) {
+    for (const auto& e : p.track) {
+      const auto kf = keyframe_of_image.find(e.image_id);
+      if (kf == keyframe_of_image.end()) {
+        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + " is seen by image id " +
+                       std::to_string(e.image_id) + ", which is not in " + images_file.string());
+      }
+      const auto& im = images[kf->second];
+      if (e.point2d_idx >= im.point3d_ids.size() || im.point3d_ids[e.point2d_idx] != p.id) {
+        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
+                       std::to_string(e.point2d_idx) + " of image '" + PrintableForMessage(im.name) + "', which does not refer back to it");
+      }
+    }
+  }
+}
+
+// Every keypoint of every image, in OpenCV's pixels, in the order of `images`.
+std::vector<std::vector<Eigen::Vector2f>> AllKeypoints(const std::vector<ColmapImage>& images) {
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  for (const auto& im : images) {
+    std::vector<Eigen::Vector2f>& all = keypoints.emplace_back();
+    all.reserve(im.xy.size());
+    for (const Eigen::Vector2d& xy : im.xy) all.push_back((xy - Eigen::Vector2d(0.5, 0.5)).cast<float>());
+  }
+  return keypoints;
+}
+
 }  // namespace
 
 std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
@@ -395,21 +444,8 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
   if (images.empty()) throw map::MapError(images_file.string() + ": the model has no registered images");
   if (points.empty()) throw map::MapError(points_file.string() + ": the model has no 3D points");
 
-  // One camera for all keyframes (arview runs COLMAP with --ImageReader.single_camera 1).
-  const std::uint32_t camera_id = images.front().camera_id;
   map::Map map;
-  for (const auto& im : images) {
-    if (im.camera_id != camera_id) {
-      throw map::MapError(images_file.string() + ": images use several cameras (" + std::to_string(camera_id) + ", " +
-                     std::to_string(im.camera_id) + "); arview maps have one");
-    }
-  }
-  const auto cam = cameras.find(camera_id);
-  if (cam == cameras.end()) {
-    throw map::MapError(images_file.string() + ": camera id " + std::to_string(camera_id) + " is not in " +
-                   cameras_file.string());
-  }
-  map.camera = cam->second;
+  map.camera = TheOneCamera(cameras, images, cameras_file, images_file);
 
   auto frame_of = [&](const ColmapImage& im) {
     if (frames.empty()) return FrameInfo{};
@@ -449,21 +485,7 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
   }
   if (rows > std::numeric_limits<std::uint32_t>::max()) throw map::MapError(points_file.string() + ": tracks too long");
 
-  // Track elements must name registered images and 2D points that point back at them.
-  for (const auto& p : points) {
-    for (const auto& e : p.track) {
-      const auto kf = keyframe_of_image.find(e.image_id);
-      if (kf == keyframe_of_image.end()) {
-        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + " is seen by image id " +
-                       std::to_string(e.image_id) + ", which is not in " + images_file.string());
-      }
-      const auto& im = images[kf->second];
-      if (e.point2d_idx >= im.point3d_ids.size() || im.point3d_ids[e.point2d_idx] != p.id) {
-        throw map::MapError(points_file.string() + ": 3D point " + std::to_string(p.id) + "'s track names 2D point " +
-                       std::to_string(e.point2d_idx) + " of image '" + PrintableForMessage(im.name) + "', which does not refer back to it");
-      }
-    }
-  }
+  RequireTracksReferBack(points, images, keyframe_of_image, points_file, images_file);
 
   Database db(database);
   map.descriptors.create(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
@@ -520,14 +542,7 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
       kf.observations.push_back({pi->second, px.cast<float>(), ri->second});
     }
   }
-  if (keypoints) {
-    keypoints->clear();
-    for (const auto& im : images) {
-      std::vector<Eigen::Vector2f>& all = keypoints->emplace_back();
-      all.reserve(im.xy.size());
-      for (const Eigen::Vector2d& xy : im.xy) all.push_back((xy - Eigen::Vector2d(0.5, 0.5)).cast<float>());
-    }
-  }
+  if (keypoints) *keypoints = AllKeypoints(images);
   if (check_values) RequireModelValuesInRange(map, sparse_dir);
   return map;
 }

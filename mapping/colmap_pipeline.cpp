@@ -368,6 +368,68 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const StageRecord& sta
     cb.note("the model of try " + std::to_string(tried) + " is not folded (" + disagreement() + " disagree)");
 }
 
+// COLMAP's command lines for the three stages. Each stage's inputs include the previous
+// stage's, so that a change re-runs everything after it.
+std::vector<std::string> ExtractArgs(const calib::Camera& camera, const MapBuildOptions& options, const fs::path& database,
+                                     const fs::path& image_root, const fs::path& image_list) {
+  bool full_opencv = false;
+  const std::vector<double> params = ColmapCameraParams(camera, &full_opencv);
+  return {"feature_extractor", "--database_path", database.string(), "--image_path", image_root.string(),
+          "--image_list_path", image_list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
+          "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
+          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", std::to_string(options.threads),
+          "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
+          "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations)};
+}
+
+std::vector<std::string> MatchArgs(const MapBuildOptions& options, const fs::path& database, int frames) {
+  const bool exhaustive = options.matcher == MatcherKind::kExhaustive ||
+                          (options.matcher == MatcherKind::kAuto && frames <= options.auto_exhaustive_limit);
+  std::vector<std::string> args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
+                                "--database_path", database.string(),
+                                "--SiftMatching.use_gpu", "0",
+                                "--SiftMatching.num_threads", std::to_string(options.threads)};
+  if (!exhaustive) {
+    args.insert(args.end(), {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
+                             "--SequentialMatching.quadratic_overlap", options.quadratic_overlap ? "1" : "0"});
+  }
+  return args;
+}
+
+std::vector<std::string> MapperArgs(const MapBuildOptions& options, const fs::path& database, const fs::path& image_root,
+                                    const fs::path& sparse) {
+  const std::string refine = options.refine_intrinsics ? "1" : "0";
+  std::vector<std::string> args{"mapper", "--database_path", database.string(), "--image_path",
+                                image_root.string(), "--output_path", sparse.string(),
+                                "--Mapper.num_threads", std::to_string(options.threads),
+                                "--Mapper.ba_refine_focal_length", refine,
+                                "--Mapper.ba_refine_principal_point", refine,
+                                "--Mapper.ba_refine_extra_params", refine,
+                                "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
+                                "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
+                                "--Mapper.ba_global_max_num_iterations",
+                                std::to_string(options.ba_global_max_iterations),
+                                "--Mapper.ba_local_max_num_iterations",
+                                std::to_string(options.ba_local_max_iterations)};
+  args.insert(args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
+  return args;
+}
+
+// check.json, the keyframes, the top view, and the map file last: a disk that fills at an
+// earlier file fails the command without a new map.arvmap beside the error (each file is
+// written atomically; a previous map stays whole).
+void WriteMapFolder(const MapBuildResult& result, const fs::path& out_dir, const MapBuildOptions& options,
+                    const MapBuildCallbacks& cb) {
+  WriteMapCheck(result.check, out_dir / kMapCheckFileName);
+  if (cb.warning)
+    for (const std::string& w : result.check.warnings) cb.warning(w);
+  RequireModelValuesInRange(result.map, result.model_dir);
+  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+  WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
+  WriteTopView(result.map, out_dir / "map.png");
+  map::SaveMap(result.map, out_dir / map::kMapFileName);
+}
+
 }  // namespace
 
 MapCheck RecheckMap(const fs::path& map_dir) {
@@ -428,18 +490,9 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   WriteFileAtomically(list, names);  // a full disk: "cannot write (<why>)", no empty list left
   const fs::path database = out_dir / "database.db";
   const fs::path sparse = out_dir / "sparse";
-  const std::string threads = std::to_string(options.threads);
 
   // Each stage's inputs include the previous stage's, so that a change re-runs everything after it.
-  bool full_opencv = false;
-  const std::vector<double> params = ColmapCameraParams(recording.camera, &full_opencv);
-  const std::vector<std::string> extract_args{
-      "feature_extractor", "--database_path", database.string(), "--image_path", images.root.string(),
-      "--image_list_path", list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
-      "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
-      "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads,
-      "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
-      "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations)};
+  const std::vector<std::string> extract_args = ExtractArgs(recording.camera, options, database, images.root, list);
   std::string inputs = Joined(extract_args);
   for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
 
@@ -471,36 +524,13 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   const auto remove_database = [&] { RemoveDatabase(database); };
   stage("extract", inputs, remove_database, extract_args, fs::exists(database), remove_database);
 
-  const bool exhaustive = options.matcher == MatcherKind::kExhaustive ||
-                          (options.matcher == MatcherKind::kAuto && n <= options.auto_exhaustive_limit);
-  std::vector<std::string> match_args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
-                                      "--database_path", database.string(),
-                                      "--SiftMatching.use_gpu", "0",
-                                      "--SiftMatching.num_threads", threads};
-  if (!exhaustive) {
-    match_args.insert(match_args.end(), {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
-                                         "--SequentialMatching.quadratic_overlap",
-                                         options.quadratic_overlap ? "1" : "0"});
-  }
+  const std::vector<std::string> match_args = MatchArgs(options, database, n);
   inputs += "--\n" + Joined(match_args);
   const std::string match_inputs = inputs;
   // Half-written matches stay until the next run clears them (clearing needs room to write).
   const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, match_args, true, nullptr); };
 
-  const std::string refine = options.refine_intrinsics ? "1" : "0";
-  std::vector<std::string> mapper_args{"mapper", "--database_path", database.string(), "--image_path",
-                                       images.root.string(), "--output_path", sparse.string(),
-                                       "--Mapper.num_threads", threads,
-                                       "--Mapper.ba_refine_focal_length", refine,
-                                       "--Mapper.ba_refine_principal_point", refine,
-                                       "--Mapper.ba_refine_extra_params", refine,
-                                       "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
-                                       "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
-                                       "--Mapper.ba_global_max_num_iterations",
-                                       std::to_string(options.ba_global_max_iterations),
-                                       "--Mapper.ba_local_max_num_iterations",
-                                       std::to_string(options.ba_local_max_iterations)};
-  mapper_args.insert(mapper_args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
+  const std::vector<std::string> mapper_args = MapperArgs(options, database, images.root, sparse);
   inputs += "--\n" + Joined(mapper_args);
   const std::string mapper_inputs = inputs;
   const auto mapper = [&] {
@@ -539,16 +569,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     RetryFoldedMap(options.fold_retries, out_dir, stages, cb, match, mapper, read_model, remember_stages, &result);
     t0 = std::chrono::steady_clock::now();
   }
-  WriteMapCheck(result.check, out_dir / kMapCheckFileName);
-  if (cb.warning)
-    for (const std::string& w : result.check.warnings) cb.warning(w);
-  RequireModelValuesInRange(result.map, result.model_dir);
-  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-  WriteKeyframesTum(result.map, out_dir / "keyframes.txt");
-  WriteTopView(result.map, out_dir / "map.png");
-  // The map file last: a disk that fills at an earlier file fails the command without a new
-  // map.arvmap beside the error (each file is written atomically; a previous map stays whole).
-  map::SaveMap(result.map, out_dir / map::kMapFileName);
+  WriteMapFolder(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
 }

@@ -116,8 +116,8 @@ std::shared_ptr<const anim::Character> MakeTube(int triangles) {
 
 struct Subject {
   std::shared_ptr<const anim::Character> character;
-  anim::CharacterSpec spec;
-  std::unique_ptr<anim::AnimatedCharacter> animated;
+  authoring::CharacterSpec spec;
+  std::unique_ptr<authoring::AnimatedCharacter> animated;
   calib::Pose camera_pose;
 };
 
@@ -128,11 +128,11 @@ std::unique_ptr<Subject> MakeSubject(std::shared_ptr<const anim::Character> char
   s->spec.name = s->character->source;
   s->spec.scale = scale;
   s->spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());
-  anim::KeySpec key;
+  authoring::KeySpec key;
   key.clip = s->character->clips.empty() ? "" : s->character->clips[0].name;
-  key.source = s->character->clips.empty() ? anim::KeySpec::Source::kRestPose : anim::KeySpec::Source::kClip;
+  key.source = s->character->clips.empty() ? authoring::KeySpec::Source::kRestPose : authoring::KeySpec::Source::kClip;
   s->spec.keys.push_back(key);
-  s->animated = std::make_unique<anim::AnimatedCharacter>(s->character, s->spec);
+  s->animated = std::make_unique<authoring::AnimatedCharacter>(s->character, s->spec);
   const Eigen::Vector3d eye(0.8, -2.4, 1.2), target(0, 0, 0.6);
   const Eigen::Vector3d forward = (target - eye).normalized();
   const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
@@ -152,7 +152,7 @@ Subject* GetSubject(const std::string& name) {
     const auto path = name == "Fox" ? arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb")
                                     : arview::testing::SharedData("characters/CesiumMan.glb");
     if (!std::filesystem::exists(path)) return nullptr;
-    subject = MakeSubject(std::make_shared<const anim::Character>(anim::LoadCharacter(path)), name == "Fox" ? 0.01 : 1.0);
+    subject = MakeSubject(std::make_shared<const anim::Character>(authoring::LoadCharacter(path)), name == "Fox" ? 0.01 : 1.0);
   }
   return (cache[name] = std::move(subject)).get();
 }

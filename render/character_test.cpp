@@ -18,8 +18,8 @@ namespace fs = std::filesystem;
 
 fs::path Fox() { return arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
 
-anim::Scene FoxScene() {
-  return anim::ParseScene("characters:\n  - name: fox\n    asset: " + Fox().string() +
+authoring::Scene FoxScene() {
+  return authoring::ParseScene("characters:\n  - name: fox\n    asset: " + Fox().string() +
                               "\n    scale: 0.01\n    anchor:\n      position: [0.2, 0.1, 0]\n"
                               "      rotation_deg: [90, 0, 30]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
                               "        clip: Walk\n",
@@ -49,7 +49,7 @@ cv::Mat NotBackground(const cv::Mat& image, const cv::Scalar& background) {
 }
 
 // The silhouette of anim/'s CPU-skinned meshes, projected with OpenCV and filled per triangle.
-cv::Mat CpuSilhouette(const anim::Character& character, const anim::CharacterSpec& spec,
+cv::Mat CpuSilhouette(const anim::Character& character, const authoring::CharacterSpec& spec,
                       const anim::AnimatorFrame& frame, anim::SkinningMethod method, const calib::Camera& camera,
                       const calib::Pose& pose) {
   cv::Mat mask = cv::Mat::zeros(camera.height, camera.width, CV_8U);
@@ -92,7 +92,7 @@ struct Silhouettes {
   double iou = 0;
 };
 
-Silhouettes Compare(ArRenderer& renderer, const anim::AnimatedCharacter& c, const anim::AnimatorFrame* frame,
+Silhouettes Compare(ArRenderer& renderer, const authoring::AnimatedCharacter& c, const anim::AnimatorFrame* frame,
                     anim::SkinningMethod method, const calib::Camera& camera, const calib::Pose& pose) {
   Silhouettes s;
   s.rendered = NotBackground(renderer.Render({}, pose, {&frame, 1}), kMagenta);
@@ -106,13 +106,13 @@ class FoxTest : public ::testing::Test {
   void SetUp() override {
     ARVIEW_REQUIRE_DATA_PATH(Fox(), "../shared/data");
     scene_ = FoxScene();
-    fox_ = std::make_unique<anim::AnimatedCharacter>(scene_.characters[0]);
+    fox_ = std::make_unique<authoring::AnimatedCharacter>(scene_.characters[0]);
   }
   const anim::AnimatorFrame& Frame(double time, const calib::Pose& pose) {
     return fox_->Update(fox_->spec().placement().ViewpointFromCamera(pose.Center()), time);
   }
-  anim::Scene scene_;
-  std::unique_ptr<anim::AnimatedCharacter> fox_;
+  authoring::Scene scene_;
+  std::unique_ptr<authoring::AnimatedCharacter> fox_;
 };
 
 TEST_F(FoxTest, GpuSkinningMatchesCpuSkinningForBothMethods) {
@@ -302,13 +302,13 @@ TEST(ArRenderer, DrawsUntexturedMeshesInTheirColourAndTexturedOnesWithTheirTextu
   green.width = green.height = 2;
   for (int i = 0; i < 4; ++i) green.rgba.insert(green.rgba.end(), {0, 230, 0, 255});
   c->textures.push_back(green);
-  anim::CharacterSpec spec;
+  authoring::CharacterSpec spec;
   spec.name = "quads";
   spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
-  anim::KeySpec key;
-  key.source = anim::KeySpec::Source::kRestPose;
+  authoring::KeySpec key;
+  key.source = authoring::KeySpec::Source::kRestPose;
   spec.keys.push_back(key);
-  anim::AnimatedCharacter quads(std::shared_ptr<const anim::Character>(c), spec);
+  authoring::AnimatedCharacter quads(std::shared_ptr<const anim::Character>(c), spec);
 
   const calib::Camera camera = TestCamera();
   const Eigen::Quaterniond level(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));
@@ -345,12 +345,12 @@ namespace {
 TEST(CesiumMan, GpuSilhouetteMatchesCpuSkinningWithBackFacesCulled) {
   const fs::path asset = arview::testing::SharedData("characters/CesiumMan.glb");
   ARVIEW_REQUIRE_DATA_PATH(asset, "../shared/data");
-  const anim::Scene scene = anim::ParseScene(
+  const authoring::Scene scene = authoring::ParseScene(
       "characters:\n  - name: man\n    asset: " + asset.string() +
           "\n    anchor:\n      position: [0.1, 0, 0.2]\n      rotation_deg: [90, 0, 0]\n    keys:\n"
           "      - viewpoint: [0, 0, 1]\n        clip: Anim_0\n",
       "cesium_test.yaml");
-  anim::AnimatedCharacter man(scene.characters[0]);
+  authoring::AnimatedCharacter man(scene.characters[0]);
   const calib::Camera camera = TestCamera();
   // 2.2 m in front and behind, at hip height, looking level.
   const Eigen::Quaterniond level(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));

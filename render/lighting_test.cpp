@@ -511,13 +511,13 @@ TEST(Prt, FootOfAWallSeesHalfTheUniformSky) {
 TEST(Prt, ShaderRotatesTheTransferWithTheSkinning) {
   auto sphere = std::make_shared<const anim::Character>(
       RigidCharacter(SphereOrCylinder(0.4, 0, 32, 64), Eigen::Quaterniond(Eigen::AngleAxisd(1.2, Eigen::Vector3d(0.3, 1, 0.2).normalized()))));
-  anim::CharacterSpec spec;
+  authoring::CharacterSpec spec;
   spec.name = "sphere";
   spec.anchor.position = {0, 0, 0.5};
-  anim::KeySpec key;
-  key.source = anim::KeySpec::Source::kRestPose;
+  authoring::KeySpec key;
+  key.source = authoring::KeySpec::Source::kRestPose;
   spec.keys.push_back(key);
-  anim::AnimatedCharacter animated(sphere, spec);
+  authoring::AnimatedCharacter animated(sphere, spec);
   const calib::Camera camera = calib::Camera::Pinhole(320, 240, 300, 300, 159.5, 119.5);
   const calib::Pose pose = LookAt({0, -2, 0.8}, {0, 0, 0.5});
   RoomLight light;
@@ -558,8 +558,8 @@ TEST(Prt, ShaderRotatesTheTransferWithTheSkinning) {
 // cast shadow and with the given occluders.
 struct PostScene {
   const AnalyticRoom room;
-  anim::CharacterSpec spec;
-  std::unique_ptr<anim::AnimatedCharacter> animated;
+  authoring::CharacterSpec spec;
+  std::unique_ptr<authoring::AnimatedCharacter> animated;
   const calib::Camera camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
   Eigen::Vector3d above;
   calib::Pose pose;
@@ -568,10 +568,10 @@ struct PostScene {
     spec.name = "post";
     spec.anchor.position = {room.position.x(), room.position.y(), 0};
     spec.anchor.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX());  // model y up → map z up
-    anim::KeySpec key;
-    key.source = anim::KeySpec::Source::kRestPose;
+    authoring::KeySpec key;
+    key.source = authoring::KeySpec::Source::kRestPose;
     spec.keys.push_back(key);
-    animated = std::make_unique<anim::AnimatedCharacter>(post, spec);
+    animated = std::make_unique<authoring::AnimatedCharacter>(post, spec);
     above = spec.anchor.position + Eigen::Vector3d(0, 0, 6);
     pose = LookAt(above, spec.anchor.position, Eigen::Vector3d::UnitY());
   }
@@ -594,7 +594,7 @@ TEST(CastShadow, FallsAwayFromTheDominantLightWithin10Degrees) {
   PostScene scene;
   const AnalyticRoom& room = scene.room;
   const RoomLight& light = AnalyticEstimate();
-  const anim::CharacterSpec& spec = scene.spec;
+  const authoring::CharacterSpec& spec = scene.spec;
   const calib::Pose& pose = scene.pose;
   const Eigen::Vector3d& above = scene.above;
   const cv::Mat images[2] = {scene.Render(false), scene.Render(true)};
@@ -683,7 +683,7 @@ TEST(CastShadow, IsNotSeenFromBelowTheFloor) {
 // The capsules against the mesh they stand for, seen from the light: the skinned mesh's outline
 // (anim/'s CPU skinning, filled triangle by triangle) and the capsules' coverage with a hard edge,
 // in the same orthographic view at 256 x 256 (the cast shadow's coverage has 64 x 64).
-double CapsuleOutlineIoU(const anim::AnimatedCharacter& animated, const anim::AnimatorFrame& frame,
+double CapsuleOutlineIoU(const authoring::AnimatedCharacter& animated, const anim::AnimatorFrame& frame,
                          const Eigen::Vector3d& towards_light, cv::Mat* mesh_mask, cv::Mat* capsule_mask) {
   constexpr int kSize = 256;
   const anim::Character& character = animated.character();
@@ -734,12 +734,12 @@ TEST(CastShadow, CapsulesCoverTheSkinnedMeshSeenFromTheLight) {
   };
   const Case cases[] = {{fox, 0.01, "Walk"}, {fox, 0.01, "Survey"}, {cesium, 1.0, "Anim_0"}};
   for (const Case& c : cases) {
-    const anim::Scene scene = anim::ParseScene("characters:\n  - name: c\n    asset: " + c.asset.string() + "\n    scale: " +
+    const authoring::Scene scene = authoring::ParseScene("characters:\n  - name: c\n    asset: " + c.asset.string() + "\n    scale: " +
                                                    std::to_string(c.scale) + "\n    anchor:\n      position: [0, 0, 0]\n"
                                                    "      rotation_deg: [90, 0, 0]\n    keys:\n      - viewpoint: [0, 0, 1]\n" +
                                                    "        clip: " + c.clip + "\n",
                                                "capsule_test.yaml");
-    anim::AnimatedCharacter animated(scene.characters[0]);
+    authoring::AnimatedCharacter animated(scene.characters[0]);
     for (double t : {0.0, 0.4, 0.8}) {
       const anim::AnimatorFrame& frame = animated.Update(Eigen::Vector3d::UnitZ(), t);
       cv::Mat mesh, capsules;
@@ -774,12 +774,12 @@ cv::Mat CoveredMask(ArRenderer& renderer, const calib::Pose& pose, const anim::A
 TEST(Occlusion, PillarProxyFromMapPointsMatchesTheExactPillarIoUAbove09) {
   const fs::path asset = arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb");
   ARVIEW_REQUIRE_DATA_PATH(asset, "../shared/data");
-  const anim::Scene scene = anim::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
+  const authoring::Scene scene = authoring::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
                                                  "\n    scale: 0.01\n    anchor:\n      position: [0, 0, 0]\n"
                                                  "      rotation_deg: [90, 0, 0]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
                                                  "        clip: Survey\n",
                                              "pillar_test.yaml");
-  anim::AnimatedCharacter fox(scene.characters[0]);
+  authoring::AnimatedCharacter fox(scene.characters[0]);
   const calib::Camera camera = calib::Camera::Pinhole(640, 480, 525, 525, 319.5, 239.5);
   const calib::Pose pose = LookAt({2.4, -0.6, 1.1}, {0, 0, 0.35});
   // A 0.3 m square pillar 1.1 m in front of the Fox, covering about half of it.
@@ -864,12 +864,12 @@ TEST(RoomLight, CharacterFollowsAColouredLightAndAnExposureRampLikeAGreyCard) {
   const Eigen::Vector3d corners[4] = {{2.8, 0.4, 0.45}, {2.8, 0.0, 0.45}, {2.8, 0.0, 0.05}, {2.8, 0.4, 0.05}};
   AppendQuad(card, corners, Eigen::Vector4f(0, 0, 1, 1), Eigen::Vector3f::Constant(0.5f));
   room.batches.push_back(card);
-  const anim::Scene scene = anim::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
+  const authoring::Scene scene = authoring::ParseScene("characters:\n  - name: fox\n    asset: " + asset.string() +
                                                  "\n    scale: 0.01\n    anchor:\n      position: [2.8, -0.5, 0]\n"
                                                  "      rotation: [0.5, -0.5, -0.5, 0.5]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
                                                  "        clip: Survey\n",
                                              "room_test.yaml");
-  anim::AnimatedCharacter fox(scene.characters[0]);
+  authoring::AnimatedCharacter fox(scene.characters[0]);
   OffscreenContext& context = SharedContext();
   RoomRenderer camera_view(context, room, RoomCamera(), 4);
   const RoomPath path(10, 1);

@@ -18,15 +18,6 @@
 namespace arview::tracker {
 namespace {
 
-int SquaredDistance(const std::uint8_t* a, const std::uint8_t* b) {
-  int sum = 0;
-  for (int i = 0; i < 128; ++i) {
-    const int d = int(a[i]) - int(b[i]);
-    sum += d * d;
-  }
-  return sum;
-}
-
 void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
   result->inliers = pose.stats.inliers;
   result->rms_px = pose.stats.rms_px;
@@ -35,59 +26,6 @@ void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
 }
 
 }  // namespace
-
-calib::Pose PredictConstantVelocity(const calib::Pose& last, const calib::Pose& velocity) {
-  return velocity * last;
-}
-
-calib::Pose RelativeMotion(const calib::Pose& previous, const calib::Pose& last) {
-  return last * previous.Inverse();
-}
-
-calib::Pose ScaleMotion(const calib::Pose& motion, double ratio) {
-  Eigen::AngleAxisd rotation(motion.q_cw);
-  rotation.angle() *= ratio;
-  return {Eigen::Quaterniond(rotation).normalized(), ratio * motion.t_cw};
-}
-
-Track2D3D SpreadTracks(const Track2D3D& tracks, int max_count, int cell, const cv::Size& size) {
-  if (static_cast<int>(tracks.pixels.size()) <= max_count) return tracks;
-  const int gw = size.width / cell + 1, gh = size.height / cell + 1;
-  std::vector<std::vector<int>> cells(static_cast<size_t>(gw) * gh);
-  for (size_t i = 0; i < tracks.pixels.size(); ++i) {
-    const int gx = std::clamp(static_cast<int>(tracks.pixels[i].x / cell), 0, gw - 1);
-    const int gy = std::clamp(static_cast<int>(tracks.pixels[i].y / cell), 0, gh - 1);
-    cells[gy * gw + gx].push_back(static_cast<int>(i));
-  }
-  Track2D3D out;
-  for (size_t round = 0; static_cast<int>(out.pixels.size()) < max_count; ++round) {
-    bool any = false;
-    for (const auto& c : cells) {
-      if (round >= c.size()) continue;
-      any = true;
-      out.pixels.push_back(tracks.pixels[c[round]]);
-      out.points.push_back(tracks.points[c[round]]);
-      if (static_cast<int>(out.pixels.size()) == max_count) break;
-    }
-    if (!any) break;
-  }
-  return out;
-}
-
-void CheckTrackable(const map::Map& map, int min_points) {
-  if (static_cast<int>(map.points.size()) < min_points) {
-    std::ostringstream msg;
-    msg << "map has " << map.points.size() << " points, at least " << min_points
-        << " are needed to track against it";
-    throw TrackerError(msg.str());
-  }
-  try {
-    map::ValidateMap(map, "map");
-  } catch (const map::MapError& e) {
-    throw TrackerError(e.what());
-  }
-  if (map.descriptors.rows == 0) throw TrackerError("map has no descriptors to match against");
-}
 
 Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
     : map_(map),
@@ -121,20 +59,6 @@ void Tracker::WarmUp() {
   (void)nothing, (void)none, (void)pyramid, (void)nearest;
 }
 
-std::vector<int> Tracker::CovisibleKeyframes(const std::vector<std::uint32_t>& points) const {
-  std::vector<int> votes(map_.keyframes.size(), 0);
-  for (std::uint32_t p : points)
-    for (std::uint32_t k : point_keyframes_[p]) ++votes[k];
-  std::vector<std::pair<int, int>> ranked;  // (−votes, keyframe)
-  for (size_t k = 0; k < votes.size(); ++k)
-    if (votes[k] > 0) ranked.emplace_back(-votes[k], static_cast<int>(k));
-  const size_t n = std::min<size_t>(ranked.size(), options_.tracking.guided_keyframes);
-  std::partial_sort(ranked.begin(), ranked.begin() + n, ranked.end());
-  std::vector<int> best;
-  for (size_t i = 0; i < n; ++i) best.push_back(ranked[i].second);
-  return best;
-}
-
 void Tracker::Reset() {
   prefetch_.reset();  // waits for a pending extraction
   feature_centres_.Clear();
@@ -143,104 +67,6 @@ void Tracker::Reset() {
   last_pyramid_.clear();
   last_inliers_ = {};
   smoother_.Reset();
-}
-
-std::vector<int> Tracker::NearestKeyframes(const calib::Pose& pose) const {
-  const Eigen::Vector3d centre = pose.Center();
-  const Eigen::Vector3d axis = pose.q_cw.conjugate() * Eigen::Vector3d::UnitZ();
-  std::vector<std::pair<double, int>> ranked;
-  for (size_t k = 0; k < map_.keyframes.size(); ++k) {
-    const calib::Pose& kp = map_.keyframes[k].pose;
-    // Keyframes looking more than ~70° away see other surfaces or other sides of them.
-    if ((kp.q_cw.conjugate() * Eigen::Vector3d::UnitZ()).dot(axis) < 0.34) continue;
-    ranked.emplace_back((kp.Center() - centre).squaredNorm(), static_cast<int>(k));
-  }
-  const size_t n = std::min<size_t>(ranked.size(), options_.tracking.guided_keyframes);
-  std::partial_sort(ranked.begin(), ranked.begin() + n, ranked.end());
-  std::vector<int> nearest;
-  for (size_t i = 0; i < n; ++i) nearest.push_back(ranked[i].second);
-  return nearest;
-}
-
-// Guided matching: SIFT keypoints of the frame against map points projected with the predicted
-// pose, only within a small radius, with a ratio test between distinct points.
-struct Tracker::Guided {
-  using Candidate = GuidedCandidate;
-
-  static std::vector<MapMatch> Match(const Features& features, const std::vector<Candidate>& cands,
-                                     const map::Map& map, double radius, double ratio,
-                                     const cv::Size& size) {
-    const int cell = std::max(4, static_cast<int>(std::ceil(radius)));
-    const int gw = size.width / cell + 1, gh = size.height / cell + 1;
-    std::vector<std::vector<int>> grid(static_cast<size_t>(gw) * gh);
-    for (size_t i = 0; i < cands.size(); ++i) {
-      const int gx = std::clamp(static_cast<int>(cands[i].pixel.x() / cell), 0, gw - 1);
-      const int gy = std::clamp(static_cast<int>(cands[i].pixel.y() / cell), 0, gh - 1);
-      grid[gy * gw + gx].push_back(static_cast<int>(i));
-    }
-    std::vector<MapMatch> matches;
-    std::unordered_map<std::uint32_t, size_t> best_for_point;
-    const double r2 = radius * radius;
-    for (size_t k = 0; k < features.keypoints.size(); ++k) {
-      const cv::Point2f& kp = features.keypoints[k].pt;
-      const std::uint8_t* desc = features.descriptors.ptr<std::uint8_t>(static_cast<int>(k));
-      const int cx = static_cast<int>(kp.x / cell), cy = static_cast<int>(kp.y / cell);
-      int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max();
-      std::uint32_t best_point = 0;
-      for (int gy = std::max(0, cy - 1); gy <= std::min(gh - 1, cy + 1); ++gy) {
-        for (int gx = std::max(0, cx - 1); gx <= std::min(gw - 1, cx + 1); ++gx) {
-          for (int i : grid[gy * gw + gx]) {
-            const Candidate& c = cands[i];
-            if ((c.pixel - Eigen::Vector2d(kp.x, kp.y)).squaredNorm() > r2) continue;
-            const map::MapPoint& mp = map.points[c.point];
-            int d = std::numeric_limits<int>::max();
-            if (c.descriptor != Candidate::kEveryDescriptor) {
-              d = SquaredDistance(desc, map.descriptors.ptr<std::uint8_t>(static_cast<int>(c.descriptor)));
-            } else {
-              for (std::uint32_t r = 0; r < mp.descriptor_count; ++r)
-                d = std::min(d, SquaredDistance(desc, map.descriptors.ptr<std::uint8_t>(
-                                                          static_cast<int>(mp.first_descriptor + r))));
-            }
-            if (d < best) {
-              if (c.point != best_point) second = best;
-              best = d;
-              best_point = c.point;
-            } else if (d < second && c.point != best_point) {
-              second = d;
-            }
-          }
-        }
-      }
-      if (best == std::numeric_limits<int>::max()) continue;
-      // Distances are squared: compare with the squared ratio.
-      if (second != std::numeric_limits<int>::max() &&
-          static_cast<double>(best) > ratio * ratio * static_cast<double>(second))
-        continue;
-      const MapMatch match{static_cast<int>(k), best_point, std::sqrt(static_cast<float>(best))};
-      auto [it, inserted] = best_for_point.try_emplace(best_point, matches.size());
-      if (inserted) matches.push_back(match);
-      else if (match.distance < matches[it->second].distance) matches[it->second] = match;
-    }
-    return matches;
-  }
-};
-
-std::vector<Tracker::GuidedCandidate> Tracker::GuidedCandidates(const calib::Pose& pose,
-                                                                const std::vector<std::uint32_t>& tracked_points) {
-  const calib::Camera& camera = resolution_.work();
-  const std::vector<int> keyframes = tracked_points.empty() ? NearestKeyframes(pose) : CovisibleKeyframes(tracked_points);
-  std::vector<GuidedCandidate> candidates;
-  for (int k : keyframes) {
-    for (const auto& obs : map_.keyframes[k].observations) {
-      if (point_stamp_[obs.point] == frame_counter_) continue;  // already tracked or queued
-      point_stamp_[obs.point] = frame_counter_;
-      const Eigen::Vector3d pc = pose.ToCamera(map_.points[obs.point].xyz);
-      if (pc.z() <= 0) continue;
-      const Eigen::Vector2d px = camera.Project(pc);
-      if (camera.InImage(px)) candidates.push_back({px, obs.point});
-    }
-  }
-  return candidates;
 }
 
 std::vector<cv::Mat> Tracker::FlowPyramid(const cv::Mat& gray) const {
@@ -312,8 +138,8 @@ int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose&
   result->times.cpu_ms += extracted.cpu_ms;  // Track() adds its own thread's
   const auto match_start = std::chrono::steady_clock::now();
   // The map points the prefetched frame's neighbours see, projected with its own pose.
-  const std::vector<Guided::Candidate> candidates = GuidedCandidates(prefetch->pose, prefetch->tracked_points);
-  const auto matches = Guided::Match(extracted.features, candidates, map_, opt.guided_radius_px, opt.guided_ratio,
+  const std::vector<GuidedCandidate> candidates = GuidedCandidates(prefetch->pose, prefetch->tracked_points);
+  const auto matches = MatchGuided(extracted.features, candidates, map_, opt.guided_radius_px, opt.guided_ratio,
                                      camera.Size());
   // Followed from the prefetched frame into this one, started where this frame's pose puts them;
   // only as many, spread over the picture, as the flow follows (LK costs ~10 us a point).
@@ -434,8 +260,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       result->keypoints = static_cast<int>(features.keypoints.size());
       result->times.extract_ms = MillisecondsSince(extract_start);
       const auto match_start = std::chrono::steady_clock::now();
-      const std::vector<Guided::Candidate> candidates = GuidedCandidates(projecting, point_ids);
-      const auto guided = Guided::Match(features, candidates, map_, radius, opt.guided_ratio, gray.size());
+      const std::vector<GuidedCandidate> candidates = GuidedCandidates(projecting, point_ids);
+      const auto guided = MatchGuided(features, candidates, map_, radius, opt.guided_ratio, gray.size());
       for (const auto& m : guided) {
         const cv::Point2f& p = features.keypoints[m.keypoint].pt;
         pixels.emplace_back(p.x, p.y);
@@ -549,7 +375,7 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   for (int k : NearestKeyframes(predicted))
     if (std::find(keyframes.begin(), keyframes.end(), k) == keyframes.end()) keyframes.push_back(k);
   ++frame_counter_;  // a fresh stamp: points gathered by TrackWithPrior are candidates again
-  std::vector<Guided::Candidate> candidates;
+  std::vector<GuidedCandidate> candidates;
   for (int k : keyframes) {
     for (const auto& obs : map_.keyframes[k].observations) {
       if (point_stamp_[obs.point] == frame_counter_) continue;
@@ -567,7 +393,7 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
       candidates.push_back({px, obs.point, obs.descriptor});
     }
   }
-  const auto matches = Guided::Match(features, candidates, map_, radius, opt.wide_ratio, gray.size());
+  const auto matches = MatchGuided(features, candidates, map_, radius, opt.wide_ratio, gray.size());
   result->wide_matches = static_cast<int>(matches.size());
   result->times.match_ms += MillisecondsSince(match_start);
 

@@ -39,104 +39,74 @@ constexpr auto EnumNames(TrackStatus) {
 
 // Every pixel quantity below is in working-resolution pixels (TrackerOptions::working_long_side).
 struct TrackingOptions {
-  // An 11x11 window: LK's cost grows with the window's area (21x21 took 2.1-3.6x as long on the
-  // demo's lap), and the smaller window was also the more exact there (centre error median
-  // 3.1-3.8 mm against 5.1-5.7 mm with 21x21, frames 1-4 apart; docs/tracker.md).
+  // Side of LK's window: its cost grows with the area, and 11x11 was faster and more exact than
+  // 21x21 (docs/tracker.md, "Why the tracking options are what they are").
   int lk_window_px = 11;
-  // 5 levels follow ~160 px of unpredicted motion at the working resolution (window half-size
-  // x 2^levels: frames 2-4 video frames apart, or the first frame after a relocalization, which
-  // has no velocity yet), as 21x21 with 4 levels did.
+  // LK pyramid levels above the frame, each doubling the motion followed: 5 follow ~160 px, as
+  // 21x21 with 4 levels did (docs/tracker.md, "Why the tracking options are what they are").
   int lk_pyramid_levels = 5;
-  int lk_max_iterations = 20;
-  // At most this many inliers are followed into the next frame, spread over the image (LK and
-  // refinement time grow with the count; a few hundred well-spread points pin the pose).
+  int lk_max_iterations = 20;  // LK's iterations per pyramid level
+  // At most this many inliers are followed into the next frame, spread over the image: LK and
+  // refinement time grow with the count, and a few hundred well-spread points pin the pose.
   int max_flow_tracks = 300;
-  // An inlier is followed into the next frame only when its reprojection error is below this
-  // many times the residual scale of recent tracked frames (ResidualGate::Scale()): LK drifts a
-  // little on every frame, and a track followed for many frames would otherwise fit ever worse
-  // (on a hand-held phone clip the inlier RMS grew 0.7 → 1.6 px over four frames and the RMS
-  // gate refused the pose). Dropped tracks are replaced by guided matching.
+  // An inlier is followed on only within this many residual scales (ResidualGate::Scale()): LK
+  // drifts, old tracks fit worse (docs/tracker.md, "Why the tracking options are what they are").
   double max_track_residual_scales = 2.0;
   int flow_grid_cell_px = 40;  // cell of the grid the followed inliers are spread over
   // Guided matching (SIFT on the frame, matched only against map points projected within a
   // radius) runs when fewer flow tracks than this survive.
   int replenish_below = 150;
-  // Keyframes whose observations are projected: those seeing most of the flow tracks
+  // Keyframes whose observations guided matching projects: those seeing most of the flow tracks
   // (covisibility), or without tracks the nearest looking the same way.
   int guided_keyframes = 4;
-  // Radius around the projection with the pose refined on the flow tracks; with only the
-  // motion prediction to project with (too few flow tracks), the wider radius.
+  // Guided matching's radius around a projection by the pose refined on the flow tracks.
   double guided_radius_px = 10;
+  // The wider radius when only the motion prediction projects (too few flow tracks); also the
+  // farthest a prefetched keypoint may end from where the current pose projects its point.
   double guided_radius_predicted_px = 25;
-  double guided_ratio = 0.85;
-  // SIFT keypoints for guided matching: more than relocalization uses, since matching them
-  // costs little and the tracked pose needs points spread over the whole view.
+  double guided_ratio = 0.85;  // ratio test of guided matching
+  // SIFT keypoints for guided matching: many, since matching them costs little and the tracked
+  // pose needs points spread over the whole view.
   int guided_max_features = 2000;
-  // Guided matching's SIFT contrast threshold (OpenCV's definition, FeatureOptions), at any
-  // working resolution: OpenCV's default. Its matches are searched within a few pixels of the
-  // projection, where the stronger keypoints suffice. Kept apart from relocalization's
-  // threshold (RelocalizerOptions::features: COLMAP's lower one, which helps frames without a
-  // prior); applied here too, it made the rendered room's blurred lap worse (docs/tracker.md).
-  // The wide search extracts these features too.
+  // SIFT contrast threshold of guided matching and the wide search: near a projection OpenCV's
+  // default suffices; 0.02 did worse (docs/tracker.md, "Why the tracking options are what they are").
   double guided_contrast_threshold = 0.04;
-  // Guided matching's SIFT, extracted ahead on a worker thread: when a tracked frame keeps fewer
-  // flow tracks than `prefetch_below`, its SIFT is extracted in the background while the next
-  // frames track on flow alone; `prefetch_lag_frames` frames later (or sooner, when the flow
-  // tracks fall below replenish_below) the keypoints are matched to the map with that frame's
-  // pose and followed into the current frame by LK. The extraction (60-160 ms at 640x480 here,
-  // 15-30 frames' worth of tracking) then no longer stalls the frame that needs it, and a
-  // pipeline keeps its frame rate. The frame that consumes it waits for it if it is not done,
-  // so results do not depend on timing. 0 (the default): off, guided matching extracts in the
-  // frame itself. On the demo's lap it gained ~1 fps (76 against 75 fps, within the runs' spread)
-  // and cost accuracy (centre error median 4.2-5.5 mm over 9 settings against 4.2 mm: the frame
-  // that replenishes is posed on its ~300 followed keypoints rather than ~1000 fresh matches);
-  // docs/tracker.md. For a live camera whose frames drop at guided matching's frames.
+  // Guided SIFT is extracted ahead on a worker thread below this many flow tracks, for a camera
+  // dropping frames; 0, off: less exact (docs/tracker.md, "Why the tracking options are what they are").
   int prefetch_below = 0;
+  // Frames after which features extracted ahead are used (sooner when the flow tracks fall below
+  // replenish_below); the frame that uses them waits for them, so results do not depend on timing.
   int prefetch_lag_frames = 6;
   // The pose is first refined from the constant-velocity prediction; it is kept when its inliers
   // are at least this fraction of the correspondences, else a short RANSAC runs.
   double prior_min_inlier_ratio = 0.5;
   int ransac_max_iterations = 50;  // the inlier ratio is high when tracking
-  // RANSAC's inlier threshold of tracking and the wide search (relocalization has its own,
-  // RelocalizerOptions::pose): a tracked frame's correspondences come from flow and guided
-  // matching on a moving, often blurred camera.
+  // RANSAC's inlier threshold when tracking and in the wide search (relocalization has its own):
+  // the correspondences come from flow and guided matching on a moving, often blurred camera.
   double ransac_threshold_px = 4.0;
   // A RANSAC pose turned further than this from the prediction is refused (a P3P solution
   // mirrored on a nearly planar patch explains the points almost as well as the true one).
   double max_rotation_from_prediction_deg = 20;
   int min_inliers = 30;            // below this, fall back to relocalization
-  // When flow and guided matching fail (a motion the pyramid cannot follow: on a hand-held
-  // phone clip 175-275 working pixels between frames several video frames apart), the map
-  // points of the keyframes near the last pose are searched for within this fraction of the
-  // working image's longest side around their predicted projections (0: off), with this ratio,
-  // before falling back to relocalization over the whole map. A pose so found must pass the RMS
-  // gate like any tracked pose and turn at most wide_max_rotation_deg from the nearer of the last
-  // pose and the prediction (on phone-fox the constant-velocity prediction was further off than
-  // no motion at all on 14 of 24 frames; the motions recovered turned 21-24 deg from it); the
-  // frame's `wide_matches` says it was found this way.
+  // The wide search, for jumps flow cannot follow, matches within this fraction of the image's
+  // longest side; 0: off (docs/tracker.md, "Why the tracking options are what they are").
   double wide_radius_fraction = 0.3;
+  // The most a wide-search pose may turn from the last pose or the prediction, whichever is nearer:
+  // the jumps seen turned over 20 deg (docs/tracker.md, "Why the tracking options are what they are").
   double wide_max_rotation_deg = 30;
-  double wide_ratio = 0.8;
-  int wide_ransac_iterations = 500;
+  double wide_ratio = 0.8;           // ratio test of the wide search
+  int wide_ransac_iterations = 500;  // RANSAC iterations of the wide search
   // The largest accepted inlier RMS follows the residual scale of recent tracked frames
-  // (tracker/residual_gate.h): drifted flow tracks or wrong guided matches (seen in fast turns)
-  // fit worse than the camera's genuine poses, and the frame is relocalised instead.
+  // (tracker/residual_gate.h): drifted tracks and wrong matches fit worse, and are relocalised.
   ResidualGateOptions rms_gate;
-  // Constant-velocity prediction scaled by the time since the last frame over the time the
-  // velocity was measured on, within these bounds (a dropped frame doubles the motion).
+  // The constant-velocity motion is scaled by the time since the last frame over the time it was
+  // measured on, at most this many times (a dropped frame doubles the motion).
   double max_prediction_ratio = 4;
-  // A frame that flow, guided matching, the wide search and relocalization all failed on, right
-  // after a posed frame, takes its rotation from aligning its small blurred image with that
-  // frame's (tracker/rotation_aligner.h) and its centre from a straight line fitted to the
-  // centres of the last frames posed from features (CentreFitter), for at most
-  // `align_max_seconds` after the last of them (0: off). Such frames are whip-pans, smeared by
-  // tens of pixels: on the synthetic room's blurred lap (a turn
-  // peaking at 320 deg/s, 1/60 s exposure) flow and SIFT found 1-29 correspondences in 13
-  // consecutive frames. The frame's `align_zncc` says it was posed this way; its pose must turn
-  // at most `align_max_from_prediction_deg` from the prediction.
+  // Whip-pans, which no feature survives, are posed by image alignment for this long after the
+  // last pose from features; 0: off (docs/tracker.md, "Why the tracking options are what they are").
   double align_max_seconds = 0.5;
-  double align_max_from_prediction_deg = 15;
-  RotationAlignerOptions align;
+  double align_max_from_prediction_deg = 15;  // the most an aligned rotation may turn
+  RotationAlignerOptions align;               // tracker/rotation_aligner.h
 };
 // FLANN's default 64 leaves per query, halved: on templeRing and the synthetic room the same
 // frames localise with the same accuracy, and global matching is ~1.5x faster.
@@ -212,7 +182,6 @@ class Tracker {
   const calib::Camera& working_camera() const { return resolution_.work(); }
 
  private:
-  struct Guided;
   struct Prefetch;
   struct GuidedCandidate {  // a map point where a pose projects it, for guided matching
     static constexpr std::uint32_t kEveryDescriptor = 0xffffffffu;
@@ -222,6 +191,10 @@ class Tracker {
     // the point), or kEveryDescriptor: the nearest of all of the point's.
     std::uint32_t descriptor = kEveryDescriptor;
   };
+  // `features` matched to the candidates within `radius` pixels, with Lowe's `ratio`; one match
+  // per map point, the closest (guided_matching.cpp).
+  static std::vector<MapMatch> MatchGuided(const Features& features, const std::vector<GuidedCandidate>& candidates,
+                                           const map::Map& map, double radius, double ratio, const cv::Size& size);
   // `features` receives the frame's SIFT when guided matching extracted it, so that a fallback
   // to relocalization does not extract it again.
   bool TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult* result,

@@ -61,9 +61,9 @@ std::string TextureText(const anim::Character& c, int texture) {
 }
 
 void RunInfo(const AnimArgs& args) {
-  const anim::Character c = anim::LoadCharacter(args.asset);
+  const anim::Character c = authoring::LoadCharacter(args.asset);
   const anim::Skeleton& sk = c.skeleton;
-  const std::vector<std::string> chain = anim::DefaultLookAtChain(sk);
+  const std::vector<std::string> chain = authoring::DefaultLookAtChain(sk);
   if (args.json) {
     nlohmann::ordered_json j = {{"asset", c.source}};
     nlohmann::ordered_json& joints = j["joints"] = nlohmann::ordered_json::array();
@@ -85,8 +85,8 @@ void RunInfo(const AnimArgs& args) {
     nlohmann::ordered_json& chain_json = j["default_lookat_chain"] = nlohmann::ordered_json::array();
     for (const std::string& n : chain) chain_json.push_back({{"joint", n}});
     nlohmann::ordered_json& arms = j["default_arm_chains"] = nlohmann::ordered_json::object();
-    for (anim::ArmSide side : {anim::ArmSide::kRight, anim::ArmSide::kLeft})
-      arms[std::string(ToString(side))] = anim::DefaultArmChain(sk, side);
+    for (authoring::ArmSide side : {authoring::ArmSide::kRight, authoring::ArmSide::kLeft})
+      arms[std::string(ToString(side))] = authoring::DefaultArmChain(sk, side);
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -116,8 +116,8 @@ void RunInfo(const AnimArgs& args) {
   if (chain.empty()) std::cout << "none found (name the joints in the scene's lookat.chain)";
   for (std::size_t i = 0; i < chain.size(); ++i) std::cout << (i ? " > " : "") << chain[i];
   std::cout << "\n";
-  for (anim::ArmSide side : {anim::ArmSide::kRight, anim::ArmSide::kLeft}) {
-    const std::vector<std::string> arm = anim::DefaultArmChain(sk, side);
+  for (authoring::ArmSide side : {authoring::ArmSide::kRight, authoring::ArmSide::kLeft}) {
+    const std::vector<std::string> arm = authoring::DefaultArmChain(sk, side);
     std::cout << "default " << ToString(side) << " arm chain (gesture keys): ";
     if (arm.empty()) std::cout << "none found (name the joints in the scene's gesture.chain)";
     for (std::size_t i = 0; i < arm.size(); ++i) std::cout << (i ? " > " : "") << arm[i];
@@ -126,24 +126,24 @@ void RunInfo(const AnimArgs& args) {
 }
 
 // "lookat", or "lookat+point" for a gesture key.
-std::string SourceText(const anim::KeySpec& key) {
+std::string SourceText(const authoring::KeySpec& key) {
   std::string s(ToString(key.source));
-  if (key.gesture != anim::Gesture::kNone) s += std::string("+") + std::string(ToString(key.gesture));
+  if (key.gesture != authoring::Gesture::kNone) s += std::string("+") + std::string(ToString(key.gesture));
   return s;
 }
 
 void RunWeights(const AnimArgs& args) {
-  const Eigen::Vector3d v = anim::ParseViewpoint(args.viewpoint, "--viewpoint");
+  const Eigen::Vector3d v = authoring::ParseViewpoint(args.viewpoint, "--viewpoint");
   if (!std::isfinite(args.time)) throw CommandError("--time must be a finite number of seconds");
-  const anim::Scene scene = anim::LoadScene(args.scene);
-  const anim::CharacterSpec* spec = nullptr;
-  for (const anim::CharacterSpec& c : scene.characters)
+  const authoring::Scene scene = authoring::LoadScene(args.scene);
+  const authoring::CharacterSpec* spec = nullptr;
+  for (const authoring::CharacterSpec& c : scene.characters)
     if (args.character.empty() || c.name == args.character) {
       spec = &c;
       break;
     }
   if (!spec) throw CommandError(args.scene + ": no character named '" + args.character + "'");
-  anim::AnimatedCharacter ch(*spec);
+  authoring::AnimatedCharacter ch(*spec);
   const anim::AnimatorFrame& out = ch.Update(v, args.time);
   const bool lookat = !ch.lookat_chain().joints.empty();
   double head_deg = 0;
@@ -154,21 +154,21 @@ void RunWeights(const AnimArgs& args) {
   // Gesture keys: the arm's direction to the viewpoint, measured as the heaviest gesture key
   // aims it (point: the forearm; reach: shoulder to hand).
   const bool gesture = ch.arm_chain().upper >= 0;
-  anim::Gesture kind = anim::Gesture::kNone;
+  authoring::Gesture kind = authoring::Gesture::kNone;
   double heaviest = -1, arm_deg = 0;
   for (std::size_t k = 0; k < spec->keys.size(); ++k)
-    if (spec->keys[k].gesture != anim::Gesture::kNone && out.key_weights[k] > heaviest) {
+    if (spec->keys[k].gesture != authoring::Gesture::kNone && out.key_weights[k] > heaviest) {
       heaviest = out.key_weights[k];
       kind = spec->keys[k].gesture;
     }
   if (gesture) {
-    const Eigen::Vector3d d = anim::GestureDirection(ch.arm_chain(), kind, out.model);
+    const Eigen::Vector3d d = authoring::GestureDirection(ch.arm_chain(), kind, out.model);
     arm_deg = std::atan2(d.cross(v).norm(), d.dot(v)) * 180 / M_PI;
   }
   const bool dib = spec->blend == anim::BlendMethod::kDib;
   // The idle section learned as the appliance learns it: what the data gave each layer.
-  anim::IdleLayerReport idle;
-  if (spec->idle.given) anim::BuildIdleLayer(ch, &idle);
+  authoring::IdleLayerReport idle;
+  if (spec->idle.given) authoring::BuildIdleLayer(ch, &idle);
   const std::string balance_text =
       idle.balance + (idle.balance_built ? "" : "; the character idles without balance shifts");
   if (args.json) {
@@ -178,7 +178,7 @@ void RunWeights(const AnimArgs& args) {
                                 {"time_s", args.time}};
     nlohmann::ordered_json& keys = j["keys"] = nlohmann::ordered_json::array();
     for (std::size_t k = 0; k < spec->keys.size(); ++k) {
-      const anim::KeySpec& key = spec->keys[k];
+      const authoring::KeySpec& key = spec->keys[k];
       keys.push_back({{"index", k},
                       {"source", SourceText(key)},
                       {"clip", ch.key_clip(int(k)).name},
@@ -194,7 +194,7 @@ void RunWeights(const AnimArgs& args) {
     if (gesture) {
       j["gesture"] = ToString(kind);
       j["arm_to_viewpoint_deg"] = arm_deg;
-      j["elbow_bend_deg"] = anim::ElbowBendDeg(ch.arm_chain(), out.model);
+      j["elbow_bend_deg"] = authoring::ElbowBendDeg(ch.arm_chain(), out.model);
     }
     if (spec->idle.given) j["idle"] = idle.idle;
     if (spec->idle.balance.given) j["balance"] = {{"built", idle.balance_built}, {"summary", idle.balance}};
@@ -204,7 +204,7 @@ void RunWeights(const AnimArgs& args) {
   std::cout << "character " << spec->name << ", viewpoint (" << Fixed(v.x()) << ", " << Fixed(v.y()) << ", "
             << Fixed(v.z()) << "), t = " << Fixed(args.time) << " s\n";
   for (std::size_t k = 0; k < spec->keys.size(); ++k) {
-    const anim::KeySpec& key = spec->keys[k];
+    const authoring::KeySpec& key = spec->keys[k];
     std::cout << "  key " << k << "  (" << Fixed(key.viewpoint.x()) << ", " << Fixed(key.viewpoint.y()) << ", "
               << Fixed(key.viewpoint.z()) << ")  " << SourceText(key) << " " << ch.key_clip(int(k)).name
               << "  weight " << Fixed(out.key_weights[k], 4) << "\n";
@@ -215,7 +215,7 @@ void RunWeights(const AnimArgs& args) {
   if (lookat) std::cout << "head forward to viewpoint: " << Fixed(head_deg, 2) << " deg\n";
   if (gesture)
     std::cout << ToString(spec->gesture.side) << " arm (" << ToString(kind) << ") to viewpoint: " << Fixed(arm_deg, 2)
-              << " deg, elbow bend " << Fixed(anim::ElbowBendDeg(ch.arm_chain(), out.model), 1) << " deg\n";
+              << " deg, elbow bend " << Fixed(authoring::ElbowBendDeg(ch.arm_chain(), out.model), 1) << " deg\n";
   if (spec->idle.given) std::cout << "idle: " << idle.idle << "\n";
   if (spec->idle.balance.given) std::cout << "balance: " << balance_text << "\n";
 }

@@ -26,7 +26,7 @@ struct PlaceArgs {
 // is written (the scene would only fail when loaded, far from the command that made it).
 void RequireBaseClip(const std::string& asset, const std::string& clip) {
   if (clip.empty() || clip == "rest") return;
-  const anim::Character character = anim::LoadCharacter(asset);
+  const anim::Character character = authoring::LoadCharacter(asset);
   std::string names;
   for (const auto& c : character.clips) {
     if (c.name == clip) return;

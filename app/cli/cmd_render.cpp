@@ -80,11 +80,11 @@ void RunRender(const RenderArgs& args) {
   const std::string ext = std::filesystem::path(args.out).extension().string();
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") throw CommandError(args.out + ": --out must end in .png or .jpg");
   try {
-    const anim::Scene scene = anim::LoadScene(args.scene);
+    const authoring::Scene scene = authoring::LoadScene(args.scene);
     if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
     const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
-    std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
-    for (const anim::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
+    std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
+    for (const authoring::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
 
     render::OffscreenOptions gl;
     gl.backend = render::ParseGlBackend(args.backend);

@@ -222,7 +222,7 @@ struct DemoCharacter {
 
 DemoCharacter PlaceDemoCharacter(const DemoOptions& o, const map::Map& map, const recordings::Sim3& to_room,
                                  const synth::OrbitWalk& orbit, const fs::path& work) {
-  DemoCharacter c{anim::LoadCharacter(o.character), {}, work / "scene.yaml"};
+  DemoCharacter c{authoring::LoadCharacter(o.character), {}, work / "scene.yaml"};
   const double asset_height = anim::RestHeight(c.asset, Eigen::Vector3d::UnitY());
   if (!(asset_height > 0)) throw Error(o.character + ": the character has no height to scale");
   PlaceCharacterOptions place_options;
@@ -332,7 +332,7 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
                            const recordings::Sim3& to_room, const synth::OrbitWalk& orbit, const SessionResult& result,
                            const recordings::AccuracyReport& report, const recordings::Trajectory& second_lap,
                            const fs::path& out, const fs::path& work) {
-  const anim::Scene loaded = anim::LoadScene(character.scene);
+  const authoring::Scene loaded = authoring::LoadScene(character.scene);
   const CharacterMarkers markers = MarkersOf(character.asset, to_room.Matrix() * loaded.characters[0].placement().ModelToMap());
   std::map<double, bool> localized;
   for (const FrameLog& f : result.report.frames) localized[f.timestamp] = f.track.status != tracker::TrackStatus::kLost;

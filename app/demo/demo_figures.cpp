@@ -22,7 +22,7 @@ CharacterMarkers MarkersOf(const anim::Character& character, const Eigen::Matrix
 
   CharacterMarkers m;
   for (const auto& joint : model) m.joints.push_back(world(joint.block<3, 1>(0, 3)));
-  const std::vector<std::string> chain = anim::DefaultLookAtChain(sk);
+  const std::vector<std::string> chain = authoring::DefaultLookAtChain(sk);
   int head = chain.empty() ? -1 : sk.Find(chain.back());
   if (head < 0) {
     head = 0;

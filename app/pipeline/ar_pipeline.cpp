@@ -72,6 +72,51 @@ std::optional<double> GazeErrorDeg(const anim::PlacedCharacter& character, std::
   return std::acos(std::clamp(forward.dot(to_camera), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
+namespace {
+
+// The render stage's work on one frame: the characters animated (from the smoothed camera
+// centre, or nothing when the frame was lost), composed over the video, and the overlay kept for
+// the sink to draw. Returns the frame's log.
+FrameLog AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animators, FrameCompositor& compositor,
+                           StageStats& stats) {
+  FrameLog log;
+  log.index = item.frame.index;
+  log.timestamp = item.frame.timestamp;
+  log.track = item.track;
+  const bool localized = item.track.status != tracker::TrackStatus::kLost;
+  FrameToCompose compose{&item.frame, &item.track, {}};
+  if (!animators.empty()) {
+    const Clock::time_point t0 = Clock::now();
+    std::optional<Eigen::Vector3d> centre;
+    if (localized) centre = item.track.smoothed_center;
+    for (LayeredAnimator* animator : animators) {
+      compose.animations.push_back(&animator->Update(centre, item.frame.timestamp));
+    }
+    log.idle_weight = compose.animations.front()->idle_weight();
+    log.actions_triggered = compose.animations.front()->triggered;
+    if (localized) {
+      log.gaze_error_deg = GazeErrorDeg(animators.front()->character(), compose.animations.front()->model,
+                                        item.track.center);
+    }
+    stats.Record("animate", MsSince(t0));
+  }
+  const Clock::time_point t1 = Clock::now();
+  item.output = compositor.Compose(compose);
+  item.overlay = compositor.DeferredOverlay(compose);
+  stats.Record("render", MsSince(t1));
+  return log;
+}
+
+// The run's wall time, frame rate, CPU per frame and stage summaries.
+void FillTotals(Clock::time_point start, double cpu_start, const StageStats& stats, PipelineReport& report) {
+  report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  report.fps = report.wall_seconds > 0 ? report.frames_processed / report.wall_seconds : 0;
+  if (report.frames_processed > 0) report.cpu_ms_per_frame = 1e3 * (ProcessCpuSeconds() - cpu_start) / report.frames_processed;
+  report.stages = stats.Summaries();
+}
+
+}  // namespace
+
 PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
                            FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,
                            const std::function<void(const PipelineReport&)>& on_frame,
@@ -89,11 +134,14 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   // A stop request closes every queue, so that no stage stays blocked pushing to one that
   // stopped popping.
-  auto stopped = [&] {
-    if (!(stop && stop())) return false;
+  auto close_all = [&] {
     to_track.Close();
     to_render.Close();
     to_sink.Close();
+  };
+  auto stopped = [&] {
+    if (!(stop && stop())) return false;
+    close_all();
     return true;
   };
 
@@ -103,10 +151,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
         body();
       } catch (...) {
         error.Set(std::current_exception());
-        // Unblock every other stage, upstream ones included.
-        to_track.Close();
-        to_render.Close();
-        to_sink.Close();
+        close_all();  // unblock every other stage, upstream ones included
       }
       (downstream.Close(), ...);
     };
@@ -147,31 +192,8 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
         compositor.BindToThread();
         while (auto item = to_render.Pop()) {
           if (error.failed() || stopped()) break;
-          FrameLog log;
-          log.index = item->frame.index;
-          log.timestamp = item->frame.timestamp;
-          log.track = item->track;
+          FrameLog log = AnimateAndCompose(*item, animators, compositor, stats);
           const bool localized = item->track.status != tracker::TrackStatus::kLost;
-          FrameToCompose compose{&item->frame, &item->track, {}};
-          if (!animators.empty()) {
-            const Clock::time_point t0 = Clock::now();
-            std::optional<Eigen::Vector3d> centre;
-            if (localized) centre = item->track.smoothed_center;
-            for (LayeredAnimator* animator : animators) {
-              compose.animations.push_back(&animator->Update(centre, item->frame.timestamp));
-            }
-            log.idle_weight = compose.animations.front()->idle_weight();
-            log.actions_triggered = compose.animations.front()->triggered;
-            if (localized) {
-              log.gaze_error_deg = GazeErrorDeg(animators.front()->character(), compose.animations.front()->model,
-                                                item->track.center);
-            }
-            stats.Record("animate", MsSince(t0));
-          }
-          const Clock::time_point t1 = Clock::now();
-          item->output = compositor.Compose(compose);
-          item->overlay = compositor.DeferredOverlay(compose);
-          stats.Record("render", MsSince(t1));
           {
             std::lock_guard lock(report_mutex);
             if (localized) {
@@ -211,10 +233,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   error.RethrowIfAny();
 
   report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
-  report.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  report.fps = report.wall_seconds > 0 ? report.frames_processed / report.wall_seconds : 0;
-  if (report.frames_processed > 0) report.cpu_ms_per_frame = 1e3 * (ProcessCpuSeconds() - cpu_start) / report.frames_processed;
-  report.stages = stats.Summaries();
+  FillTotals(start, cpu_start, stats, report);
   return report;
 }
 

@@ -13,8 +13,8 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
                                const PlaceCharacterOptions& o) {
   // A built-in asset ("builtin:figure") is a name, not a file.
   const std::filesystem::path asset =
-      anim::IsBuiltinAsset(asset_path) ? asset_path : std::filesystem::absolute(asset_path);
-  const anim::Character character = anim::LoadCharacter(asset);
+      authoring::IsBuiltinAsset(asset_path) ? asset_path : std::filesystem::absolute(asset_path);
+  const anim::Character character = authoring::LoadCharacter(asset);
   const double height = anim::RestHeight(character, Eigen::Vector3d::UnitY());
 
   std::vector<Eigen::Vector3d> points, centres, up_axes;
@@ -35,7 +35,7 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
   options.plane.seed = o.seed;
 
   ScenePlacement placed;
-  placed.name = anim::IsBuiltinAsset(asset) ? asset.string().substr(std::string(anim::kBuiltinAssetPrefix).size())
+  placed.name = authoring::IsBuiltinAsset(asset) ? asset.string().substr(std::string(authoring::kBuiltinAssetPrefix).size())
                                             : asset.stem().string();
   placed.asset = asset;
   placed.anchor = o.anchor ? *o.anchor : PlaceOnDominantPlane(points, centres, up_axes, height, options);

@@ -136,7 +136,7 @@ std::string SceneYaml(const ScenePlacement& c) {
 
 void WriteSceneFile(const ScenePlacement& c, const std::filesystem::path& file) {
   const std::string text = SceneYaml(c);
-  anim::ParseScene(text, file);  // throws anim::Error when the text would not load
+  authoring::ParseScene(text, file);  // throws anim::Error when the text would not load
   WriteFileAtomically(file, text);
 }
 

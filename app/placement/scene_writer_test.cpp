@@ -26,9 +26,9 @@ ScenePlacement Placed() {
 TEST(SceneWriter, WritesWhatTheSceneReaderReadsBack) {
   const ScenePlacement c = Placed();
   const std::string text = SceneYaml(c);
-  const anim::Scene s = anim::ParseScene(text, "/tmp/placed.yaml");
+  const authoring::Scene s = authoring::ParseScene(text, "/tmp/placed.yaml");
   ASSERT_EQ(s.characters.size(), 1u);
-  const anim::CharacterSpec& spec = s.characters[0];
+  const authoring::CharacterSpec& spec = s.characters[0];
   EXPECT_EQ(spec.name, "fox");
   EXPECT_EQ(spec.asset, std::filesystem::path(c.asset));
   EXPECT_LT((spec.anchor.position - c.anchor.position).norm(), 1e-9);
@@ -37,7 +37,7 @@ TEST(SceneWriter, WritesWhatTheSceneReaderReadsBack) {
   EXPECT_EQ(spec.lookat.base_clip, "Survey");
   ASSERT_EQ(spec.keys.size(), 6u);
   for (int k = 0; k < 6; ++k) {
-    EXPECT_EQ(spec.keys[k].source, anim::KeySpec::Source::kLookAt);
+    EXPECT_EQ(spec.keys[k].source, authoring::KeySpec::Source::kLookAt);
     EXPECT_NEAR(std::asin(spec.keys[k].viewpoint.y()) * 180 / M_PI, 12.5, 1e-9);
   }
   // The comment stays one comment line.
@@ -51,8 +51,8 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   c.behaviour.greet_clip = "Run";
   c.behaviour.greet_within = 1.5;
   c.behaviour.front_gesture = "point";  // keys at 0, 60 and 300 degrees (within 50 of the front)
-  const anim::Scene s = anim::ParseScene(SceneYaml(c), "/tmp/placed.yaml");
-  const anim::CharacterSpec& spec = s.characters[0];
+  const authoring::Scene s = authoring::ParseScene(SceneYaml(c), "/tmp/placed.yaml");
+  const authoring::CharacterSpec& spec = s.characters[0];
   ASSERT_TRUE(spec.idle.given);
   EXPECT_EQ(spec.idle.clips, (std::vector<std::string>{"Survey", "Walk"}));
   EXPECT_EQ(spec.idle.seed, 7u);
@@ -60,10 +60,10 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_EQ(spec.schedule.view_action, "view");
   EXPECT_DOUBLE_EQ(spec.schedule.hold_seconds, 0.5);
   ASSERT_EQ(spec.schedule.actions.size(), 3u);
-  const anim::ActionSpec& idle = spec.schedule.actions[0];
-  EXPECT_EQ(idle.object.kind, anim::ObjectSpec::Kind::kIdle);
-  const anim::ActionSpec& view = spec.schedule.actions[1];
-  EXPECT_EQ(view.object.kind, anim::ObjectSpec::Kind::kViewAdaptive);
+  const authoring::ActionSpec& idle = spec.schedule.actions[0];
+  EXPECT_EQ(idle.object.kind, authoring::ObjectSpec::Kind::kIdle);
+  const authoring::ActionSpec& view = spec.schedule.actions[1];
+  EXPECT_EQ(view.object.kind, authoring::ObjectSpec::Kind::kViewAdaptive);
   EXPECT_EQ(view.layer, 1);
   ASSERT_EQ(view.masks.size(), 1u);
   EXPECT_EQ(view.masks[0].default_rotation, 0);
@@ -72,7 +72,7 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_EQ(view.masks[0].scopes[0].rotation, 1);
   EXPECT_EQ(view.masks[0].scopes[0].translation, 0);
   EXPECT_EQ(view.masks[0].scopes[1].name, "torso");
-  const anim::ActionSpec& greet = spec.schedule.actions[2];
+  const authoring::ActionSpec& greet = spec.schedule.actions[2];
   EXPECT_EQ(greet.object.clip, "Run");
   EXPECT_TRUE(greet.has_trigger);
   EXPECT_DOUBLE_EQ(greet.trigger_near, 1.5);
@@ -82,12 +82,12 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_EQ(view.masks[0].scopes[3].name, "right_arm");
   EXPECT_EQ(view.masks[0].scopes[3].rotation, 1);  // the gesture keys move it
   int gestures = 0;
-  for (const anim::KeySpec& k : spec.keys) gestures += k.gesture != anim::Gesture::kNone;
+  for (const authoring::KeySpec& k : spec.keys) gestures += k.gesture != authoring::Gesture::kNone;
   EXPECT_EQ(gestures, 1);  // 6 keys, 60 degrees apart: only the front one is within 50 degrees
 }
 
 TEST(SceneWriter, NoBehaviourKeepsTheDefaultSchedule) {
-  const anim::Scene s = anim::ParseScene(SceneYaml(Placed()), "/tmp/placed.yaml");
+  const authoring::Scene s = authoring::ParseScene(SceneYaml(Placed()), "/tmp/placed.yaml");
   EXPECT_FALSE(s.characters[0].idle.given);
   EXPECT_FALSE(s.characters[0].schedule.given);
 }

@@ -38,14 +38,14 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   tracker::Tracker tracker(map, o.tracker);
   tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
 
-  std::vector<std::unique_ptr<anim::AnimatedCharacter>> characters;
+  std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
   std::vector<LayeredAnimator*> animator_ptrs;
   std::vector<const anim::PlacedCharacter*> character_ptrs;
   if (!o.scene_file.empty()) {
-    const anim::Scene scene = anim::LoadScene(o.scene_file);
-    for (const anim::CharacterSpec& spec : scene.characters) {
-      characters.push_back(std::make_unique<anim::AnimatedCharacter>(spec));
+    const authoring::Scene scene = authoring::LoadScene(o.scene_file);
+    for (const authoring::CharacterSpec& spec : scene.characters) {
+      characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
       animators.push_back(MakeLayeredAnimator(*characters.back(), "", o.fade));
       for (const std::string& note : animators.back()->notes()) std::cerr << "note: " << note << "\n";
       animator_ptrs.push_back(animators.back().get());

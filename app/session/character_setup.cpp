@@ -4,10 +4,10 @@
 
 namespace arview::app {
 
-std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const anim::AnimatedCharacter& character,
+std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const authoring::AnimatedCharacter& character,
                                                      const std::string& idle_clip, const FadeOptions& fade) {
   const anim::Character& c = character.character();
-  const anim::CharacterSpec& spec = character.spec();
+  const authoring::CharacterSpec& spec = character.spec();
   const anim::Clip* idle = nullptr;
   if (!idle_clip.empty()) {
     idle = c.FindClip(idle_clip);
@@ -16,12 +16,12 @@ std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const anim::AnimatedCharact
     if (!spec.lookat.base_clip.empty()) idle = c.FindClip(spec.lookat.base_clip);
     if (!idle && !c.clips.empty()) idle = &c.clips.front();
   }
-  anim::AnimatorOverrides overrides;
+  authoring::AnimatorOverrides overrides;
   overrides.idle_clip = idle_clip;
   overrides.hold_seconds = fade.hold_seconds;
   overrides.fade_seconds = fade.fade_seconds;
   std::vector<std::string> notes;
-  std::unique_ptr<anim::Animator> animator = anim::BuildAnimator(character, overrides, &notes);
+  std::unique_ptr<anim::Animator> animator = authoring::BuildAnimator(character, overrides, &notes);
   return std::make_unique<LayeredAnimator>(character, std::move(animator), idle, std::move(notes));
 }
 

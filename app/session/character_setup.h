@@ -15,7 +15,7 @@ namespace arview::app {
 // asset, or the scene's idle synthesizer, or its look-at base clip ("rest": the rest pose), or
 // the asset's first clip, or the rest pose. `fade` overrides the scene's tracking_loss. Throws
 // anim::Error for an unknown `idle_clip` or a schedule the character cannot play.
-std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const anim::AnimatedCharacter& character,
+std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const authoring::AnimatedCharacter& character,
                                                      const std::string& idle_clip = "", const FadeOptions& fade = {});
 
 }  // namespace arview::app

@@ -8,12 +8,12 @@ namespace arview::app {
 namespace {
 
 // The Fox with 8 generated look-at keys on the horizon, standing at the map origin.
-anim::CharacterSpec FoxSpec() {
+authoring::CharacterSpec FoxSpec() {
   const auto fox = arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb");
   std::string yaml = "characters:\n  - name: fox\n    asset: " + fox.string() +
                      "\n    lookat:\n      base_clip: Survey\n    keys:\n";
   for (int k = 0; k < 8; ++k) yaml += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
-  return anim::ParseScene(yaml, "fox-test.yaml").characters.at(0);
+  return authoring::ParseScene(yaml, "fox-test.yaml").characters.at(0);
 }
 
 double MaxJump(std::span<const Eigen::Matrix4f> a, const std::vector<Eigen::Matrix4f>& b) {
@@ -24,7 +24,7 @@ double MaxJump(std::span<const Eigen::Matrix4f> a, const std::vector<Eigen::Matr
 
 TEST(LayeredAnimator, HoldsThenFadesToIdleAndBackWithoutJumps) {
   ARVIEW_REQUIRE_DATA_PATH(arview::testing::SharedData("characters/Fox"), "../shared/data");
-  anim::AnimatedCharacter fox(FoxSpec());
+  authoring::AnimatedCharacter fox(FoxSpec());
   std::unique_ptr<LayeredAnimator> animator = MakeLayeredAnimator(fox, "", {0.5, 1.0});
   ASSERT_NE(animator->idle_clip(), nullptr);
   EXPECT_EQ(animator->idle_clip()->name, "Survey");
@@ -62,7 +62,7 @@ TEST(LayeredAnimator, HoldsThenFadesToIdleAndBackWithoutJumps) {
 
 TEST(LayeredAnimator, UnknownIdleClipIsAnError) {
   ARVIEW_REQUIRE_DATA_PATH(arview::testing::SharedData("characters/Fox"), "../shared/data");
-  anim::AnimatedCharacter fox(FoxSpec());
+  authoring::AnimatedCharacter fox(FoxSpec());
   EXPECT_THROW(MakeLayeredAnimator(fox, "Dance"), anim::Error);
 }
 
@@ -71,11 +71,11 @@ TEST(LayeredAnimator, UnknownIdleClipIsAnError) {
 TEST(LayeredAnimator, NotesABalanceLayerItsDataCannotSupport) {
   const std::string bcn = "/usr/share/assimp/models/X/BCN_Epileptic.X", cmu = "/usr/share/assimp/models/BVH/01_01.bvh";
   ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(cmu), "Debian package assimp-testmodels");
-  const anim::Scene scene = anim::ParseScene("characters:\n  - asset: " + bcn +
+  const authoring::Scene scene = authoring::ParseScene("characters:\n  - asset: " + bcn +
                                                  "\n    keys: [{azimuth: 0, generate: lookat}]\n    idle:\n      clips: "
                                                  "[Epileptisch]\n      balance: {motion: " + cmu + "}\n",
                                              "bcn-test.yaml");
-  anim::AnimatedCharacter bcn_character(scene.characters.at(0));
+  authoring::AnimatedCharacter bcn_character(scene.characters.at(0));
   std::unique_ptr<LayeredAnimator> animator = MakeLayeredAnimator(bcn_character);
   ASSERT_EQ(animator->notes().size(), 1u);
   EXPECT_EQ(animator->notes()[0].rfind("bcn-test.yaml:6: idle.balance: " + cmu + ": ", 0), 0u) << animator->notes()[0];

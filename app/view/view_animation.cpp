@@ -8,8 +8,8 @@
 
 namespace arview::app {
 
-ViewAnimation::ViewAnimation(const anim::CharacterSpec& spec) : spec_(spec) {
-  auto first = std::make_unique<anim::AnimatedCharacter>(spec_);
+ViewAnimation::ViewAnimation(const authoring::CharacterSpec& spec) : spec_(spec) {
+  auto first = std::make_unique<authoring::AnimatedCharacter>(spec_);
   asset_ = first->shared_character();
   character_ = std::move(first);
   animator_ = MakeLayeredAnimator(*character_);
@@ -17,10 +17,10 @@ ViewAnimation::ViewAnimation(const anim::CharacterSpec& spec) : spec_(spec) {
   if (!(height_ > 0)) height_ = 1;
 }
 
-void ViewAnimation::SetKeys(const std::vector<anim::KeySpec>& keys) {
-  anim::CharacterSpec next = spec_;
+void ViewAnimation::SetKeys(const std::vector<authoring::KeySpec>& keys) {
+  authoring::CharacterSpec next = spec_;
   next.keys = keys;
-  auto rebuilt = std::make_unique<anim::AnimatedCharacter>(asset_, next);  // throws: old keys stay
+  auto rebuilt = std::make_unique<authoring::AnimatedCharacter>(asset_, next);  // throws: old keys stay
   animator_.reset();
   character_ = std::move(rebuilt);
   animator_ = MakeLayeredAnimator(*character_);

@@ -18,11 +18,11 @@ namespace arview::app {
 class ViewAnimation {
  public:
   // Loads the asset and builds the keys; throws anim::Error naming the scene and the problem.
-  explicit ViewAnimation(const anim::CharacterSpec& spec);
+  explicit ViewAnimation(const authoring::CharacterSpec& spec);
 
   // Rebuilds the key clips for `keys` (throws anim::Error if a key cannot be built, leaving the
   // previous keys in place).
-  void SetKeys(const std::vector<anim::KeySpec>& keys);
+  void SetKeys(const std::vector<authoring::KeySpec>& keys);
 
   // The animation for a camera centre in map coordinates at `time` seconds. Valid until the
   // next call.
@@ -33,9 +33,9 @@ class ViewAnimation {
   // What the renderer draws: the asset and the spec (anchor, axes); both stay valid for the
   // lifetime of this object, across SetKeys.
   const anim::Character& asset() const { return *asset_; }
-  const anim::CharacterSpec& spec() const { return spec_; }
-  const std::vector<anim::KeySpec>& keys() const { return spec_.keys; }
-  const anim::AnimatedCharacter& character() const { return *character_; }
+  const authoring::CharacterSpec& spec() const { return spec_; }
+  const std::vector<authoring::KeySpec>& keys() const { return spec_.keys; }
+  const authoring::AnimatedCharacter& character() const { return *character_; }
   // "Survey", "lookat", "rest", "Walk@0.25": what key k plays.
   std::string KeyLabel(int key) const;
   // What the animation could not do as the scene asked (LayeredAnimator::notes).
@@ -45,8 +45,8 @@ class ViewAnimation {
 
  private:
   std::shared_ptr<const anim::Character> asset_;
-  anim::CharacterSpec spec_;
-  std::unique_ptr<anim::AnimatedCharacter> character_;
+  authoring::CharacterSpec spec_;
+  std::unique_ptr<authoring::AnimatedCharacter> character_;
   std::unique_ptr<LayeredAnimator> animator_;
   Eigen::Vector3d viewpoint_ = Eigen::Vector3d::UnitZ();
   double height_ = 1;

@@ -56,19 +56,19 @@ std::string Number(double v) {
 }
 
 // The YAML of one key, as an item of a block sequence at `indent`.
-std::vector<std::string> KeyText(const anim::KeySpec& key, const anim::CharacterSpec& spec, int indent) {
+std::vector<std::string> KeyText(const authoring::KeySpec& key, const authoring::CharacterSpec& spec, int indent) {
   const Eigen::Vector2d ae = AzimuthElevation(key.viewpoint, spec.forward, spec.up);
   const std::string pad(static_cast<size_t>(indent), ' ');
   std::vector<std::string> out{pad + "- azimuth: " + Number(ae.x()), pad + "  elevation: " + Number(ae.y())};
   switch (key.source) {
-    case anim::KeySpec::Source::kClip: out.push_back(pad + "  clip: \"" + key.clip + "\""); break;
-    case anim::KeySpec::Source::kLookAt:
+    case authoring::KeySpec::Source::kClip: out.push_back(pad + "  clip: \"" + key.clip + "\""); break;
+    case authoring::KeySpec::Source::kLookAt:
       // A gesture key is a look-at key with the arm on top: saving must keep its gesture.
-      if (key.gesture != anim::Gesture::kNone) out.push_back(pad + "  gesture: " + ToString(key.gesture));
+      if (key.gesture != authoring::Gesture::kNone) out.push_back(pad + "  gesture: " + ToString(key.gesture));
       else out.push_back(pad + "  generate: lookat");
       break;
-    case anim::KeySpec::Source::kRestPose: out.push_back(pad + "  pose: rest"); break;
-    case anim::KeySpec::Source::kStaticPose:
+    case authoring::KeySpec::Source::kRestPose: out.push_back(pad + "  pose: rest"); break;
+    case authoring::KeySpec::Source::kStaticPose:
       out.push_back(pad + "  pose: \"" + key.clip + "@" + Number(key.pose_time) + "\"");
       break;
   }
@@ -90,25 +90,25 @@ int LineOf(const std::string& where) {
 std::vector<KeyChoice> KeyChoices(const anim::Character& asset) {
   std::vector<KeyChoice> choices;
   for (const anim::Clip& clip : asset.clips) {
-    choices.push_back({anim::KeySpec::Source::kClip, clip.name, "clip " + clip.name});
+    choices.push_back({authoring::KeySpec::Source::kClip, clip.name, "clip " + clip.name});
   }
-  choices.push_back({anim::KeySpec::Source::kLookAt, "", "generate lookat"});
-  choices.push_back({anim::KeySpec::Source::kRestPose, "", "pose rest"});
+  choices.push_back({authoring::KeySpec::Source::kLookAt, "", "generate lookat"});
+  choices.push_back({authoring::KeySpec::Source::kRestPose, "", "pose rest"});
   for (const anim::Clip& clip : asset.clips) {
-    choices.push_back({anim::KeySpec::Source::kStaticPose, clip.name, "pose " + clip.name + "@now"});
+    choices.push_back({authoring::KeySpec::Source::kStaticPose, clip.name, "pose " + clip.name + "@now"});
   }
   return choices;
 }
 
-anim::KeySpec MakeKey(const Eigen::Vector3d& viewpoint, const KeyChoice& choice, const anim::Character& asset,
-                      const anim::CharacterSpec& spec, double time) {
-  anim::KeySpec key;
+authoring::KeySpec MakeKey(const Eigen::Vector3d& viewpoint, const KeyChoice& choice, const anim::Character& asset,
+                      const authoring::CharacterSpec& spec, double time) {
+  authoring::KeySpec key;
   const Eigen::Vector2d ae = AzimuthElevation(viewpoint, spec.forward, spec.up);
   auto hundredths = [](double deg) { return std::floor(deg * 100 + 0.5) / 100; };
   key.viewpoint = anim::DirectionFromAzimuthElevation(hundredths(ae.x()), hundredths(ae.y()), spec.forward, spec.up);
   key.source = choice.source;
   key.clip = choice.clip;
-  if (choice.source == anim::KeySpec::Source::kStaticPose) {
+  if (choice.source == authoring::KeySpec::Source::kStaticPose) {
     const anim::Clip* clip = asset.FindClip(choice.clip);
     const double duration = clip ? clip->duration : 0;
     double t = duration > 0 ? std::fmod(std::max(0.0, time), duration) : 0;
@@ -131,7 +131,7 @@ Eigen::Vector2d AzimuthElevation(const Eigen::Vector3d& direction, const Eigen::
   return {azimuth, elevation};
 }
 
-KeyEditor::KeyEditor(std::vector<anim::KeySpec> keys) : keys_(std::move(keys)) {
+KeyEditor::KeyEditor(std::vector<authoring::KeySpec> keys) : keys_(std::move(keys)) {
   for (size_t i = 0; i < keys_.size(); ++i) keys_ids_.push_back(next_id_++);
   saved_ids_ = keys_ids_;
 }
@@ -145,7 +145,7 @@ std::vector<int> KeyEditor::FileOrigins() const {
   return origins;
 }
 
-void KeyEditor::Add(const anim::KeySpec& key) {
+void KeyEditor::Add(const authoring::KeySpec& key) {
   history_.push_back({keys_, keys_ids_});
   keys_.push_back(key);
   keys_ids_.push_back(next_id_++);
@@ -180,10 +180,10 @@ int KeyEditor::Nearest(const Eigen::Vector3d& viewpoint) const {
   return best;
 }
 
-std::string SpliceKeys(const std::string& text, const anim::Scene& scene, int character,
-                       const std::vector<anim::KeySpec>& keys, const std::vector<int>& origins) {
+std::string SpliceKeys(const std::string& text, const authoring::Scene& scene, int character,
+                       const std::vector<authoring::KeySpec>& keys, const std::vector<int>& origins) {
   const std::string file = scene.file.string();
-  const anim::CharacterSpec& spec = scene.characters.at(static_cast<size_t>(character));
+  const authoring::CharacterSpec& spec = scene.characters.at(static_cast<size_t>(character));
   auto fail = [&](const std::string& why) {
     throw std::runtime_error(file + ": cannot write the keys of character '" + spec.name + "': " + why);
   };
@@ -247,15 +247,15 @@ std::string SpliceKeys(const std::string& text, const anim::Scene& scene, int ch
   return result;
 }
 
-anim::Scene ValidateSceneText(const std::string& text, const std::filesystem::path& file, int character,
-                              const std::vector<anim::KeySpec>& keys) {
-  anim::Scene scene;
+authoring::Scene ValidateSceneText(const std::string& text, const std::filesystem::path& file, int character,
+                              const std::vector<authoring::KeySpec>& keys) {
+  authoring::Scene scene;
   try {
-    scene = anim::ParseScene(text, file);
+    scene = authoring::ParseScene(text, file);
   } catch (const anim::Error& e) {
     throw std::runtime_error(std::string("the edited scene does not read back (not written): ") + e.what());
   }
-  const std::vector<anim::KeySpec>& got = scene.characters.at(static_cast<size_t>(character)).keys;
+  const std::vector<authoring::KeySpec>& got = scene.characters.at(static_cast<size_t>(character)).keys;
   auto fail = [&](const std::string& why) {
     throw std::runtime_error(file.string() + ": the edited scene reads back with " + why + " (not written)");
   };

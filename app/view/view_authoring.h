@@ -23,7 +23,7 @@ namespace arview::app {
 
 // What a new key plays.
 struct KeyChoice {
-  anim::KeySpec::Source source = anim::KeySpec::Source::kClip;
+  authoring::KeySpec::Source source = authoring::KeySpec::Source::kClip;
   std::string clip;             // kClip; kStaticPose: the clip frozen at the time of adding
   std::string label;            // "clip Survey", "pose rest", "pose Walk@now", "generate lookat"
 };
@@ -35,8 +35,8 @@ std::vector<KeyChoice> KeyChoices(const anim::Character& asset);
 // `time` (seconds, wrapped into the clip, rounded to 0.01 s). The key's azimuth and elevation in
 // the frame of `spec`'s forward and up are rounded to 0.01°, so the file says exactly what is
 // played.
-anim::KeySpec MakeKey(const Eigen::Vector3d& viewpoint, const KeyChoice& choice, const anim::Character& asset,
-                      const anim::CharacterSpec& spec, double time);
+authoring::KeySpec MakeKey(const Eigen::Vector3d& viewpoint, const KeyChoice& choice, const anim::Character& asset,
+                      const authoring::CharacterSpec& spec, double time);
 
 // Azimuth and elevation (degrees) of a direction in the frame of `forward` and `up`, as the
 // scene format measures them.
@@ -46,16 +46,16 @@ Eigen::Vector2d AzimuthElevation(const Eigen::Vector3d& direction, const Eigen::
 // The keys of one character and their history.
 class KeyEditor {
  public:
-  explicit KeyEditor(std::vector<anim::KeySpec> keys = {});
+  explicit KeyEditor(std::vector<authoring::KeySpec> keys = {});
 
-  const std::vector<anim::KeySpec>& keys() const { return keys_; }
+  const std::vector<authoring::KeySpec>& keys() const { return keys_; }
   // Each key's index among the keys of the scene file as last read or written, or -1 for a key
   // added since.
   std::vector<int> FileOrigins() const;
   bool dirty() const { return keys_ids_ != saved_ids_; }
   bool can_undo() const { return !history_.empty(); }
 
-  void Add(const anim::KeySpec& key);
+  void Add(const authoring::KeySpec& key);
   // Throws std::runtime_error if it would leave no key (a character needs one).
   void Remove(int index);
   // Restores the keys before the last Add/Remove; false if there is nothing to undo.
@@ -68,10 +68,10 @@ class KeyEditor {
 
  private:
   struct Snapshot {
-    std::vector<anim::KeySpec> keys;
+    std::vector<authoring::KeySpec> keys;
     std::vector<int> ids;
   };
-  std::vector<anim::KeySpec> keys_;
+  std::vector<authoring::KeySpec> keys_;
   std::vector<int> keys_ids_;   // a unique id per key, kept by undo
   std::vector<int> saved_ids_;  // ids of the keys in the file, in file order
   std::vector<Snapshot> history_;
@@ -81,12 +81,12 @@ class KeyEditor {
 // The scene text with the keys block of character `character` (its index in `scene`, parsed
 // from `text`) holding `keys`; `origins[i]` >= 0 keeps the text of that key of the file.
 // Throws std::runtime_error naming the file when the block cannot be found in block style.
-std::string SpliceKeys(const std::string& text, const anim::Scene& scene, int character,
-                       const std::vector<anim::KeySpec>& keys, const std::vector<int>& origins);
+std::string SpliceKeys(const std::string& text, const authoring::Scene& scene, int character,
+                       const std::vector<authoring::KeySpec>& keys, const std::vector<int>& origins);
 
 // Re-reads `text` with anim's scene reader and checks that character `character` has exactly
 // `keys` (directions within 1e-6 rad, same sources). Throws naming the file.
-anim::Scene ValidateSceneText(const std::string& text, const std::filesystem::path& file, int character,
-                              const std::vector<anim::KeySpec>& keys);
+authoring::Scene ValidateSceneText(const std::string& text, const std::filesystem::path& file, int character,
+                              const std::vector<authoring::KeySpec>& keys);
 
 }  // namespace arview::app

@@ -28,8 +28,8 @@ characters:
       pose: rest
 )";
 
-anim::KeySpec Key(double azimuth, anim::KeySpec::Source source, const std::string& clip = "", double t = 0) {
-  anim::KeySpec k;
+authoring::KeySpec Key(double azimuth, authoring::KeySpec::Source source, const std::string& clip = "", double t = 0) {
+  authoring::KeySpec k;
   k.viewpoint = anim::DirectionFromAzimuthElevation(azimuth, 0);
   k.source = source;
   k.clip = clip;
@@ -38,10 +38,10 @@ anim::KeySpec Key(double azimuth, anim::KeySpec::Source source, const std::strin
 }
 
 TEST(KeyEditor, AddRemoveUndoAndDirty) {
-  KeyEditor e({Key(0, anim::KeySpec::Source::kClip, "Survey"), Key(90, anim::KeySpec::Source::kLookAt)});
+  KeyEditor e({Key(0, authoring::KeySpec::Source::kClip, "Survey"), Key(90, authoring::KeySpec::Source::kLookAt)});
   EXPECT_FALSE(e.dirty());
   EXPECT_FALSE(e.can_undo());
-  e.Add(Key(45, anim::KeySpec::Source::kRestPose));
+  e.Add(Key(45, authoring::KeySpec::Source::kRestPose));
   EXPECT_TRUE(e.dirty());
   EXPECT_EQ(e.keys().size(), 3u);
   EXPECT_EQ(e.FileOrigins(), (std::vector<int>{0, 1, -1}));
@@ -54,7 +54,7 @@ TEST(KeyEditor, AddRemoveUndoAndDirty) {
   EXPECT_EQ(e.keys().size(), 2u);
   EXPECT_FALSE(e.dirty());  // back to what the file holds
   EXPECT_FALSE(e.Undo());
-  e.Add(Key(10, anim::KeySpec::Source::kLookAt));
+  e.Add(Key(10, authoring::KeySpec::Source::kLookAt));
   e.MarkSaved();
   EXPECT_FALSE(e.dirty());
   EXPECT_EQ(e.FileOrigins(), (std::vector<int>{0, 1, 2}));
@@ -63,44 +63,44 @@ TEST(KeyEditor, AddRemoveUndoAndDirty) {
 }
 
 TEST(KeyEditor, TheLastKeyStays) {
-  KeyEditor e({Key(0, anim::KeySpec::Source::kLookAt)});
+  KeyEditor e({Key(0, authoring::KeySpec::Source::kLookAt)});
   EXPECT_THROW(e.Remove(0), std::runtime_error);
   EXPECT_EQ(e.keys().size(), 1u);
 }
 
 TEST(SpliceKeys, KeepsEverythingButTheEditedKeys) {
-  const anim::Scene scene = anim::ParseScene(kScene, "s.yaml");
-  std::vector<anim::KeySpec> keys = scene.characters[0].keys;
+  const authoring::Scene scene = authoring::ParseScene(kScene, "s.yaml");
+  std::vector<authoring::KeySpec> keys = scene.characters[0].keys;
   keys.erase(keys.begin());                                          // the front key goes
-  keys.push_back(Key(-37.25, anim::KeySpec::Source::kStaticPose, "Walk", 0.25));  // a new one comes
+  keys.push_back(Key(-37.25, authoring::KeySpec::Source::kStaticPose, "Walk", 0.25));  // a new one comes
   const std::string text = SpliceKeys(kScene, scene, 0, keys, {1, -1});
   EXPECT_NE(text.find("# my scene: keep this comment"), std::string::npos);
   EXPECT_EQ(text.find("looks around"), std::string::npos);  // its comment went with it
   EXPECT_NE(text.find("      - viewpoint: [1, 0, 0]\n        generate: lookat\n"), std::string::npos) << text;
   EXPECT_NE(text.find("      - azimuth: -37.25\n        elevation: 0\n        pose: \"Walk@0.25\"\n"), std::string::npos) << text;
   EXPECT_NE(text.find("    phase: shared\n  - name: second"), std::string::npos) << text;
-  const anim::Scene reread = ValidateSceneText(text, "s.yaml", 0, keys);
+  const authoring::Scene reread = ValidateSceneText(text, "s.yaml", 0, keys);
   EXPECT_EQ(reread.characters[1].keys.size(), 1u);
-  EXPECT_EQ(reread.characters[0].keys[1].source, anim::KeySpec::Source::kStaticPose);
+  EXPECT_EQ(reread.characters[0].keys[1].source, authoring::KeySpec::Source::kStaticPose);
   EXPECT_DOUBLE_EQ(reread.characters[0].keys[1].pose_time, 0.25);
 }
 
 TEST(SpliceKeys, AGestureKeyKeepsItsGesture) {
-  const anim::Scene scene = anim::ParseScene(kScene, "s.yaml");
-  std::vector<anim::KeySpec> keys = scene.characters[0].keys;
-  anim::KeySpec pointing = Key(30, anim::KeySpec::Source::kLookAt);
-  pointing.gesture = anim::Gesture::kPoint;
+  const authoring::Scene scene = authoring::ParseScene(kScene, "s.yaml");
+  std::vector<authoring::KeySpec> keys = scene.characters[0].keys;
+  authoring::KeySpec pointing = Key(30, authoring::KeySpec::Source::kLookAt);
+  pointing.gesture = authoring::Gesture::kPoint;
   keys.push_back(pointing);  // an edit elsewhere must not turn it into a plain look-at key
   const std::string text = SpliceKeys(kScene, scene, 0, keys, {0, 1, -1});
   EXPECT_NE(text.find("        elevation: 0\n        gesture: point\n"), std::string::npos) << text;
-  const anim::Scene reread = ValidateSceneText(text, "s.yaml", 0, keys);
-  EXPECT_EQ(reread.characters[0].keys.back().gesture, anim::Gesture::kPoint);
+  const authoring::Scene reread = ValidateSceneText(text, "s.yaml", 0, keys);
+  EXPECT_EQ(reread.characters[0].keys.back().gesture, authoring::Gesture::kPoint);
 }
 
 TEST(SpliceKeys, SecondCharacterWithItemsAtTheKeysColumn) {
-  const anim::Scene scene = anim::ParseScene(kScene, "s.yaml");
-  std::vector<anim::KeySpec> keys = scene.characters[1].keys;
-  keys.push_back(Key(12.5, anim::KeySpec::Source::kClip, "Run"));
+  const authoring::Scene scene = authoring::ParseScene(kScene, "s.yaml");
+  std::vector<authoring::KeySpec> keys = scene.characters[1].keys;
+  keys.push_back(Key(12.5, authoring::KeySpec::Source::kClip, "Run"));
   const std::string text = SpliceKeys(kScene, scene, 1, keys, {0, -1});
   EXPECT_NE(text.find("    - azimuth: 180\n      pose: rest\n    - azimuth: 12.5\n      elevation: 0\n      clip: \"Run\"\n"),
             std::string::npos)
@@ -111,7 +111,7 @@ TEST(SpliceKeys, SecondCharacterWithItemsAtTheKeysColumn) {
 
 TEST(SpliceKeys, RefusesFlowStyleKeysAndMismatches) {
   const std::string flow = "characters:\n  - name: f\n    asset: a.glb\n    keys: [{azimuth: 0, clip: A}]\n";
-  const anim::Scene scene = anim::ParseScene(flow, "f.yaml");
+  const authoring::Scene scene = authoring::ParseScene(flow, "f.yaml");
   try {
     SpliceKeys(flow, scene, 0, scene.characters[0].keys, {0});
     ADD_FAILURE();
@@ -120,8 +120,8 @@ TEST(SpliceKeys, RefusesFlowStyleKeysAndMismatches) {
               std::string::npos)
         << e.what();
   }
-  const anim::Scene good = anim::ParseScene(kScene, "s.yaml");
-  std::vector<anim::KeySpec> other = good.characters[0].keys;
+  const authoring::Scene good = authoring::ParseScene(kScene, "s.yaml");
+  std::vector<authoring::KeySpec> other = good.characters[0].keys;
   other[0].viewpoint = anim::DirectionFromAzimuthElevation(1, 0);
   EXPECT_THROW(ValidateSceneText(kScene, "s.yaml", 0, other), std::runtime_error);
 }
@@ -129,9 +129,9 @@ TEST(SpliceKeys, RefusesFlowStyleKeysAndMismatches) {
 TEST(MakeKey, RoundsToHundredthsOfADegreeAndFreezesPosesInTheClip) {
   anim::Character asset;
   asset.clips.push_back({"Walk", 0.708, 1000, {}});
-  anim::CharacterSpec spec;
+  authoring::CharacterSpec spec;
   const Eigen::Vector3d v = anim::DirectionFromAzimuthElevation(33.333333, 12.345678);
-  const anim::KeySpec k = MakeKey(v, {anim::KeySpec::Source::kStaticPose, "Walk", ""}, asset, spec, 2.0);
+  const authoring::KeySpec k = MakeKey(v, {authoring::KeySpec::Source::kStaticPose, "Walk", ""}, asset, spec, 2.0);
   const Eigen::Vector2d ae = AzimuthElevation(k.viewpoint, spec.forward, spec.up);
   EXPECT_NEAR(ae.x(), 33.33, 1e-9);
   EXPECT_NEAR(ae.y(), 12.35, 1e-9);

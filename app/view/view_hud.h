@@ -15,7 +15,7 @@
 namespace arview::app {
 
 // `height` is the character's rest height in map units: the sphere's radius is 1.1× that.
-render::HudSphere HudSphereFor(const anim::CharacterSpec& spec, std::span<const double> weights,
+render::HudSphere HudSphereFor(const authoring::CharacterSpec& spec, std::span<const double> weights,
                                const Eigen::Vector3d& viewpoint, double height, int highlighted_key = -1);
 
 }  // namespace arview::app

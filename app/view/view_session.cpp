@@ -44,21 +44,21 @@ bool SamePose(const calib::Pose& a, const calib::Pose& b) {
 ViewSession::ViewSession(const std::filesystem::path& scene_file, const ViewOptions& options)
     : scene_file_(scene_file), options_(options), camera_(ViewCamera(options.size.width, options.size.height, options.fov_deg)) {
   scene_text_ = ReadText(scene_file_);
-  scene_ = anim::ParseScene(scene_text_, scene_file_);
+  scene_ = authoring::ParseScene(scene_text_, scene_file_);
   if (scene_.characters.empty()) throw std::runtime_error(scene_file_.string() + ": has no character");
   edited_ = -1;
   for (size_t i = 0; i < scene_.characters.size(); ++i) {
     if (options.character.empty() ? i == 0 : scene_.characters[i].name == options.character) edited_ = static_cast<int>(i);
   }
   if (edited_ < 0) throw std::runtime_error(scene_file_.string() + ": no character named '" + options.character + "'");
-  for (const anim::CharacterSpec& spec : scene_.characters) {
+  for (const authoring::CharacterSpec& spec : scene_.characters) {
     animations_.push_back(std::make_unique<ViewAnimation>(spec));
     for (const std::string& note : animations_.back()->notes()) std::cerr << "note: " << note << "\n";
   }
   editor_ = KeyEditor(edited().keys());
   choices_ = KeyChoices(edited().asset());
 
-  const anim::CharacterSpec& spec = edited().spec();
+  const authoring::CharacterSpec& spec = edited().spec();
   const Eigen::Matrix3d rotation = spec.anchor.rotation.normalized().toRotationMatrix();
   const Eigen::Vector3d up = (rotation * spec.up).normalized(), forward = rotation * spec.forward;
   orbit_ = OrbitCamera(forward, up, HomeView());
@@ -77,7 +77,7 @@ ViewSession::ViewSession(const std::filesystem::path& scene_file, const ViewOpti
 ViewSession::~ViewSession() = default;
 
 OrbitState ViewSession::HomeView() const {
-  const anim::CharacterSpec& spec = edited().spec();
+  const authoring::CharacterSpec& spec = edited().spec();
   const Eigen::Vector3d up = (spec.anchor.rotation.normalized() * spec.up).normalized();
   const double h = edited().height();
   OrbitState s;
@@ -138,7 +138,7 @@ std::vector<std::string> ViewSession::HelpLines() {
 }
 
 std::vector<std::string> ViewSession::StatusLines() const {
-  const anim::CharacterSpec& spec = edited().spec();
+  const authoring::CharacterSpec& spec = edited().spec();
   const Eigen::Vector2d ae = AzimuthElevation(viewpoint_, spec.forward, spec.up);
   std::vector<std::string> lines;
   lines.push_back(scene_file_.filename().string() + (dirty() ? " (unsaved changes)" : "") + "   character " + spec.name +
@@ -214,8 +214,8 @@ void ViewSession::ApplyKeys() {
 }
 
 void ViewSession::AddKey(double time) {
-  const anim::CharacterSpec& spec = edited().spec();
-  const anim::KeySpec key = MakeKey(CurrentViewpoint(), choice(), edited().asset(), spec, time);
+  const authoring::CharacterSpec& spec = edited().spec();
+  const authoring::KeySpec key = MakeKey(CurrentViewpoint(), choice(), edited().asset(), spec, time);
   editor_.Add(key);
   try {
     ApplyKeys();
@@ -262,7 +262,7 @@ void ViewSession::Save() {
       throw std::runtime_error(scene_file_.string() + " changed on disk since it was read; not overwritten");
     }
     const std::string text = SpliceKeys(scene_text_, scene_, edited_, editor_.keys(), editor_.FileOrigins());
-    anim::Scene reread = ValidateSceneText(text, scene_file_, edited_, editor_.keys());
+    authoring::Scene reread = ValidateSceneText(text, scene_file_, edited_, editor_.keys());
     WriteFileAtomically(scene_file_, text);
     scene_text_ = text;
     scene_ = std::move(reread);
@@ -280,7 +280,7 @@ Eigen::Vector3d ViewSession::CurrentViewpoint() const {
 }
 
 std::string ViewSession::StateJson() const {
-  const anim::CharacterSpec& spec = edited().spec();
+  const authoring::CharacterSpec& spec = edited().spec();
   // What the last frame showed: the viewpoint and weights the animation used for it.
   const Eigen::Vector3d& viewpoint = viewpoint_;
   const std::vector<double>& weights = weights_;
@@ -300,7 +300,7 @@ std::string ViewSession::StateJson() const {
   j["time_s"] = last_time_;
   j["keys"] = nlohmann::json::array();
   for (size_t k = 0; k < keys().size(); ++k) {
-    const anim::KeySpec& key = keys()[k];
+    const authoring::KeySpec& key = keys()[k];
     j["keys"].push_back({{"index", k},
                          {"plays", KeySourceLabel(key)},
                          {"viewpoint", {key.viewpoint.x(), key.viewpoint.y(), key.viewpoint.z()}},

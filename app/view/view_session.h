@@ -61,7 +61,7 @@ class ViewSession {
   void CycleChoice(int step);
   const KeyChoice& choice() const { return choices_[choice_]; }
   bool dirty() const { return editor_.dirty(); }
-  const std::vector<anim::KeySpec>& keys() const { return editor_.keys(); }
+  const std::vector<authoring::KeySpec>& keys() const { return editor_.keys(); }
   const std::string& message() const { return message_; }
 
   // The state as one JSON object: camera, keys, and the viewpoint and weights the last frame
@@ -81,7 +81,7 @@ class ViewSession {
 
   std::filesystem::path scene_file_;
   std::string scene_text_;  // as last read or written
-  anim::Scene scene_;       // parsed from scene_text_
+  authoring::Scene scene_;       // parsed from scene_text_
   ViewOptions options_;
   calib::Camera camera_;
   std::vector<std::unique_ptr<ViewAnimation>> animations_;

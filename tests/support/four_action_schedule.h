@@ -29,8 +29,8 @@ class FourActionSchedule {
   enum class Gesture { kMirroredClip, kPoint };
 
   FourActionSchedule(Gesture gesture, bool dib)
-      : character_(anim::ParseScene(SceneText(gesture, dib), "four_action.yaml").characters[0]),
-        animator_(anim::BuildAnimator(character_)) {
+      : character_(authoring::ParseScene(SceneText(gesture, dib), "four_action.yaml").characters[0]),
+        animator_(authoring::BuildAnimator(character_)) {
     const anim::Clip* base = character_.character().FindClip("Epileptisch");
     gesture_length_ = base->duration;
     if (gesture == Gesture::kPoint) AddPointGesture(*base);
@@ -48,7 +48,7 @@ class FourActionSchedule {
   }
 
   anim::Animator& animator() { return *animator_; }
-  const anim::AnimatedCharacter& character() const { return character_; }
+  const authoring::AnimatedCharacter& character() const { return character_; }
   double time() const { return t_; }
 
  private:
@@ -83,10 +83,10 @@ class FourActionSchedule {
 
   void AddPointGesture(const anim::Clip& base) {
     const anim::Skeleton& sk = character_.character().skeleton;
-    const anim::CharacterSpec& spec = character_.spec();
-    const anim::ArmChain arm = anim::MakeArmChain(sk, {}, anim::ArmSide::kRight, {}, spec.forward, spec.up);
-    auto clip = std::make_shared<const anim::Clip>(anim::GenerateGestureClip(
-        sk, &base, &character_.lookat_chain(), arm, anim::Gesture::kPoint, anim::DirectionFromAzimuthElevation(30, 0)));
+    const authoring::CharacterSpec& spec = character_.spec();
+    const anim::ArmChain arm = authoring::MakeArmChain(sk, {}, authoring::ArmSide::kRight, {}, spec.forward, spec.up);
+    auto clip = std::make_shared<const anim::Clip>(authoring::GenerateGestureClip(
+        sk, &base, &character_.lookat_chain(), arm, authoring::Gesture::kPoint, anim::DirectionFromAzimuthElevation(30, 0)));
     anim::Action point;
     point.object = std::make_shared<anim::ClipSource>(character_.shared_skeleton(), clip);
     point.name = "gesture";
@@ -99,7 +99,7 @@ class FourActionSchedule {
     animator_->schedule().Add(std::move(point));
   }
 
-  anim::AnimatedCharacter character_;
+  authoring::AnimatedCharacter character_;
   std::unique_ptr<anim::Animator> animator_;
   int gesture_ = -1;
   double gesture_length_ = 0;

@@ -113,7 +113,7 @@ struct StandingPerson {
   anim::Character person;
   anim::IdleModel idle;
   std::optional<anim::BalanceModel> balance;
-  anim::BalanceLearningReport report;
+  authoring::BalanceLearningReport report;
   std::shared_ptr<const anim::Skeleton> skeleton() const { return std::make_shared<const anim::Skeleton>(person.skeleton); }
 };
 
@@ -122,10 +122,10 @@ inline std::unique_ptr<StandingPerson> LearnFromStanding(const std::vector<Stay>
   l->person.source = "constructed";
   l->person.skeleton = StandingSkeleton(true);
   l->person.clips = {StandingRecording(stays)};
-  const anim::IdleSource own{&l->person, {&l->person.clips[0]}, true};
-  const anim::IdleLearningOptions options;
-  l->idle = anim::LearnIdleModel(l->person.skeleton, {own}, options);
-  l->balance = anim::LearnBalanceModel(l->person.skeleton, own, l->idle, options, {}, &l->report);
+  const authoring::IdleSource own{&l->person, {&l->person.clips[0]}, true};
+  const authoring::IdleLearningOptions options;
+  l->idle = authoring::LearnIdleModel(l->person.skeleton, {own}, options);
+  l->balance = authoring::LearnBalanceModel(l->person.skeleton, own, l->idle, options, {}, &l->report);
   return l;
 }
 
