@@ -17,6 +17,22 @@ double DistanceWeight::At(double d) const {
   return points.back().second;
 }
 
+FrameBuffers::FrameBuffers(const Skeleton& skeleton)
+    : local(1, LocalPose::Rest(skeleton)),
+      model(skeleton.size(), Eigen::Matrix4d::Identity()),
+      skin(skeleton.size(), Eigen::Matrix4f::Identity()),
+      skin_dq(skeleton.size(), DualQuatf()) {}
+
+void FrameBuffers::Finish(const Skeleton& skeleton, AnimatorFrame& frame, const char* local_to_model,
+                          const char* skinning) {
+  MustRun(LocalToModelJob{&skeleton, &local[0], model}, local_to_model);
+  MustRun(SkinningMatricesJob{&skeleton, model, skin, skin_dq}, skinning);
+  frame.skinning_matrices = skin;
+  frame.skinning_dual_quats = skin_dq;
+  frame.model = model;
+  frame.local = local;
+}
+
 Animator::Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Schedule> schedule, AnimatorOptions options,
                    std::shared_ptr<const ViewAdaptiveBlend> view)
     : skeleton_(std::move(skeleton)), schedule_(std::move(schedule)), options_(std::move(options)), view_(std::move(view)) {
@@ -42,11 +58,7 @@ Animator::Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Sch
   }
   armed_.assign(options_.triggers.size(), true);
   fired_ids_.reserve(16);
-  const int n = skeleton_->size();
-  pose_.assign(1, LocalPose::Rest(*skeleton_));
-  model_.assign(n, Eigen::Matrix4d::Identity());
-  skin_.assign(n, Eigen::Matrix4f::Identity());
-  skin_dq_.assign(n, DualQuatf());
+  buffers_ = FrameBuffers(*skeleton_);
 }
 
 void Animator::Track(double time, bool tracking) {
@@ -108,13 +120,8 @@ const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {
   Distance(time, inputs.distance);
   inputs_ = inputs;
   inputs_.viewpoint = viewpoint_;  // held while lost
-  if (!schedule_->Sample(time, inputs_, pose_[0])) throw Error("animator: an action's object refused its inputs");
-  MustRun(LocalToModelJob{skeleton_.get(), &pose_[0], model_}, "animator: local to model");
-  MustRun(SkinningMatricesJob{skeleton_.get(), model_, skin_, skin_dq_}, "animator: skinning matrices");
-  frame_.skinning_matrices = skin_;
-  frame_.skinning_dual_quats = skin_dq_;
-  frame_.model = model_;
-  frame_.local = pose_;
+  if (!schedule_->Sample(time, inputs_, buffers_.local[0])) throw Error("animator: an action's object refused its inputs");
+  buffers_.Finish(*skeleton_, frame_, "animator: local to model", "animator: skinning matrices");
   frame_.key_weights = view_ ? view_->weights() : std::span<const double>();
   frame_.view_gain = view_id_ >= 0 ? schedule_->Gain(view_id_, time) : 0.0;
   frame_.viewpoint = viewpoint_;

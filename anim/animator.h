@@ -67,6 +67,22 @@ struct AnimatorFrame {
   double idle_weight() const { return 1.0 - view_gain; }
 };
 
+// The buffers an animated frame is built in, sized once for a skeleton: the one blended local
+// pose, its model-space joints and skinning transforms. Finish() is the step the Animator and
+// PlacedCharacter::Update both end with.
+struct FrameBuffers {
+  FrameBuffers() = default;
+  explicit FrameBuffers(const Skeleton& skeleton);
+  // local[0] to model space, then to skinning transforms; `frame`'s pose spans point at them.
+  // The two names label a failed job's error.
+  void Finish(const Skeleton& skeleton, AnimatorFrame& frame, const char* local_to_model, const char* skinning);
+
+  std::vector<LocalPose> local;  // one
+  std::vector<Eigen::Matrix4d> model;
+  std::vector<Eigen::Matrix4f> skin;
+  std::vector<DualQuatf> skin_dq;
+};
+
 class Animator {
  public:
   // `view` is the view-adaptive blend the schedule's view action plays (for its key weights), or
@@ -99,10 +115,7 @@ class Animator {
   bool fading_out_ = false;
   Eigen::Vector3d viewpoint_ = Eigen::Vector3d::UnitZ();
   FrameInputs inputs_;
-  std::vector<LocalPose> pose_;      // one
-  std::vector<Eigen::Matrix4d> model_;
-  std::vector<Eigen::Matrix4f> skin_;
-  std::vector<DualQuatf> skin_dq_;
+  FrameBuffers buffers_;
   AnimatorFrame frame_;
 };
 

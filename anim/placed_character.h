@@ -66,11 +66,7 @@ class PlacedCharacter {
 
  private:
   PlacedCharacterParts parts_;
-  // Per-frame buffers.
-  std::vector<LocalPose> blended_;  // one
-  std::vector<Eigen::Matrix4d> model_;
-  std::vector<Eigen::Matrix4f> skin_;
-  std::vector<DualQuatf> skin_dq_;
+  FrameBuffers buffers_;
   AnimatorFrame frame_;
 };
 
