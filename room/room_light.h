@@ -26,9 +26,9 @@
 #include <filesystem>
 #include <memory>
 #include <span>
-#include <stdexcept>
 #include <vector>
 
+#include "base/error.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "room/ray_caster.h"
@@ -36,8 +36,8 @@
 
 namespace arview::room {
 
-struct LightError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+struct LightError : Error {
+  using Error::Error;
 };
 
 struct LightKeyframe {
