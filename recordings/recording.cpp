@@ -159,6 +159,9 @@ std::vector<int> ParseFrameSpec(const std::string& spec, int frame_count) {
   std::stringstream ss(spec);
   std::string item;
   bool any = false;
+  // getline reads no item after a trailing comma: "1," would have been taken for "1".
+  const size_t last = spec.find_last_not_of(" \t");
+  if (last != std::string::npos && spec[last] == ',') throw RecordingError("frame spec '" + spec + "': empty item");
   while (std::getline(ss, item, ',')) {
     item.erase(std::remove_if(item.begin(), item.end(), ::isspace), item.end());
     if (item.empty()) throw RecordingError("frame spec '" + spec + "': empty item");

@@ -183,6 +183,10 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
         "nan"},
        "--time"},
       {{"synth", "room", "--out", tmp + "/arview_cli_seed", "--seed", "-1"}, "--seed"},
+      // Issue 41: an empty value ran as 0.
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--seed", ""}, "--seed"},
+      {{"place", "/nonexistent/map", "--character", "builtin:figure", "--out", tmp + "/s.yaml", "--seed", " "}, "--seed"},
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--ratio", ""}, "--ratio"},
   };
   for (const Case& c : cases) {
     const auto r = RunArview(c.args);

@@ -26,12 +26,20 @@ std::string CheckNotNegative(std::string& text) {
   return "";
 }
 
+// CLI11 converts an empty value to 0 (`--seed ''` ran with seed 0).
+std::string CheckNotBlank(std::string& text) {
+  if (text.find_first_not_of(" \t") == std::string::npos) return "an empty value (a number is needed)";
+  return "";
+}
+
 void Guard(CLI::App& app) {
   for (CLI::Option* option : app.get_options()) {
     const std::string type = option->get_type_name();
     // An empty description keeps --help's type column as it was.
     if (type.rfind("FLOAT", 0) == 0) option->check(CLI::Validator(CheckFinite, ""));
     if (type.rfind("UINT", 0) == 0) option->check(CLI::Validator(CheckNotNegative, ""));
+    if (type.rfind("FLOAT", 0) == 0 || type.rfind("UINT", 0) == 0 || type.rfind("INT", 0) == 0)
+      option->check(CLI::Validator(CheckNotBlank, ""));
   }
   for (CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) Guard(*sub);
 }

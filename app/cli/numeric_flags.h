@@ -12,8 +12,9 @@
 namespace arview::app {
 
 // Adds to every floating-point option of `app` and its subcommands a check that the value is
-// a finite number of at most 1e12 in magnitude, and to every unsigned one a check that it is
-// not negative. Call once, after every command is registered.
+// a finite number of at most 1e12 in magnitude, to every unsigned one a check that it is not
+// negative, and to every numeric one a check that it is not empty. Call once, after every
+// command is registered.
 void GuardNumericOptions(CLI::App& app);
 
 // A frame size written WIDTHxHEIGHT (digits only, `x` or `X`), as every command's --size takes
