@@ -30,4 +30,8 @@ double RestHeight(const Character& c, const Eigen::Vector3d& up_axis) {
   return hi > lo ? hi - lo : 0.0;
 }
 
+double RestHeightInMap(const Character& character, const Placement& placement) {
+  return RestHeight(character, placement.up) * placement.scale * placement.anchor.scale;
+}
+
 }  // namespace arview::anim

@@ -13,8 +13,6 @@ Eigen::Matrix4d Placement::ModelToMap() const {
 
 Eigen::Vector3d Placement::UpInMap() const { return (anchor.rotation.normalized() * up).normalized(); }
 
-Eigen::Vector3d Placement::ForwardInMap() const { return (anchor.rotation.normalized() * forward).normalized(); }
-
 Eigen::Vector3d Placement::ViewpointFromCamera(const Eigen::Vector3d& camera_center_map) const {
   const Eigen::Vector3d d = anchor.rotation.normalized().conjugate() * (camera_center_map - anchor.position);
   const double n = d.norm();

@@ -26,9 +26,8 @@ struct Placement {
   Eigen::Matrix4d ModelToMap() const;
   // The anchor's rotation, normalised.
   Eigen::Matrix3d Rotation() const;
-  // The character's up and front in map coordinates (unit).
+  // The character's up in map coordinates (unit).
   Eigen::Vector3d UpInMap() const;
-  Eigen::Vector3d ForwardInMap() const;
   // Unit direction from the character to a camera centre given in map coordinates, in the
   // character's frame; the zero vector when the camera sits on the anchor.
   Eigen::Vector3d ViewpointFromCamera(const Eigen::Vector3d& camera_center_map) const;

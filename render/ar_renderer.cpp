@@ -99,7 +99,7 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::AnimatorFrame&
   double radius = 0;
   CapsuleBounds(posed, &centre, &radius);
   const double soft = options_.cast_shadow_softness * 2 * radius;
-  const Eigen::Vector3d normal = (placement.anchor.rotation.normalized() * placement.up).normalized();
+  const Eigen::Vector3d normal = placement.UpInMap();
   // Below 15 degrees of elevation the shadow would stretch across the room: none.
   if (!MakeLightView(room_light_.dominant.direction, centre, radius + soft, placement.anchor.position, normal, 15.0, view)) {
     return false;
@@ -117,7 +117,7 @@ bool ArRenderer::CastShadowView(const Placed& placed, const anim::AnimatorFrame&
 
 float ArRenderer::CastShadowStrength(const Placed& placed) const {
   // The share of the floor's irradiance the dominant light brings: what the character's shadow removes.
-  const Eigen::Vector3d normal = (placed.placement.anchor.rotation.normalized() * placed.placement.up).normalized();
+  const Eigen::Vector3d normal = placed.placement.UpInMap();
   const Eigen::Vector3d w = room::LuminanceWeights();
   const double total = room::IrradianceSh(room_light_.sh, normal).dot(w);
   const double direct = room_light_.dominant.color.dot(w) * std::max(0.0, room_light_.dominant.direction.dot(normal));
@@ -146,7 +146,7 @@ cv::Mat ArRenderer::PrepareBackground(const cv::Mat& background) {
 bool ArRenderer::Shadow(const Placed& placed, const anim::AnimatorFrame& frame, ShadowEllipse* ellipse) const {
   const anim::Placement& placement = placed.placement;
   const Eigen::Matrix4d model_to_map = placement.ModelToMap();
-  const Eigen::Matrix3d rotation = placement.anchor.rotation.normalized().toRotationMatrix();
+  const Eigen::Matrix3d rotation = placement.Rotation();
   const Eigen::Vector3d origin = placement.anchor.position;
   const Eigen::Vector3d normal = (rotation * placement.up).normalized();
   Eigen::Vector3d u = rotation * placement.forward;
@@ -275,7 +275,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
                            double farthest) {
   const GlApi& gl = context_->gl();
   auto character_draw = [&](const Placed& placed, const anim::AnimatorFrame& out) {
-    const Eigen::Matrix3d rotation = placed.placement.anchor.rotation.normalized().toRotationMatrix();
+    const Eigen::Matrix3d rotation = placed.placement.Rotation();
     CharacterDraw draw;
     draw.model_to_map = placed.placement.ModelToMap();
     draw.skinning_matrices = out.skinning_matrices;

@@ -21,7 +21,7 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   if (options_.room_light) renderer_->SetRoomLight(*options_.room_light);
   for (const anim::PlacedCharacter* c : characters_) {
     renderer_->AddCharacter(c->character(), c->placement());
-    heights_.push_back(anim::RestHeight(c->character(), c->placement().up) * c->placement().scale * c->placement().anchor.scale);
+    heights_.push_back(anim::RestHeightInMap(c->character(), c->placement()));
   }
   if (options_.ar.lighting == render::LightingMode::kShShadowed && !characters_.empty()) {
     char line[96];

@@ -13,7 +13,7 @@ ViewAnimation::ViewAnimation(const authoring::CharacterSpec& spec) : spec_(spec)
   asset_ = first->shared_character();
   character_ = std::move(first);
   animator_ = MakeLayeredAnimator(*character_);
-  height_ = anim::RestHeight(*asset_, spec_.up) * spec_.scale * spec_.anchor.scale;
+  height_ = anim::RestHeightInMap(*asset_, spec_.placement());
   if (!(height_ > 0)) height_ = 1;
 }
 
