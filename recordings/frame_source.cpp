@@ -85,16 +85,17 @@ cv::Mat RecordingSource::ReadFrame(int index) {
   return image;
 }
 
-void RecordingSource::WaitUntilDue(double timestamp) {
+std::chrono::steady_clock::time_point RecordingSource::WaitUntilDue(double timestamp) {
   if (!started_) {
     started_ = true;
     wall_start_ = std::chrono::steady_clock::now();
     first_timestamp_ = timestamp;
-    return;
+    return wall_start_;
   }
   const auto due = wall_start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                      std::chrono::duration<double>((timestamp - first_timestamp_) / options_.speed));
   std::this_thread::sleep_until(due);
+  return due;
 }
 
 bool RecordingSource::Next(Frame& frame) {
@@ -108,7 +109,9 @@ bool RecordingSource::Next(Frame& frame) {
   frame.image = ReadFrame(index);
   frame.index = index;
   frame.timestamp = recording_.frames[index].timestamp + loop_offset_;
-  if (options_.paced) WaitUntilDue(frame.timestamp);
+  // Paced, the frame is "captured" when it is due, as a camera's would be: a slow read shows as
+  // latency. Unpaced, it is captured when it is read.
+  frame.capture_time = options_.paced ? WaitUntilDue(frame.timestamp) : std::chrono::steady_clock::now();
   return true;
 }
 

@@ -20,6 +20,18 @@ struct Frame {
   cv::Mat image;          // BGR, 8 bits per channel
   double timestamp = 0;   // seconds (recording: frames.txt time; live: kernel capture time)
   int64_t index = 0;      // recording: the frame's 0-based line in frames.txt; live: sequence number
+  // When the frame was captured, on the steady clock (CLOCK_MONOTONIC on Linux): a camera's
+  // kernel timestamp; a paced replay's due time; an unpaced replay's delivery. Latency is
+  // measured from here. The epoch (zero): unknown, the pipeline takes the frame's arrival.
+  std::chrono::steady_clock::time_point capture_time{};
+};
+
+// What a source discarded before delivering, counted since it started. Read by the progress
+// line while the capture thread runs: a source keeps them in atomics.
+struct SourceCounts {
+  int64_t driver_dropped = 0;   // a camera: frames the driver dropped (gaps in its sequence numbers)
+  int64_t corrupt_skipped = 0;  // a camera: frames flagged in error or undecodable
+  int64_t stale_skipped = 0;    // a camera: frames that waited in its buffers while a newer one was ready
 };
 
 // A source that fails while running (file unreadable, device gone); the message names it.
@@ -34,6 +46,8 @@ class FrameSource {
   virtual bool Next(Frame& frame) = 0;
   // The recording folder or device path, for messages.
   virtual std::string Name() const = 0;
+  // Safe to call from another thread while Next runs.
+  virtual SourceCounts Counts() const { return {}; }
 };
 
 struct ReplayOptions {
@@ -61,7 +75,8 @@ class RecordingSource : public FrameSource {
  private:
   cv::Mat ReadFrame(int index);
   cv::Mat ReadVideoFrame(int index);
-  void WaitUntilDue(double timestamp);
+  // Sleeps until the frame at `timestamp` is due and returns when that is.
+  std::chrono::steady_clock::time_point WaitUntilDue(double timestamp);
 
   Recording recording_;
   ReplayOptions options_;
