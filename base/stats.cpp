@@ -53,6 +53,7 @@ Summary Summarize(std::span<const double> values) {
   s.median = PercentileOfSorted(sorted, 0.5);
   s.p90 = PercentileOfSorted(sorted, 0.90);
   s.p95 = PercentileOfSorted(sorted, 0.95);
+  s.p99 = PercentileOfSorted(sorted, 0.99);
   return s;
 }
 

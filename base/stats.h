@@ -31,6 +31,7 @@ struct Summary {
   double max = 0;
   double p90 = 0;
   double p95 = 0;
+  double p99 = 0;
 };
 Summary Summarize(std::span<const double> values);
 

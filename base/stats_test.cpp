@@ -45,6 +45,7 @@ TEST(Summarize, GivesEveryFigureFromOneDefinition) {
   EXPECT_EQ(s.max, 5);
   EXPECT_DOUBLE_EQ(s.p90, Percentile(v, 0.9));
   EXPECT_DOUBLE_EQ(s.p95, Percentile(v, 0.95));
+  EXPECT_DOUBLE_EQ(s.p99, Percentile(v, 0.99));
 }
 
 TEST(Summarize, EmptyInputIsAllZero) {

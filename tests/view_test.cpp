@@ -25,110 +25,19 @@
 
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
+#include "tests/support/virtual_display.h"
 
 namespace arview {
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+using testing::Child;
 using testing::RunArview;
+using testing::Shell;
+using testing::VirtualDisplay;
 
 constexpr double kDegPerPixel = 0.4;  // app/view/view_camera.h OrbitCamera::kDegPerPixel
-
-bool OnPath(const std::string& program) {
-  return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;
-}
-
-#define REQUIRE_PROGRAM(program)                                                                 \
-  do {                                                                                           \
-    if (!OnPath(program)) {                                                                      \
-      if (testing::DataRequired()) FAIL() << program << " is missing (scripts/install-deps.sh)"; \
-      GTEST_SKIP() << "needs " << program << " (scripts/install-deps.sh installs it)";            \
-    }                                                                                            \
-  } while (0)
-
-// A process started with fork/exec, stopped (SIGTERM, then SIGKILL) when it goes out of scope.
-class Child {
- public:
-  Child(const std::vector<std::string>& argv, const std::string& stdout_file = "/dev/null", int keep_fd = -1) {
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int out = ::open(stdout_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(out, 1);
-      const int null = ::open("/dev/null", O_RDONLY);
-      ::dup2(null, 0);
-      for (int fd = 3; fd < 256; ++fd) {
-        if (fd != keep_fd && fd != out) ::close(fd);
-      }
-      std::vector<char*> args;
-      for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      ::execvp(args[0], args.data());
-      ::_exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ <= 0 || exited_) return;
-    ::kill(pid_, SIGTERM);
-    if (Wait(5) < 0) {
-      ::kill(pid_, SIGKILL);
-      Wait(5);
-    }
-  }
-  // The exit status, or -1 if it is still running after `seconds`.
-  int Wait(double seconds) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < until) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool exited_ = false;
-};
-
-// Xvfb on a display number it picks itself (-displayfd), 1280x720 24-bit.
-class VirtualDisplay {
- public:
-  VirtualDisplay() {
-    int fds[2];
-    if (::pipe(fds) != 0) return;
-    server_ = std::make_unique<Child>(std::vector<std::string>{"Xvfb", "-displayfd", std::to_string(fds[1]), "-screen", "0",
-                                                               "1280x720x24", "-nolisten", "tcp"},
-                                      "/dev/null", fds[1]);
-    ::close(fds[1]);
-    std::string number;
-    pollfd p{fds[0], POLLIN, 0};
-    while (::poll(&p, 1, 20000) > 0) {
-      char c;
-      if (::read(fds[0], &c, 1) != 1 || c == '\n') break;
-      number += c;
-    }
-    ::close(fds[0]);
-    if (!number.empty()) name_ = ":" + number;
-  }
-  const std::string& name() const { return name_; }
-
- private:
-  std::unique_ptr<Child> server_;
-  std::string name_;
-};
-
-std::string Shell(const std::string& command, const std::string& display) {
-  const std::string out = "/tmp/arview_view_shell_" + std::to_string(::getpid());
-  const int rc = std::system(("DISPLAY=" + display + " " + command + " >" + out + " 2>&1").c_str());
-  std::string text = testing::ReadWholeFile(out);
-  std::remove(out.c_str());
-  EXPECT_EQ(rc, 0) << command << ": " << text;
-  return text;
-}
 
 std::string FoxScene(const fs::path& dir) {
   const fs::path scene = dir / "fox.yaml";
@@ -189,25 +98,13 @@ std::vector<double> AnimWeights(const std::string& scene, const Eigen::Vector3d&
   return w;
 }
 
-class ViewWindowTest : public ::testing::Test {
+class ViewWindowTest : public testing::XSessionTest<::testing::Test> {
  protected:
   void SetUp() override {
-    REQUIRE_PROGRAM("Xvfb");
-    REQUIRE_PROGRAM("xdotool");
-    REQUIRE_PROGRAM("ffmpeg");
+    StartXSession("view");
+    if (HasFatalFailure() || IsSkipped()) return;
     ARVIEW_REQUIRE_DATA_PATH(testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"), "../shared/data");
-    dir_ = fs::temp_directory_path() / ("arview_view_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    display_ = std::make_unique<VirtualDisplay>();
-    ASSERT_FALSE(display_->name().empty()) << "Xvfb did not start";
   }
-  void TearDown() override {
-    display_.reset();
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
-  fs::path dir_;
-  std::unique_ptr<VirtualDisplay> display_;
 };
 
 // The procedure: drag, check the weights against `arview anim weights`, add a key with

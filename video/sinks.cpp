@@ -1,16 +1,18 @@
 #include "video/sinks.h"
 
+#include "base/error.h"
 #include "base/image_file.h"
 
-#include <opencv2/highgui.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <atomic>
 #include <cstdlib>
 #include <filesystem>
 
 #include "video/h264_writer.h"
 #include "render/offscreen.h"
+#include "video/window.h"
 
 namespace arview::video {
 namespace {
@@ -30,40 +32,47 @@ class WindowSink final : public FrameSink {
  public:
   WindowSink(std::string title, cv::Size size) : title_(std::move(title)), size_(size) {
     if (!HasDisplay()) {
-      throw render::RenderError("window output needs a display, and neither DISPLAY nor WAYLAND_DISPLAY is set; "
-                        "write to a file instead (e.g. --out out.mp4)");
+      throw render::RenderError("window output needs a display, and DISPLAY is not set; "
+                                "write to a file instead (e.g. --out out.mp4)");
     }
     try {
-      cv::namedWindow(title_, cv::WINDOW_AUTOSIZE);
-    } catch (const cv::Exception& e) {
-      throw render::RenderError("cannot open a window: " + std::string(e.what()));
+      window_ = DisplayWindow::Open(title_, size, "write to a file instead (e.g. --out out.mp4)");
+    } catch (const Error& e) {
+      throw render::RenderError(e.what());
     }
   }
   ~WindowSink() override { Close(); }
   void Write(const cv::Mat& bgr) override {
     CheckFrame(bgr, size_, "window");
-    cv::imshow(title_, bgr);
-    const int key = cv::waitKey(1);
-    if (key == 27 || key == 'q') stop_ = true;
-    if (cv::getWindowProperty(title_, cv::WND_PROP_VISIBLE) < 1) stop_ = true;
+    window_->Show(bgr);
+    PumpEvents();
   }
-  void Close() override {
-    if (open_) {
-      open_ = false;
-      try {
-        cv::destroyWindow(title_);
-      } catch (const cv::Exception&) {
-      }
+  void PumpEvents() override {
+    if (!window_) return;
+    for (const InputEvent& e : window_->Poll()) {
+      const bool quit_key = e.type == InputEvent::Type::kKey && (e.key == "Escape" || e.key == "q");
+      if (quit_key || e.type == InputEvent::Type::kClose) stop_ = true;
+      else if (e.type == InputEvent::Type::kKey && key_handler_) key_handler_(e.key);
     }
   }
+  void SetStatus(const std::string& status) override {
+    // A title change is a round trip to the server: only when the text changes.
+    const std::string title = status.empty() ? title_ : title_ + " | " + status;
+    if (!window_ || title == shown_title_) return;
+    window_->SetTitle(title);
+    shown_title_ = title;
+  }
+  void Close() override { window_.reset(); }
   bool StopRequested() const override { return stop_; }
-  std::string Describe() const override { return "window \"" + title_ + "\""; }
+  std::string Describe() const override {
+    return "window \"" + title_ + "\"" + (window_ ? " (" + window_->PresentMethod() + ")" : "");
+  }
 
  private:
-  std::string title_;
+  std::string title_, shown_title_;
   cv::Size size_;
-  bool open_ = true;
-  bool stop_ = false;
+  std::unique_ptr<DisplayWindow> window_;
+  std::atomic<bool> stop_{false};  // set on the writing thread, read by the capture thread
 };
 
 class VideoSink final : public FrameSink {
@@ -163,11 +172,8 @@ class NullSink final : public FrameSink {
 }  // namespace
 
 bool HasDisplay() {
-  for (const char* name : {"DISPLAY", "WAYLAND_DISPLAY"}) {
-    const char* value = std::getenv(name);
-    if (value != nullptr && *value != '\0') return true;
-  }
-  return false;
+  const char* value = std::getenv("DISPLAY");
+  return value != nullptr && *value != '\0';
 }
 
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps) {

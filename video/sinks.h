@@ -1,13 +1,14 @@
 #pragma once
-// Where augmented frames go: a window (OpenCV highgui), an MP4 file (OpenCV's FFmpeg writer),
-// or a folder of PNGs. OpenSink picks by the target's form:
-//   "window" or "window:<title>"  → a highgui window (no display → RenderError saying so)
+// Where augmented frames go: a window (video/window.h), an MP4 file (libx264, else OpenCV's
+// FFmpeg writer), or a folder of PNGs. OpenSink picks by the target's form:
+//   "window" or "window:<title>"  → an X11 window (no display → RenderError saying so)
 //   "null"                         → frames counted and discarded (soak runs, timing)
 //   "<file>.mp4" | ".avi" | ".mkv" → a video file at the given frame rate
 //   "<folder>/" or an existing folder or a name without extension → <folder>/000000.png, ...
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -21,14 +22,32 @@ class FrameSink {
   virtual void Write(const cv::Mat& bgr) = 0;
   // Flushes and closes; safe to call twice. Destruction closes too, without throwing.
   virtual void Close() = 0;
-  // For a window: whether the user asked to stop (Esc or q, or closed the window).
+  // For a window: whether the user asked to stop (Esc or q, or closed the window). Safe to
+  // call from any thread.
   virtual bool StopRequested() const { return false; }
   virtual std::string Describe() const = 0;
+
+  // A window is used by one thread at a time: it is opened by OpenSink, then Write, PumpEvents
+  // and SetStatus come from the thread that writes the frames, then Close from the opener once
+  // that thread has ended.
+  //
+  // Reads the window's events (keys, close, expose) without a frame: the writing thread calls
+  // it when no frame came for a while, so that Esc works and an uncovered window is repainted
+  // while the camera stalls. Write reads them too.
+  virtual void PumpEvents() {}
+  // A short live status (frame rate, latency, drops): a window shows it in its title.
+  virtual void SetStatus(const std::string& /*status*/) {}
+  // Keys other than those that stop (Esc, q) go here, as X keysym names ("h", "F1"); called on
+  // the writing thread.
+  void SetKeyHandler(std::function<void(const std::string& key)> handler) { key_handler_ = std::move(handler); }
+
+ protected:
+  std::function<void(const std::string&)> key_handler_;
 };
 
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps);
 
-// Whether a display is available for highgui windows (DISPLAY or WAYLAND_DISPLAY set).
+// Whether a display is available for the window (DISPLAY set: an X server, or Xwayland).
 bool HasDisplay();
 
 }  // namespace arview::video

@@ -62,9 +62,13 @@ void AddReplayCommand(CLI::App& app) {
     o.sink_fps = MedianFrameRate(recording.frames);
     o.cancel = signals.token();
     o.output_name = a->out;
+    // Shown in a window, Ctrl-C is how a person ends a replay, as Esc is: the report, the
+    // trajectory and the stats are written. To a file, it leaves no partial video.
+    const bool to_window = a->out == "window" || a->out.rfind("window:", 0) == 0;
+    o.cancel_ends_normally = to_window;
 
     // A video or a PNG folder is written under a temporary name and renamed when complete.
-    const bool to_file = a->out != "window" && a->out.rfind("window:", 0) != 0 && a->out != "null";
+    const bool to_file = !to_window && a->out != "null";
     std::unique_ptr<PendingOutput> pending;
     if (to_file) {
       pending = std::make_unique<PendingOutput>(a->out);

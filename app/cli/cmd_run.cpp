@@ -32,12 +32,16 @@ void AddRunCommand(CLI::App& app) {
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     SessionOptions o;
+    o.command_start = Clock::now();
     ApplySessionFlags(a->session, o);
     // Per-frame records only for the files that need them: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = !o.stats_out.empty();
     o.pipeline.keep_trajectory = !o.trajectory_out.empty();
     o.sink = a->out;
     o.pipeline.drop_frames = true;  // live: never fall behind the camera
+    // An unplugged or stalled camera ends the session with what it has: the video, the
+    // trajectory and the stats so far are written, then the fault is the command's error.
+    o.pipeline.end_on_source_fault = true;
     const ScopedSignalCancellation signals;
     o.cancel = signals.token();
     o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends
@@ -54,7 +58,17 @@ void AddRunCommand(CLI::App& app) {
                  source.size().width, source.size().height, source.FormatName().c_str());
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
     std::printf("%s", PipelineReportText(result.report).c_str());
-    std::printf("renderer: %s\n", result.renderer.c_str());
+    std::printf("renderer: %s\noutput: %s\n", result.renderer.c_str(), result.output.c_str());
+    if (result.seconds_to_first_output >= 0) {
+      std::printf("first frame shown %.2f s after the command started\n", result.seconds_to_first_output);
+    }
+    if (!result.report.source_fault.empty()) {
+      std::string kept = a->out == "window" || a->out.rfind("window:", 0) == 0 || a->out == "null" ? "" : a->out;
+      for (const std::string& file : {o.trajectory_out.string(), o.stats_out.string()}) {
+        if (!file.empty()) kept += (kept.empty() ? "" : ", ") + file;
+      }
+      throw Error(result.report.source_fault + (kept.empty() ? std::string() : "; kept what was recorded: " + kept));
+    }
   });
 }
 

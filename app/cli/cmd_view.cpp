@@ -18,7 +18,7 @@
 #include "app/pipeline/stage_stats.h"
 #include "app/view/view_orbit.h"
 #include "app/view/view_session.h"
-#include "app/view/view_window.h"
+#include "video/window.h"
 #include "base/cancellation.h"
 #include "video/sinks.h"
 
@@ -121,7 +121,8 @@ void RunOrbit(const ViewArgs& a) {
 void RunWindow(const ViewArgs& a) {
   const ViewOptions o = Options(a);
   // The display first: without one, say so before loading anything.
-  std::unique_ptr<ViewWindow> window = ViewWindow::Open("arview view: " + a.scene, o.size);
+  std::unique_ptr<video::DisplayWindow> window =
+      video::DisplayWindow::Open("arview view: " + a.scene, o.size, "render without a window with --orbit <spec> --out orbit.mp4");
   ViewSession session(a.scene, o);
   const ScopedSignalCancellation signals;
   StageStats stats;
@@ -134,7 +135,7 @@ void RunWindow(const ViewArgs& a) {
   while (!session.quit_requested() && !signals.token().IsCancelled()) {
     const double t = Seconds(start);
     if (a.seconds > 0 && t >= a.seconds) break;
-    for (const InputEvent& e : window->Poll()) session.Handle(e, t);
+    for (const video::InputEvent& e : window->Poll()) session.Handle(e, t);
     if (session.quit_requested()) break;
     const cv::Mat frame = session.Render(t, &stats);
     const Clock::time_point t0 = Clock::now();

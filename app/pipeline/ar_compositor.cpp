@@ -13,7 +13,7 @@ namespace arview::app {
 
 ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
                            const CompositorOptions& options)
-    : camera_(camera), characters_(std::move(characters)), options_(options) {
+    : camera_(camera), characters_(std::move(characters)), options_(options), hud_visible_(options.hud) {
   // Created here, before the pipeline's threads start: creating a context sets LP_NUM_THREADS
   // in the environment, which must not race with other threads.
   context_ = render::OffscreenContext::Create(options_.gl);
@@ -60,7 +60,7 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
 }
 
 std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose& input) {
-  if (!options_.hud || characters_.empty()) return {};
+  if (!hud_visible_ || characters_.empty()) return {};
   // Everything the drawing needs is copied now: the animations' frames change with the next one.
   std::vector<render::HudSphere> spheres;
   const bool localized = input.track->status != tracker::TrackStatus::kLost;

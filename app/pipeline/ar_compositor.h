@@ -3,6 +3,7 @@
 // compositor and bound to the render thread (BindToThread); the characters are drawn where the tracker says the camera is, and
 // lost frames show the video alone.
 
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -41,6 +42,8 @@ class ArCompositor : public FrameCompositor {
   // cache), for the command to print as `note:` lines.
   const std::vector<std::string>& LoadNotes() const { return load_notes_; }
   cv::Size OutputSize() const;
+  // Shows or hides the HUD from another thread (the window's 'h' key): from the next frame on.
+  void ToggleHud() { hud_visible_ = !hud_visible_; }
 
  private:
   // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
@@ -60,6 +63,7 @@ class ArCompositor : public FrameCompositor {
   std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
   std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
+  std::atomic<bool> hud_visible_;  // starts as options_.hud
 };
 
 }  // namespace arview::app

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -11,6 +12,7 @@
 
 #include "anim/chains.h"
 #include "app/pipeline/bounded_queue.h"
+#include "base/stats.h"
 
 namespace arview::app {
 
@@ -18,10 +20,43 @@ namespace {
 
 struct InFlight {
   recordings::Frame frame;
-  Clock::time_point arrival;
+  Clock::time_point captured;  // the source's capture time, or the arrival when it has none
   tracker::FrameResult track;
+  FrameLog log;  // filled stage by stage, kept by the sink stage
   cv::Mat output;
   std::function<void(cv::Mat&)> overlay;  // FrameCompositor::DeferredOverlay, run by the sink stage
+
+  // Milliseconds from the capture to now, for the frame's timeline.
+  float MsSinceCapture() const {
+    return static_cast<float>(std::chrono::duration<double, std::milli>(Clock::now() - captured).count());
+  }
+};
+
+// The output rate and the median latency over the last second or so, for the progress line
+// and the window's title.
+class RecentOutput {
+ public:
+  void Add(Clock::time_point at, double latency_ms) {
+    samples_.push_back({at, latency_ms});
+    while (samples_.size() > 2 && at - samples_.front().at > std::chrono::seconds(1)) samples_.pop_front();
+  }
+  double Fps() const {
+    if (samples_.size() < 2) return 0;
+    const double seconds = std::chrono::duration<double>(samples_.back().at - samples_.front().at).count();
+    return seconds > 0 ? (samples_.size() - 1) / seconds : 0;
+  }
+  double MedianLatencyMs() const {
+    std::vector<double> latencies;
+    for (const Sample& s : samples_) latencies.push_back(s.latency_ms);
+    return latencies.empty() ? 0 : Median(latencies);
+  }
+
+ private:
+  struct Sample {
+    Clock::time_point at;
+    double latency_ms;
+  };
+  std::deque<Sample> samples_;
 };
 
 double ProcessCpuSeconds() {
@@ -76,12 +111,10 @@ namespace {
 
 // The render stage's work on one frame: the characters animated (from the smoothed camera
 // centre, or nothing when the frame was lost), composed over the video, and the overlay kept for
-// the sink to draw. Returns the frame's log.
-FrameLog AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animators, FrameCompositor& compositor,
-                           StageStats& stats) {
-  FrameLog log;
-  log.index = item.frame.index;
-  log.timestamp = item.frame.timestamp;
+// the sink to draw; the frame's log gets what was animated.
+void AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animators, FrameCompositor& compositor,
+                       StageStats& stats) {
+  FrameLog& log = item.log;
   log.track = item.track;
   const bool localized = item.track.status != tracker::TrackStatus::kLost;
   FrameToCompose compose{&item.frame, &item.track, {}};
@@ -104,7 +137,6 @@ FrameLog AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> ani
   item.output = compositor.Compose(compose);
   item.overlay = compositor.DeferredOverlay(compose);
   stats.Record("render", MsSince(t1));
-  return log;
 }
 
 // The run's wall time, frame rate, CPU per frame and stage summaries.
@@ -122,9 +154,12 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
                            const std::function<void(const PipelineReport&)>& on_frame,
                            const std::function<bool()>& stop) {
   const OverflowPolicy policy = options.drop_frames ? OverflowPolicy::kDropOldest : OverflowPolicy::kBlock;
-  BoundedQueue<InFlight> to_track(options.queue_capacity, policy);
-  BoundedQueue<InFlight> to_render(options.queue_capacity, policy);
-  BoundedQueue<InFlight> to_sink(options.queue_capacity, policy);
+  // Live: one waiting frame per stage, so that no stage ever starts on a frame older than the
+  // newest one waiting.
+  const size_t capacity = options.drop_frames ? 1 : options.queue_capacity;
+  BoundedQueue<InFlight> to_track(capacity, policy);
+  BoundedQueue<InFlight> to_render(capacity, policy);
+  BoundedQueue<InFlight> to_sink(capacity, policy);
   StageStats stats;
   ErrorSlot error;
   PipelineReport report;
@@ -132,15 +167,15 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   const Clock::time_point start = Clock::now();
   const double cpu_start = ProcessCpuSeconds();
 
-  // A stop request closes every queue, so that no stage stays blocked pushing to one that
-  // stopped popping.
+  // A stop request (the caller's, or the sink's: Esc in the window) closes every queue, so that
+  // no stage stays blocked pushing to one that stopped popping.
   auto close_all = [&] {
     to_track.Close();
     to_render.Close();
     to_sink.Close();
   };
   auto stopped = [&] {
-    if (!(stop && stop())) return false;
+    if (!(stop && stop()) && !sink.StopRequested()) return false;
     close_all();
     return true;
   };
@@ -161,10 +196,23 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       [&] {
         NameThisThread("arview-capture");
         size_t read = 0;
-        while (!error.failed() && !stopped() && !sink.StopRequested()) {
+        while (!error.failed() && !stopped()) {
           InFlight item;
-          if (!source.Next(item.frame)) break;
-          item.arrival = Clock::now();
+          try {
+            if (!source.Next(item.frame)) break;
+          } catch (const recordings::SourceError& e) {
+            if (!options.end_on_source_fault) throw;
+            std::lock_guard lock(report_mutex);
+            report.source_fault = e.what();
+            break;
+          }
+          const Clock::time_point arrival = Clock::now();
+          item.captured = item.frame.capture_time == Clock::time_point{} ? arrival : item.frame.capture_time;
+          item.log.index = item.frame.index;
+          item.log.timestamp = item.frame.timestamp;
+          item.log.captured_s = std::chrono::duration<double>(item.captured - start).count();
+          item.log.timeline.arrived = item.MsSinceCapture();
+          stats.Record("arrival", item.log.timeline.arrived);
           ++read;
           if (!to_track.Push(std::move(item))) break;
         }
@@ -179,8 +227,10 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
         while (auto item = to_track.Pop()) {
           if (error.failed() || stopped()) break;
           const Clock::time_point t0 = Clock::now();
+          item->log.timeline.track_start = item->MsSinceCapture();
           item->track = tracker.Track(item->frame.image, item->frame.timestamp);
           stats.Record("track", MsSince(t0));
+          item->log.timeline.track_end = item->MsSinceCapture();
           if (!to_render.Push(std::move(*item))) break;
         }
       },
@@ -192,18 +242,14 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
         compositor.BindToThread();
         while (auto item = to_render.Pop()) {
           if (error.failed() || stopped()) break;
-          FrameLog log = AnimateAndCompose(*item, animators, compositor, stats);
-          const bool localized = item->track.status != tracker::TrackStatus::kLost;
-          {
+          item->log.timeline.render_start = item->MsSinceCapture();
+          AnimateAndCompose(*item, animators, compositor, stats);
+          item->log.timeline.render_end = item->MsSinceCapture();
+          // The pose is kept whether or not the frame is shown: a frame dropped before the sink
+          // was still tracked.
+          if (options.keep_trajectory && item->track.status != tracker::TrackStatus::kLost) {
             std::lock_guard lock(report_mutex);
-            if (localized) {
-              ++report.frames_localized;
-              if (options.keep_trajectory) report.trajectory.push_back({item->frame.timestamp, item->track.pose});
-            }
-            report.briefs.push_back({static_cast<float>(log.track.times.total_ms),
-                                     log.gaze_error_deg ? static_cast<float>(*log.gaze_error_deg) : -1.0f,
-                                     log.track.status});
-            if (options.keep_frame_logs) report.frames.push_back(std::move(log));
+            report.trajectory.push_back({item->frame.timestamp, item->track.pose});
           }
           if (!to_sink.Push(std::move(*item))) break;
         }
@@ -212,15 +258,39 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   std::thread write(guarded([&] {
     NameThisThread("arview-sink");
-    while (auto item = to_sink.Pop()) {
-      if (error.failed() || stopped()) break;
+    RecentOutput recent;
+    for (;;) {
+      bool timed_out = false;
+      // Not a plain Pop: the window's events (Esc, an uncovered window) and a stop request are
+      // seen even while no frame comes.
+      std::optional<InFlight> item = to_sink.PopFor(std::chrono::milliseconds(50), timed_out);
+      if (timed_out) {
+        sink.PumpEvents();
+        if (stopped()) break;
+        continue;
+      }
+      if (!item || error.failed() || stopped()) break;
       const Clock::time_point t0 = Clock::now();
+      item->log.timeline.sink_start = item->MsSinceCapture();
       if (item->overlay) item->overlay(item->output);
       sink.Write(item->output);
+      const Clock::time_point written = Clock::now();
       stats.Record("sink", MsSince(t0));
-      stats.Record("latency", MsSince(item->arrival));
+      FrameLog& log = item->log;
+      log.timeline.output = item->MsSinceCapture();
+      stats.Record("latency", log.timeline.output);
+      recent.Add(written, log.timeline.output);
       std::lock_guard lock(report_mutex);
       ++report.frames_processed;
+      if (log.track.status != tracker::TrackStatus::kLost) ++report.frames_localized;
+      if (!report.first_output) report.first_output = written;
+      report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
+      report.source = source.Counts();
+      report.recent_fps = recent.Fps();
+      report.recent_latency_ms = recent.MedianLatencyMs();
+      report.briefs.push_back({static_cast<float>(log.track.times.total_ms),
+                               log.gaze_error_deg ? static_cast<float>(*log.gaze_error_deg) : -1.0f, log.track.status});
+      if (options.keep_frame_logs) report.frames.push_back(std::move(log));
       if (on_frame) on_frame(report);
     }
   }));
@@ -233,6 +303,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
   error.RethrowIfAny();
 
   report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
+  report.source = source.Counts();
   FillTotals(start, cpu_start, stats, report);
   return report;
 }

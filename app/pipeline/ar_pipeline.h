@@ -1,8 +1,11 @@
 #pragma once
 // The real-time pipeline: capture → track → animate → render + composite → sink, each on its
-// own thread, joined by bounded queues. Live sources drop the oldest waiting frame when a stage
-// falls behind (and count it); replays of a recording may instead process every frame.
-// Per-stage times and the end-to-end latency (frame arrival to output) are measured.
+// own thread, joined by bounded queues. Live sources keep one waiting frame per stage, the
+// newest: a stage that falls behind makes the older one drop (counted), so that after a stall
+// every stage jumps to the newest frame instead of draining a backlog. Replays of a recording
+// may instead process every frame. Per-stage times and the end-to-end latency (from the frame's
+// capture time to its hand-over to the sink) are measured, and each frame's way through the
+// stages is logged, so that a late frame can be traced to the stage it waited on.
 
 #include <chrono>
 #include <functional>
@@ -47,9 +50,14 @@ class FrameCompositor {
 };
 
 struct PipelineOptions {
-  // Live sources: a slower stage makes the oldest waiting frame drop. Replays: every frame.
+  // Live sources: a slower stage makes the older waiting frame drop, and each queue holds one
+  // frame (the freshest). Replays: every frame, through queues of `queue_capacity`.
   bool drop_frames = false;
   size_t queue_capacity = 2;
+  // Live sources: a source that fails while running (a camera unplugged or stalled) ends the
+  // run like the end of the stream, and PipelineReport::source_fault says why; the outputs so
+  // far are complete. Otherwise its error is rethrown.
+  bool end_on_source_fault = false;
   // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for --stats and the
   // demo's figures) and `trajectory` (80 bytes a localized frame). A long run that writes
   // neither turns them off, so that its memory stays flat (the soak test, docs/reliability.md);
@@ -65,9 +73,24 @@ struct FrameBrief {
   tracker::TrackStatus status = tracker::TrackStatus::kLost;
 };
 
+// A frame's way through the pipeline, in milliseconds since its capture.
+struct FrameTimeline {
+  float arrived = 0;       // the capture thread has it (decoded)
+  float track_start = 0, track_end = 0;
+  float render_start = 0, render_end = 0;  // animate + render + composite
+  float sink_start = 0;
+  float output = 0;        // handed to the sink (shown, encoded): the frame's latency
+  // Time spent waiting in each queue: what a late frame waited on.
+  float WaitBeforeTrack() const { return track_start - arrived; }
+  float WaitBeforeRender() const { return render_start - track_end; }
+  float WaitBeforeSink() const { return sink_start - render_end; }
+};
+
 struct FrameLog {
-  int64_t index = 0;
+  int64_t index = 0;        // a recording's frame index; a camera's sequence number
   double timestamp = 0;
+  double captured_s = 0;    // capture time, seconds since the pipeline started (< 0: before)
+  FrameTimeline timeline;
   tracker::FrameResult track;
   double idle_weight = 0;
   std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
@@ -77,22 +100,33 @@ struct FrameLog {
 struct PipelineReport {
   size_t frames_read = 0;
   size_t frames_processed = 0;  // reached the sink
-  size_t frames_dropped = 0;
-  size_t frames_localized = 0;
+  size_t frames_dropped = 0;    // dropped between stages (a stage was slower than the frame rate)
+  size_t frames_localized = 0;  // of the frames processed
+  recordings::SourceCounts source;  // what the source discarded (a camera's driver drops, ...)
+  // A live source's failure that ended the run (PipelineOptions::end_on_source_fault): the
+  // source's one-line message. Empty: the run ended normally.
+  std::string source_fault;
+  // While running, over the last second or so of output: for the progress line and the window.
+  double recent_fps = 0;
+  double recent_latency_ms = 0;  // median
+  std::optional<Clock::time_point> first_output;  // when the first frame reached the sink
   double wall_seconds = 0;
   double fps = 0;  // frames processed per wall-clock second
   // CPU time of the whole process (every thread: the stages, llvmpipe's, the encoder's) per
   // frame processed, over the run. On a shared machine this is steadier than the frame rate,
   // and it bounds it: two cores give at most 2000 / cpu_ms_per_frame frames per second.
   double cpu_ms_per_frame = 0;
-  std::map<std::string, TimingSummary> stages;  // track, animate, render, sink (with the deferred overlay), latency
+  // track, animate, render, sink (with the deferred overlay), latency (capture → sink), arrival
+  // (capture → the capture thread has it: a camera's decode and buffering)
+  std::map<std::string, TimingSummary> stages;
   std::vector<FrameLog> frames;                 // in processing order (PipelineOptions::keep_frame_logs)
   std::vector<FrameBrief> briefs;               // in processing order, always
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 
-// Runs until the source ends (or `stop()` returns true, checked by every stage between frames:
-// a stopped run drains nothing). Rethrows on the
+// Runs until the source ends (or `stop()` returns true, or the sink asks to stop: checked by
+// every stage between frames, and by the sink's thread at least every 50 ms; a stopped run
+// drains nothing). `on_frame` runs on the sink's thread after each frame. Rethrows on the
 // caller's thread the first error any stage raised, after every thread has stopped.
 PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
                            FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,

@@ -4,6 +4,7 @@
 // waiting item (and counts it) so the consumer always gets the freshest frame. Offline work that
 // must see every frame uses kBlock.
 
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -38,6 +39,18 @@ class BoundedQueue {
   std::optional<T> Pop() {
     std::unique_lock lock(mutex_);
     not_empty_.wait(lock, [&] { return closed_ || !items_.empty(); });
+    if (items_.empty()) return std::nullopt;
+    T item = std::move(items_.front());
+    items_.pop_front();
+    not_full_.notify_one();
+    return item;
+  }
+
+  // Like Pop, but waits at most `timeout`; `timed_out` says whether it gave up for that
+  // (nothing returned, the queue still open).
+  std::optional<T> PopFor(std::chrono::milliseconds timeout, bool& timed_out) {
+    std::unique_lock lock(mutex_);
+    timed_out = !not_empty_.wait_for(lock, timeout, [&] { return closed_ || !items_.empty(); });
     if (items_.empty()) return std::nullopt;
     T item = std::move(items_.front());
     items_.pop_front();

@@ -32,7 +32,7 @@ namespace {
 }  // namespace
 
 nlohmann::ordered_json TimingJson(const TimingSummary& s) {
-  return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"mean_ms", s.mean}, {"max_ms", s.max}};
+  return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"p99_ms", s.p99}, {"mean_ms", s.mean}, {"max_ms", s.max}};
 }
 
 namespace {
@@ -55,6 +55,10 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
   j["frames_processed"] = r.frames_processed;
   j["frames_dropped"] = r.frames_dropped;
   j["frames_localized"] = r.frames_localized;
+  j["source"] = {{"driver_dropped", r.source.driver_dropped},
+                 {"corrupt_skipped", r.source.corrupt_skipped},
+                 {"stale_skipped", r.source.stale_skipped}};
+  if (!r.source_fault.empty()) j["source_fault"] = r.source_fault;
   j["wall_seconds"] = r.wall_seconds;
   j["frames_per_second"] = r.fps;
   j["cpu_ms_per_frame"] = r.cpu_ms_per_frame;
@@ -70,8 +74,21 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
                {"frames_within_20_deg", g.within_20_deg}};
   nlohmann::ordered_json& frames = j["frames"] = nlohmann::ordered_json::array();
   for (const FrameLog& f : r.frames) {
+    const FrameTimeline& t = f.timeline;
     nlohmann::ordered_json frame = {{"index", f.index},
                                     {"timestamp", f.timestamp},
+                                    {"captured_s", f.captured_s},
+                                    {"latency_ms", t.output},
+                                    {"timeline_ms", {{"arrived", t.arrived},
+                                                     {"track_start", t.track_start},
+                                                     {"track_end", t.track_end},
+                                                     {"render_start", t.render_start},
+                                                     {"render_end", t.render_end},
+                                                     {"sink_start", t.sink_start},
+                                                     {"output", t.output}}},
+                                    {"waited_ms", {{"before_track", t.WaitBeforeTrack()},
+                                                   {"before_render", t.WaitBeforeRender()},
+                                                   {"before_sink", t.WaitBeforeSink()}}},
                                     {"status", ToString(f.track.status)},
                                     {"inliers", f.track.inliers},
                                     {"rms_px", f.track.rms_px},
@@ -93,8 +110,20 @@ std::string PipelineReportText(const PipelineReport& r) {
                 r.frames_read, r.frames_processed, r.frames_dropped, r.frames_localized,
                 r.frames_processed ? 100.0 * r.frames_localized / r.frames_processed : 0.0);
   out += line;
+  if (r.source.driver_dropped || r.source.corrupt_skipped || r.source.stale_skipped) {
+    std::snprintf(line, sizeof(line), "camera: %lld dropped by the driver, %lld corrupt, %lld stale (a newer frame was ready)\n",
+                  static_cast<long long>(r.source.driver_dropped), static_cast<long long>(r.source.corrupt_skipped),
+                  static_cast<long long>(r.source.stale_skipped));
+    out += line;
+  }
   std::snprintf(line, sizeof(line), "throughput: %.1f frames per second (%.2f s wall clock)\n", r.fps, r.wall_seconds);
   out += line;
+  if (const auto latency = r.stages.find("latency"); latency != r.stages.end()) {
+    const TimingSummary& l = latency->second;
+    std::snprintf(line, sizeof(line), "latency, capture to output: median %.1f ms, p99 %.1f ms, max %.1f ms\n", l.median,
+                  l.p99, l.max);
+    out += line;
+  }
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   std::snprintf(line, sizeof(line), "process CPU: %.1f ms per frame, all threads (%u cores: at most %.0f frames per second)\n",
                 r.cpu_ms_per_frame, cores, r.cpu_ms_per_frame > 0 ? 1000.0 * cores / r.cpu_ms_per_frame : 0.0);

@@ -37,11 +37,15 @@ struct SessionOptions {
   // outputs are written.
   bool cancel_ends_normally = false;
   bool quiet = false;
+  // When the command started, for "first frame shown after ..." (default: RunSession's start).
+  std::optional<Clock::time_point> command_start;
 };
 
 struct SessionResult {
   PipelineReport report;
   std::string renderer;
+  std::string output;  // the sink's description ("window \"arview\" (MIT-SHM)", a file, ...)
+  double seconds_to_first_output = -1;  // from SessionOptions::command_start; < 0: no frame shown
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10

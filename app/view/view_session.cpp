@@ -151,11 +151,11 @@ std::vector<std::string> ViewSession::StatusLines() const {
   return lines;
 }
 
-void ViewSession::Handle(const InputEvent& e, double time) {
+void ViewSession::Handle(const video::InputEvent& e, double time) {
   switch (e.type) {
-    case InputEvent::Type::kClose: quit_ = true; return;
-    case InputEvent::Type::kKey: HandleKey(e, time); return;
-    case InputEvent::Type::kPress:
+    case video::InputEvent::Type::kClose: quit_ = true; return;
+    case video::InputEvent::Type::kKey: HandleKey(e, time); return;
+    case video::InputEvent::Type::kPress:
       if (e.button == 4 || e.button == 5) {
         orbit_.Zoom(e.button == 4 ? 1 : -1);
         return;
@@ -165,19 +165,19 @@ void ViewSession::Handle(const InputEvent& e, double time) {
                                                                            : Drag::kNone;
       drag_x_ = e.x, drag_y_ = e.y;
       return;
-    case InputEvent::Type::kRelease:
-    case InputEvent::Type::kMotion: {
+    case video::InputEvent::Type::kRelease:
+    case video::InputEvent::Type::kMotion: {
       const int dx = e.x - drag_x_, dy = e.y - drag_y_;
       if (drag_ == Drag::kOrbit) orbit_.Orbit(dx, dy);
       if (drag_ == Drag::kPan) orbit_.Pan(dx, dy, camera_);
       drag_x_ = e.x, drag_y_ = e.y;
-      if (e.type == InputEvent::Type::kRelease) drag_ = Drag::kNone;
+      if (e.type == video::InputEvent::Type::kRelease) drag_ = Drag::kNone;
       return;
     }
   }
 }
 
-void ViewSession::HandleKey(const InputEvent& e, double time) {
+void ViewSession::HandleKey(const video::InputEvent& e, double time) {
   const std::string& k = e.key;
   if (k == "q" || k == "Escape") quit_ = true;
   else if (k == "h") options_.hud = !options_.hud;

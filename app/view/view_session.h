@@ -18,7 +18,7 @@
 #include "app/view/view_authoring.h"
 #include "app/view/view_camera.h"
 #include "app/view/view_ground.h"
-#include "app/view/view_window.h"
+#include "video/window.h"
 #include "render/ar_renderer.h"
 #include "render/offscreen.h"
 
@@ -41,7 +41,7 @@ class ViewSession {
   ~ViewSession();
 
   // One input event at animation time `time`.
-  void Handle(const InputEvent& event, double time);
+  void Handle(const video::InputEvent& event, double time);
   bool quit_requested() const { return quit_; }
 
   // The frame at animation time `time` for the current camera; stage times go to `stats`.
@@ -77,7 +77,7 @@ class ViewSession {
   Eigen::Vector3d CurrentViewpoint() const;  // for the camera as it is now
   void ApplyKeys();  // the editor's keys to the animation (reverts the edit when they cannot be built)
   std::vector<std::string> StatusLines() const;
-  void HandleKey(const InputEvent& e, double time);
+  void HandleKey(const video::InputEvent& e, double time);
 
   std::filesystem::path scene_file_;
   std::string scene_text_;  // as last read or written

@@ -1,4 +1,4 @@
-#include "app/view/view_window.h"
+#include "video/window.h"
 
 #include <X11/Xlib.h>
 #include <X11/Xutil.h>
@@ -12,7 +12,9 @@
 #include <cstring>
 #include <stdexcept>
 
-namespace arview::app {
+#include "base/error.h"
+
+namespace arview::video {
 
 namespace {
 
@@ -24,26 +26,22 @@ int RecordXError(Display*, XErrorEvent*) {
   return 0;
 }
 
-class X11Window final : public ViewWindow {
+class X11Window final : public DisplayWindow {
  public:
-  X11Window(const std::string& title, cv::Size size) : size_(size) {
+  X11Window(const std::string& title, cv::Size size, const std::string& without_display) : size_(size) {
     const char* name = std::getenv("DISPLAY");
     if (name == nullptr || *name == '\0') {
-      throw std::runtime_error(
-          "view: no display (DISPLAY is not set); render without a window with --orbit <spec> --out orbit.mp4");
+      throw Error("window: no display (DISPLAY is not set); " + without_display);
     }
     display_ = XOpenDisplay(name);
-    if (!display_) {
-      throw std::runtime_error(std::string("view: cannot open display '") + name +
-                               "'; render without a window with --orbit <spec> --out orbit.mp4");
-    }
+    if (!display_) throw Error(std::string("window: cannot open display '") + name + "'; " + without_display);
     const int screen = DefaultScreen(display_);
     Visual* visual = DefaultVisual(display_, screen);
     const int depth = DefaultDepth(display_, screen);
     if (depth != 24 || visual->red_mask != 0xff0000 || visual->green_mask != 0xff00 || visual->blue_mask != 0xff) {
       XCloseDisplay(display_);
-      throw std::runtime_error(std::string("view: display '") + name + "' has a " + std::to_string(depth) +
-                               "-bit visual; a 24-bit true-colour display is needed");
+      throw Error(std::string("window: display '") + name + "' has a " + std::to_string(depth) +
+                  "-bit visual; a 24-bit true-colour display is needed");
     }
     window_ = XCreateSimpleWindow(display_, RootWindow(display_, screen), 0, 0, size.width, size.height, 0,
                                   BlackPixel(display_, screen), BlackPixel(display_, screen));
@@ -79,9 +77,36 @@ class X11Window final : public ViewWindow {
   }
 
   void Show(const cv::Mat& bgr) override {
-    if (bgr.size() != size_ || bgr.type() != CV_8UC3) throw std::runtime_error("view: frame does not fit the window");
+    if (bgr.size() != size_ || bgr.type() != CV_8UC3) throw Error("window: frame does not fit the window");
     cv::Mat pixels(size_, CV_8UC4, image_->data, image_->bytes_per_line);
     cv::cvtColor(bgr, pixels, cv::COLOR_BGR2BGRA);
+    shown_ = true;
+    PutImage();
+  }
+
+  std::vector<InputEvent> Poll() override {
+    std::vector<InputEvent> events;
+    bool exposed = false;
+    while (XPending(display_) > 0) {
+      XEvent e;
+      XNextEvent(display_, &e);
+      exposed |= e.type == Expose;
+      Translate(e, events);
+    }
+    if (exposed && shown_) PutImage();
+    return events;
+  }
+
+  void SetTitle(const std::string& title) override {
+    XStoreName(display_, window_, title.c_str());
+    XFlush(display_);
+  }
+
+  std::string PresentMethod() const override { return shm_image_ ? "MIT-SHM" : "XPutImage"; }
+  cv::Size size() const override { return size_; }
+
+ private:
+  void PutImage() {
     if (shm_image_) {
       XShmPutImage(display_, window_, gc_, image_, 0, 0, 0, 0, size_.width, size_.height, False);
     } else {
@@ -92,20 +117,6 @@ class X11Window final : public ViewWindow {
     XSync(display_, False);
   }
 
-  std::vector<InputEvent> Poll() override {
-    std::vector<InputEvent> events;
-    while (XPending(display_) > 0) {
-      XEvent e;
-      XNextEvent(display_, &e);
-      Translate(e, events);
-    }
-    return events;
-  }
-
-  std::string PresentMethod() const override { return shm_image_ ? "MIT-SHM" : "XPutImage"; }
-  cv::Size size() const override { return size_; }
-
- private:
   void CreateImage(Visual* visual, int depth) {
     if (XShmQueryExtension(display_)) {
       image_ = XShmCreateImage(display_, visual, depth, ZPixmap, nullptr, &shm_, size_.width, size_.height);
@@ -134,9 +145,9 @@ class X11Window final : public ViewWindow {
     if (!image_) {
       char* pixels = static_cast<char*>(std::malloc(static_cast<size_t>(size_.width) * size_.height * 4));
       image_ = XCreateImage(display_, visual, depth, ZPixmap, 0, pixels, size_.width, size_.height, 32, 0);
-      if (!image_) throw std::runtime_error("view: cannot create the window's image");
+      if (!image_) throw Error("window: cannot create the window's image");
     }
-    if (image_->bits_per_pixel != 32) throw std::runtime_error("view: the display does not store 32-bit pixels");
+    if (image_->bits_per_pixel != 32) throw Error("window: the display does not store 32-bit pixels");
   }
 
   void Translate(const XEvent& e, std::vector<InputEvent>& out) {
@@ -192,13 +203,14 @@ class X11Window final : public ViewWindow {
   XImage* image_ = nullptr;
   XShmSegmentInfo shm_{};
   bool shm_image_ = false;
+  bool shown_ = false;  // the image holds a frame (Expose repaints it)
 };
 
 }  // namespace
 
-std::unique_ptr<ViewWindow> ViewWindow::Open(const std::string& title, cv::Size size) {
-  if (size.width <= 0 || size.height <= 0) throw std::runtime_error("view: window size must be positive");
-  return std::make_unique<X11Window>(title, size);
+std::unique_ptr<DisplayWindow> DisplayWindow::Open(const std::string& title, cv::Size size, const std::string& without_display) {
+  if (size.width <= 0 || size.height <= 0) throw Error("window: size must be positive");
+  return std::make_unique<X11Window>(title, size, without_display);
 }
 
-}  // namespace arview::app
+}  // namespace arview::video

@@ -1,0 +1,186 @@
+// The live window as a person meets it (issue 35): `arview replay --out window` and `arview run
+// --out window` in a real X session (Xvfb), frames appearing in the window, and each way of
+// ending it (Esc, q, Ctrl-C, SIGTERM) ending the session promptly with the report, the stats
+// and the trajectory written. The window used to freeze on its first frame (highgui shown from
+// the sink's thread); only the no-display error was tested then.
+//
+// Inputs stay small: the 60-frame rendered room of the cancellation tests (made once per machine
+// with `arview synth room`) with a synthetic map (random points: every frame is lost, so the
+// window shows the video alone, but every stage runs), and for `run` the emulated camera
+// (tests/support/fake_v4l2_device.cpp) with a synthetic map of its size.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "calib/camera.h"
+#include "tests/support/random_map.h"
+#include "tests/support/run_command.h"
+#include "tests/support/test_data.h"
+#include "tests/support/virtual_display.h"
+
+namespace arview {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Child;
+using testing::ReadWholeFile;
+using testing::Shell;
+using testing::ShellQuote;
+using testing::VirtualDisplay;
+
+constexpr int kRoomFrames = 60;
+
+enum class Ending { kEscape, kQ, kSigint, kSigterm };
+enum class Input { kReplay, kCamera };
+
+struct Case {
+  Input input;
+  Ending ending;
+};
+
+std::string CaseName(const ::testing::TestParamInfo<Case>& info) {
+  const char* input = info.param.input == Input::kReplay ? "Replay" : "Run";
+  const char* ending[] = {"Escape", "Q", "Sigint", "Sigterm"};
+  return std::string(input) + "EndedBy" + ending[static_cast<int>(info.param.ending)];
+}
+
+// The rendered room, shared with the cancellation tests (same name: made once per machine).
+fs::path SharedRoom() {
+  const fs::path room = fs::temp_directory_path() /
+                        ("arview_cancellation_room_" + std::to_string(::getuid()) + "_" + std::to_string(kRoomFrames));
+  if (fs::exists(room / "frames.txt")) return room;
+  const fs::path rendering = room.string() + ".rendering_" + std::to_string(::getpid());
+  const auto r = testing::RunArview(
+      {"synth", "room", "--out", rendering.string(), "--frames", std::to_string(kRoomFrames), "--seed", "1", "--quiet"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  std::error_code ec;
+  fs::rename(rendering, room, ec);  // fails harmlessly when a parallel test got there first
+  fs::remove_all(rendering, ec);
+  return room;
+}
+
+class LiveWindow : public testing::XSessionTest<::testing::TestWithParam<Case>> {
+ protected:
+  void SetUp() override { StartXSession("live_window"); }
+
+  // The command line (through `sh -c 'exec ...'`, so that the child's pid is arview's) and the
+  // size of the window it opens.
+  std::vector<std::string> Command(Input input, cv::Size& window) {
+    const char* bin_env = std::getenv("ARVIEW_BIN");
+    const std::string bin = bin_env ? bin_env : "arview";
+    const std::string outputs = " --out window --stats " + ShellQuote((dir_ / "stats.json").string()) +
+                                " --trajectory " + ShellQuote((dir_ / "trajectory.txt").string());
+    std::string line;
+    if (input == Input::kReplay) {
+      const fs::path room = SharedRoom();
+      const calib::Camera camera = calib::LoadCamera(room / "camera.yaml");
+      testing::WriteRandomMap(camera, dir_ / "map");
+      window = camera.Size();
+      // Looped and paced: it runs until it is ended, as a camera would.
+      line = "exec " + ShellQuote(bin) + " replay " + ShellQuote(room.string()) + " --map " +
+             ShellQuote((dir_ / "map").string()) + " --paced --loop 1000" + outputs;
+    } else {
+      // The emulated camera: 64x48 frames at 30 per second.
+      const calib::Camera camera = calib::Camera::Pinhole(64, 48, 60, 60, 32, 24);
+      testing::WriteRandomMap(camera, dir_ / "map");
+      window = camera.Size();
+      line = "exec env LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) + " " + ShellQuote(bin) +
+             " run --device /dev/video-arview-fake --map " + ShellQuote((dir_ / "map").string()) + outputs;
+    }
+    line += " 2>" + ShellQuote((dir_ / "stderr.txt").string());
+    return {"sh", "-c", line};
+  }
+
+  // The window's id once its title shows the live status (frames have been shown), or "".
+  std::string WaitForLiveWindow(Child& app) {
+    const std::string d = display_->name();
+    for (int i = 0; i < 600 && app.Wait(0) < 0; ++i) {
+      const int rc = std::system(("DISPLAY=" + d + " xdotool search --name '^arview .*fps' > " +
+                                  ShellQuote((dir_ / "window_id").string()) + " 2>/dev/null").c_str());
+      if (rc == 0) {
+        std::string id = ReadWholeFile((dir_ / "window_id").string());
+        id = id.substr(0, id.find('\n'));
+        if (!id.empty()) return id;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return "";
+  }
+};
+
+TEST_P(LiveWindow, ShowsFramesAndEndsPromptlyWithItsOutputs) {
+  const Case c = GetParam();
+  if (c.input == Input::kReplay) {
+    ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+  }
+  ::setenv("DISPLAY", display_->name().c_str(), 1);
+  cv::Size window;
+  const std::vector<std::string> command = Command(c.input, window);
+  const fs::path out = dir_ / "stdout.txt";
+  Child app(command, out.string());
+  const std::string id = WaitForLiveWindow(app);
+  ASSERT_FALSE(id.empty()) << "no window with a live status appeared\n" << ReadWholeFile((dir_ / "stderr.txt").string());
+  // Let it run a little, then look at what the window shows (no window manager: it sits at 0,0).
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const fs::path shot = dir_ / "window.png";
+  Shell("ffmpeg -loglevel error -y -f x11grab -video_size 1280x720 -i " + display_->name() + " -frames:v 1 " +
+            ShellQuote(shot.string()),
+        display_->name());
+  const cv::Mat screen = cv::imread(shot.string());
+  ASSERT_FALSE(screen.empty());
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(screen(cv::Rect({0, 0}, window)), mean, stddev);
+  // The room's video (textured walls) or the emulated camera's mid-grey, not a blank window.
+  if (c.input == Input::kReplay) {
+    EXPECT_GT(stddev[0] + stddev[1] + stddev[2], 30) << "the window shows no picture";
+  } else {
+    EXPECT_NEAR(mean[0], 128, 20) << "the window does not show the camera's grey";
+  }
+  const std::string title = Shell("xdotool getwindowname " + id, display_->name());
+  EXPECT_TRUE(std::regex_search(title, std::regex(R"(\d+\.\d fps, latency \d+ ms, \d+ dropped)"))) << title;
+
+  const auto signalled = std::chrono::steady_clock::now();
+  switch (c.ending) {
+    case Ending::kEscape: Shell("xdotool key --window " + id + " Escape", display_->name()); break;
+    case Ending::kQ: Shell("xdotool key --window " + id + " q", display_->name()); break;
+    case Ending::kSigint: ::kill(app.pid(), SIGINT); break;
+    case Ending::kSigterm: ::kill(app.pid(), SIGTERM); break;
+  }
+  const int status = app.Wait(10);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
+  ASSERT_GE(status, 0) << "still running 10 s after it was asked to end";
+  std::printf("[live window] %s ended %.3f s after it was asked\n", CaseName({c, 0}).c_str(), seconds);
+  // Issue 35 asks 0.5 s; the bound here leaves room for a machine running other tests.
+  EXPECT_LT(seconds, 1.5);
+  const std::string report = ReadWholeFile(out.string());
+  EXPECT_EQ(status, 0) << report << ReadWholeFile((dir_ / "stderr.txt").string());
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(report, m, std::regex(R"(frames: \d+ read, (\d+) processed)"))) << report;
+  EXPECT_GE(std::stoi(m[1]), 2) << report;  // few on a busy machine: every lost frame relocalizes
+  EXPECT_NE(report.find("latency, capture to output: median"), std::string::npos) << report;
+  const nlohmann::json stats = nlohmann::json::parse(ReadWholeFile((dir_ / "stats.json").string()));
+  EXPECT_EQ(stats["frames"].size(), stats["frames_processed"].get<size_t>());
+  EXPECT_GT(stats["frames"][0]["latency_ms"].get<double>(), 0);
+  EXPECT_TRUE(fs::exists(dir_ / "trajectory.txt"));
+}
+
+INSTANTIATE_TEST_SUITE_P(EachWayToEnd, LiveWindow,
+                         ::testing::Values(Case{Input::kReplay, Ending::kEscape}, Case{Input::kReplay, Ending::kQ},
+                                           Case{Input::kReplay, Ending::kSigint}, Case{Input::kReplay, Ending::kSigterm},
+                                           Case{Input::kCamera, Ending::kEscape}, Case{Input::kCamera, Ending::kSigint},
+                                           Case{Input::kCamera, Ending::kSigterm}),
+                         CaseName);
+
+}  // namespace
+}  // namespace arview
