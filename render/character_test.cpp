@@ -9,6 +9,7 @@
 #include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
 #include "render/test_scene.h"
+#include "tests/support/fox_view.h"
 #include "tests/support/test_data.h"
 
 namespace arview::render {
@@ -18,23 +19,9 @@ namespace fs = std::filesystem;
 
 fs::path Fox() { return arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb"); }
 
-authoring::Scene FoxScene() {
-  return authoring::ParseScene("characters:\n  - name: fox\n    asset: " + Fox().string() +
-                              "\n    scale: 0.01\n    anchor:\n      position: [0.2, 0.1, 0]\n"
-                              "      rotation_deg: [90, 0, 30]\n    keys:\n      - viewpoint: [0, 0, 1]\n"
-                              "        clip: Walk\n",
-                          "fox_test.yaml");
-}
+authoring::Scene FoxScene() { return authoring::ParseScene(arview::testing::FoxSceneYaml(), "fox_test.yaml"); }
 
-// Looking at the anchor from 2 m, 0.8 m up, z up.
-calib::Pose LookingAtFox() {
-  const Eigen::Vector3d eye(0.9, -1.8, 0.8), target(0.2, 0.1, 0.35);
-  const Eigen::Vector3d forward = (target - eye).normalized();
-  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
-  Eigen::Matrix3d r_wc;
-  r_wc << right, forward.cross(right), forward;
-  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
-}
+using arview::testing::LookingAtFox;
 
 calib::Camera TestCamera() { return calib::Camera::Pinhole(640, 480, 600, 590, 322.5, 236.0); }
 

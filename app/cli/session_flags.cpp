@@ -1,6 +1,7 @@
 #include "app/cli/session_flags.h"
 
 #include "app/placement/scene_lighting.h"
+#include "render/hmd.h"
 #include "render/offscreen.h"
 #include "render/prt_cache.h"
 
@@ -18,8 +19,15 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
   cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)");
   cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON");
-  cmd->add_flag("--hmd", f.hmd, "Head-mounted display: side-by-side stereo, one render per eye");
-  cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --hmd, in map units (metres for metric maps)")
+  cmd->add_flag("--hmd", f.hmd,
+                "Head-mounted display: one half per eye, the same video in both (one camera), the character "
+                "rendered once (biocular; see --stereo-character)");
+  cmd->add_option("--hmd-profile", f.hmd_profile,
+                  "Headset profile (YAML: panel, eye_fov_deg, lens_centre, distortion; docs/examples/hmd-cardboard.yaml): "
+                  "the eyes' views placed on its panel and pre-distorted for its lenses; implies --hmd");
+  cmd->add_flag("--stereo-character", f.stereo_character,
+                "With --hmd: render the character once per eye, --ipd apart (true depth only on a metric map)");
+  cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --stereo-character, in map units (metres for metric maps)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--hud", f.hud, "Draw the view-sphere overlay: key viewpoints coloured by weight, the current viewpoint");
@@ -54,7 +62,10 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.stats_out = f.stats;
   o.compositor.gl.backend = render::ParseGlBackend(f.gl);
   o.compositor.gl.threads = f.gl_threads;
-  o.compositor.hmd = f.hmd;
+  o.compositor.hmd = f.hmd || !f.hmd_profile.empty();
+  if (!f.hmd_profile.empty()) o.compositor.hmd_profile = render::LoadHmdProfile(f.hmd_profile);
+  if (f.stereo_character && !o.compositor.hmd) throw CommandError("--stereo-character needs --hmd or --hmd-profile");
+  o.compositor.stereo_character = f.stereo_character;
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
   o.tracker.tracking.prefetch_below = f.prefetch_below;

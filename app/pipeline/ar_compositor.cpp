@@ -31,6 +31,7 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
     if (!renderer_->prt_cache_note().empty()) load_notes_.push_back(renderer_->prt_cache_note());
   }
   description_ = context_->Description();
+  if (options_.hmd && options_.hmd_profile) presenter_.emplace(*options_.hmd_profile, renderer_->pinhole());
 }
 
 void ArCompositor::NoteFrameComposed() {
@@ -59,7 +60,7 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
   return status;
 }
 
-std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose& input) {
+ArCompositor::HudDraw ArCompositor::MakeHud(const FrameToCompose& input) {
   if (!hud_visible_ || characters_.empty()) return {};
   // Everything the drawing needs is copied now: the animations' frames change with the next one.
   std::vector<render::HudSphere> spheres;
@@ -73,15 +74,22 @@ std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose
   render::HudText text;
   text.status = HudStatus(input);
   const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
-  return [spheres = std::move(spheres), text = std::move(text), pose, camera = renderer_->pinhole(), hmd = options_.hmd,
-          ipd_m = options_.ipd_m](cv::Mat& frame) {
-    if (!hmd) {
-      render::DrawHud(frame, camera, pose, spheres, text);
-      return;
-    }
+  return [spheres = std::move(spheres), text = std::move(text), pose, camera = renderer_->pinhole()](
+             cv::Mat& view, double eye_offset_m) {
+    render::DrawHud(view, camera, eye_offset_m == 0 ? pose : render::OffsetEye(pose, eye_offset_m), spheres, text);
+  };
+}
+
+std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose& input) {
+  if (presenter_) return {};  // drawn into the eyes' views before the pre-distortion (Compose)
+  HudDraw hud = MakeHud(input);
+  if (!hud) return {};
+  if (!options_.hmd) return [hud = std::move(hud)](cv::Mat& frame) { hud(frame, 0); };
+  const double half_ipd = options_.stereo_character ? 0.5 * options_.ipd_m : 0.0;
+  return [hud = std::move(hud), half_ipd, width = camera_.width, height = camera_.height](cv::Mat& frame) {
     for (int eye = 0; eye < 2; ++eye) {
-      cv::Mat half = frame(cv::Rect(eye * camera.width, 0, camera.width, camera.height));
-      render::DrawHud(half, camera, render::OffsetEye(pose, (eye == 0 ? -0.5 : 0.5) * ipd_m), spheres, text);
+      cv::Mat half = frame(cv::Rect(eye * width, 0, width, height));
+      hud(half, eye == 0 ? -half_ipd : half_ipd);
     }
   };
 }
@@ -89,6 +97,7 @@ std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose
 void ArCompositor::BindToThread() { context_->MakeCurrent(); }
 
 cv::Size ArCompositor::OutputSize() const {
+  if (presenter_) return presenter_->panel();
   return {options_.hmd ? 2 * camera_.width : camera_.width, camera_.height};
 }
 
@@ -97,13 +106,45 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
   const bool localized = input.track->status != tracker::TrackStatus::kLost;
   output_ptrs_.clear();
   if (localized) output_ptrs_.assign(input.animations.begin(), input.animations.end());
+  if (options_.hmd) return ComposeForHmd(input, localized);
   if (localized || characters_.empty()) {
-    const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
-    return options_.hmd ? renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m)
-                        : renderer_->Render(input.frame->image, pose, output_ptrs_);
+    return renderer_->Render(input.frame->image, localized ? input.track->pose : calib::Pose{}, output_ptrs_);
   }
-  // Lost: no pose to register the characters with, so the video is shown alone, undistorted
-  // like the augmented frames (the renderer's maps: same K, pinhole output).
+  return VideoAlone(input).clone();  // the HUD, drawn by DeferredOverlay, says "lost"
+}
+
+cv::Mat ArCompositor::ComposeForHmd(const FrameToCompose& input, bool localized) {
+  const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
+  cv::Mat left, right;
+  if (!localized && !characters_.empty()) {
+    left = right = VideoAlone(input).clone();
+  } else if (options_.stereo_character) {
+    const cv::Mat both = renderer_->RenderSideBySide(input.frame->image, pose, output_ptrs_, options_.ipd_m);
+    left = both(cv::Rect(0, 0, camera_.width, camera_.height));
+    right = both(cv::Rect(camera_.width, 0, camera_.width, camera_.height));
+  } else {
+    left = right = renderer_->Render(input.frame->image, pose, output_ptrs_);  // biocular: one render
+  }
+  if (!presenter_) {
+    cv::Mat out;
+    cv::hconcat(left, right, out);
+    return out;
+  }
+  if (HudDraw hud = MakeHud(input)) {
+    const double half_ipd = options_.stereo_character ? 0.5 * options_.ipd_m : 0.0;
+    if (left.data == right.data) {
+      hud(left, 0);
+    } else {
+      hud(left, -half_ipd);
+      hud(right, half_ipd);
+    }
+  }
+  return presenter_->Present(left, right);
+}
+
+cv::Mat ArCompositor::VideoAlone(const FrameToCompose& input) {
+  // No pose to register the characters with, so the video is shown alone, undistorted like the
+  // augmented frames (the renderer's maps: same K, pinhole output).
   cv::Mat frame = input.frame->image;
   if (frame.channels() == 1) cv::cvtColor(frame, frame, cv::COLOR_GRAY2BGR);
   if (camera_.HasDistortion()) {
@@ -115,10 +156,7 @@ cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
     cv::remap(frame, undistorted, undistort_x_, undistort_y_, cv::INTER_LINEAR);
     frame = undistorted;
   }
-  cv::Mat out;
-  if (options_.hmd) cv::hconcat(frame, frame, out);
-  else out = frame.clone();
-  return out;  // the HUD, drawn by DeferredOverlay, says "lost"
+  return frame;
 }
 
 }  // namespace arview::app

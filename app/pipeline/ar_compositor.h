@@ -14,6 +14,7 @@
 
 #include "app/pipeline/ar_pipeline.h"
 #include "render/ar_renderer.h"
+#include "render/hmd.h"
 #include "render/offscreen.h"
 
 namespace arview::app {
@@ -21,7 +22,13 @@ namespace arview::app {
 struct CompositorOptions {
   render::OffscreenOptions gl;
   render::ArOptions ar;
-  bool hmd = false;   // side-by-side stereo
+  bool hmd = false;   // side by side, one half per eye (render/hmd.h)
+  // With hmd: the headset's panel, lens and pre-distortion; without, the halves are the camera's
+  // views side by side (2W x H), undistorted.
+  std::optional<render::HmdProfile> hmd_profile;
+  // With hmd: the character rendered once per eye, ±ipd/2 apart; otherwise once, the same in
+  // both eyes (biocular), as the video is (one camera: no per-eye view of the room).
+  bool stereo_character = false;
   double ipd_m = 0.064;
   std::optional<room::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
   bool hud = false;   // the overlay (render/hud.h): view sphere, weights, tracking status, frame rate
@@ -46,6 +53,14 @@ class ArCompositor : public FrameCompositor {
   void ToggleHud() { hud_visible_ = !hud_visible_; }
 
  private:
+  // Draws the HUD of one frame on a camera-sized view whose eye sits `eye_offset_m` along the
+  // camera's x axis; empty when the HUD is hidden.
+  using HudDraw = std::function<void(cv::Mat& view, double eye_offset_m)>;
+  HudDraw MakeHud(const FrameToCompose& input);
+  // The two eyes' views of a frame (the same picture unless stereo_character), then the panel.
+  cv::Mat ComposeForHmd(const FrameToCompose& input, bool localized);
+  // The video alone, undistorted like the augmented frames: a lost frame.
+  cv::Mat VideoAlone(const FrameToCompose& input);
   // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
   std::vector<std::string> HudStatus(const FrameToCompose& input) const;
   // Composed frames per second over the last second or so of output (wall clock).
@@ -64,6 +79,7 @@ class ArCompositor : public FrameCompositor {
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
   std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
   std::atomic<bool> hud_visible_;  // starts as options_.hud
+  std::optional<render::HmdPresenter> presenter_;  // hmd with a profile
 };
 
 }  // namespace arview::app
