@@ -17,7 +17,7 @@ PACKAGES=(
   ffmpeg
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libyaml-cpp-dev nlohmann-json3-dev
-  libx11-dev libxext-dev
+  libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
 )

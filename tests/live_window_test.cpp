@@ -184,3 +184,42 @@ INSTANTIATE_TEST_SUITE_P(EachWayToEnd, LiveWindow,
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+class WindowPlacement : public testing::XSessionTest<::testing::Test> {
+ protected:
+  void SetUp() override {
+    StartXSession("window_placement");
+    if (HasFatalFailure() || IsSkipped()) return;
+    ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+    room_ = SharedRoom();
+    testing::WriteRandomMap(calib::LoadCamera(room_ / "camera.yaml"), dir_ / "map");
+    ::setenv("DISPLAY", display_->name().c_str(), 1);
+  }
+  testing::CommandResult Replay(const std::vector<std::string>& placement) {
+    std::vector<std::string> args = {"replay", room_.string(), "--map", (dir_ / "map").string(), "--frames", "0-9",
+                                     "--out", "window"};
+    args.insert(args.end(), placement.begin(), placement.end());
+    return testing::RunArview(args);
+  }
+  fs::path room_;
+};
+
+// A headset's panel is a display output: the window opens at its corner (Xvfb has one output,
+// "screen"), and an output that is not there is one line naming those that are.
+TEST_F(WindowPlacement, OpensOnANamedOutputAndNamesTheOutputsWhenItIsNotThere) {
+  const auto placed = Replay({"--window-output", "screen", "--fullscreen"});
+  ASSERT_EQ(placed.exit_code, 0) << placed.err;
+  EXPECT_NE(placed.out.find("shown in window \"arview\""), std::string::npos) << placed.out;
+  EXPECT_NE(placed.out.find("at screen (1280x720+0+0), fullscreen"), std::string::npos) << placed.out;
+  const auto missing = Replay({"--window-output", "HDMI-9"});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_EQ(testing::LineCount(missing.err), 1) << missing.err;
+  EXPECT_NE(missing.err.find("no connected output 'HDMI-9' (connected: screen 1280x720+0+0)"), std::string::npos)
+      << missing.err;
+}
+
+}  // namespace
+}  // namespace arview

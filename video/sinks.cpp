@@ -30,16 +30,19 @@ void CheckFrame(const cv::Mat& frame, cv::Size size, const std::string& target) 
 
 class WindowSink final : public FrameSink {
  public:
-  WindowSink(std::string title, cv::Size size) : title_(std::move(title)), size_(size) {
+  WindowSink(std::string title, cv::Size size, const WindowPlacement& placement) : title_(std::move(title)), size_(size) {
     if (!HasDisplay()) {
       throw render::RenderError("window output needs a display, and DISPLAY is not set; "
                                 "write to a file instead (e.g. --out out.mp4)");
     }
     try {
-      window_ = DisplayWindow::Open(title_, size, "write to a file instead (e.g. --out out.mp4)");
+      window_ = DisplayWindow::Open(title_, size, "write to a file instead (e.g. --out out.mp4)", placement);
     } catch (const Error& e) {
       throw render::RenderError(e.what());
     }
+    // Kept for after Close: the session describes its output once the window is gone.
+    const std::string placed = window_->PlacementText();
+    description_ = "window \"" + title_ + "\" (" + window_->PresentMethod() + (placed.empty() ? "" : ", " + placed) + ")";
   }
   ~WindowSink() override { Close(); }
   void Write(const cv::Mat& bgr) override {
@@ -64,12 +67,10 @@ class WindowSink final : public FrameSink {
   }
   void Close() override { window_.reset(); }
   bool StopRequested() const override { return stop_; }
-  std::string Describe() const override {
-    return "window \"" + title_ + "\"" + (window_ ? " (" + window_->PresentMethod() + ")" : "");
-  }
+  std::string Describe() const override { return description_; }
 
  private:
-  std::string title_, shown_title_;
+  std::string title_, shown_title_, description_;
   cv::Size size_;
   std::unique_ptr<DisplayWindow> window_;
   std::atomic<bool> stop_{false};  // set on the writing thread, read by the capture thread
@@ -176,10 +177,11 @@ bool HasDisplay() {
   return value != nullptr && *value != '\0';
 }
 
-std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps) {
+std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
+                                    const WindowPlacement& window) {
   if (frame_size.width <= 0 || frame_size.height <= 0) throw render::RenderError("sink: frame size must be positive");
   if (target == "window" || target.rfind("window:", 0) == 0) {
-    return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size);
+    return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size, window);
   }
   if (target == "null") return std::make_unique<NullSink>(frame_size);
   if (target.empty()) throw render::RenderError("sink: no output given");

@@ -8,6 +8,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "video/window.h"
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -45,7 +47,9 @@ class FrameSink {
   std::function<void(const std::string&)> key_handler_;
 };
 
-std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps);
+// `window` places a window target (video/window.h); other targets ignore it.
+std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
+                                    const WindowPlacement& window = {});
 
 // Whether a display is available for the window (DISPLAY set: an X server, or Xwayland).
 bool HasDisplay();

@@ -1,8 +1,10 @@
 #include "video/window.h"
 
 #include <X11/Xlib.h>
+#include <X11/Xatom.h>
 #include <X11/Xutil.h>
 #include <X11/extensions/XShm.h>
+#include <X11/extensions/Xrandr.h>
 #include <sys/ipc.h>
 #include <sys/shm.h>
 
@@ -26,9 +28,37 @@ int RecordXError(Display*, XErrorEvent*) {
   return 0;
 }
 
+std::string AreaText(const cv::Rect& r) {
+  return std::to_string(r.width) + "x" + std::to_string(r.height) + "+" + std::to_string(r.x) + "+" + std::to_string(r.y);
+}
+
+// The connected outputs that show part of the screen (a CRTC drives them).
+std::vector<DisplayOutput> ConnectedOutputs(Display* display) {
+  std::vector<DisplayOutput> outputs;
+  int event_base = 0, error_base = 0;
+  if (!XRRQueryExtension(display, &event_base, &error_base)) return outputs;
+  XRRScreenResources* resources = XRRGetScreenResourcesCurrent(display, DefaultRootWindow(display));
+  if (!resources) return outputs;
+  for (int i = 0; i < resources->noutput; ++i) {
+    XRROutputInfo* output = XRRGetOutputInfo(display, resources, resources->outputs[i]);
+    if (!output) continue;
+    if (output->connection == RR_Connected && output->crtc) {
+      if (XRRCrtcInfo* crtc = XRRGetCrtcInfo(display, resources, output->crtc)) {
+        outputs.push_back({std::string(output->name, static_cast<size_t>(output->nameLen)),
+                           cv::Rect(crtc->x, crtc->y, static_cast<int>(crtc->width), static_cast<int>(crtc->height))});
+        XRRFreeCrtcInfo(crtc);
+      }
+    }
+    XRRFreeOutputInfo(output);
+  }
+  XRRFreeScreenResources(resources);
+  return outputs;
+}
+
 class X11Window final : public DisplayWindow {
  public:
-  X11Window(const std::string& title, cv::Size size, const std::string& without_display) : size_(size) {
+  X11Window(const std::string& title, cv::Size size, const std::string& without_display, const WindowPlacement& placement)
+      : size_(size) {
     const char* name = std::getenv("DISPLAY");
     if (name == nullptr || *name == '\0') {
       throw Error("window: no display (DISPLAY is not set); " + without_display);
@@ -43,15 +73,30 @@ class X11Window final : public DisplayWindow {
       throw Error(std::string("window: display '") + name + "' has a " + std::to_string(depth) +
                   "-bit visual; a 24-bit true-colour display is needed");
     }
-    window_ = XCreateSimpleWindow(display_, RootWindow(display_, screen), 0, 0, size.width, size.height, 0,
+    cv::Point origin(0, 0);
+    if (!placement.output.empty()) {
+      const cv::Rect area = OutputArea(placement.output, name);
+      origin = area.tl();
+      placement_text_ = "at " + placement.output + " (" + AreaText(area) + ")";
+    }
+    window_ = XCreateSimpleWindow(display_, RootWindow(display_, screen), origin.x, origin.y, size.width, size.height, 0,
                                   BlackPixel(display_, screen), BlackPixel(display_, screen));
     XStoreName(display_, window_, title.c_str());
-    // A fixed size: the renderer's camera has the window's size.
+    // A fixed size: the renderer's camera has the window's size. The position is the user's
+    // (USPosition): a window manager keeps it.
     XSizeHints hints{};
-    hints.flags = PMinSize | PMaxSize;
+    hints.flags = PMinSize | PMaxSize | (placement.output.empty() ? 0 : USPosition | PPosition);
+    hints.x = origin.x, hints.y = origin.y;
     hints.min_width = hints.max_width = size.width;
     hints.min_height = hints.max_height = size.height;
     XSetWMNormalHints(display_, window_, &hints);
+    if (placement.fullscreen) {
+      // Before mapping: an EWMH window manager then maps it fullscreen on the output it sits on.
+      Atom state = XInternAtom(display_, "_NET_WM_STATE", False);
+      Atom fullscreen = XInternAtom(display_, "_NET_WM_STATE_FULLSCREEN", False);
+      XChangeProperty(display_, window_, state, XA_ATOM, 32, PropModeReplace, reinterpret_cast<unsigned char*>(&fullscreen), 1);
+      placement_text_ += placement_text_.empty() ? "fullscreen" : ", fullscreen";
+    }
     XSelectInput(display_, window_,
                  ExposureMask | KeyPressMask | ButtonPressMask | ButtonReleaseMask | PointerMotionMask |
                      StructureNotifyMask);
@@ -103,9 +148,23 @@ class X11Window final : public DisplayWindow {
   }
 
   std::string PresentMethod() const override { return shm_image_ ? "MIT-SHM" : "XPutImage"; }
+  std::string PlacementText() const override { return placement_text_; }
   cv::Size size() const override { return size_; }
 
  private:
+  // The area of the connected output `output`; an Error listing the outputs when there is none.
+  cv::Rect OutputArea(const std::string& output, const char* display_name) {
+    const std::vector<DisplayOutput> outputs = ConnectedOutputs(display_);
+    std::string list;
+    for (const DisplayOutput& o : outputs) {
+      if (o.name == output) return o.area;
+      list += (list.empty() ? "" : ", ") + o.name + " " + AreaText(o.area);
+    }
+    XCloseDisplay(display_);
+    throw Error(std::string("window: display '") + display_name + "' has no connected output '" + output + "' (" +
+                (list.empty() ? std::string("it reports none through RandR") : "connected: " + list) + ")");
+  }
+
   void PutImage() {
     if (shm_image_) {
       XShmPutImage(display_, window_, gc_, image_, 0, 0, 0, 0, size_.width, size_.height, False);
@@ -204,13 +263,15 @@ class X11Window final : public DisplayWindow {
   XShmSegmentInfo shm_{};
   bool shm_image_ = false;
   bool shown_ = false;  // the image holds a frame (Expose repaints it)
+  std::string placement_text_;
 };
 
 }  // namespace
 
-std::unique_ptr<DisplayWindow> DisplayWindow::Open(const std::string& title, cv::Size size, const std::string& without_display) {
+std::unique_ptr<DisplayWindow> DisplayWindow::Open(const std::string& title, cv::Size size, const std::string& without_display,
+                                                   const WindowPlacement& placement) {
   if (size.width <= 0 || size.height <= 0) throw Error("window: size must be positive");
-  return std::make_unique<X11Window>(title, size, without_display);
+  return std::make_unique<X11Window>(title, size, without_display, placement);
 }
 
 }  // namespace arview::video

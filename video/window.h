@@ -27,12 +27,29 @@ struct InputEvent {
   std::string key;   // kKey: the X keysym name ("a", "s", "bracketright", "Delete", "Escape", "F1", ...)
 };
 
+// Where the window opens.
+struct WindowPlacement {
+  // A RandR output's name ("HDMI-1", "DP-2"; Xvfb's is "screen"): the window opens at its
+  // top-left corner, e.g. on a headset's panel. Empty: where the window manager puts it.
+  std::string output;
+  // Asks the window manager for fullscreen (EWMH _NET_WM_STATE_FULLSCREEN), on `output` if given.
+  bool fullscreen = false;
+};
+
+// A connected output of the display with its area on the root window.
+struct DisplayOutput {
+  std::string name;
+  cv::Rect area;
+};
+
 class DisplayWindow {
  public:
   // Opens a window of `size` on $DISPLAY. Throws arview::Error with one line when there is no
   // display (DISPLAY unset, or the server refuses) or its visual is not 24-bit true colour;
   // `without_display` ends that line (what to do instead, e.g. "write to a file with --out").
-  static std::unique_ptr<DisplayWindow> Open(const std::string& title, cv::Size size, const std::string& without_display);
+  // An unknown `placement.output` is an Error listing the connected ones.
+  static std::unique_ptr<DisplayWindow> Open(const std::string& title, cv::Size size, const std::string& without_display,
+                                             const WindowPlacement& placement = {});
   virtual ~DisplayWindow() = default;
 
   // Shows an 8-bit BGR frame of the window's size.
@@ -44,6 +61,8 @@ class DisplayWindow {
   // "MIT-SHM" or "XPutImage".
   virtual std::string PresentMethod() const = 0;
   virtual cv::Size size() const = 0;
+  // "at HDMI-1 (2560x1440+1920+0), fullscreen", or "" without a placement.
+  virtual std::string PlacementText() const = 0;
 };
 
 }  // namespace arview::video

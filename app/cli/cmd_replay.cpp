@@ -81,7 +81,8 @@ void AddReplayCommand(CLI::App& app) {
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
-    std::printf("renderer: %s\nwrote %s\n", result.renderer.c_str(), a->out.c_str());
+    std::printf("renderer: %s\n%s %s\n", result.renderer.c_str(), to_window ? "shown in" : "wrote",
+                to_window ? result.output.c_str() : a->out.c_str());
   });
 }
 

@@ -25,6 +25,10 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--hmd-profile", f.hmd_profile,
                   "Headset profile (YAML: panel, eye_fov_deg, lens_centre, distortion; docs/examples/hmd-cardboard.yaml): "
                   "the eyes' views placed on its panel and pre-distorted for its lenses; implies --hmd");
+  cmd->add_option("--window-output", f.window_output,
+                  "With --out window: the display output (xrandr's name, e.g. HDMI-1) whose top-left corner the "
+                  "window opens at: a headset's panel");
+  cmd->add_flag("--fullscreen", f.fullscreen, "With --out window: ask the window manager for a fullscreen window");
   cmd->add_flag("--stereo-character", f.stereo_character,
                 "With --hmd: render the character once per eye, --ipd apart (true depth only on a metric map)");
   cmd->add_option("--ipd", f.ipd, "Interpupillary distance for --stereo-character, in map units (metres for metric maps)")
@@ -66,6 +70,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   if (!f.hmd_profile.empty()) o.compositor.hmd_profile = render::LoadHmdProfile(f.hmd_profile);
   if (f.stereo_character && !o.compositor.hmd) throw CommandError("--stereo-character needs --hmd or --hmd-profile");
   o.compositor.stereo_character = f.stereo_character;
+  o.window = {f.window_output, f.fullscreen};
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
   o.tracker.tracking.prefetch_below = f.prefetch_below;

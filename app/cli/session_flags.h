@@ -12,7 +12,8 @@ struct SessionFlags {
   std::string scene, trajectory, stats, gl = "auto", aa = "msaa";
   std::string lighting = "auto", light;  // see app/placement/scene_lighting.h
   bool hmd = false, hud = false, stereo_character = false;
-  std::string hmd_profile;
+  std::string hmd_profile, window_output;
+  bool fullscreen = false;
   double ipd = 0.064, hold = 0.5, fade = 1.0;
   int gl_threads = 1;
   int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below

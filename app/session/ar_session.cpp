@@ -77,7 +77,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
 
   ArCompositor compositor(map.camera, character_ptrs, o.compositor);
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
-  std::unique_ptr<video::FrameSink> sink = video::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps);
+  std::unique_ptr<video::FrameSink> sink = video::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps, o.window);
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
   });

@@ -21,6 +21,7 @@ namespace arview::app {
 struct SessionOptions {
   std::filesystem::path scene_file;          // empty: no character (tracking + video only)
   std::string sink = "window";               // video::OpenSink target
+  video::WindowPlacement window;             // for a window sink: its output, fullscreen
   double sink_fps = 30;
   std::filesystem::path trajectory_out;      // optional TUM file
   std::filesystem::path stats_out;           // optional stats.json
