@@ -42,6 +42,7 @@ void AddRunCommand(CLI::App& app) {
     // An unplugged or stalled camera ends the session with what it has: the video, the
     // trajectory and the stats so far are written, then the fault is the command's error.
     o.pipeline.end_on_source_fault = true;
+    o.pipeline.on_source_note = [](const std::string& note) { std::fprintf(stderr, "\nnote: %s\n", note.c_str()); };
     const ScopedSignalCancellation signals;
     o.cancel = signals.token();
     o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends

@@ -92,6 +92,42 @@ class ErrorSlot {
   std::atomic<bool> failed_{false};
 };
 
+// Watches the rate at which a source captures frames: over the last two seconds, against the
+// best rate it kept since its third second (a camera settles its exposure first). Falling below
+// 60 % of it is noted once, and so is coming back above 85 %.
+class SourceRateWatch {
+ public:
+  std::optional<std::string> Add(Clock::time_point captured) {
+    if (!first_) first_ = captured;
+    times_.push_back(captured);
+    while (times_.size() > 2 && captured - times_.front() > std::chrono::seconds(2)) times_.pop_front();
+    if (captured - *first_ < std::chrono::seconds(3) || times_.size() < 3) return std::nullopt;
+    const double span = std::chrono::duration<double>(times_.back() - times_.front()).count();
+    const double rate = span > 0 ? (times_.size() - 1) / span : 0;
+    best_ = std::max(best_, rate);
+    char line[200];
+    if (!slow_ && rate < 0.6 * best_) {
+      slow_ = true;
+      std::snprintf(line, sizeof line,
+                    "frames arrive at %.1f per second, down from %.1f (auto exposure in dim light? try --exposure "
+                    "lock, or more light; or a busy USB bus)", rate, best_);
+      return std::string(line);
+    }
+    if (slow_ && rate > 0.85 * best_) {
+      slow_ = false;
+      std::snprintf(line, sizeof line, "frames arrive at %.1f per second again", rate);
+      return std::string(line);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  std::optional<Clock::time_point> first_;
+  std::deque<Clock::time_point> times_;
+  double best_ = 0;
+  bool slow_ = false;
+};
+
 }  // namespace
 
 std::optional<double> GazeErrorDeg(const anim::PlacedCharacter& character, std::span<const Eigen::Matrix4d> model,
@@ -196,6 +232,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       [&] {
         NameThisThread("arview-capture");
         size_t read = 0;
+        SourceRateWatch rate;
         while (!error.failed() && !stopped()) {
           InFlight item;
           try {
@@ -213,6 +250,9 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
           item.log.captured_s = std::chrono::duration<double>(item.captured - start).count();
           item.log.timeline.arrived = item.MsSinceCapture();
           stats.Record("arrival", item.log.timeline.arrived);
+          if (options.on_source_note) {
+            if (const auto note = rate.Add(item.captured)) options.on_source_note(source.Name() + ": " + *note);
+          }
           ++read;
           if (!to_track.Push(std::move(item))) break;
         }

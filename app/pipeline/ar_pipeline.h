@@ -58,6 +58,10 @@ struct PipelineOptions {
   // run like the end of the stream, and PipelineReport::source_fault says why; the outputs so
   // far are complete. Otherwise its error is rethrown.
   bool end_on_source_fault = false;
+  // Live sources: called on the capture thread with one line when the source's frame rate falls
+  // well below the rate it kept at first (a camera halving its rate in dim light), and when it
+  // recovers.
+  std::function<void(const std::string&)> on_source_note;
   // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for --stats and the
   // demo's figures) and `trajectory` (80 bytes a localized frame). A long run that writes
   // neither turns them off, so that its memory stays flat (the soak test, docs/reliability.md);
