@@ -565,12 +565,16 @@ int64_t V4l2Source::ReadControl(const CameraControl& control) {
   return c.value;
 }
 
-void V4l2Source::WriteControl(const CameraControl& control, int64_t value, const std::string& what) {
+void V4l2Source::CheckRange(const CameraControl& control, int64_t value, const std::string& what) const {
   if (value < control.minimum || value > control.maximum) {
     Fail(what + " " + std::to_string(value) + " is outside the range of control '" + control.name + "' (" +
          std::to_string(control.minimum) + ".." + std::to_string(control.maximum) + ", step " +
          std::to_string(control.step) + ")");
   }
+}
+
+void V4l2Source::WriteControl(const CameraControl& control, int64_t value, const std::string& what) {
+  CheckRange(control, value, what);
   v4l2_control c{};
   c.id = control.id;
   c.value = static_cast<int32_t>(value);
@@ -605,6 +609,7 @@ void V4l2Source::ApplyFocus() {
     notes_.push_back(device_ + " has no focus position control; --focus " + focus + " does nothing");
     return;
   }
+  CheckRange(*absolute, value, "focus");  // before anything changes
   if (automatic != nullptr) WriteControl(*automatic, 0, "focus auto");
   WriteControl(*absolute, value, "focus");
 }
@@ -628,9 +633,7 @@ void V4l2Source::ApplyExposure() {
   }
   int64_t value = 0;
   const bool number = ParseInteger(exposure, value);
-  if (number && (value < absolute->minimum || value > absolute->maximum)) {
-    WriteControl(*absolute, value, "exposure");  // refused with the range before anything changes
-  }
+  if (number) CheckRange(*absolute, value, "exposure");  // before anything changes
   if (!number) value = ReadControl(*absolute);  // lock: the exposure time in use now
   WriteControl(*mode, V4L2_EXPOSURE_MANUAL, "exposure mode");
   WriteControl(*absolute, value, "exposure");

@@ -199,6 +199,7 @@ class V4l2Source : public FrameSource {
   void ApplyExposure();
   const CameraControl* FindControl(uint32_t id) const;
   int64_t ReadControl(const CameraControl& control);
+  void CheckRange(const CameraControl& control, int64_t value, const std::string& what) const;
   void WriteControl(const CameraControl& control, int64_t value, const std::string& what);
   void MapBuffers();
   void StartStreaming();
