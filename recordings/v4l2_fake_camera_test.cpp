@@ -795,6 +795,21 @@ TEST(V4l2FakeCamera, TheNewestOfSeveralReadyFramesIsKeptAndTheOlderCountedStale)
   EXPECT_EQ(f.index, 4);
 }
 
+TEST(V4l2FakeCamera, WithoutNewestOnlyEveryFrameTheBuffersHoldComesInOrder) {
+  FakeCamera camera({});
+  V4l2Options o;
+  o.newest_only = false;  // a recording
+  V4l2Source source("/dev/video7", o, camera);
+  Frame f;
+  ASSERT_TRUE(source.Next(f));
+  camera.Arrive(3);
+  for (int i = 1; i <= 3; ++i) {
+    ASSERT_TRUE(source.Next(f));
+    EXPECT_EQ(f.index, i);
+  }
+  EXPECT_EQ(source.Counts().stale_skipped, 0);
+}
+
 TEST(V4l2FakeCamera, GapsInTheSequenceAreCountedAsDriverDrops) {
   FakeCamera camera({});
   V4l2Source source("/dev/video7", {}, camera);

@@ -747,6 +747,7 @@ bool V4l2Source::TakeNewest(v4l2_buffer& newest) {
     }
     CountSequence(buf.sequence);
     ready.push_back(buf);
+    if (!options_.newest_only) break;
   }
   // The newest one the driver did not flag; the others go back without being decoded.
   int keep = -1;

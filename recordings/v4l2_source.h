@@ -138,6 +138,10 @@ struct V4l2Options {
   // (V4L2_CID_EXPOSURE_ABSOLUTE in the control's units, 100 µs on UVC cameras).
   std::string exposure = "auto";
   int buffer_count = 4;
+  // Live use: each Next() returns the newest frame ready and puts the older ones back unread
+  // (a frame shown late is worse than one not shown). false: every frame in order, as long as
+  // the buffers hold them (a recording).
+  bool newest_only = true;
   // No frame within this time is an error (a stalled or unplugged camera). The first frame
   // may take up to kFirstFrameTimeout (cameras settle their exposure first).
   double timeout_seconds = 1.0;
@@ -158,7 +162,8 @@ class V4l2Source : public FrameSource {
   V4l2Source& operator=(const V4l2Source&) = delete;
 
   // The newest frame ready: every buffer the driver has filled is dequeued and only the newest
-  // decoded; the older ones go back undecoded (counted stale_skipped). The frame carries the
+  // decoded; the older ones go back undecoded (counted stale_skipped). (With newest_only false:
+  // the oldest ready frame.) The frame carries the
   // kernel's capture timestamp (seconds, the driver's clock, normally CLOCK_MONOTONIC; the
   // dequeue time for drivers that give none) as `timestamp` and `capture_time`, and the driver's
   // sequence number as index. Frames the driver flags or that do not decode are skipped
@@ -204,8 +209,8 @@ class V4l2Source : public FrameSource {
   void MapBuffers();
   void StartStreaming();
   void Shutdown();
-  // Dequeues every filled buffer; keeps the newest good one (returns false when none), requeues
-  // the rest.
+  // Dequeues every filled buffer (one with newest_only false); keeps the newest good one
+  // (returns false when none), requeues the rest.
   bool TakeNewest(::v4l2_buffer& newest);
   void CountSequence(uint32_t sequence);
   void Requeue(::v4l2_buffer& buffer);

@@ -10,7 +10,8 @@
 //   (64x48 without a recording); frame sizes and intervals enumerable (ENUM_FRAMESIZES,
 //   ENUM_FRAMEINTERVALS); S_FMT takes the nearest listed size, S_PARM the nearest listed rate
 //   and G_PARM says which. YUYV is limited as USB 2 bandwidth limits it: 30 fps up to 640x480,
-//   10 up to 1280x720, 5 above; MJPEG 30 at every size (and 15). MJPEG frames are JPEGs of
+//   10 up to 1280x720, 5 above; MJPEG 30 at every size. Each lists the rates of 30, 15, 10 and 5
+//   up to its highest. MJPEG frames are JPEGs of
 //   quality 80 (cv::imencode), so their sizes are realistic.
 // - controls (QUERYCTRL with V4L2_CTRL_FLAG_NEXT_CTRL, QUERYMENU, G_CTRL, S_CTRL): the camera
 //   class heading, exposure_auto (menu: 1 manual, 3 aperture priority; starts at 3),
@@ -19,8 +20,9 @@
 //   setting it then fails with EACCES; a value out of range fails with ERANGE.
 // - driver-like buffers: from STREAMON a producer thread fills the next queued buffer at every
 //   frame time on CLOCK_MONOTONIC (absolute deadlines: no drift); a frame that finds no queued
-//   buffer is dropped and its sequence number skipped. Buffers carry CLOCK_MONOTONIC
-//   timestamps with V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC. poll() waits (a condition variable) for
+//   buffer is dropped and its sequence number skipped; frame times missed while the process was
+//   stopped are caught up (free buffers filled, the rest dropped). Buffers carry their frame
+//   time on CLOCK_MONOTONIC with V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC. poll() waits (a condition variable) for
 //   a filled buffer within its timeout.
 //
 // Configured by environment variables, read at each open of the device:
@@ -596,14 +598,16 @@ const std::vector<uint8_t>& Camera::Payload(long n) {
   return scratch_;
 }
 
-timeval MonotonicNow() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_MONOTONIC, &ts);
-  return {ts.tv_sec, static_cast<suseconds_t>(ts.tv_nsec / 1000)};
+// A time on steady_clock (CLOCK_MONOTONIC in libstdc++) as a buffer's timestamp.
+timeval MonotonicTime(std::chrono::steady_clock::time_point t) {
+  const auto us = std::chrono::duration_cast<std::chrono::microseconds>(t.time_since_epoch()).count();
+  return {static_cast<time_t>(us / 1000000), static_cast<suseconds_t>(us % 1000000)};
 }
 
 // The sensor: one frame per interval on CLOCK_MONOTONIC (steady_clock), into the next queued
-// buffer or dropped.
+// buffer or dropped. Frame times missed (the process stopped, a slow encode) are caught up at
+// once, as a sensor that went on meanwhile: the free buffers are filled, the rest dropped. (The
+// emulation lives in the reader's process, so a SIGSTOP stops it too.)
 void Camera::Produce() {
   using Clock = std::chrono::steady_clock;
   std::unique_lock<std::mutex> lock(m_);
@@ -611,9 +615,8 @@ void Camera::Produce() {
   for (;;) {
     const long n = sequence_;
     const bool half = settings_.half_rate_after >= 0 && n >= settings_.half_rate_after;
-    const auto interval = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+    due += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
         (half ? 2.0 : 1.0) * interval_.numerator / std::max<uint32_t>(interval_.denominator, 1)));
-    due += interval;
     if (changed_.wait_until(lock, due, [&] { return stop_; })) return;
     if (settings_.unplug_after >= 0 && n >= settings_.unplug_after) {
       unplugged_ = true;
@@ -624,13 +627,14 @@ void Camera::Produce() {
       changed_.wait(lock, [&] { return stop_; });
       return;
     }
-    // Encoded without the lock: the reader goes on dequeueing meanwhile.
+    ++sequence_;
+    if (queued_.empty()) continue;  // no buffer: this frame is dropped, its number skipped
+    // Encoded without the lock: the reader goes on dequeueing meanwhile (only this thread
+    // takes from queued_, so the buffer waits).
     lock.unlock();
     const std::vector<uint8_t>& payload = Payload(n);
     lock.lock();
     if (stop_) return;
-    ++sequence_;
-    if (queued_.empty()) continue;  // no buffer: this frame is dropped, its number skipped
     const uint32_t index = queued_.front();
     queued_.pop_front();
     std::vector<uint8_t>& buffer = buffers_[index];
@@ -645,15 +649,13 @@ void Camera::Produce() {
     b.bytesused = static_cast<uint32_t>(used);
     b.field = V4L2_FIELD_NONE;
     b.sequence = static_cast<uint32_t>(n);
-    b.timestamp = MonotonicNow();
+    b.timestamp = MonotonicTime(due);  // the frame's capture time, not when it was copied
     b.flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC | V4L2_BUF_FLAG_TSTAMP_SRC_SOE | V4L2_BUF_FLAG_DONE;
     if (corrupt && format_ == V4L2_PIX_FMT_YUYV) b.flags |= V4L2_BUF_FLAG_ERROR;
     b.length = static_cast<uint32_t>(buffer.size());
     b.m.offset = static_cast<uint32_t>(index * kPage);
     filled_.push_back(b);
     changed_.notify_all();
-    // A reader far behind (a debugger, a stopped process): catch up instead of a burst.
-    if (Clock::now() - due > 10 * interval) due = Clock::now();
   }
 }
 
