@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
 
@@ -41,12 +42,14 @@ class Camera : public ::testing::Test {
   // Runs arview with the emulated camera preloaded and `env` set. `pause` (seconds after the
   // start, for how long): the process is stopped in between (SIGSTOP), as a reader that falls
   // behind the camera.
+  // `interrupt_after` > 0: Ctrl-C (SIGINT) after that many seconds, as a user ends `run`.
   CommandResult RunWithCamera(const std::vector<std::string>& args, const std::map<std::string, std::string>& env,
-                              std::pair<double, double> pause = {0, 0}) {
+                              std::pair<double, double> pause = {0, 0}, double interrupt_after = 0) {
     const char* bin = std::getenv("ARVIEW_BIN");
     std::string cmd = "LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
                       " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\"";
     for (const auto& [name, value] : env) cmd += " " + name + "=" + ShellQuote(value);
+    if (interrupt_after > 0) cmd += " timeout -s INT " + std::to_string(interrupt_after);
     cmd += " " + ShellQuote(bin ? bin : "arview");
     for (const std::string& a : args) cmd += " " + ShellQuote(a);
     const fs::path out = dir_ / "cmd.out", err = dir_ / "cmd.err", code = dir_ / "cmd.code";
@@ -160,6 +163,31 @@ TEST_F(Camera, AskingFor1280x720At30GetsMjpegAt30WhereYuyvOffersOnly10) {
   s = ParseSummary(r.out);
   EXPECT_GE(s.frames + s.lost, 9) << r.out;  // 1 s at 10 fps: 11 frames
   EXPECT_LE(s.frames + s.lost, 13) << r.out;
+}
+
+// `run` asks the camera for the map's size at the rate asked: MJPEG at 1280x720 for 30 fps.
+TEST_F(Camera, RunAsksForTheMapsSizeAndSaysWhatTheCameraGranted) {
+  const fs::path map = dir_ / "map";
+  testing::WriteRandomMap(calib::Camera::Pinhole(1280, 720, 900, 900, 639.5, 359.5), map);
+  const CommandResult r =
+      RunWithCamera({"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--fps", "30"}, {}, {0, 0}, 3);
+  EXPECT_NE(r.err.find(std::string(kDevice) + ": arview emulated camera, 1280x720 MJPEG at 30 fps (asked 30)"),
+            std::string::npos)
+      << r.err;
+  // The emulated camera has auto-focus: the default locks it without a note.
+  EXPECT_EQ(r.err.find("note: "), std::string::npos) << r.err;
+}
+
+TEST_F(Camera, RunRefusesASizeOtherThanTheMapsCamera) {
+  const fs::path map = dir_ / "map";
+  testing::WriteRandomMap(calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5), map);
+  const CommandResult r =
+      RunWithCamera({"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--size", "1280x720"}, {});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("arview: --size 1280x720 differs from the map's camera (640x480, " + map.string() + ")"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST_F(Camera, RecordPlaysARealRecordingAt640x480InMjpegAndYuyv) {
