@@ -54,6 +54,7 @@ struct FakeConfig {
   int stall_after = -1;        // frames produced before the device stops sending
   int corrupt_frame = -1;      // this frame comes flagged V4L2_BUF_FLAG_ERROR
   uint32_t timestamp_flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+  bool refuse_writes = false;  // S_CTRL fails with EACCES (a read-only control, a camera that will not)
 };
 
 FakeControl Control(uint32_t id, const char* name, uint32_t type, int32_t min, int32_t max, int32_t step, int32_t def,
@@ -342,6 +343,7 @@ class FakeCamera : public V4l2Io {
   int SetControl(v4l2_control* v) {
     FakeControl* c = FindControl(v->id);
     if (c == nullptr) return Error(EINVAL);
+    if (c_.refuse_writes) return Error(EACCES);
     if (v->value < c->query.minimum || v->value > c->query.maximum) return Error(ERANGE);
     v4l2_queryctrl q{};
     q.id = v->id;
@@ -705,11 +707,36 @@ TEST(V4l2FakeCamera, TheDefaultLocksFocusWhereItStandsAndLeavesExposureAutomatic
   EXPECT_TRUE(source.notes().empty());
   EXPECT_EQ(camera.control(V4L2_CID_FOCUS_AUTO), 0);
   EXPECT_EQ(camera.control(V4L2_CID_FOCUS_ABSOLUTE), 40);
-  // Aperture priority: UVC's automatic mode (its menu has no V4L2_EXPOSURE_AUTO).
-  EXPECT_EQ(camera.control(V4L2_CID_EXPOSURE_AUTO), V4L2_EXPOSURE_APERTURE_PRIORITY);
-  const std::vector<std::pair<uint32_t, int32_t>> writes = {
-      {V4L2_CID_FOCUS_AUTO, 0}, {V4L2_CID_FOCUS_ABSOLUTE, 40}, {V4L2_CID_EXPOSURE_AUTO, 3}};
+  // Exposure automatic already: left alone.
+  const std::vector<std::pair<uint32_t, int32_t>> writes = {{V4L2_CID_FOCUS_AUTO, 0}, {V4L2_CID_FOCUS_ABSOLUTE, 40}};
   EXPECT_EQ(camera.writes(), writes);
+
+  // Exposure left manual by another program: the default switches it back to automatic,
+  // aperture priority (UVC's automatic mode: its menu has no V4L2_EXPOSURE_AUTO).
+  FakeConfig manual = Usb2Webcam();
+  manual.controls[1].value = V4L2_EXPOSURE_MANUAL;
+  FakeCamera second(manual);
+  V4l2Source other("/dev/video7", {}, second);
+  EXPECT_EQ(second.control(V4L2_CID_EXPOSURE_AUTO), V4L2_EXPOSURE_APERTURE_PRIORITY);
+}
+
+TEST(V4l2FakeCamera, ACameraThatRefusesTheFocusLockGetsANoteNotAnError) {
+  FakeConfig c = Usb2Webcam();
+  c.refuse_writes = true;
+  FakeCamera camera(c);
+  V4l2Source source("/dev/video7", {}, camera);
+  ASSERT_EQ(source.notes().size(), 1u);
+  EXPECT_TRUE(Contains(source.notes()[0], "/dev/video7 refused to switch auto-focus off (Permission denied)"))
+      << source.notes()[0];
+  V4l2Options o;
+  o.focus = "auto";  // asked for explicitly: an error
+  FakeCamera second(c);
+  try {
+    V4l2Source("/dev/video7", o, second);
+    FAIL() << "expected a SourceError";
+  } catch (const SourceError& e) {
+    EXPECT_TRUE(Contains(e.what(), "/dev/video7: cannot set control 'Focus, Automatic Continuous' to 1")) << e.what();
+  }
 }
 
 TEST(V4l2FakeCamera, AFocusNumberAndAnExposureLockSetTheControls) {
@@ -867,6 +894,30 @@ TEST(V4l2FakeCamera, CountsCanBeReadWhileAnotherThreadTakesFrames) {
   }
   reader.join();
   EXPECT_EQ(source.Counts().stale_skipped, 30);
+}
+
+TEST(V4l2FakeCamera, ListCamerasNamesTheVideoNodesInNumberOrder) {
+  test::TempDir dir("v4l2_list");
+  for (const char* name : {"video10", "video2", "video0", "videoX", "media0", "video"}) test::WriteFile(dir.path() / name, "");
+  FakeConfig metadata;
+  metadata.caps = V4L2_CAP_META_CAPTURE | V4L2_CAP_STREAMING;
+  FakeCamera camera(metadata);
+  const std::vector<CameraListing> list = ListCameras(dir.path(), camera);
+  ASSERT_EQ(list.size(), 3u);
+  EXPECT_EQ(list[0].device, (dir.path() / "video0").string());
+  EXPECT_EQ(list[1].device, (dir.path() / "video2").string());
+  EXPECT_EQ(list[2].device, (dir.path() / "video10").string());
+  EXPECT_EQ(list[0].card, "Fake camera");
+  EXPECT_FALSE(list[0].capture);  // a metadata node
+  EXPECT_TRUE(list[0].problem.empty());
+  EXPECT_FALSE(camera.open());
+
+  FakeConfig busy;
+  busy.open_errno = EBUSY;
+  FakeCamera in_use(busy);
+  const std::vector<CameraListing> busy_list = ListCameras(dir.path(), in_use);
+  ASSERT_EQ(busy_list.size(), 3u);
+  EXPECT_EQ(busy_list[0].problem.rfind("busy", 0), 0u) << busy_list[0].problem;
 }
 
 }  // namespace

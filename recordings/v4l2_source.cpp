@@ -558,11 +558,25 @@ const CameraControl* V4l2Source::FindControl(uint32_t id) const {
   return nullptr;
 }
 
-int64_t V4l2Source::ReadControl(const CameraControl& control) {
+bool V4l2Source::TryReadControl(const CameraControl& control, int64_t& value) {
   v4l2_control c{};
   c.id = control.id;
-  if (Ioctl(VIDIOC_G_CTRL, &c) != 0) Fail("cannot read control '" + control.name + "' (" + ErrnoText(errno) + ")");
-  return c.value;
+  if (Ioctl(VIDIOC_G_CTRL, &c) != 0) return false;
+  value = c.value;
+  return true;
+}
+
+int64_t V4l2Source::ReadControl(const CameraControl& control) {
+  int64_t value = 0;
+  if (!TryReadControl(control, value)) Fail("cannot read control '" + control.name + "' (" + ErrnoText(errno) + ")");
+  return value;
+}
+
+bool V4l2Source::TryWriteControl(const CameraControl& control, int64_t value) {
+  v4l2_control c{};
+  c.id = control.id;
+  c.value = static_cast<int32_t>(value);
+  return Ioctl(VIDIOC_S_CTRL, &c) == 0;
 }
 
 void V4l2Source::CheckRange(const CameraControl& control, int64_t value, const std::string& what) const {
@@ -575,10 +589,7 @@ void V4l2Source::CheckRange(const CameraControl& control, int64_t value, const s
 
 void V4l2Source::WriteControl(const CameraControl& control, int64_t value, const std::string& what) {
   CheckRange(control, value, what);
-  v4l2_control c{};
-  c.id = control.id;
-  c.value = static_cast<int32_t>(value);
-  if (Ioctl(VIDIOC_S_CTRL, &c) != 0) {
+  if (!TryWriteControl(control, value)) {
     Fail("cannot set control '" + control.name + "' to " + std::to_string(value) + " (" + ErrnoText(errno) + ")");
   }
 }
@@ -596,11 +607,20 @@ void V4l2Source::ApplyFocus() {
     }
     if (focus == "auto") return WriteControl(*automatic, 1, "focus auto");
     // Off where it stands. Some cameras move the lens to their stored position when auto-focus
-    // is switched off: the position read before is written back.
+    // is switched off: the position read before is written back. lock is the default: a camera
+    // that refuses is worth a note, not the end of the session.
     const bool readable = absolute != nullptr && !(absolute->flags & V4L2_CTRL_FLAG_WRITE_ONLY);
-    const int64_t position = readable ? ReadControl(*absolute) : 0;
-    WriteControl(*automatic, 0, "focus auto");
-    if (readable) WriteControl(*absolute, position, "focus");
+    int64_t position = 0;
+    const bool known = readable && TryReadControl(*absolute, position);
+    if (!TryWriteControl(*automatic, 0)) {
+      notes_.push_back(device_ + " refused to switch auto-focus off (" + ErrnoText(errno) +
+                       "): the focus, and with it the focal length, may change under the calibration");
+      return;
+    }
+    if (known && !TryWriteControl(*absolute, position)) {
+      notes_.push_back(device_ + " refused to hold the focus at " + std::to_string(position) + " (" +
+                       ErrnoText(errno) + ")");
+    }
     return;
   }
   int64_t value = 0;
@@ -621,11 +641,16 @@ void V4l2Source::ApplyExposure() {
   if (exposure == "auto") {
     if (mode == nullptr) return;  // the camera's own choice is automatic already: nothing to say
     const int64_t automatic = AutoExposureMode(*mode);
+    if (mode->value_known && mode->value != V4L2_EXPOSURE_MANUAL) return;  // automatic already
     if (automatic < 0) {
       notes_.push_back(device_ + " offers no automatic exposure mode; exposure left as it is");
       return;
     }
-    return WriteControl(*mode, automatic, "exposure mode");
+    // The default: a camera that refuses gets a note, as for the focus lock.
+    if (!TryWriteControl(*mode, automatic)) {
+      notes_.push_back(device_ + " refused to switch automatic exposure on (" + ErrnoText(errno) + ")");
+    }
+    return;
   }
   if (mode == nullptr || absolute == nullptr) {
     notes_.push_back(device_ + " has no manual exposure control; --exposure " + exposure + " does nothing");
@@ -694,8 +719,8 @@ void V4l2Source::Shutdown() {
 std::string V4l2Source::FormatName() const { return pixel_format_ == V4L2_PIX_FMT_YUYV ? "YUYV" : "MJPEG"; }
 
 std::string V4l2Source::GrantedLine() const {
-  std::string line = device_ + ": " + card_ + ", " + SizeText(width_, height_) + " " + FormatName() + " at " +
-                     (granted_fps_ > 0 ? FpsText(granted_fps_) : std::string("an unreported rate of")) + " fps";
+  std::string line = device_ + ": " + card_ + ", " + SizeText(width_, height_) + " " + FormatName() +
+                     (granted_fps_ > 0 ? " at " + FpsText(granted_fps_) + " fps" : std::string(", rate not reported"));
   line += options_.fps > 0 ? " (asked " + FpsText(options_.fps) + ")" : " (the highest offered)";
   return line;
 }

@@ -203,7 +203,9 @@ class V4l2Source : public FrameSource {
   void ApplyFocus();
   void ApplyExposure();
   const CameraControl* FindControl(uint32_t id) const;
-  int64_t ReadControl(const CameraControl& control);
+  bool TryReadControl(const CameraControl& control, int64_t& value);  // false: errno says why
+  int64_t ReadControl(const CameraControl& control);  // throws SourceError
+  bool TryWriteControl(const CameraControl& control, int64_t value);  // false: errno says why
   void CheckRange(const CameraControl& control, int64_t value, const std::string& what) const;
   void WriteControl(const CameraControl& control, int64_t value, const std::string& what);
   void MapBuffers();

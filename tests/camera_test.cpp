@@ -249,6 +249,18 @@ TEST_F(Camera, RecordCountsCorruptFramesAndSkipsThem) {
   }
 }
 
+// A camera whose frame rate halves after a second (automatic exposure in dim light): 30 frames
+// in the first second, 15 in the next.
+TEST_F(Camera, AHalvedFrameRateGivesHalfTheFrames) {
+  const fs::path rec = dir_ / "rec";
+  const CommandResult r = RunWithCamera({"record", "--device", kDevice, "--out", rec.string(), "--seconds", "2"},
+                                        {{"ARVIEW_FAKE_CAMERA_HALF_RATE_AFTER", "30"}});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Recorded s = ParseSummary(r.out);
+  EXPECT_GE(s.frames + s.lost, 43) << r.out;  // 30 + 1 s at 15 fps: 46 (61 at full rate)
+  EXPECT_LE(s.frames + s.lost, 48) << r.out;
+}
+
 TEST_F(Camera, UnpluggingOrAStallEndsARecordingWithOneLineAndKeepsTheFramesBefore) {
   const fs::path rec = dir_ / "rec";
   CommandResult r = RunWithCamera({"record", "--device", kDevice, "--out", rec.string()},

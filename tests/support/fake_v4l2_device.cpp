@@ -436,6 +436,7 @@ int Camera::RequestBuffers(v4l2_requestbuffers* req) {
 }
 
 int Camera::StreamOn() {
+  if (unplugged_) return Fail(ENODEV);
   if (buffers_.empty()) return Fail(EINVAL);
   if (streaming_) return 0;
   streaming_ = true;
