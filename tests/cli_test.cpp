@@ -17,7 +17,7 @@ namespace {
 using testing::LineCount;
 using testing::RunArview;
 
-const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "map", "track", "eval",
+const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "camera", "map", "track", "eval",
                               "anim", "place", "render", "view", "replay", "run", "demo"};
 
 TEST(Cli, HelpListsEverySubcommand) {
@@ -118,6 +118,13 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
       {{"view", "--size", "32x32"}, "--size"},
       {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--size", "-640x480"}, "--size"},
       {{"demo", "--aa", "fxaa"}, "--aa"},
+      {{"camera", "info", "/dev/null"}, "/dev/null: not a V4L2 video device"},
+      {{"camera", "info", "--device", "/dev/video-none"}, "/dev/video-none: no such device"},
+      {{"camera", "info"}, "name the device"},
+      {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--focus", "near"}, "--focus"},
+      {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--exposure", "keep"}, "--exposure"},
+      {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--fps", "-1"}, "--fps"},
+      {{"run", "--device", "/dev/null", "--map", "/nonexistent/map", "--fps", "nan"}, "--fps"},
       {{"replay", "/nonexistent/recording", "--map", "/nonexistent/map", "--aa", "fxaa"}, "--aa"},
   };
   for (const Case& c : cases) {

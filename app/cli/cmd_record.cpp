@@ -1,11 +1,13 @@
-// arview record --device /dev/video0 --out <recording> [--size 640x480] [--seconds N]
-//               [--format auto|yuyv|mjpeg] [--camera camera.yaml] [--force]
+// arview record --device /dev/video0 --out <recording> [--size 640x480] [--fps N] [--seconds N]
+//               [--format auto|yuyv|mjpeg] [--focus lock|auto|keep|N] [--exposure auto|lock|N]
+//               [--camera camera.yaml] [--force]
 
 #include <cstdio>
 #include <iostream>
 #include <optional>
 #include <sstream>
 
+#include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
 #include "app/cli/numeric_flags.h"
 #include "base/cancellation.h"
@@ -19,15 +21,34 @@ namespace {
 struct RecordArgs {
   std::string device = "/dev/video0";
   std::string out;
-  std::string size = "640x480";
+  CameraFlags camera_flags;
   double seconds = 0;
-  std::string format = "auto";
   std::string camera;
   bool force = false;
 };
 
+constexpr const char* kDefaultSize = "640x480";
+
+// "; 3 frames lost (2 dropped by the driver, 1 corrupt)": said even when none were, since a
+// recording with holes must not pass for a complete one.
+std::string LostText(const recordings::SourceCounts& counts, int out_of_order) {
+  const int64_t lost = counts.driver_dropped + counts.corrupt_skipped + counts.stale_skipped + out_of_order;
+  std::string text = "; " + std::to_string(lost) + " frame" + (lost == 1 ? "" : "s") + " lost";
+  if (lost == 0) return text;
+  std::string parts;
+  auto add = [&](int64_t n, const char* what) {
+    if (n > 0) parts += (parts.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  add(counts.driver_dropped, "dropped by the driver");
+  add(counts.corrupt_skipped, "corrupt");
+  add(counts.stale_skipped, "waiting behind newer ones");
+  add(out_of_order, "out of order");
+  return text + " (" + parts + ")";
+}
+
 void RunRecord(const RecordArgs& args) {
-  const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
+  const std::string size_text = args.camera_flags.size.empty() ? kDefaultSize : args.camera_flags.size;
+  const cv::Size size = *ParseFrameSize(size_text);  // checked by --size's validator
   std::optional<calib::Camera> camera;
   if (!args.camera.empty()) {
     try {
@@ -42,13 +63,18 @@ void RunRecord(const RecordArgs& args) {
   recordings::V4l2Options options;
   options.width = size.width;
   options.height = size.height;
-  options.format = args.format;
+  ApplyCameraFlags(args.camera_flags, options);
+  // A recording keeps every frame the buffers hold, in order: the newest-only reading of a live
+  // session would leave holes whenever a PNG takes longer to write than a frame period.
+  options.newest_only = false;
   options.cancel = signals.token();
   try {
     recordings::V4l2Source source(args.device, options);
+    std::cerr << source.GrantedLine() << "\n";
+    for (const std::string& note : source.notes()) std::cerr << "note: " << note << "\n";
     if (source.size() != size) {
       std::cerr << "note: " << args.device << " gives " << source.size().width << "x" << source.size().height
-                << " instead of " << args.size << "\n";
+                << " instead of " << size_text << "\n";
     }
     if (camera && camera->Size() != source.size()) {
       throw CommandError(args.camera + ": camera is " + std::to_string(camera->width) + "x" +
@@ -56,12 +82,12 @@ void RunRecord(const RecordArgs& args) {
                          std::to_string(source.size().width) + "x" + std::to_string(source.size().height));
     }
     recordings::RecordingWriter writer(args.out, camera, args.force);
-    std::cerr << "recording " << args.device << " (" << source.CardName() << ", " << source.FormatName() << " "
-              << source.size().width << "x" << source.size().height << ") into " << args.out
-              << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
+    std::cerr << "recording into " << args.out << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
     bool progress_shown = false;  // the progress line is redrawn in place: ended before any other line
     auto progress = [&](const recordings::RecordStats& s) {
-      std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps", s.seconds, s.frames, s.fps);
+      const recordings::SourceCounts c = source.Counts();
+      std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps  %5lld lost", s.seconds, s.frames, s.fps,
+                   static_cast<long long>(c.driver_dropped + c.corrupt_skipped + c.stale_skipped + s.skipped));
       std::fflush(stderr);
       progress_shown = true;
     };
@@ -74,7 +100,8 @@ void RunRecord(const RecordArgs& args) {
       if (progress_shown) std::fprintf(stderr, "\n");
       if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
       throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
-                         " frames recorded before stay a valid recording in " + args.out);
+                         " frames recorded before stay a valid recording in " + args.out +
+                         LostText(source.Counts(), 0));
     }
     if (progress_shown) std::fprintf(stderr, "\n");
     if (writer.RemoveIfEmpty()) {
@@ -87,11 +114,8 @@ void RunRecord(const RecordArgs& args) {
            << " frames recorded stay a valid recording in " << args.out;
       signals.token().ThrowIfCancelled(what.str());
     }
-    std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out;
-    if (source.skipped_frames() + stats.skipped > 0) {
-      std::cout << " (" << source.skipped_frames() + stats.skipped << " corrupt or out-of-order frames skipped)";
-    }
-    std::cout << "\n";
+    std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out
+              << LostText(source.Counts(), stats.skipped) << "\n";
     if (!camera) {
       std::cout << "note: no --camera given: put a camera.yaml (arview calibrate) into " << args.out
                 << " before mapping or tracking\n";
@@ -108,14 +132,9 @@ void AddRecordCommand(CLI::App& app) {
   auto args = std::make_shared<RecordArgs>();
   cmd->add_option("--device", args->device, "V4L2 capture device")->capture_default_str();
   cmd->add_option("--out", args->out, "Recording folder to create")->required();
-  cmd->add_option("--size", args->size, "Requested frame size WIDTHxHEIGHT (the driver may choose the nearest)")
-      ->capture_default_str()
-      ->check(FrameSizeCheck({16, 16}, {7680, 4320}));
+  AddCameraFlags(cmd, args->camera_flags, std::string("default ") + kDefaultSize + "; the driver may give the nearest");
   cmd->add_option("--seconds", args->seconds, "Stop after this many seconds (0: until Ctrl-C)")
       ->check(CLI::Range(0.0, 1e7))
-      ->capture_default_str();
-  cmd->add_option("--format", args->format, "Pixel format to ask the camera for")
-      ->check(CLI::IsMember({"auto", "yuyv", "mjpeg"}))
       ->capture_default_str();
   cmd->add_option("--camera", args->camera, "camera.yaml to store with the recording (its size must match)");
   cmd->add_flag("--force", args->force, "Replace a recording already in --out");

@@ -3,8 +3,10 @@
 #include <cstdio>
 
 #include "app/session/ar_session.h"
+#include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
 #include "app/pipeline/pipeline_report.h"
+#include "app/cli/numeric_flags.h"
 #include "app/cli/session_flags.h"
 #include "base/cancellation.h"
 #include "map/map_file.h"
@@ -16,7 +18,8 @@ namespace arview::app {
 namespace {
 
 struct RunArgs {
-  std::string device = "/dev/video0", map_dir, out = "window", format = "auto";
+  std::string device = "/dev/video0", map_dir, out = "window";
+  CameraFlags camera;
   SessionFlags session;
 };
 
@@ -28,7 +31,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--device", a->device, "V4L2 capture device")->capture_default_str();
   cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (made with this camera)")->required();
   cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
-  cmd->add_option("--format", a->format, "Camera pixel format: auto, yuyv or mjpeg")->capture_default_str();
+  AddCameraFlags(cmd, a->camera, "default: the map's camera size, which it must match");
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     SessionOptions o;
@@ -49,14 +52,19 @@ void AddRunCommand(CLI::App& app) {
 
     // The camera must deliver the map camera's size; the map is read first to know it.
     recordings::V4l2Options v4l2;
-    v4l2.format = a->format;
+    ApplyCameraFlags(a->camera, v4l2);
     v4l2.cancel = signals.token();
     const map::Map map = map::LoadMap(a->map_dir);
     v4l2.width = map.camera.width;
     v4l2.height = map.camera.height;
+    if (!a->camera.size.empty() && *ParseFrameSize(a->camera.size) != cv::Size(v4l2.width, v4l2.height)) {
+      throw CommandError("--size " + a->camera.size + " differs from the map's camera (" + std::to_string(v4l2.width) +
+                         "x" + std::to_string(v4l2.height) + ", " + a->map_dir +
+                         "): the camera must deliver the size the map was calibrated at");
+    }
     recordings::V4l2Source source(a->device, v4l2);
-    std::fprintf(stderr, "%s: %s, %dx%d %s (Ctrl-C stops)\n", a->device.c_str(), source.CardName().c_str(),
-                 source.size().width, source.size().height, source.FormatName().c_str());
+    std::fprintf(stderr, "%s (Ctrl-C stops)\n", source.GrantedLine().c_str());
+    for (const std::string& note : source.notes()) std::fprintf(stderr, "note: %s\n", note.c_str());
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
     std::printf("%s", PipelineReportText(result.report).c_str());
     std::printf("renderer: %s\noutput: %s\n", result.renderer.c_str(), result.output.c_str());

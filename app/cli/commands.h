@@ -22,6 +22,7 @@ void AddCalibrateCommand(CLI::App& app);
 void AddImportCommand(CLI::App& app);
 void AddSynthCommand(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
+void AddCameraCommand(CLI::App& app);
 void AddMapCommand(CLI::App& app);
 void AddTrackCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);

@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   AddImportCommand(app);
   AddSynthCommand(app);
   AddRecordCommand(app);
+  AddCameraCommand(app);
   AddMapCommand(app);
   AddTrackCommand(app);
   AddEvalCommand(app);
