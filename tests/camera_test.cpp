@@ -17,6 +17,7 @@
 
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
+#include "tests/support/emulated_camera.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -27,7 +28,7 @@ using testing::CommandResult;
 using testing::ReadWholeFile;
 using testing::ShellQuote;
 
-constexpr const char* kDevice = "/dev/video-arview-fake";
+constexpr const char* kDevice = testing::kEmulatedCamera;
 
 class Camera : public ::testing::Test {
  protected:
@@ -39,33 +40,10 @@ class Camera : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // Runs arview with the emulated camera preloaded and `env` set. `pause` (seconds after the
-  // start, for how long): the process is stopped in between (SIGSTOP), as a reader that falls
-  // behind the camera.
-  // `interrupt_after` > 0: Ctrl-C (SIGINT) after that many seconds, as a user ends `run`.
+  // arview with the emulated camera preloaded (tests/support/emulated_camera.h).
   CommandResult RunWithCamera(const std::vector<std::string>& args, const std::map<std::string, std::string>& env,
                               std::pair<double, double> pause = {0, 0}, double interrupt_after = 0) {
-    const char* bin = std::getenv("ARVIEW_BIN");
-    std::string cmd = "LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
-                      " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\"";
-    for (const auto& [name, value] : env) cmd += " " + name + "=" + ShellQuote(value);
-    if (interrupt_after > 0) cmd += " timeout -s INT " + std::to_string(interrupt_after);
-    cmd += " " + ShellQuote(bin ? bin : "arview");
-    for (const std::string& a : args) cmd += " " + ShellQuote(a);
-    const fs::path out = dir_ / "cmd.out", err = dir_ / "cmd.err", code = dir_ / "cmd.code";
-    cmd += " >" + ShellQuote(out.string()) + " 2>" + ShellQuote(err.string()) + " </dev/null";
-    if (pause.second > 0) {
-      cmd = "{ " + cmd + " & pid=$!; sleep " + std::to_string(pause.first) + "; kill -STOP $pid; sleep " +
-            std::to_string(pause.second) + "; kill -CONT $pid; wait $pid; echo $? >" + ShellQuote(code.string()) + "; }";
-    } else {
-      cmd = "{ " + cmd + "; echo $? >" + ShellQuote(code.string()) + "; }";
-    }
-    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    CommandResult r;
-    r.exit_code = std::stoi(ReadWholeFile(code.string()));
-    r.out = ReadWholeFile(out.string());
-    r.err = ReadWholeFile(err.string());
-    return r;
+    return testing::RunWithEmulatedCamera(args, env, dir_, pause, interrupt_after);
   }
 
   // The recording the emulated camera plays: templeRing's 47 real 640x480 photos.
@@ -178,16 +156,30 @@ TEST_F(Camera, RunAsksForTheMapsSizeAndSaysWhatTheCameraGranted) {
   EXPECT_EQ(r.err.find("note: "), std::string::npos) << r.err;
 }
 
-TEST_F(Camera, RunRefusesASizeOtherThanTheMapsCamera) {
+TEST_F(Camera, RunRefusesASizeOfAnotherAspectThanTheMapsCamera) {
   const fs::path map = dir_ / "map";
   testing::WriteRandomMap(calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5), map);
   const CommandResult r =
       RunWithCamera({"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--size", "1280x720"}, {});
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("arview: --size 1280x720 differs from the map's camera (640x480, " + map.string() + ")"),
+  EXPECT_NE(r.err.find("arview: --size 1280x720: another aspect than the map's camera (640x480, " + map.string() + ")"),
             std::string::npos)
       << r.err;
+}
+
+// A map calibrated at 1280x960 runs on the camera's 640x480: the same aspect, the camera scaled.
+TEST_F(Camera, RunScalesTheMapsCameraToASizeOfTheSameAspect) {
+  const fs::path map = dir_ / "map";
+  testing::WriteRandomMap(calib::Camera::Pinhole(1280, 960, 1000, 1000, 639.5, 479.5), map);
+  const CommandResult r = RunWithCamera(
+      {"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--size", "640x480"}, {}, {0, 0}, 3);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("640x480"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("note: the map's camera, calibrated at 1280x960, is scaled exactly to 640x480 (fx 1000.0 -> 500.0)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(frames: \d+ read, [1-9]\d* processed)"))) << r.out;
 }
 
 TEST_F(Camera, RecordPlaysARealRecordingAt640x480InMjpegAndYuyv) {

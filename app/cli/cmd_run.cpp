@@ -12,6 +12,7 @@
 #include "map/map_file.h"
 #include "recordings/v4l2_source.h"
 #include "render/offscreen.h"
+#include "tracker/working_resolution.h"
 
 namespace arview::app {
 
@@ -23,6 +24,17 @@ struct RunArgs {
   SessionFlags session;
 };
 
+std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+
+// A camera calibrated at one size works at another of the same aspect (its intrinsics scale
+// exactly); across aspects the sensor is cropped differently and the calibration does not hold.
+void RequireSameAspect(cv::Size calibrated, cv::Size used, const std::string& what, const std::string& map_dir) {
+  const double cross = static_cast<double>(used.width) * calibrated.height - static_cast<double>(used.height) * calibrated.width;
+  if (std::abs(cross) <= 0.005 * static_cast<double>(used.width) * calibrated.height) return;
+  throw CommandError(what + ": another aspect than the map's camera (" + SizeText(calibrated) + ", " + map_dir +
+                     "); a camera calibrated at one aspect cannot be scaled to another (calibrate and map at this size)");
+}
+
 }  // namespace
 
 void AddRunCommand(CLI::App& app) {
@@ -31,7 +43,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--device", a->device, "V4L2 capture device")->capture_default_str();
   cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (made with this camera)")->required();
   cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
-  AddCameraFlags(cmd, a->camera, "default: the map's camera size, which it must match");
+  AddCameraFlags(cmd, a->camera, "default: the map's camera size; another of the same aspect scales the map's camera exactly");
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     SessionOptions o;
@@ -50,21 +62,26 @@ void AddRunCommand(CLI::App& app) {
     o.cancel = signals.token();
     o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends
 
-    // The camera must deliver the map camera's size; the map is read first to know it.
+    // The camera delivers the map camera's size, or --size where its aspect is the map's (the
+    // map's camera is then scaled exactly); the map is read first to know it.
     recordings::V4l2Options v4l2;
     ApplyCameraFlags(a->camera, v4l2);
     v4l2.cancel = signals.token();
-    const map::Map map = map::LoadMap(a->map_dir);
-    v4l2.width = map.camera.width;
-    v4l2.height = map.camera.height;
-    if (!a->camera.size.empty() && *ParseFrameSize(a->camera.size) != cv::Size(v4l2.width, v4l2.height)) {
-      throw CommandError("--size " + a->camera.size + " differs from the map's camera (" + std::to_string(v4l2.width) +
-                         "x" + std::to_string(v4l2.height) + ", " + a->map_dir +
-                         "): the camera must deliver the size the map was calibrated at");
-    }
+    map::Map map = map::LoadMap(a->map_dir);
+    const cv::Size wanted = a->camera.size.empty() ? map.camera.Size() : *ParseFrameSize(a->camera.size);
+    RequireSameAspect(map.camera.Size(), wanted, "--size " + a->camera.size, a->map_dir);
+    v4l2.width = wanted.width;
+    v4l2.height = wanted.height;
     recordings::V4l2Source source(a->device, v4l2);
     std::fprintf(stderr, "%s (Ctrl-C stops)\n", source.GrantedLine().c_str());
     for (const std::string& note : source.notes()) std::fprintf(stderr, "note: %s\n", note.c_str());
+    if (source.size() != map.camera.Size()) {
+      RequireSameAspect(map.camera.Size(), source.size(), a->device + " delivers " + SizeText(source.size()), a->map_dir);
+      const calib::Camera calibrated = map.camera;
+      map.camera = tracker::ScaleCamera(calibrated, source.size().width, source.size().height);
+      std::fprintf(stderr, "note: the map's camera, calibrated at %s, is scaled exactly to %s (fx %.1f -> %.1f)\n",
+                   SizeText(calibrated.Size()).c_str(), SizeText(source.size()).c_str(), calibrated.fx, map.camera.fx);
+    }
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
     std::printf("%s", PipelineReportText(result.report).c_str());
     std::printf("renderer: %s\noutput: %s\n", result.renderer.c_str(), result.output.c_str());
