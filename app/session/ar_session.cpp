@@ -57,8 +57,16 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                              " was built for a " + std::to_string(map.camera.width) + "x" +
                              std::to_string(map.camera.height) + " camera");
   }
+  Clock::time_point step = Clock::now();
+  const auto seconds_of_step = [&step] {
+    const Clock::time_point now = Clock::now();
+    const double seconds = std::chrono::duration<double>(now - step).count();
+    step = now;
+    return seconds;
+  };
   tracker::Tracker tracker(map, o.tracker);
   tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
+  const double tracker_seconds = seconds_of_step();
 
   std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
@@ -75,7 +83,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     }
   }
 
+  const double characters_seconds = seconds_of_step();
   ArCompositor compositor(map.camera, character_ptrs, o.compositor);
+  const double renderer_seconds = seconds_of_step();
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
   std::unique_ptr<video::FrameSink> sink = video::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps, o.window);
   sink->SetKeyHandler([&compositor](const std::string& key) {
@@ -116,6 +126,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   }
 
   SessionResult result{std::move(report), compositor.Description(), sink->Describe()};
+  result.tracker_seconds = tracker_seconds;
+  result.characters_seconds = characters_seconds;
+  result.renderer_seconds = renderer_seconds;
   if (result.report.first_output) {
     result.seconds_to_first_output = std::chrono::duration<double>(*result.report.first_output - command_start).count();
   }

@@ -47,6 +47,9 @@ struct SessionResult {
   std::string renderer;
   std::string output;  // the sink's description ("window \"arview\" (MIT-SHM)", a file, ...)
   double seconds_to_first_output = -1;  // from SessionOptions::command_start; < 0: no frame shown
+  // What the start-up took before the first frame was asked for, in seconds: the tracker (its
+  // descriptor index) and its warm-up, the characters, the renderer (GL context, PRT).
+  double tracker_seconds = 0, characters_seconds = 0, renderer_seconds = 0;
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10
