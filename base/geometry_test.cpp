@@ -87,6 +87,29 @@ TEST(EstimateSim3, RefusesDegeneratePointSets) {
   EXPECT_THROW(EstimateSim3(plane, line, true), Error);  // different lengths
 }
 
+// Issue 41: every centre (1, 2, 3), its mean off by rounding, passed the relative test and was
+// scored with a scale of 8e-17; a coordinate of 1e308 gave an ATE of inf.
+TEST(EstimateSim3, RefusesOnePointUpToRoundingAndPositionsThatOverflow) {
+  std::vector<Eigen::Vector3d> one_point(100, Eigen::Vector3d(1, 2, 3));
+  for (size_t i = 0; i < one_point.size(); ++i) one_point[i].x() += (i % 3) * 1e-16;  // rounding-level scatter
+  std::vector<Eigen::Vector3d> circle;
+  for (int i = 0; i < 100; ++i) circle.emplace_back(std::cos(i * 0.1), std::sin(i * 0.1), 0.01 * i);
+  EXPECT_THROW(EstimateSim3(circle, one_point, true), Error);
+  EXPECT_THROW(EstimateSim3(one_point, circle, true), Error);
+  std::vector<Eigen::Vector3d> far = circle;
+  far[3].x() = 1e308;
+  try {
+    EstimateSim3(circle, far, true, "gt.txt");
+    ADD_FAILURE() << "accepted a position of 1e308";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gt.txt: position 3 is (1e+308"), std::string::npos) << e.what();
+  }
+  // A real trajectory far from the origin, in millimetres, still fits.
+  std::vector<Eigen::Vector3d> far_mm = circle;
+  for (Eigen::Vector3d& p : far_mm) p = 1000 * p + Eigen::Vector3d(1e6, 2e6, 0);
+  EXPECT_NO_THROW(EstimateSim3(circle, far_mm, true));
+}
+
 TEST(Anchor, MatrixAndApplyAgree) {
   Anchor a;
   a.position = {1, 2, 3};

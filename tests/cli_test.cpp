@@ -6,6 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <cstdio>
 #include <regex>
 
 #include "tests/support/run_command.h"
@@ -223,6 +225,43 @@ TEST(Cli, TextQuotedFromAFileStaysOneLineWithoutControlCharacters) {
   }
   EXPECT_NE(RunArview({"eval", escape_file.string(), good.string()}).err.find("'\\x1b[2J'"), std::string::npos);
   EXPECT_NE(RunArview({"eval", newline_name.string(), good.string()}).err.find("two lines.txt"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: ground truth whose every camera centre is (1, 2, 3) was scored ("scale 8.03e-17 ...
+// ATE rmse 1.80e-15", exit 0); a centre at 1e308 gave an ATE of inf. Both are one line now.
+TEST(Cli, EvalRefusesPositionsAtOnePointOrOverflowing) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_eval_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream estimate(dir / "est.txt"), one_point(dir / "gt_one_point.txt"), huge(dir / "gt_huge.txt");
+  for (int i = 0; i < 50; ++i) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%.3f %.6f %.6f %.6f 0 0 0 1\n", i * 0.1, std::cos(i * 0.1), std::sin(i * 0.1),
+                  0.02 * i);
+    estimate << line;
+    std::snprintf(line, sizeof line, "%.3f 1 2 3 0 0 0 1\n", i * 0.1);
+    one_point << line;
+    std::snprintf(line, sizeof line, "%.3f %s %.6f %.6f 0 0 0 1\n", i * 0.1, i == 7 ? "1e308" : "0.5",
+                  std::sin(i * 0.1), 0.02 * i);
+    huge << line;
+  }
+  estimate.close(), one_point.close(), huge.close();
+  for (const std::string gt : {"gt_one_point.txt", "gt_huge.txt"}) {
+    for (const std::string align : {"sim3", "se3"}) {
+      const auto r = testing::RunArview({"eval", (dir / "est.txt").string(), (dir / gt).string(), "--align", align});
+      EXPECT_NE(r.exit_code, 0) << gt << " " << align << ": " << r.out;
+      EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+      EXPECT_NE(r.err.find(gt), std::string::npos) << r.err;
+      EXPECT_EQ(r.out.find("ATE"), std::string::npos) << r.out;
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 
