@@ -135,8 +135,17 @@ class XSessionTest : public Base {
     dir_ = std::filesystem::temp_directory_path() / ("arview_" + name + "_" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
-    display_ = std::make_unique<VirtualDisplay>();
-    ASSERT_FALSE(display_->name().empty()) << "Xvfb did not start";
+    // A server that reported its display but does not answer (seen once under a parallel
+    // ctest: "cannot open display ':0'") is replaced once by a fresh one.
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      display_ = std::make_unique<VirtualDisplay>();
+      if (!display_->name().empty() && Answers(display_->name())) return;
+      std::fprintf(stderr, "[x session] Xvfb on '%s' does not answer; starting another\n", display_->name().c_str());
+    }
+    FAIL() << "Xvfb did not start, or does not answer on " << display_->name();
+  }
+  static bool Answers(const std::string& display) {
+    return std::system(("DISPLAY=" + display + " xdotool getdisplaygeometry >/dev/null 2>&1").c_str()) == 0;
   }
   void TearDown() override {
     display_.reset();
