@@ -10,7 +10,14 @@
 #include <cstdlib>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
+
+#include <unistd.h>
+
+#include "base/hash.h"
 
 namespace arview::map {
 
@@ -70,6 +77,89 @@ DescriptorIndex::DescriptorIndex(const cv::Mat& descriptors, const IndexParams& 
   impl_->index = std::make_unique<FlannIndex>(View(impl_->data), ToFlann(params));
   impl_->index->buildIndex();
   cv::theRNG() = caller_rng;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The cache file's name: the descriptors' bytes, the parameters that shape the index, and the
+// versions of OpenCV and of this format, hashed.
+std::string CacheKey(const cv::Mat& descriptors, const IndexParams& params) {
+  Fnv1a h;
+  for (int r = 0; r < descriptors.rows; ++r) h.Add(descriptors.ptr(r), descriptors.cols * descriptors.elemSize());
+  for (int v : {static_cast<int>(params.kind), params.trees, params.branching, params.iterations, descriptors.rows,
+                descriptors.cols, CV_VERSION_MAJOR, CV_VERSION_MINOR, CV_VERSION_REVISION, /*format*/ 1}) {
+    h.AddValue(v);
+  }
+  h.AddValue(params.seed);
+  char name[40];
+  std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(h.hash));
+  return name;
+}
+
+std::string ReadBytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return in ? bytes.str() : std::string();
+}
+
+std::string ChecksumText(const std::string& bytes) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(Fnv1aOf(bytes.data(), bytes.size())));
+  return text;
+}
+
+}  // namespace
+
+DescriptorIndex DescriptorIndex::Cached(const cv::Mat& descriptors, const IndexParams& params,
+                                        const std::filesystem::path& cache_folder, std::string* note) {
+  auto say = [note](const std::string& text) {
+    if (note) *note = text;
+  };
+  if (cache_folder.empty() || params.kind == IndexKind::kLinear) return DescriptorIndex(descriptors, params);
+  CheckDescriptorMatrix(descriptors, "indexed descriptors");
+  if (descriptors.rows == 0) throw DescriptorIndexError("DescriptorIndex: no descriptors to index");
+  const std::string key = CacheKey(descriptors, params);
+  const fs::path file = cache_folder / (key + ".flann"), sum = cache_folder / (key + ".sum");
+  std::error_code ec;
+  if (fs::exists(file, ec) && fs::exists(sum, ec)) {
+    // Verified before cvflann reads it: its loader trusts the sizes it finds in the file.
+    const std::string bytes = ReadBytes(file);
+    if (!bytes.empty() && ReadBytes(sum) == ChecksumText(bytes)) {
+      try {
+        DescriptorIndex index;
+        index.impl_ = std::make_unique<Impl>();
+        index.params_ = params;
+        index.impl_->data = descriptors;
+        index.impl_->index = std::make_unique<FlannIndex>(View(index.impl_->data), cvflann::SavedIndexParams(file.string()));
+        say("descriptor index read from its cache (" + file.string() + ")");
+        return index;
+      } catch (const cv::Exception&) {
+        // An index of another dataset or type: built again below.
+      }
+    }
+    say("descriptor index cache " + file.string() + " did not verify; built again");
+  }
+  DescriptorIndex index(descriptors, params);
+  // Written under temporary names and renamed, the checksum last: a reader never sees half a file.
+  const std::string suffix = ".tmp" + std::to_string(::getpid());
+  fs::create_directories(cache_folder, ec);
+  try {
+    index.impl_->index->save((file.string() + suffix));
+    const std::string bytes = ReadBytes(file.string() + suffix);
+    std::ofstream(sum.string() + suffix) << ChecksumText(bytes);
+    fs::rename(file.string() + suffix, file, ec);
+    if (!ec) fs::rename(sum.string() + suffix, sum, ec);
+    if (ec) throw std::runtime_error(ec.message());
+    if (!note || note->empty()) say("descriptor index built and cached (" + file.string() + ")");
+  } catch (const std::exception&) {
+    fs::remove(file.string() + suffix, ec);
+    fs::remove(sum.string() + suffix, ec);
+    say("descriptor index built; it could not be cached in " + cache_folder.string());
+  }
+  return index;
 }
 
 std::size_t DescriptorIndex::size() const { return impl_ ? static_cast<std::size_t>(impl_->data.rows) : 0; }

@@ -1,6 +1,9 @@
 #include "map/descriptor_index.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+#include <fstream>
+#include <filesystem>
 
 #include <opencv2/core.hpp>
 
@@ -116,6 +119,65 @@ TEST(DescriptorIndex, RejectsWrongMatrices) {
   const DescriptorIndex empty;
   EXPECT_TRUE(empty.empty());
   EXPECT_TRUE(empty.Knn(RandomDescriptors(2, 8), 1)[0].empty());
+}
+
+void ExpectSameNeighbours(const std::vector<std::vector<Neighbor>>& a, const std::vector<std::vector<Neighbor>>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t q = 0; q < a.size(); ++q) {
+    ASSERT_EQ(a[q].size(), b[q].size()) << "query " << q;
+    for (size_t j = 0; j < a[q].size(); ++j) {
+      ASSERT_EQ(a[q][j].row, b[q][j].row) << "query " << q;
+      ASSERT_EQ(a[q][j].distance, b[q][j].distance) << "query " << q;
+    }
+  }
+}
+
+// The cached index is the built one: read back, after a damaged file and without a writable
+// folder, the neighbours are those of a fresh build.
+TEST(DescriptorIndex, ACachedIndexIsReadBackAndADamagedOneBuiltAgain) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::temp_directory_path() / ("arview_index_cache_" + std::to_string(::getpid()));
+  fs::remove_all(folder);
+  for (IndexKind kind : {IndexKind::kKdTree, IndexKind::kKMeans}) {
+    const cv::Mat data = RandomDescriptors(3000, 5);
+    const cv::Mat queries = RandomDescriptors(300, 6);
+    const IndexParams params{.kind = kind, .checks = 16, .seed = 7};
+    const auto built = DescriptorIndex(data, params).Knn(queries, 4);
+    std::string note;
+    ExpectSameNeighbours(DescriptorIndex::Cached(data, params, folder, &note).Knn(queries, 4), built);
+    EXPECT_NE(note.find("built and cached"), std::string::npos) << note;
+    note.clear();
+    ExpectSameNeighbours(DescriptorIndex::Cached(data, params, folder, &note).Knn(queries, 4), built);
+    EXPECT_NE(note.find("read from its cache"), std::string::npos) << note;
+    // Another seed is another index: not read from this one's file.
+    IndexParams other = params;
+    other.seed = 8;
+    note.clear();
+    DescriptorIndex::Cached(data, other, folder, &note);
+    EXPECT_NE(note.find("built and cached"), std::string::npos) << note;
+  }
+  // Damage every cached index: each is rebuilt (and rewritten), with the same neighbours.
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().extension() != ".flann") continue;
+    fs::resize_file(entry.path(), fs::file_size(entry.path()) / 2);
+  }
+  const cv::Mat data = RandomDescriptors(3000, 5), queries = RandomDescriptors(300, 6);
+  const IndexParams params{.kind = IndexKind::kKdTree, .checks = 16, .seed = 7};
+  std::string note;
+  ExpectSameNeighbours(DescriptorIndex::Cached(data, params, folder, &note).Knn(queries, 4),
+                       DescriptorIndex(data, params).Knn(queries, 4));
+  EXPECT_NE(note.find("did not verify"), std::string::npos) << note;
+  note.clear();
+  DescriptorIndex::Cached(data, params, folder, &note);
+  EXPECT_NE(note.find("read from its cache"), std::string::npos) << note;
+  // A folder that cannot be made (a file stands in its way): built, and said.
+  const fs::path blocked = folder / "blocked";
+  std::ofstream(blocked) << "a file";
+  note.clear();
+  ExpectSameNeighbours(DescriptorIndex::Cached(data, params, blocked / "cache", &note).Knn(queries, 4),
+                       DescriptorIndex(data, params).Knn(queries, 4));
+  EXPECT_NE(note.find("could not be cached"), std::string::npos) << note;
+  fs::remove_all(folder);
 }
 
 }  // namespace

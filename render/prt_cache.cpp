@@ -1,5 +1,7 @@
 #include "render/prt_cache.h"
 
+#include "base/cache_folder.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -123,16 +125,7 @@ std::string Hex(std::uint64_t key) {
 
 }  // namespace
 
-fs::path DefaultPrtCacheFolder() {
-  auto set = [](const char* name) -> const char* {
-    const char* value = std::getenv(name);
-    return value && *value ? value : nullptr;
-  };
-  if (const char* dir = set("ARVIEW_CACHE_DIR")) return fs::path(dir) / "prt";
-  if (const char* dir = set("XDG_CACHE_HOME")) return fs::path(dir) / "arview" / "prt";
-  if (const char* dir = set("HOME")) return fs::path(dir) / ".cache" / "arview" / "prt";
-  return {};
-}
+fs::path DefaultPrtCacheFolder() { return CacheFolder("prt"); }
 
 std::uint64_t PrtCacheKey(const anim::Character& character, const PrtOptions& options) {
   Fnv1a h;

@@ -34,7 +34,9 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
       rms_gate_(options.tracking.rms_gate),
       smoother_(options.smoothing) {
   CheckTrackable(map, options.min_map_points);
-  index_ = map::DescriptorIndex(map.descriptors, options.index);
+  index_ = options.index_cache_folder.empty()
+               ? map::DescriptorIndex(map.descriptors, options.index)
+               : map::DescriptorIndex::Cached(map.descriptors, options.index, options.index_cache_folder, &index_note_);
   relocalizer_ = std::make_unique<Relocalizer>(map_, resolution_.work(), index_, options.relocalization);
   FeatureOptions guided_features = options.relocalization.features;
   guided_features.max_features = options.tracking.guided_max_features;

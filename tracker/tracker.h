@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -127,6 +128,9 @@ struct TrackerOptions {
   int working_long_side = 960;
   // The final refinement on the full camera model (pixels mapped back to full resolution).
   bool refine_on_full_camera = true;
+  // Where the map's descriptor index is kept between sessions (map::DescriptorIndex::Cached);
+  // empty: built every time. The same index either way.
+  std::filesystem::path index_cache_folder;
 };
 
 struct StageTimes {
@@ -178,6 +182,9 @@ class Tracker {
   // Sessions call it once after construction, before frames arrive; the result is unchanged.
   void WarmUp();
   const TrackerOptions& options() const { return options_; }
+  // How the descriptor index came to be (read from its cache, built and cached, ...); empty
+  // without a cache folder.
+  const std::string& index_note() const { return index_note_; }
   // The camera every per-frame step uses (the map camera scaled to the working resolution).
   const calib::Camera& working_camera() const { return resolution_.work(); }
 
@@ -241,6 +248,7 @@ class Tracker {
   WorkingResolution resolution_;
   ResidualGate rms_gate_;
   map::DescriptorIndex index_;
+  std::string index_note_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<SiftExtractor> guided_extractor_;
   // Whether the inliers of a relocalization on its own SIFT are followed by flow into the next

@@ -1,6 +1,7 @@
 #include "app/cli/session_flags.h"
 
 #include "app/placement/scene_lighting.h"
+#include "base/cache_folder.h"
 #include "render/hmd.h"
 #include "render/offscreen.h"
 #include "render/prt_cache.h"
@@ -80,6 +81,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
   o.compositor.ar.lighting = lighting.mode;
   o.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();
+  o.tracker.index_cache_folder = CacheFolder("descriptor-index");
   o.compositor.room_light = lighting.light;
 }
 

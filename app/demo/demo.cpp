@@ -1,5 +1,7 @@
 #include "app/demo/demo.h"
 
+#include "base/cache_folder.h"
+
 #include <Eigen/Geometry>
 
 #include <cstdio>
@@ -264,6 +266,7 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   const SceneLighting lighting = ResolveSceneLighting(scene, "auto", {});
   session.compositor.ar.lighting = lighting.mode;
   session.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();
+  session.tracker.index_cache_folder = CacheFolder("descriptor-index");
   session.compositor.room_light = lighting.light;
   session.expected_frames = o.frames - half;
   session.cancel = cancel;

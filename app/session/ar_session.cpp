@@ -66,6 +66,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   };
   tracker::Tracker tracker(map, o.tracker);
   tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
+  if (!o.quiet && !tracker.index_note().empty()) std::cerr << "note: " << tracker.index_note() << "\n";
   const double tracker_seconds = seconds_of_step();
 
   std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
