@@ -114,10 +114,12 @@ std::string ChecksumText(const std::string& bytes) {
 }  // namespace
 
 DescriptorIndex DescriptorIndex::Cached(const cv::Mat& descriptors, const IndexParams& params,
-                                        const std::filesystem::path& cache_folder, std::string* note) {
-  auto say = [note](const std::string& text) {
-    if (note) *note = text;
+                                        const std::filesystem::path& cache_folder, std::string* problem,
+                                        bool* read_from_cache) {
+  auto say = [problem](const std::string& text) {
+    if (problem) *problem = text;
   };
+  if (read_from_cache) *read_from_cache = false;
   if (cache_folder.empty() || params.kind == IndexKind::kLinear) return DescriptorIndex(descriptors, params);
   CheckDescriptorMatrix(descriptors, "indexed descriptors");
   if (descriptors.rows == 0) throw DescriptorIndexError("DescriptorIndex: no descriptors to index");
@@ -134,7 +136,7 @@ DescriptorIndex DescriptorIndex::Cached(const cv::Mat& descriptors, const IndexP
         index.params_ = params;
         index.impl_->data = descriptors;
         index.impl_->index = std::make_unique<FlannIndex>(View(index.impl_->data), cvflann::SavedIndexParams(file.string()));
-        say("descriptor index read from its cache (" + file.string() + ")");
+        if (read_from_cache) *read_from_cache = true;
         return index;
       } catch (const cv::Exception&) {
         // An index of another dataset or type: built again below.
@@ -153,7 +155,6 @@ DescriptorIndex DescriptorIndex::Cached(const cv::Mat& descriptors, const IndexP
     fs::rename(file.string() + suffix, file, ec);
     if (!ec) fs::rename(sum.string() + suffix, sum, ec);
     if (ec) throw std::runtime_error(ec.message());
-    if (!note || note->empty()) say("descriptor index built and cached (" + file.string() + ")");
   } catch (const std::exception&) {
     fs::remove(file.string() + suffix, ec);
     fs::remove(sum.string() + suffix, ec);

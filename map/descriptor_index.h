@@ -61,9 +61,12 @@ class DescriptorIndex {
   // descriptors and parameters: building it over a room's map took 1.8 s of `arview run`'s
   // start-up. The file is cvflann's saved index beside an FNV-1a checksum of it; one that does
   // not verify (cut, changed) is rebuilt and rewritten, and a folder that cannot be written
-  // leaves the index built as usual. `note` (optional) says which happened, for the user.
+  // leaves the index built as usual. `problem` (optional) gets one line for the user when the
+  // cache could not be used (did not verify, could not be written), else stays empty;
+  // `read_from_cache` (optional) says whether the index came from the file.
   static DescriptorIndex Cached(const cv::Mat& descriptors, const IndexParams& params,
-                                const std::filesystem::path& cache_folder, std::string* note = nullptr);
+                                const std::filesystem::path& cache_folder, std::string* problem = nullptr,
+                                bool* read_from_cache = nullptr);
 
   // For each row of `queries` (M x 128, CV_8U), its k nearest rows of the indexed matrix, best
   // first. result[q] has min(k, size()) entries (fewer only if an approximate index finds fewer).

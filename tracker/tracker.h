@@ -182,8 +182,8 @@ class Tracker {
   // Sessions call it once after construction, before frames arrive; the result is unchanged.
   void WarmUp();
   const TrackerOptions& options() const { return options_; }
-  // How the descriptor index came to be (read from its cache, built and cached, ...); empty
-  // without a cache folder.
+  // One line when the descriptor index's cache could not be used (map::DescriptorIndex::Cached);
+  // empty when it was, or without a cache folder.
   const std::string& index_note() const { return index_note_; }
   // The camera every per-frame step uses (the map camera scaled to the working resolution).
   const calib::Camera& working_camera() const { return resolution_.work(); }

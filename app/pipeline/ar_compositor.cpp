@@ -96,10 +96,12 @@ std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose
 
 void ArCompositor::BindToThread() { context_->MakeCurrent(); }
 
-cv::Size ArCompositor::OutputSize() const {
-  if (presenter_) return presenter_->panel();
-  return {options_.hmd ? 2 * camera_.width : camera_.width, camera_.height};
+cv::Size ArCompositor::OutputSizeFor(const calib::Camera& camera, const CompositorOptions& options) {
+  if (options.hmd && options.hmd_profile) return options.hmd_profile->panel;
+  return {options.hmd ? 2 * camera.width : camera.width, camera.height};
 }
+
+cv::Size ArCompositor::OutputSize() const { return OutputSizeFor(camera_, options_); }
 
 cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
   NoteFrameComposed();

@@ -49,6 +49,8 @@ class ArCompositor : public FrameCompositor {
   // cache), for the command to print as `note:` lines.
   const std::vector<std::string>& LoadNotes() const { return load_notes_; }
   cv::Size OutputSize() const;
+  // The output's size for these options, before a compositor exists (to open the sink first).
+  static cv::Size OutputSizeFor(const calib::Camera& camera, const CompositorOptions& options);
   // Shows or hides the HUD from another thread (the window's 'h' key): from the next frame on.
   void ToggleHud() { hud_visible_ = !hud_visible_; }
 

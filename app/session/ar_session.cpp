@@ -57,6 +57,10 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                              " was built for a " + std::to_string(map.camera.width) + "x" +
                              std::to_string(map.camera.height) + " camera");
   }
+  // The output first: a window without a display, or an unwritable file, is said before anything
+  // loads.
+  std::unique_ptr<video::FrameSink> sink =
+      video::OpenSink(o.sink, ArCompositor::OutputSizeFor(map.camera, o.compositor), o.sink_fps, o.window);
   Clock::time_point step = Clock::now();
   const auto seconds_of_step = [&step] {
     const Clock::time_point now = Clock::now();
@@ -88,7 +92,6 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   ArCompositor compositor(map.camera, character_ptrs, o.compositor);
   const double renderer_seconds = seconds_of_step();
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
-  std::unique_ptr<video::FrameSink> sink = video::OpenSink(o.sink, compositor.OutputSize(), o.sink_fps, o.window);
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
   });

@@ -86,14 +86,16 @@ class Child {
   bool exited_ = false;
 };
 
-// Xvfb on a display number it picks itself (-displayfd), 1280x720 24-bit.
+// Xvfb on a display number it picks itself (-displayfd), 1280x720 24-bit. -noreset: by default
+// the server resets when its last client leaves (the check that it answers, an xdotool call), and
+// a client connecting meanwhile was refused ("cannot open display").
 class VirtualDisplay {
  public:
   VirtualDisplay() {
     int fds[2];
     if (::pipe(fds) != 0) return;
     server_ = std::make_unique<Child>(std::vector<std::string>{"Xvfb", "-displayfd", std::to_string(fds[1]), "-screen", "0",
-                                                               "1280x720x24", "-nolisten", "tcp"},
+                                                               "1280x720x24", "-nolisten", "tcp", "-noreset"},
                                       "/dev/null", fds[1]);
     ::close(fds[1]);
     std::string number;
