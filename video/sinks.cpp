@@ -172,6 +172,8 @@ class NullSink final : public FrameSink {
 
 }  // namespace
 
+bool IsWindowTarget(const std::string& target) { return target == "window" || target.rfind("window:", 0) == 0; }
+
 bool HasDisplay() {
   const char* value = std::getenv("DISPLAY");
   return value != nullptr && *value != '\0';
@@ -180,7 +182,7 @@ bool HasDisplay() {
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
                                     const WindowPlacement& window) {
   if (frame_size.width <= 0 || frame_size.height <= 0) throw render::RenderError("sink: frame size must be positive");
-  if (target == "window" || target.rfind("window:", 0) == 0) {
+  if (IsWindowTarget(target)) {
     return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size, window);
   }
   if (target == "null") return std::make_unique<NullSink>(frame_size);

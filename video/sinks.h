@@ -51,6 +51,9 @@ class FrameSink {
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
                                     const WindowPlacement& window = {});
 
+// Whether `target` names a window ("window" or "window:<title>").
+bool IsWindowTarget(const std::string& target);
+
 // Whether a display is available for the window (DISPLAY set: an X server, or Xwayland).
 bool HasDisplay();
 

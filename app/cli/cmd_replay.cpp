@@ -13,6 +13,7 @@
 #include "map/map_file.h"
 #include "recordings/recording.h"
 #include "render/offscreen.h"
+#include "video/sinks.h"
 
 namespace arview::app {
 
@@ -64,7 +65,7 @@ void AddReplayCommand(CLI::App& app) {
     o.output_name = a->out;
     // Shown in a window, Ctrl-C is how a person ends a replay, as Esc is: the report, the
     // trajectory and the stats are written. To a file, it leaves no partial video.
-    const bool to_window = a->out == "window" || a->out.rfind("window:", 0) == 0;
+    const bool to_window = video::IsWindowTarget(a->out);
     o.cancel_ends_normally = to_window;
 
     // A video or a PNG folder is written under a temporary name and renamed when complete.

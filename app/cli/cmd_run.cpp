@@ -13,6 +13,7 @@
 #include "recordings/v4l2_source.h"
 #include "render/offscreen.h"
 #include "tracker/working_resolution.h"
+#include "video/sinks.h"
 
 namespace arview::app {
 
@@ -92,7 +93,7 @@ void AddRunCommand(CLI::App& app) {
                   result.renderer_seconds);
     }
     if (!result.report.source_fault.empty()) {
-      std::string kept = a->out == "window" || a->out.rfind("window:", 0) == 0 || a->out == "null" ? "" : a->out;
+      std::string kept = video::IsWindowTarget(a->out) || a->out == "null" ? "" : a->out;
       for (const std::string& file : {o.trajectory_out.string(), o.stats_out.string()}) {
         if (!file.empty()) kept += (kept.empty() ? "" : ", ") + file;
       }

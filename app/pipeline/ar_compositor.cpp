@@ -34,22 +34,10 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   if (options_.hmd && options_.hmd_profile) presenter_.emplace(*options_.hmd_profile, renderer_->pinhole());
 }
 
-void ArCompositor::NoteFrameComposed() {
-  const auto now = std::chrono::steady_clock::now();
-  composed_at_.push_back(now);
-  while (composed_at_.size() > 2 && now - composed_at_.front() > std::chrono::seconds(1)) composed_at_.pop_front();
-}
-
-double ArCompositor::OutputRate() const {
-  if (composed_at_.size() < 2) return 0;
-  const double seconds = std::chrono::duration<double>(composed_at_.back() - composed_at_.front()).count();
-  return seconds > 0 ? (composed_at_.size() - 1) / seconds : 0;
-}
-
 std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) const {
   char line[128];
   std::snprintf(line, sizeof line, "frame %lld   %s   %.0f frames/s", static_cast<long long>(input.frame->index),
-                ToString(input.track->status).c_str(), OutputRate());
+                ToString(input.track->status).c_str(), composed_.PerSecond());
   std::vector<std::string> status = {line};
   if (input.track->status == tracker::TrackStatus::kLost) {
     status.push_back("lost: the character is hidden until the camera is found again");
@@ -104,7 +92,7 @@ cv::Size ArCompositor::OutputSizeFor(const calib::Camera& camera, const Composit
 cv::Size ArCompositor::OutputSize() const { return OutputSizeFor(camera_, options_); }
 
 cv::Mat ArCompositor::Compose(const FrameToCompose& input) {
-  NoteFrameComposed();
+  composed_.Add(std::chrono::steady_clock::now());
   const bool localized = input.track->status != tracker::TrackStatus::kLost;
   output_ptrs_.clear();
   if (localized) output_ptrs_.assign(input.animations.begin(), input.animations.end());

@@ -5,7 +5,6 @@
 
 #include <atomic>
 #include <chrono>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "app/pipeline/ar_pipeline.h"
+#include "app/pipeline/recent_rate.h"
 #include "render/ar_renderer.h"
 #include "render/hmd.h"
 #include "render/offscreen.h"
@@ -65,9 +65,6 @@ class ArCompositor : public FrameCompositor {
   cv::Mat VideoAlone(const FrameToCompose& input);
   // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
   std::vector<std::string> HudStatus(const FrameToCompose& input) const;
-  // Composed frames per second over the last second or so of output (wall clock).
-  void NoteFrameComposed();
-  double OutputRate() const;
 
   calib::Camera camera_;
   std::vector<const anim::PlacedCharacter*> characters_;
@@ -79,7 +76,7 @@ class ArCompositor : public FrameCompositor {
   std::vector<std::string> load_notes_;
   std::vector<double> heights_;  // characters' rest heights in map units, for the overlay
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
-  std::deque<std::chrono::steady_clock::time_point> composed_at_;  // the overlay's rate
+  RecentRate composed_{std::chrono::seconds(1)};  // the overlay's frame rate (wall clock)
   std::atomic<bool> hud_visible_;  // starts as options_.hud
   std::optional<render::HmdPresenter> presenter_;  // hmd with a profile
 };

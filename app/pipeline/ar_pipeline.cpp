@@ -12,6 +12,7 @@
 
 #include "anim/chains.h"
 #include "app/pipeline/bounded_queue.h"
+#include "app/pipeline/recent_rate.h"
 #include "base/stats.h"
 
 namespace arview::app {
@@ -37,26 +38,19 @@ struct InFlight {
 class RecentOutput {
  public:
   void Add(Clock::time_point at, double latency_ms) {
-    samples_.push_back({at, latency_ms});
-    while (samples_.size() > 2 && at - samples_.front().at > std::chrono::seconds(1)) samples_.pop_front();
+    rate_.Add(at);
+    latencies_.push_back(latency_ms);
+    while (latencies_.size() > rate_.size()) latencies_.pop_front();  // the same window
   }
-  double Fps() const {
-    if (samples_.size() < 2) return 0;
-    const double seconds = std::chrono::duration<double>(samples_.back().at - samples_.front().at).count();
-    return seconds > 0 ? (samples_.size() - 1) / seconds : 0;
-  }
+  double Fps() const { return rate_.PerSecond(); }
   double MedianLatencyMs() const {
-    std::vector<double> latencies;
-    for (const Sample& s : samples_) latencies.push_back(s.latency_ms);
+    const std::vector<double> latencies(latencies_.begin(), latencies_.end());
     return latencies.empty() ? 0 : Median(latencies);
   }
 
  private:
-  struct Sample {
-    Clock::time_point at;
-    double latency_ms;
-  };
-  std::deque<Sample> samples_;
+  RecentRate rate_{std::chrono::seconds(1)};
+  std::deque<double> latencies_;
 };
 
 double ProcessCpuSeconds() {
@@ -99,11 +93,9 @@ class SourceRateWatch {
  public:
   std::optional<std::string> Add(Clock::time_point captured) {
     if (!first_) first_ = captured;
-    times_.push_back(captured);
-    while (times_.size() > 2 && captured - times_.front() > std::chrono::seconds(2)) times_.pop_front();
-    if (captured - *first_ < std::chrono::seconds(3) || times_.size() < 3) return std::nullopt;
-    const double span = std::chrono::duration<double>(times_.back() - times_.front()).count();
-    const double rate = span > 0 ? (times_.size() - 1) / span : 0;
+    recent_.Add(captured);
+    if (captured - *first_ < std::chrono::seconds(3) || recent_.size() < 3) return std::nullopt;
+    const double rate = recent_.PerSecond();
     best_ = std::max(best_, rate);
     char line[200];
     if (!slow_ && rate < 0.6 * best_) {
@@ -123,7 +115,7 @@ class SourceRateWatch {
 
  private:
   std::optional<Clock::time_point> first_;
-  std::deque<Clock::time_point> times_;
+  RecentRate recent_{std::chrono::seconds(2)};
   double best_ = 0;
   bool slow_ = false;
 };
