@@ -23,6 +23,8 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
       options_(options),
       target_(context.gl(), camera.Size(), options.antialiasing == Antialiasing::kMsaa ? 4 : 0),
       shadow_(context.gl()) {
+  pixel_buffer_readback_ = options.readback == Readback::kPixelBuffer ||
+                           (options.readback == Readback::kAuto && !context.info().software);
   ProjectionMatrix(pinhole_, options_.clip);  // validates the camera and the clip range
   if (camera_.HasDistortion()) {
     cv::initUndistortRectifyMap(camera_.K(), camera_.DistCoeffs(), cv::noArray(), camera_.K(), camera_.Size(),
@@ -245,10 +247,13 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   used_linear_fallback_ = false;
   double farthest = 0;
   const cv::Rect rect = ScreenBounds(eye, frames, &farthest);
-  if (!rect.empty()) DrawLayer(rect, eye, frames, farthest);
+  if (!rect.empty()) {
+    DrawLayer(rect, eye, frames, farthest);
+    if (pixel_buffer_readback_) target_.StartReadBgra();  // a GPU copies while the CPU darkens
+  }
   // The cast shadows darken the camera image the layer goes over (the same as a premultiplied
   // shadow under the characters in the layer), on this thread while llvmpipe's rasterise the
-  // layer's draws.
+  // layer's draws (or a GPU draws and copies them).
   for (const Placed& placed : characters_) {
     if (!placed.casts) continue;
     DarkenCastShadow(frame, pinhole_, eye, options_.clip.near_m, placed.light_view, placed.coverage,
@@ -257,10 +262,16 @@ void ArRenderer::Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const
   }
   if (rect.empty()) return;  // no character in view: the video frame (and its shadows) as it is
 
+  // OpenGL's row order: no flip's copy. A mapped pixel buffer is read in place.
+  const cv::Mat layer = pixel_buffer_readback_ ? target_.MapBgraBottomUp() : target_.ReadBgraBottomUp();
+  BlendPremultiplied(layer, rect, frame);
+  if (pixel_buffer_readback_) target_.UnmapRead();
+}
+
+void ArRenderer::BlendPremultiplied(const cv::Mat& bottom_up_layer, const cv::Rect& rect, cv::Mat& frame) {
   // Premultiplied alpha over the video: out = fg + bg·(1 − a).
-  const cv::Mat layer = target_.ReadBgraBottomUp();  // OpenGL's row order: no flip's copy
   for (int y = 0; y < rect.height; ++y) {
-    const cv::Vec4b* fg = layer.ptr<cv::Vec4b>(rect.height - 1 - y);
+    const cv::Vec4b* fg = bottom_up_layer.ptr<cv::Vec4b>(rect.height - 1 - y);
     cv::Vec3b* bg = frame.ptr<cv::Vec3b>(rect.y + y) + rect.x;
     for (int x = 0; x < rect.width; ++x) {
       const int a = fg[x][3];

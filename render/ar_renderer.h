@@ -44,6 +44,15 @@ enum class Antialiasing {
 // "msaa" | "none"; throws RenderError otherwise.
 Antialiasing ParseAntialiasing(const std::string& name);
 
+// How the character's layer comes back from OpenGL (render/gl_objects.h, PixelReadback).
+enum class Readback {
+  kAuto,         // a pixel buffer on a GPU, glReadPixels on llvmpipe
+  kDirect,       // glReadPixels after the cast shadow is drawn: on llvmpipe its rasteriser
+                 // threads draw the layer while the render thread darkens the video
+  kPixelBuffer,  // the copy into a pixel buffer is started before the cast shadow, mapped after:
+                 // on a GPU the copy runs meanwhile; on llvmpipe it would wait for the raster first
+};
+
 struct ArOptions {
   Antialiasing antialiasing = Antialiasing::kMsaa;
   ClipRange clip{0.02, 200.0};
@@ -53,6 +62,7 @@ struct ArOptions {
   float shadow_strength = 0.55f;
   cv::Scalar empty_background{128, 128, 128};  // BGR, when no camera image is given
   bool full_frame = false;  // draw and read the whole frame (for checking the bounds)
+  Readback readback = Readback::kAuto;
   // The room's light (SetRoomLight) for kShUnshadowed / kShShadowed; kShShadowed ray casts
   // each character's PRT transfer in AddCharacter (prt_seconds() says how long it took).
   LightingMode lighting = LightingMode::kFixed;
@@ -104,6 +114,8 @@ class ArRenderer {
 
   const calib::Camera& pinhole() const { return pinhole_; }
   const ArOptions& options() const { return options_; }
+  // Whether the layer is read through a pixel buffer (options().readback, resolved for the context).
+  bool reads_through_pixel_buffer() const { return pixel_buffer_readback_; }
   // Whether the last Render had to skin a character linearly because its joints scale.
   bool used_linear_fallback() const { return used_linear_fallback_; }
 
@@ -124,6 +136,8 @@ class ArRenderer {
   // Draws the characters seen from `eye` and blends them over `frame` (in place), after
   // UpdateCastShadows of the same frames.
   void Compose(cv::Mat& frame, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames);
+  // The premultiplied BGRA layer (OpenGL's rows: row 0 at the bottom) over `rect` of `frame`.
+  static void BlendPremultiplied(const cv::Mat& bottom_up_layer, const cv::Rect& rect, cv::Mat& frame);
   // Draws the characters' layer (occluders, contact shadows, characters) into `rect` of the
   // region target, to be read back.
   void DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::span<const anim::AnimatorFrame* const> frames,
@@ -145,6 +159,7 @@ class ArRenderer {
   calib::Camera camera_, pinhole_;
   ArOptions options_;
   RegionTarget target_;
+  bool pixel_buffer_readback_ = false;
   cv::Mat undistort_map1_, undistort_map2_;
   ContactShadow shadow_;
   std::vector<Placed> characters_;

@@ -38,7 +38,7 @@ using namespace arview::room;  // the room's light and proxy, tested here with t
 using namespace arview::synth;  // the rendered room the light is measured in
 namespace {
 
-OffscreenOptions g_gl{GlBackend::kAuto, 1};
+OffscreenOptions g_gl;  // auto, 1 thread unless the command line says otherwise
 
 // CPU time of the whole process (all llvmpipe threads included), seconds: on a shared machine
 // this is steadier than wall time and shows what a frame costs the cores that tracking shares.

@@ -373,3 +373,68 @@ TEST(CesiumMan, GpuSilhouetteMatchesCpuSkinningWithBackFacesCulled) {
 
 }  // namespace
 }  // namespace arview::render
+
+namespace arview::render {
+namespace {
+
+double WorstDifference(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  double worst = 0;
+  cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+  return worst;
+}
+
+// The Fox over a random background at two poses and times, 4x MSAA, through `context`.
+std::vector<cv::Mat> FoxFrames(OffscreenContext& context, authoring::AnimatedCharacter& fox, const ArOptions& options) {
+  context.MakeCurrent();
+  const calib::Camera camera = TestCamera();
+  cv::Mat background(camera.height, camera.width, CV_8UC3);
+  cv::RNG(7).fill(background, cv::RNG::UNIFORM, 0, 256);  // the same for every call
+  ArRenderer renderer(context, camera, options);
+  renderer.AddCharacter(fox.character(), fox.spec().placement());
+  std::vector<cv::Mat> frames;
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.6, 0, 1.2)}) {
+    calib::Pose pose = LookingAtFox();
+    pose.t_cw -= shift;
+    for (double time : {0.1, 0.6}) {
+      const anim::AnimatorFrame* frame = &fox.Update(fox.spec().placement().ViewpointFromCamera(pose.Center()), time);
+      frames.push_back(renderer.Render(background, pose, {&frame, 1}));
+    }
+  }
+  return frames;
+}
+
+// The EGL device platform is the way to a GPU; on this machine it reaches Mesa's software
+// device, which must draw what OSMesa draws (the same llvmpipe).
+TEST_F(FoxTest, EglDevicePlatformDrawsTheSameFramesAsOsMesa) {
+  std::unique_ptr<OffscreenContext> osmesa, device;
+  try {
+    osmesa = OffscreenContext::Create(testing::GlOptions(GlBackend::kOsMesa, 2));
+    device = OffscreenContext::Create(testing::GlOptions(GlBackend::kEglDevice, 2));
+  } catch (const RenderError& e) {
+    GTEST_SKIP() << "OSMesa or the EGL device platform is missing here: " << e.what();
+  }
+  std::printf("%s\n%s\n", osmesa->Description().c_str(), device->Description().c_str());
+  const std::vector<cv::Mat> a = FoxFrames(*osmesa, *fox_, {});
+  const std::vector<cv::Mat> b = FoxFrames(*device, *fox_, {});
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_LE(WorstDifference(a[i], b[i]), 1) << "frame " << i;
+  testing::SharedContext();  // current again for the tests that follow
+}
+
+// A GPU reads the layer back through a pixel buffer; the pixels are the same as glReadPixels'.
+TEST_F(FoxTest, PixelBufferReadbackGivesTheSameFramesAsADirectRead) {
+  ArOptions direct, pixel_buffer;
+  direct.readback = Readback::kDirect;
+  pixel_buffer.readback = Readback::kPixelBuffer;
+  const std::vector<cv::Mat> a = FoxFrames(testing::SharedContext(), *fox_, direct);
+  const std::vector<cv::Mat> b = FoxFrames(testing::SharedContext(), *fox_, pixel_buffer);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(WorstDifference(a[i], b[i]), 0) << "frame " << i;
+  EXPECT_FALSE(ArRenderer(testing::SharedContext(), TestCamera(), {}).reads_through_pixel_buffer())
+      << "llvmpipe keeps the direct read (its raster overlaps the cast shadow's darkening)";
+}
+
+}  // namespace
+}  // namespace arview::render

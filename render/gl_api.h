@@ -55,6 +55,11 @@ namespace arview::render {
   X(void, BindBuffer, (GLenum, GLuint))                                                               \
   X(void, BufferData, (GLenum, GLsizeiptr, const void*, GLenum))                                      \
   X(void, BufferSubData, (GLenum, GLintptr, GLsizeiptr, const void*))                                 \
+  X(void*, MapBufferRange, (GLenum, GLintptr, GLsizeiptr, GLbitfield))                                \
+  X(GLboolean, UnmapBuffer, (GLenum))                                                                 \
+  X(GLsync, FenceSync, (GLenum, GLbitfield))                                                          \
+  X(GLenum, ClientWaitSync, (GLsync, GLbitfield, GLuint64))                                           \
+  X(void, DeleteSync, (GLsync))                                                                       \
   X(void, GenVertexArrays, (GLsizei, GLuint*))                                                        \
   X(void, DeleteVertexArrays, (GLsizei, const GLuint*))                                               \
   X(void, BindVertexArray, (GLuint))                                                                  \

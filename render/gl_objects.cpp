@@ -182,30 +182,99 @@ void RenderTarget::Bind() const {
   gl_->Viewport(0, 0, width_, height_);
 }
 
-cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect, bool top_down) const {
-  const GlApi& gl = *gl_;
+cv::Rect RenderTarget::GlRect(cv::Rect rect) const {
   rect &= cv::Rect(0, 0, width_, height_);
-  if (rect.empty()) return cv::Mat(0, 0, CV_8UC(channels));
-  // OpenGL counts rows from the bottom.
-  const GLint x0 = rect.x, y0 = height_ - rect.y - rect.height, x1 = rect.x + rect.width, y1 = y0 + rect.height;
+  return {rect.x, height_ - rect.y - rect.height, rect.width, rect.height};  // OpenGL counts rows from the bottom
+}
+
+void RenderTarget::BindResolved(const cv::Rect& r) const {
+  const GlApi& gl = *gl_;
   GLuint source = draw_fbo_.get();
   if (samples_ > 1) {
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, draw_fbo_.get());
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_.get());
     gl.Disable(GL_SCISSOR_TEST);
-    gl.BlitFramebuffer(x0, y0, x1, y1, x0, y0, x1, y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl.BlitFramebuffer(r.x, r.y, r.x + r.width, r.y + r.height, r.x, r.y, r.x + r.width, r.y + r.height,
+                       GL_COLOR_BUFFER_BIT, GL_NEAREST);
     source = resolve_fbo_.get();
   }
   gl.BindFramebuffer(GL_READ_FRAMEBUFFER, source);
   gl.ReadBuffer(GL_COLOR_ATTACHMENT0);
   gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  cv::Mat bottom_up(rect.height, rect.width, CV_8UC(channels));
-  gl.ReadPixels(x0, y0, rect.width, rect.height, format, GL_UNSIGNED_BYTE, bottom_up.data);
+}
+
+cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect, bool top_down) const {
+  const GlApi& gl = *gl_;
+  const cv::Rect r = GlRect(rect);
+  if (r.empty()) return cv::Mat(0, 0, CV_8UC(channels));
+  BindResolved(r);
+  cv::Mat bottom_up(r.height, r.width, CV_8UC(channels));
+  gl.ReadPixels(r.x, r.y, r.width, r.height, format, GL_UNSIGNED_BYTE, bottom_up.data);
   CheckGl(gl, "read-back");
   if (!top_down) return bottom_up;
   cv::Mat image;
   cv::flip(bottom_up, image, 0);
   return image;
+}
+
+void RenderTarget::StartReadBgra(const cv::Rect& rect, PixelReadback& readback) const {
+  const cv::Rect r = GlRect(rect);
+  if (!r.empty()) BindResolved(r);
+  readback.Start(r, GL_BGRA, 4);
+}
+
+PixelReadback::~PixelReadback() {
+  if (mapped_) Unmap();
+  if (fence_ != nullptr) gl_->DeleteSync(fence_);
+}
+
+void PixelReadback::Start(const cv::Rect& gl_rect, GLenum format, int channels) {
+  const GlApi& gl = *gl_;
+  if (mapped_) Unmap();
+  if (fence_ != nullptr) gl.DeleteSync(fence_);
+  fence_ = nullptr;
+  size_ = gl_rect.size();
+  type_ = CV_8UC(channels);
+  if (gl_rect.empty()) return;
+  const size_t bytes = static_cast<size_t>(gl_rect.area()) * channels;
+  if (bytes > capacity_) {
+    // GL_STREAM_READ: written by the GL once, read by the CPU once.
+    buffer_ = MakeBuffer(gl, GL_PIXEL_PACK_BUFFER, nullptr, bytes, GL_STREAM_READ);
+    capacity_ = bytes;
+  }
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer_.get());
+  gl.ReadPixels(gl_rect.x, gl_rect.y, gl_rect.width, gl_rect.height, format, GL_UNSIGNED_BYTE, nullptr);
+  fence_ = gl.FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  CheckGl(gl, "read-back into a pixel buffer");
+}
+
+cv::Mat PixelReadback::Map() {
+  const GlApi& gl = *gl_;
+  if (size_.empty()) return cv::Mat(0, 0, type_);
+  if (fence_ == nullptr) throw RenderError("pixel buffer mapped without a read started");
+  // Flush the fence with the first wait; a second is never needed, the wait is unbounded.
+  const GLenum waited = gl.ClientWaitSync(fence_, GL_SYNC_FLUSH_COMMANDS_BIT, GL_TIMEOUT_IGNORED);
+  if (waited == GL_WAIT_FAILED) throw RenderError("waiting for the pixel buffer's read-back failed");
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer_.get());
+  void* pixels = gl.MapBufferRange(GL_PIXEL_PACK_BUFFER, 0, static_cast<GLsizeiptr>(size_.area()) * CV_ELEM_SIZE(type_),
+                                   GL_MAP_READ_BIT);
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  if (pixels == nullptr) {
+    CheckGl(gl, "mapping the pixel buffer");
+    throw RenderError("the pixel buffer could not be mapped");
+  }
+  mapped_ = true;
+  return cv::Mat(size_, type_, pixels);
+}
+
+void PixelReadback::Unmap() {
+  if (!mapped_) return;
+  const GlApi& gl = *gl_;
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, buffer_.get());
+  gl.UnmapBuffer(GL_PIXEL_PACK_BUFFER);
+  gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  mapped_ = false;
 }
 
 cv::Mat RenderTarget::ReadBgr() const { return Read(GL_BGR, 3, {0, 0, width_, height_}); }
@@ -274,6 +343,25 @@ cv::Mat RegionTarget::ReadBgraBottomUp() const {
   if (rect_.empty() || !target_) return cv::Mat(0, 0, CV_8UC4);
   target_->Scissor({});
   return target_->ReadBgraBottomUp(TargetRect());
+}
+
+void RegionTarget::StartReadBgra() {
+  if (!readback_) readback_ = std::make_unique<PixelReadback>(*gl_);
+  if (rect_.empty() || !target_) {
+    readback_->Start({}, GL_BGRA, 4);
+    return;
+  }
+  target_->Scissor({});
+  target_->StartReadBgra(TargetRect(), *readback_);
+}
+
+cv::Mat RegionTarget::MapBgraBottomUp() {
+  if (!readback_) throw RenderError("region mapped without a read started");
+  return readback_->Map();
+}
+
+void RegionTarget::UnmapRead() {
+  if (readback_) readback_->Unmap();
 }
 
 }  // namespace arview::render

@@ -64,6 +64,33 @@ void UpdateTexture(const GlApi& gl, GLuint texture, const cv::Mat& image);
 GlName MakeBuffer(const GlApi& gl, GLenum target, const void* data, size_t bytes, GLenum usage = GL_STATIC_DRAW);
 GlName MakeVertexArray(const GlApi& gl);
 
+// A read-back through a pixel-buffer object: Start asks the GL to copy a rectangle into the
+// buffer and sets a fence, and returns at once on a GPU (the copy runs while the CPU does other
+// work); Map waits for the fence and maps the buffer. glReadPixels into client memory instead
+// makes the CPU wait for every queued draw and then for the copy: on a GPU that stall is the
+// read-back's cost. On llvmpipe the copy is done by the CPU inside Start either way.
+class PixelReadback {
+ public:
+  explicit PixelReadback(const GlApi& gl) : gl_(&gl) {}
+  PixelReadback(const PixelReadback&) = delete;
+  PixelReadback& operator=(const PixelReadback&) = delete;
+  ~PixelReadback();
+  // Reads `gl_rect` (OpenGL's coordinates: rows from the bottom) of the bound read framebuffer.
+  void Start(const cv::Rect& gl_rect, GLenum format, int channels);
+  // The pixels Start asked for, row 0 at the bottom; valid until Unmap (or the next Start).
+  cv::Mat Map();
+  void Unmap();
+
+ private:
+  const GlApi* gl_;
+  GlName buffer_;
+  size_t capacity_ = 0;
+  GLsync fence_ = nullptr;
+  cv::Size size_;
+  int type_ = 0;
+  bool mapped_ = false;
+};
+
 // A framebuffer to draw into: colour RGBA8 + depth 24, multisampled when samples > 1 and
 // resolved on read-back.
 class RenderTarget {
@@ -84,11 +111,18 @@ class RenderTarget {
   // The same in OpenGL's row order (row 0 at the bottom), without the flip's copy: for a
   // caller that walks the rows anyway (the compositing, on the render stage's critical path).
   cv::Mat ReadBgraBottomUp(const cv::Rect& rect) const;
+  // The same through a pixel-buffer object (PixelReadback): resolves `rect` and starts its copy,
+  // which `readback.Map()` then returns (row 0 at the bottom).
+  void StartReadBgra(const cv::Rect& rect, PixelReadback& readback) const;
   // Limits clears and drawing to `rect` (image coordinates); an empty rect disables the limit.
   void Scissor(const cv::Rect& rect) const;
 
  private:
   cv::Mat Read(GLenum format, int channels, cv::Rect rect, bool top_down = true) const;
+  // Resolves the multisampled rectangle (OpenGL's coordinates) and binds what holds it for reading.
+  void BindResolved(const cv::Rect& gl_rect) const;
+  // `rect` (rows from the top) clipped to the target, in OpenGL's coordinates.
+  cv::Rect GlRect(cv::Rect rect) const;
   const GlApi* gl_;
   int width_, height_, samples_;
   GlName draw_fbo_, color_rb_, depth_rb_;
@@ -113,6 +147,11 @@ class RegionTarget {
   // scissor test is off again.
   cv::Mat ReadBgra() const;
   cv::Mat ReadBgraBottomUp() const;  // the same, row 0 at the bottom (RenderTarget::ReadBgraBottomUp)
+  // The same through a pixel-buffer object: StartReadBgra, other work, then MapBgraBottomUp,
+  // whose image stays valid until UnmapRead.
+  void StartReadBgra();
+  cv::Mat MapBgraBottomUp();
+  void UnmapRead();
   cv::Size target_size() const { return target_ ? cv::Size(target_->width(), target_->height()) : cv::Size(); }
 
  private:
@@ -125,6 +164,7 @@ class RegionTarget {
   cv::Point origin_;    // the target's pixel (0, 0) in the image, OpenGL's rows (from the bottom)
   cv::Rect in_target_;  // rect_ in the target, OpenGL's rows
   std::unique_ptr<RenderTarget> target_;
+  std::unique_ptr<PixelReadback> readback_;
 };
 
 }  // namespace arview::render

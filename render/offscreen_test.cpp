@@ -11,6 +11,7 @@ TEST(Offscreen, ParsesBackendNames) {
   EXPECT_EQ(ParseGlBackend("osmesa"), GlBackend::kOsMesa);
   EXPECT_EQ(ParseGlBackend("egl"), GlBackend::kEgl);
   EXPECT_EQ(ParseGlBackend("auto"), GlBackend::kAuto);
+  EXPECT_EQ(ParseGlBackend("egl-device"), GlBackend::kEglDevice);
   EXPECT_THROW(ParseGlBackend("vulkan"), RenderError);
 }
 
@@ -23,14 +24,17 @@ TEST(Offscreen, SharedContextIsCoreFourFiveWithMultisampling) {
 }
 
 // Each backend, when present, clears a framebuffer object and reads the colour back.
-void ExpectClearReadsBack(GlBackend backend) {
+void ExpectClearReadsBack(GlBackend backend, bool egl_config_and_pbuffer = false) {
   std::unique_ptr<OffscreenContext> context;
   try {
-    context = OffscreenContext::Create({backend, 2});
+    OffscreenOptions options = testing::GlOptions(backend, 2);
+    options.egl_config_and_pbuffer = egl_config_and_pbuffer;
+    context = OffscreenContext::Create(options);
   } catch (const RenderError& e) {
     GTEST_SKIP() << ToString(backend) << " unavailable here: " << e.what();
   }
   EXPECT_EQ(context->backend(), backend);
+  std::printf("%s\n", context->Description().c_str());
   const GlApi& gl = context->gl();
   RenderTarget target(gl, 32, 24, 4);
   target.Bind();
@@ -46,10 +50,59 @@ void ExpectClearReadsBack(GlBackend backend) {
 
 TEST(Offscreen, OsMesaBackendRendersIntoFramebufferObject) { ExpectClearReadsBack(GlBackend::kOsMesa); }
 TEST(Offscreen, EglSurfacelessBackendRendersIntoFramebufferObject) { ExpectClearReadsBack(GlBackend::kEgl); }
+// Mesa's EGL lists its software device on the device platform: the GPU path, run on llvmpipe.
+TEST(Offscreen, EglDevicePlatformRendersIntoFramebufferObject) { ExpectClearReadsBack(GlBackend::kEglDevice); }
+// A driver without configless and surfaceless contexts: a chosen config and a 1x1 pbuffer.
+TEST(Offscreen, EglWithAConfigAndAPbufferRendersIntoFramebufferObject) {
+  ExpectClearReadsBack(GlBackend::kEglDevice, true);
+  ExpectClearReadsBack(GlBackend::kEgl, true);
+}
 
 TEST(Offscreen, RefusesToChangeThreadCountWithinProcess) {
-  testing::SharedContext();  // fixes 2 threads for OSMesa (auto picks OSMesa here)
-  EXPECT_THROW(OffscreenContext::Create({GlBackend::kOsMesa, 3}), RenderError);
+  const GlBackend shared = testing::SharedContext().backend();  // fixes 2 threads for its library
+  EXPECT_THROW(OffscreenContext::Create(testing::GlOptions(shared, 3)), RenderError);
+}
+
+// The renderer auto takes is described by what it is: a CPU renderer with its thread count.
+TEST(Offscreen, DescribesTheRendererItTookAndWhatItTriedBefore) {
+  const OffscreenContext& context = testing::SharedContext();
+  const RendererInfo& info = context.info();
+  EXPECT_NE(info.backend, GlBackend::kAuto);
+  EXPECT_FALSE(info.renderer.empty());
+  EXPECT_FALSE(info.vendor.empty());
+  ASSERT_FALSE(context.attempts().empty());
+  EXPECT_TRUE(context.attempts().back().failure.empty());
+  for (size_t i = 0; i + 1 < context.attempts().size(); ++i) EXPECT_FALSE(context.attempts()[i].failure.empty());
+  if (info.software) {
+    EXPECT_EQ(info.threads, 2);
+    EXPECT_NE(context.Description().find(", 2 llvmpipe threads"), std::string::npos) << context.Description();
+  }
+}
+
+TEST(Offscreen, ANamedDeviceThatDoesNotExistIsRefused) {
+  testing::SharedContext();
+  try {
+    OffscreenOptions options = testing::GlOptions(GlBackend::kAuto, 2);
+    options.device = 64;
+    OffscreenContext::Create(options);
+    FAIL() << "device 64 accepted";
+  } catch (const RenderError& e) {
+    EXPECT_NE(std::string(e.what()).find("GL device 64 does not exist"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Offscreen, TheProbeListsEveryDeviceAndWhatAutoTakes) {
+  const GlProbe probe = ProbeGl(testing::GlOptions(GlBackend::kAuto, 2));
+  for (const GlProbe::Device& d : probe.devices) {
+    EXPECT_TRUE(d.renderer || !d.failure.empty()) << "device " << d.device.index;
+    if (d.renderer) {
+      EXPECT_EQ(d.renderer->device, d.device.index);
+    }
+  }
+  EXPECT_TRUE(probe.osmesa || !probe.osmesa_failure.empty());
+  ASSERT_FALSE(probe.auto_attempts.empty()) << probe.auto_failure;
+  EXPECT_EQ(probe.auto_attempts.back().candidate.kind == GlCandidateKind::kOsMesa,
+            testing::SharedContext().backend() == GlBackend::kOsMesa);
 }
 
 TEST(Offscreen, RejectsImpossibleRenderTargets) {

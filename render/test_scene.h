@@ -15,8 +15,15 @@
 
 namespace arview::render::testing {
 
+inline OffscreenOptions GlOptions(GlBackend backend, int threads) {
+  OffscreenOptions options;
+  options.backend = backend;
+  options.threads = threads;
+  return options;
+}
+
 inline OffscreenContext& SharedContext() {
-  static std::unique_ptr<OffscreenContext> context = OffscreenContext::Create({GlBackend::kAuto, 2});
+  static std::unique_ptr<OffscreenContext> context = OffscreenContext::Create(GlOptions(GlBackend::kAuto, 2));
   context->MakeCurrent();
   return *context;
 }

@@ -214,7 +214,7 @@ SynthRoomOptions FourNoisyFrames(const fs::path& out) {
   options.frames = 4;
   options.seed = 5;
   options.noise_sigma = 2.0;
-  options.gl = {render::GlBackend::kAuto, 2};
+  options.gl.threads = 2;  // auto
   options.out = out;
   return options;
 }
@@ -282,7 +282,7 @@ TEST(SynthRoom, RealisticFootageFlags) {
   options.frames = 2;
   options.width = 1280;
   options.height = 720;
-  options.gl = {render::GlBackend::kAuto, 2};
+  options.gl.threads = 2;  // auto
   options.out = plain.path;
   SynthesizeRoom(options);
   options.out = real.path;
@@ -310,7 +310,7 @@ TEST(SynthRoom, RefusesANonEmptyFolderAndBadOptions) {
   SynthRoomOptions options;
   options.out = dir.path;
   options.frames = 1;
-  options.gl = {render::GlBackend::kAuto, 2};
+  options.gl.threads = 2;  // auto
   EXPECT_THROW(SynthesizeRoom(options), render::RenderError);
   EXPECT_TRUE(fs::exists(dir.path / "keep.txt"));
   options.frames = 0;

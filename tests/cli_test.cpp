@@ -20,7 +20,7 @@ using testing::LineCount;
 using testing::RunArview;
 
 const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "camera", "map", "track", "eval",
-                              "anim", "place", "render", "view", "replay", "run", "demo"};
+                              "anim", "place", "render", "view", "replay", "run", "demo", "info"};
 
 TEST(Cli, HelpListsEverySubcommand) {
   const auto r = RunArview({"--help"});

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "app/cli/commands.h"
+#include "app/cli/gl_flags.h"
 #include "app/cli/numeric_flags.h"
 #include "app/demo/demo.h"
 
@@ -14,6 +15,7 @@ namespace {
 struct DemoArgs {
   DemoOptions demo;
   std::string size = "640x480";  // --size, parsed into demo.frame_width/height
+  GlFlags gl;                     // into demo.gl
 };
 
 }  // namespace
@@ -35,8 +37,7 @@ void AddDemoCommand(CLI::App& app) {
                   "/usr/share/assimp/models/X/BCN_Epileptic.X, or the Fox .glb")
       ->capture_default_str();
   cmd->add_option("--height", a->demo.height, "Character height in metres")->capture_default_str()->check(CLI::Range(0.1, 5.0));
-  cmd->add_option("--gl", a->demo.gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
-  cmd->add_option("--gl-threads", a->demo.gl_threads, "llvmpipe rasterizer threads")->capture_default_str()->check(CLI::Range(0, 16));
+  AddGlFlags(cmd, a->gl);
   cmd->add_option("--size", a->size,
                   "Frame size WxH of the walk (the room is rendered, mapped and replayed at it; field of view kept), "
                   "e.g. 1280x720; use a --work folder of its own per size, or the walk and map are made again")
@@ -57,6 +58,7 @@ void AddDemoCommand(CLI::App& app) {
     const cv::Size size = *ParseFrameSize(a->size);  // checked by --size's validator
     a->demo.frame_width = size.width;
     a->demo.frame_height = size.height;
+    a->demo.gl = ToOffscreenOptions(a->gl);
     RunDemo(a->demo);
   });
 }

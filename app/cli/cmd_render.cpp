@@ -13,6 +13,7 @@
 
 #include "anim_authoring/scene.h"
 #include "app/cli/commands.h"
+#include "app/cli/gl_flags.h"
 #include "app/placement/scene_lighting.h"
 #include "calib/camera.h"
 #include "render/ar_renderer.h"
@@ -32,8 +33,7 @@ struct RenderArgs {
   bool no_shadow = false;
   std::string lighting = "auto", light;
   bool no_cast_shadow = false, no_occlusion = false;
-  std::string backend = "auto";
-  int threads = 1;
+  GlFlags gl;
 };
 
 // "tx ty tz qx qy qz qw", camera-to-world as in TUM trajectories.
@@ -86,10 +86,7 @@ void RunRender(const RenderArgs& args) {
     std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
     for (const authoring::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
 
-    render::OffscreenOptions gl;
-    gl.backend = render::ParseGlBackend(args.backend);
-    gl.threads = args.threads;
-    auto context = render::OffscreenContext::Create(gl);
+    auto context = render::OffscreenContext::Create(ToOffscreenOptions(args.gl));
     render::ArOptions options;
     options.antialiasing = render::ParseAntialiasing(args.antialiasing);
     options.shadow = !args.no_shadow;
@@ -153,12 +150,7 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--light", args->light, "Room light file (default: the scene's <scene>.light.yml)");
   cmd->add_flag("--no-cast-shadow", args->no_cast_shadow, "No shadow from the room's dominant light");
   cmd->add_flag("--no-occlusion", args->no_occlusion, "Do not let the scene proxy hide the character");
-  cmd->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
-      ->default_val(args->backend)
-      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
-  cmd->add_option("--gl-threads", args->threads, "llvmpipe rasterizer threads (LP_NUM_THREADS)")
-      ->default_val(args->threads)
-      ->check(CLI::Range(0, 32));
+  AddGlFlags(cmd, args->gl);
   cmd->callback([args] { RunRender(*args); });
 }
 

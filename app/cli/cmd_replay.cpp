@@ -82,7 +82,7 @@ void AddReplayCommand(CLI::App& app) {
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();
     std::printf("%s", PipelineReportText(result.report).c_str());
-    std::printf("renderer: %s\n%s %s\n", result.renderer.c_str(), to_window ? "shown in" : "wrote",
+    std::printf("%s %s\n", to_window ? "shown in" : "wrote",
                 to_window ? result.output.c_str() : a->out.c_str());
   });
 }

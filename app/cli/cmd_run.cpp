@@ -85,7 +85,7 @@ void AddRunCommand(CLI::App& app) {
     }
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
     std::printf("%s", PipelineReportText(result.report).c_str());
-    std::printf("renderer: %s\noutput: %s\n", result.renderer.c_str(), result.output.c_str());
+    std::printf("output: %s\n", result.output.c_str());
     if (result.seconds_to_first_output >= 0) {
       std::printf("first frame shown %.2f s after the command started (start-up: tracker %.2f s, characters %.2f s, "
                   "renderer %.2f s; then the first frame's relocalization and render)\n",

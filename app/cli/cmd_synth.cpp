@@ -5,6 +5,7 @@
 #include <map>
 
 #include "app/cli/commands.h"
+#include "app/cli/gl_flags.h"
 #include "app/cli/numeric_flags.h"
 #include "synth/synth_room.h"
 
@@ -16,7 +17,7 @@ struct SynthArgs {
   synth::SynthRoomOptions options;
   std::string out;
   std::string data_dir = synth::kOpenCvDocData;
-  std::string backend = "auto";
+  GlFlags gl{2};
   std::string size = "640x480";
   bool quiet = false;
 };
@@ -30,7 +31,7 @@ void RunSynthRoom(SynthArgs& args) {
   o.height = size.height;
   const auto start = std::chrono::steady_clock::now();
   try {
-    o.gl.backend = render::ParseGlBackend(args.backend);
+    o.gl = ToOffscreenOptions(args.gl);
     const synth::SynthRoomReport report = synth::SynthesizeRoom(o, [&](int done, int total) {
       if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
     });
@@ -76,13 +77,7 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--rolling-shutter", o.rolling_shutter_s,
                    "Rolling-shutter readout time top to bottom, seconds (0 = global shutter)")
       ->default_val(o.rolling_shutter_s);
-  room->add_option("--gl", args->backend, "OpenGL backend: auto (OSMesa, else EGL), osmesa or egl")
-      ->default_val(args->backend)
-      ->check(CLI::IsMember({"auto", "osmesa", "egl"}));
-  room->add_option("--gl-threads", o.gl.threads, "llvmpipe rasterizer threads (LP_NUM_THREADS)")
-      ->default_val(2)
-      ->check(CLI::Range(0, 32));
-  o.gl.threads = 2;
+  AddGlFlags(room, args->gl);
   room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
   room->add_option("--path", o.walk,
                    "Camera walk: room (round the room's centre, looking at the walls) or orbit (two laps round the "

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/cli/commands.h"
+#include "app/cli/gl_flags.h"
 #include "app/cli/numeric_flags.h"
 #include "base/atomic_file.h"
 #include "app/pipeline/pipeline_report.h"
@@ -29,9 +30,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct ViewArgs {
-  std::string scene, character, size = "1280x720", orbit, out, stats, aa = "msaa", gl = "auto";
+  std::string scene, character, size = "1280x720", orbit, out, stats, aa = "msaa";
   double fov = 45, fps = 30, fps_limit = 60, seconds = 0;
-  int gl_threads = 2;
+  GlFlags gl{2};
   bool no_hud = false, no_help = false, json = false;
 };
 
@@ -81,8 +82,7 @@ ViewOptions Options(const ViewArgs& a) {
   o.character = a.character;
   o.hud = !a.no_hud;
   o.help = !a.no_help;
-  o.gl.backend = render::ParseGlBackend(a.gl);
-  o.gl.threads = a.gl_threads;
+  o.gl = ToOffscreenOptions(a.gl);
   o.ar.antialiasing = render::ParseAntialiasing(a.aa);
   return o;
 }
@@ -200,8 +200,7 @@ void AddViewCommand(CLI::App& app) {
   cmd->add_option("--stats", a->stats, "Write frame rate and per-stage timings as JSON");
   cmd->add_flag("--json", a->json, "Window: print the final state (camera, viewpoint, weights, keys, timings) as JSON");
   cmd->add_option("--aa", a->aa, "Antialiasing: msaa (4x) or none")->capture_default_str();
-  cmd->add_option("--gl", a->gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
-  cmd->add_option("--gl-threads", a->gl_threads, "llvmpipe rasterizer threads")->capture_default_str()->check(CLI::Range(0, 16));
+  AddGlFlags(cmd, a->gl);
   cmd->callback([a] {
     if (a->orbit.empty() != a->out.empty()) throw CommandError("--orbit and --out go together: --orbit <spec> --out orbit.mp4");
     try {

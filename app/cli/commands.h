@@ -33,5 +33,6 @@ void AddViewCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);
 void AddDemoCommand(CLI::App& app);
+void AddInfoCommand(CLI::App& app);
 
 }  // namespace arview::app

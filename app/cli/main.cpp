@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
   AddReplayCommand(app);
   AddRunCommand(app);
   AddDemoCommand(app);
+  AddInfoCommand(app);
   GuardNumericOptions(app);  // NaN, infinities and negative unsigned values are refused
 
   // CLI11 would report an unknown command as a missing subcommand; name it instead.

@@ -36,10 +36,7 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--hud", f.hud, "Draw the view-sphere overlay: key viewpoints coloured by weight, the current viewpoint");
-  cmd->add_option("--gl", f.gl, "OpenGL backend: auto, osmesa or egl")->capture_default_str();
-  cmd->add_option("--gl-threads", f.gl_threads, "llvmpipe rasterizer threads (the tracker needs the other core)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 16));
+  AddGlFlags(cmd, f.gl);
   cmd->add_option("--prefetch-below", f.prefetch_below,
                   "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive, so "
                   "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
@@ -65,8 +62,7 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.scene_file = f.scene;
   o.trajectory_out = f.trajectory;
   o.stats_out = f.stats;
-  o.compositor.gl.backend = render::ParseGlBackend(f.gl);
-  o.compositor.gl.threads = f.gl_threads;
+  o.compositor.gl = ToOffscreenOptions(f.gl);
   o.compositor.hmd = f.hmd || !f.hmd_profile.empty();
   if (!f.hmd_profile.empty()) o.compositor.hmd_profile = render::LoadHmdProfile(f.hmd_profile);
   if (f.stereo_character && !o.compositor.hmd) throw CommandError("--stereo-character needs --hmd or --hmd-profile");

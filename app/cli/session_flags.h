@@ -5,17 +5,18 @@
 
 #include "app/session/ar_session.h"
 #include "app/cli/commands.h"
+#include "app/cli/gl_flags.h"
 
 namespace arview::app {
 
 struct SessionFlags {
-  std::string scene, trajectory, stats, gl = "auto", aa = "msaa";
+  std::string scene, trajectory, stats, aa = "msaa";
+  GlFlags gl;  // 1 llvmpipe thread: the tracker needs the other core
   std::string lighting = "auto", light;  // see app/placement/scene_lighting.h
   bool hmd = false, hud = false, stereo_character = false;
   std::string hmd_profile, window_output;
   bool fullscreen = false;
   double ipd = 0.064, hold = 0.5, fade = 1.0;
-  int gl_threads = 1;
   int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below
   double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
 };

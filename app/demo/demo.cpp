@@ -383,9 +383,7 @@ void RunDemo(const DemoOptions& o) {
   const fs::path work = o.work;
   fs::create_directories(work);
   const fs::path out = o.out.empty() ? work / "demo.mp4" : fs::path(o.out);
-  render::OffscreenOptions gl;
-  gl.backend = render::ParseGlBackend(o.gl);
-  gl.threads = o.gl_threads;
+  const render::OffscreenOptions& gl = o.gl;
   const ScopedSignalCancellation signals;
 
   Step(1, "Rendering a walk of two laps round the character's spot, with exact ground truth");

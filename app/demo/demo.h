@@ -13,6 +13,8 @@
 
 #include <string>
 
+#include "render/offscreen.h"
+
 namespace arview::app {
 
 struct DemoOptions {
@@ -22,8 +24,7 @@ struct DemoOptions {
   int map_every = 7;
   std::string character = "builtin:figure";
   double height = 1.72;  // metres
-  std::string gl = "auto";
-  int gl_threads = 1;
+  render::OffscreenOptions gl;  // auto, 1 llvmpipe thread (the tracker needs the other core)
   bool hmd = false;
   bool no_hud = false;
   double greet_within = 1.4;  // metres

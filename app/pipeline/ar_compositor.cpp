@@ -32,6 +32,7 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   }
   description_ = context_->Description();
   if (options_.hmd && options_.hmd_profile) presenter_.emplace(*options_.hmd_profile, renderer_->pinhole());
+  context_->ReleaseCurrent();  // for the render thread (BindToThread)
 }
 
 std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) const {
@@ -82,7 +83,19 @@ std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose
   };
 }
 
+// The context is made on the constructing thread and used on the render thread: EGL lets a
+// context be current on one thread at a time, so each hands it over explicitly.
 void ArCompositor::BindToThread() { context_->MakeCurrent(); }
+void ArCompositor::UnbindFromThread() { context_->ReleaseCurrent(); }
+
+ArCompositor::~ArCompositor() {
+  // The renderer's GL objects are deleted on this thread: the context must be current here.
+  try {
+    context_->MakeCurrent();
+  } catch (const render::RenderError&) {
+    // Not current: the driver frees the objects with the context.
+  }
+}
 
 cv::Size ArCompositor::OutputSizeFor(const calib::Camera& camera, const CompositorOptions& options) {
   if (options.hmd && options.hmd_profile) return options.hmd_profile->panel;

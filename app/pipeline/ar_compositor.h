@@ -39,12 +39,15 @@ class ArCompositor : public FrameCompositor {
   // The characters must outlive the compositor.
   ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
                const CompositorOptions& options);
+  ~ArCompositor() override;
   void BindToThread() override;
+  void UnbindFromThread() override;
   cv::Mat Compose(const FrameToCompose& input) override;
   // The HUD (CompositorOptions::hud), drawn on the sink's thread.
   std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& input) override;
   // The GL context's description.
   std::string Description() const { return description_; }
+  const render::RendererInfo& Renderer() const { return context_->info(); }
   // What loading the characters is worth telling the user (the PRT transfer's time and its
   // cache), for the command to print as `note:` lines.
   const std::vector<std::string>& LoadNotes() const { return load_notes_; }

@@ -272,6 +272,10 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       [&] {
         NameThisThread("arview-render");
         compositor.BindToThread();
+        struct Unbind {
+          FrameCompositor& compositor;
+          ~Unbind() { compositor.UnbindFromThread(); }
+        } unbind{compositor};
         while (auto item = to_render.Pop()) {
           if (error.failed() || stopped()) break;
           item->log.timeline.render_start = item->MsSinceCapture();

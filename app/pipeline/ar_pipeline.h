@@ -39,6 +39,9 @@ class FrameCompositor {
   virtual ~FrameCompositor() = default;
   // Called once on the render thread before the first frame (e.g. to bind a GL context).
   virtual void BindToThread() {}
+  // Called on the render thread after the last frame, however it ends (e.g. to release the context
+  // for the thread that destroys it).
+  virtual void UnbindFromThread() {}
   // The output picture: the video frame, with the character drawn over it when tracked.
   virtual cv::Mat Compose(const FrameToCompose& input) = 0;
   // Drawing over the composed picture that can wait for the sink's thread (the HUD), called on

@@ -49,7 +49,7 @@ std::map<std::string, TimingSummary> TrackTimesByStatus(const PipelineReport& re
 
 }  // namespace
 
-std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_description) {
+std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_description, const render::RendererInfo& gl) {
   nlohmann::ordered_json j;
   j["frames_read"] = r.frames_read;
   j["frames_processed"] = r.frames_processed;
@@ -63,6 +63,9 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
   j["frames_per_second"] = r.fps;
   j["cpu_ms_per_frame"] = r.cpu_ms_per_frame;
   j["renderer"] = gl_description;
+  j["gl"] = {{"backend", ToString(gl.backend)}, {"device", gl.device},   {"vendor", gl.vendor},
+             {"renderer", gl.renderer},         {"version", gl.version}, {"software", gl.software},
+             {"llvmpipe_threads", gl.threads}};
   nlohmann::ordered_json& stages = j["stages"] = nlohmann::ordered_json::object();
   for (const auto& [stage, s] : r.stages) stages[stage] = TimingJson(s);
   nlohmann::ordered_json& by_status = j["tracker_time_by_status"] = nlohmann::ordered_json::object();

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/pipeline/ar_pipeline.h"
+#include "render/offscreen.h"
 
 namespace arview::app {
 
@@ -19,7 +20,9 @@ struct GazeSummary {
 GazeSummary SummarizeGaze(const PipelineReport& report);
 // The timing object of stats.json: {count, median_ms, p95_ms, mean_ms, max_ms}.
 nlohmann::ordered_json TimingJson(const TimingSummary& summary);
-std::string PipelineReportJson(const PipelineReport& report, const std::string& gl_description);
+// `gl`: what rendered (stats.json's "gl": backend, device, vendor, renderer, version, software).
+std::string PipelineReportJson(const PipelineReport& report, const std::string& gl_description,
+                               const render::RendererInfo& gl = {});
 std::string PipelineReportText(const PipelineReport& report);
 
 }  // namespace arview::app

@@ -91,6 +91,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   const double characters_seconds = seconds_of_step();
   ArCompositor compositor(map.camera, character_ptrs, o.compositor);
   const double renderer_seconds = seconds_of_step();
+  if (!o.quiet) std::cerr << "renderer: " << compositor.Description() << "\n";
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
@@ -129,7 +130,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                               (unwritten.empty() ? std::string("nothing to keep") : "not written: " + unwritten));
   }
 
-  SessionResult result{std::move(report), compositor.Description(), sink->Describe()};
+  SessionResult result{std::move(report), compositor.Description(), compositor.Renderer(), sink->Describe()};
   result.tracker_seconds = tracker_seconds;
   result.characters_seconds = characters_seconds;
   result.renderer_seconds = renderer_seconds;
@@ -139,7 +140,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
-  if (!o.stats_out.empty()) WriteFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer));
+  if (!o.stats_out.empty()) WriteFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer, result.renderer_info));
   return result;
 }
 

@@ -45,6 +45,7 @@ struct SessionOptions {
 struct SessionResult {
   PipelineReport report;
   std::string renderer;
+  render::RendererInfo renderer_info;
   std::string output;  // the sink's description ("window \"arview\" (MIT-SHM)", a file, ...)
   double seconds_to_first_output = -1;  // from SessionOptions::command_start; < 0: no frame shown
   // What the start-up took before the first frame was asked for, in seconds: the tracker (its
