@@ -8,13 +8,16 @@
 //   BM_ArFrameLit[NoAa]/<c>     the same with the room's light (issue 14): SH through self-shadowed
 //                                PRT, exposure follower, cast shadow, depth-only occluder proxy;
 //                                counter prt_precompute_s: the PRT ray casting at AddCharacter
+//   BM_ArFrameLit1080p/tube25k   the lit 25k-triangle frame at 1920x1080 (same field of view)
+//   BM_Readback1080p/<way>       clear, resolve and read back a 4x MSAA 1920x1080 target: direct
+//                                (glReadPixels) or pixel_buffer (a fence, then a map)
 //   BM_UndistortBackground       cv::remap of a 640x480 frame with precomputed maps (the cost of
 //                                lens distortion in the AR path)
 //   BM_SynthRoomFrame            one frame of `arview synth room` (render + read-back, no PNG),
 //                                at poses spread over the default 10 s path
 // llvmpipe's thread count is fixed per process: run once per count,
 //   bench_render --gl_threads=1    and    bench_render --gl_threads=2
-// (also --gl=osmesa|egl). Characters come from ../shared/data; missing ones are skipped.
+// (also --gl=auto|egl-device|egl|osmesa, and --gl_device=N; ARVIEW_GL_DEVICE is honoured). Characters come from ../shared/data; missing ones are skipped.
 
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
@@ -57,7 +60,13 @@ OffscreenContext& Context() {
   return *context;
 }
 
-calib::Camera BenchCamera() { return calib::Camera::Pinhole(640, 480, 525, 525, 319.5, 239.5); }
+// 640x480 by default; another size keeps the horizontal field of view (1920x1080: fx 1575).
+calib::Camera BenchCamera(cv::Size size = {640, 480}) {
+  const double f = 525.0 * size.width / 640;
+  return calib::Camera::Pinhole(size.width, size.height, f, f, 0.5 * size.width - 0.5, 0.5 * size.height - 0.5);
+}
+
+const cv::Size k1080p(1920, 1080);
 
 // A standing tube of `rings` x `segments` vertices bound to a chain of joints along its axis
 // (model space: y up, 1.6 m tall), with a clip that bends it back and forth.
@@ -157,8 +166,8 @@ Subject* GetSubject(const std::string& name) {
   return (cache[name] = std::move(subject)).get();
 }
 
-cv::Mat Background() {
-  cv::Mat image(480, 640, CV_8UC3);
+cv::Mat Background(cv::Size size = {640, 480}) {
+  cv::Mat image(size, CV_8UC3);
   cv::randu(image, cv::Scalar::all(0), cv::Scalar::all(255));
   cv::GaussianBlur(image, image, {0, 0}, 3);
   return image;
@@ -177,11 +186,10 @@ void AppendBox(std::vector<Eigen::Vector3f>& out, const Eigen::Vector3f& lo, con
 // its full per-frame work), the room as the proxy, and the room plus a pillar beside the
 // character (inside the drawn rectangle, hiding none of it: the depth pass costs in full) as
 // occluders.
-RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_pose) {
+RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_pose, const calib::Camera& camera) {
   RoomLight light;
   light.sh = ConstantSh({0.25, 0.25, 0.27}) + CapSh(Eigen::Vector3d(-0.5, -0.4, 0.77).normalized(), 0.1, {40, 36, 30});
   light.dominant = ExtractDominantLight(light.sh);
-  const calib::Camera camera = BenchCamera();
   light.thumbnails.push_back({camera_pose, LinearThumbnail(background, 40), {camera.fx, camera.fy, camera.cx, camera.cy}, camera.Size()});
   AppendBox(light.scene_triangles, {-3, -3, 0}, {3, 3, 2.8});
   // The occluders, as arview place makes them: without the character's floor (z = 0).
@@ -198,7 +206,7 @@ RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_po
 enum class LitPart { kNothing, kCastShadow, kOcclusion, kPrt, kExposure };
 
 void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing, bool lit = false,
-                LitPart without = LitPart::kNothing) {
+                LitPart without = LitPart::kNothing, cv::Size size = {640, 480}) {
   Subject* subject = GetSubject(name);
   if (subject == nullptr) {
     state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
@@ -209,11 +217,12 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   if (lit) options.lighting = without == LitPart::kPrt ? LightingMode::kShUnshadowed : LightingMode::kShShadowed;
   options.cast_shadow = without != LitPart::kCastShadow;
   options.occlusion = without != LitPart::kOcclusion;
-  ArRenderer renderer(Context(), BenchCamera(), options);
+  const calib::Camera camera = BenchCamera(size);
+  ArRenderer renderer(Context(), camera, options);
   renderer.AddCharacter(subject->animated->character(), subject->spec.placement());
-  const cv::Mat background = Background();
+  const cv::Mat background = Background(size);
   if (lit) {
-    RoomLight light = BenchRoomLight(background, subject->camera_pose);
+    RoomLight light = BenchRoomLight(background, subject->camera_pose, camera);
     if (without == LitPart::kExposure) light.thumbnails.clear();  // the follower then keeps gain 1
     renderer.SetRoomLight(light);
     state.counters["prt_precompute_s"] = renderer.prt_seconds();
@@ -243,6 +252,7 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   for (const auto& m : subject->character->meshes) triangles += static_cast<int>(m.indices.size() / 3);
   state.counters["triangles"] = triangles;
   state.counters["gl_threads"] = Context().threads();
+  state.counters["pixel_buffer"] = renderer.reads_through_pixel_buffer();
 }
 
 void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa); }
@@ -251,6 +261,37 @@ void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(stat
 // shadow from the dominant light and a depth-only occluder proxy, on top of BM_ArFrame.
 void BM_ArFrameLit(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa, true); }
 void BM_ArFrameLitNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone, true); }
+
+// The same at 1920x1080 (the field of view kept: the character covers the same share).
+void BM_ArFrameLit1080p(benchmark::State& state, std::string name) {
+  RunArFrame(state, name, Antialiasing::kMsaa, true, LitPart::kNothing, k1080p);
+}
+
+// Resolving a 4x multisampled 1920x1080 target and reading it back, directly (glReadPixels into
+// memory) or through a pixel buffer (PixelReadback: a copy into a buffer, a fence, a map). On a
+// GPU the direct read waits for the GPU; on llvmpipe both are CPU copies.
+void BM_Readback1080p(benchmark::State& state, bool pixel_buffer) {
+  const GlApi& gl = Context().gl();
+  RenderTarget target(gl, k1080p.width, k1080p.height, 4);
+  PixelReadback readback(gl);
+  const cv::Rect all(cv::Point(0, 0), k1080p);
+  std::uint64_t checksum = 0;
+  const double cpu_start = ProcessCpuSeconds();
+  for (auto _ : state) {
+    target.Bind();
+    gl.ClearColor(0.2f, 0.4f, 0.6f, 1.0f);
+    gl.Clear(GL_COLOR_BUFFER_BIT);
+    if (pixel_buffer) {
+      target.StartReadBgra(all, readback);
+      checksum += readback.Map().data[0];
+      readback.Unmap();
+    } else {
+      checksum += target.ReadBgraBottomUp(all).data[0];
+    }
+  }
+  benchmark::DoNotOptimize(checksum);
+  CountProcessCpu(state, cpu_start);
+}
 
 // The lit frame without one of its parts: where its added cost goes.
 void BM_ArFrameLitWithout(benchmark::State& state, std::string name, LitPart part) {
@@ -309,6 +350,9 @@ BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_prt, std::string("tube25k"), Lit
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_exposure, std::string("tube25k"), LitPart::kExposure)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameLit1080p, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Readback1080p, direct, false)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Readback1080p, pixel_buffer, true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -322,6 +366,8 @@ int main(int argc, char** argv) {
   for (int i = 0; i < argc; ++i) {
     if (std::strncmp(argv[i], "--gl_threads=", 13) == 0) {
       arview::render::g_gl.threads = std::atoi(argv[i] + 13);
+    } else if (std::strncmp(argv[i], "--gl_device=", 12) == 0) {
+      arview::render::g_gl.device = std::atoi(argv[i] + 12);
     } else if (std::strncmp(argv[i], "--gl=", 5) == 0) {
       try {
         arview::render::g_gl.backend = arview::render::ParseGlBackend(argv[i] + 5);

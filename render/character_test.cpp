@@ -419,7 +419,11 @@ TEST_F(FoxTest, EglDevicePlatformDrawsTheSameFramesAsOsMesa) {
   const std::vector<cv::Mat> a = FoxFrames(*osmesa, *fox_, {});
   const std::vector<cv::Mat> b = FoxFrames(*device, *fox_, {});
   ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i) EXPECT_LE(WorstDifference(a[i], b[i]), 1) << "frame " << i;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double worst = WorstDifference(a[i], b[i]);
+    std::printf("frame %zu: largest difference %.0f\n", i, worst);
+    EXPECT_LE(worst, 1) << "frame " << i;
+  }
   testing::SharedContext();  // current again for the tests that follow
 }
 

@@ -87,7 +87,7 @@ void PrintText(const render::GlProbe& probe) {
     if (!a.failure.empty()) std::printf("  passed over %s: %s\n", a.candidate.Name().c_str(), a.failure.c_str());
   if (!any_gpu) {
     std::printf("No GPU renderer: arview renders on the CPU (llvmpipe). With a GPU, install its EGL driver "
-                "(NVIDIA: the driver's libEGL_nvidia0; AMD, Intel: libegl-mesa0) and check here again "
+                "(NVIDIA: the driver's libegl-nvidia0; AMD, Intel: libegl-mesa0) and check here again "
                 "(docs/render.md, \"Rendering on a GPU\").\n");
   }
 }
