@@ -328,6 +328,12 @@ cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
   return frame;
 }
 
+void ArRenderer::WarmUp(const calib::Pose& pose, std::span<const anim::AnimatorFrame* const> frames) {
+  UpdateCastShadows(frames);
+  cv::Mat frame = PrepareBackground(cv::Mat());
+  Compose(frame, pose, frames);
+}
+
 cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
                                      std::span<const anim::AnimatorFrame* const> frames, double ipd_m) {
   if (!(ipd_m >= 0 && ipd_m < 0.5)) throw RenderError("interpupillary distance must be in [0, 0.5) m");

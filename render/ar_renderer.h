@@ -97,6 +97,11 @@ class ArRenderer {
   cv::Mat RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,
                            std::span<const anim::AnimatorFrame* const> frames, double ipd_m);
 
+  // Draws `frames` from `pose` once into a scratch frame and leaves no trace in what later frames
+  // look like (the exposure followed is untouched): the shaders compile and llvmpipe builds its
+  // pipeline state now (about 1 s, and more on a loaded machine), not at the first live frame.
+  void WarmUp(const calib::Pose& pose, std::span<const anim::AnimatorFrame* const> frames);
+
   // The room's light: SH and dominant light for the SH lighting modes and the cast shadow, the
   // keyframe thumbnails the live exposure is followed against, the occluder triangles.
   void SetRoomLight(const room::RoomLight& light);

@@ -111,7 +111,8 @@ TEST_F(LiveFaults, AHalvedFrameRateIsOneNote) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.err, m, std::regex(R"(note: /dev/video-arview-fake: frames arrive at ([0-9.]+) per second, down from ([0-9.]+))")))
       << r.err;
-  EXPECT_LT(std::stod(m[1]), 0.6 * std::stod(m[2]));
+  // Below 60 % of the best rate, as the note prints them (to 0.1: 18.0 of 30.0 may be 17.96 of 29.98).
+  EXPECT_LT(std::stod(m[1]), 0.6 * std::stod(m[2]) + 0.1);
   EXPECT_NEAR(std::stod(m[2]), 30, 3);
 }
 

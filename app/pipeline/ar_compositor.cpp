@@ -3,6 +3,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <chrono>
 #include <cstdio>
 
 #include "anim/character_bounds.h"
@@ -12,11 +13,11 @@
 namespace arview::app {
 
 ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
-                           const CompositorOptions& options)
+                           const CompositorOptions& options, std::unique_ptr<render::OffscreenContext> context)
     : camera_(camera), characters_(std::move(characters)), options_(options), hud_visible_(options.hud) {
-  // Created here, before the pipeline's threads start: creating a context sets LP_NUM_THREADS
-  // in the environment, which must not race with other threads.
-  context_ = render::OffscreenContext::Create(options_.gl);
+  // Created before the pipeline's threads start: creating a context sets LP_NUM_THREADS in the
+  // environment, which must not race with other threads.
+  context_ = context ? std::move(context) : render::OffscreenContext::Create(options_.gl);
   renderer_ = std::make_unique<render::ArRenderer>(*context_, camera_, options_.ar);
   if (options_.room_light) renderer_->SetRoomLight(*options_.room_light);
   for (const anim::PlacedCharacter* c : characters_) {
@@ -81,6 +82,49 @@ std::function<void(cv::Mat&)> ArCompositor::DeferredOverlay(const FrameToCompose
       hud(half, eye == 0 ? -half_ipd : half_ipd);
     }
   };
+}
+
+namespace {
+
+// From in front of the character and a little above, looking at its middle.
+calib::Pose InFrontOf(const anim::Placement& placement, double height) {
+  const Eigen::Matrix3d rotation = placement.Rotation();
+  const Eigen::Vector3d origin = placement.ModelToMap().col(3).head<3>();
+  const Eigen::Vector3d up = (rotation * placement.up).normalized();
+  const Eigen::Vector3d front = (rotation * placement.forward).normalized();
+  const double h = height > 0 ? height : 1.0;
+  const Eigen::Vector3d eye = origin + 2.5 * h * front + 0.6 * h * up, target = origin + 0.5 * h * up;
+  const Eigen::Vector3d forward = (target - eye).normalized();
+  const Eigen::Vector3d right = forward.cross(up).normalized();
+  Eigen::Matrix3d r_wc;
+  r_wc << right, forward.cross(right), forward;  // camera x right, y down, z forward
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
+}
+
+}  // namespace
+
+double ArCompositor::WarmUp() {
+  if (characters_.empty()) return 0;
+  const auto start = std::chrono::steady_clock::now();
+  context_->MakeCurrent();
+  std::vector<anim::FrameBuffers> buffers;
+  buffers.reserve(characters_.size());
+  std::vector<anim::AnimatorFrame> frames(characters_.size());
+  std::vector<const anim::AnimatorFrame*> frame_ptrs;
+  for (size_t i = 0; i < characters_.size(); ++i) {
+    const anim::Skeleton& skeleton = characters_[i]->character().skeleton;
+    buffers.emplace_back(skeleton);
+    buffers.back().Finish(skeleton, frames[i], "warm-up pose", "warm-up skinning");
+    frame_ptrs.push_back(&frames[i]);
+  }
+  const calib::Pose pose = InFrontOf(characters_[0]->placement(), heights_[0]);
+  if (options_.hmd && options_.stereo_character) {
+    renderer_->WarmUp(render::OffsetEye(pose, -0.5 * options_.ipd_m), frame_ptrs);
+  } else {
+    renderer_->WarmUp(pose, frame_ptrs);
+  }
+  context_->ReleaseCurrent();  // for the render thread (BindToThread)
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // The context is made on the constructing thread and used on the render thread: EGL lets a

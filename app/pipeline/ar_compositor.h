@@ -36,10 +36,15 @@ struct CompositorOptions {
 
 class ArCompositor : public FrameCompositor {
  public:
-  // The characters must outlive the compositor.
+  // The characters must outlive the compositor. `context`: one made already (on this thread) with
+  // options.gl; null: made here.
   ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
-               const CompositorOptions& options);
+               const CompositorOptions& options, std::unique_ptr<render::OffscreenContext> context = nullptr);
   ~ArCompositor() override;
+  // Draws the characters once, in their rest pose, from in front of the first, on the calling
+  // thread (the context made current there and released again): the shaders' compilation and
+  // llvmpipe's first draw, otherwise paid by the first live frame (1-3 s). Returns the seconds.
+  double WarmUp();
   void BindToThread() override;
   void UnbindFromThread() override;
   cv::Mat Compose(const FrameToCompose& input) override;

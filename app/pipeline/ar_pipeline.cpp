@@ -139,9 +139,13 @@ namespace {
 
 // The render stage's work on one frame: the characters animated (from the smoothed camera
 // centre, or nothing when the frame was lost), composed over the video, and the overlay kept for
-// the sink to draw; the frame's log gets what was animated.
+// the sink to draw; the frame's log gets what was animated. The animation's clock starts at the
+// first frame composed (`first_timestamp`, set then): a camera stamps its frames with the time
+// since the machine started and an imported dataset with the Unix time, and the idle layers
+// build their motion from time 0 up to the first time they are asked for (7 h of uptime cost
+// the first live frame 1 s; a Unix time would have taken hours).
 void AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animators, FrameCompositor& compositor,
-                       StageStats& stats) {
+                       StageStats& stats, std::optional<double>& first_timestamp) {
   FrameLog& log = item.log;
   log.track = item.track;
   const bool localized = item.track.status != tracker::TrackStatus::kLost;
@@ -150,8 +154,10 @@ void AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animato
     const Clock::time_point t0 = Clock::now();
     std::optional<Eigen::Vector3d> centre;
     if (localized) centre = item.track.smoothed_center;
+    if (!first_timestamp) first_timestamp = item.frame.timestamp;
+    const double animation_time = item.frame.timestamp - *first_timestamp;
     for (LayeredAnimator* animator : animators) {
-      compose.animations.push_back(&animator->Update(centre, item.frame.timestamp));
+      compose.animations.push_back(&animator->Update(centre, animation_time));
     }
     log.idle_weight = compose.animations.front()->idle_weight();
     log.actions_triggered = compose.animations.front()->triggered;
@@ -276,10 +282,11 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
           FrameCompositor& compositor;
           ~Unbind() { compositor.UnbindFromThread(); }
         } unbind{compositor};
+        std::optional<double> first_timestamp;
         while (auto item = to_render.Pop()) {
           if (error.failed() || stopped()) break;
           item->log.timeline.render_start = item->MsSinceCapture();
-          AnimateAndCompose(*item, animators, compositor, stats);
+          AnimateAndCompose(*item, animators, compositor, stats, first_timestamp);
           item->log.timeline.render_end = item->MsSinceCapture();
           // The pose is kept whether or not the frame is shown: a frame dropped before the sink
           // was still tracked.

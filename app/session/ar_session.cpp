@@ -6,8 +6,11 @@
 
 #include <cstdio>
 #include <algorithm>
+#include <exception>
 #include <memory>
 #include <iostream>
+#include <optional>
+#include <thread>
 
 #include "base/atomic_file.h"
 #include "app/pipeline/pipeline_report.h"
@@ -68,10 +71,32 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     step = now;
     return seconds;
   };
-  tracker::Tracker tracker(map, o.tracker);
-  tracker.WarmUp();  // before the first frame, so that its latency is a relocalization's only
-  if (!o.quiet && !tracker.index_note().empty()) std::cerr << "note: " << tracker.index_note() << "\n";
-  const double tracker_seconds = seconds_of_step();
+  // The GL context first: creating it sets LP_NUM_THREADS, which must not race with another
+  // thread's getenv. Then the tracker starts (its descriptor index, its warm-up: about 1 s) on a
+  // thread of its own while this one loads the characters and warms the renderer up (its shaders
+  // and llvmpipe's first draw: 1-3 s on a loaded machine), so that the first frame pays neither.
+  std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.compositor.gl);
+  const double context_seconds = seconds_of_step();
+  std::optional<tracker::Tracker> tracker;
+  std::exception_ptr tracker_error;
+  double tracker_seconds = 0;
+  std::thread tracker_start([&] {
+    try {
+      const Clock::time_point t0 = Clock::now();
+      tracker.emplace(map, o.tracker);
+      tracker->WarmUp();  // before the first frame, so that its latency is a relocalization's only
+      tracker_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    } catch (...) {
+      tracker_error = std::current_exception();
+    }
+  });
+  // Joins the tracker's thread however this one leaves (a bad scene, a renderer that fails).
+  struct JoinTrackerStart {
+    std::thread& thread;
+    ~JoinTrackerStart() {
+      if (thread.joinable()) thread.join();
+    }
+  } join_tracker_start{tracker_start};
 
   std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
@@ -89,10 +114,15 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   }
 
   const double characters_seconds = seconds_of_step();
-  ArCompositor compositor(map.camera, character_ptrs, o.compositor);
-  const double renderer_seconds = seconds_of_step();
+  ArCompositor compositor(map.camera, character_ptrs, o.compositor, std::move(context));
+  const double renderer_seconds = context_seconds + seconds_of_step();
   if (!o.quiet) std::cerr << "renderer: " << compositor.Description() << "\n";
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
+  const double warmup_seconds = compositor.WarmUp();
+  tracker_start.join();
+  if (tracker_error) std::rethrow_exception(tracker_error);
+  seconds_of_step();
+  if (!o.quiet && !tracker->index_note().empty()) std::cerr << "note: " << tracker->index_note() << "\n";
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
   });
@@ -102,7 +132,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::size_t rss_read_at = 0;
   Clock::time_point status_at{};
   PipelineReport report = RunPipeline(
-      source, tracker, animator_ptrs, compositor, *sink, o.pipeline,
+      source, *tracker, animator_ptrs, compositor, *sink, o.pipeline,
       [&](const PipelineReport& r) {
         // On the sink's thread, which owns the window: its title twice a second.
         if (const Clock::time_point now = Clock::now(); now - status_at > std::chrono::milliseconds(500)) {
@@ -134,6 +164,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   result.tracker_seconds = tracker_seconds;
   result.characters_seconds = characters_seconds;
   result.renderer_seconds = renderer_seconds;
+  result.warmup_seconds = warmup_seconds;
   if (result.report.first_output) {
     result.seconds_to_first_output = std::chrono::duration<double>(*result.report.first_output - command_start).count();
   }

@@ -50,7 +50,8 @@ struct SessionResult {
   double seconds_to_first_output = -1;  // from SessionOptions::command_start; < 0: no frame shown
   // What the start-up took before the first frame was asked for, in seconds: the tracker (its
   // descriptor index) and its warm-up, the characters, the renderer (GL context, PRT).
-  double tracker_seconds = 0, characters_seconds = 0, renderer_seconds = 0;
+  // The tracker's start runs beside the renderer's warm-up (a first draw of the characters).
+  double tracker_seconds = 0, characters_seconds = 0, renderer_seconds = 0, warmup_seconds = 0;
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10
