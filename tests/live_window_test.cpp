@@ -228,3 +228,55 @@ TEST_F(WindowPlacement, OpensOnANamedOutputAndNamesTheOutputsWhenItIsNotThere) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+// The animation's clock starts at the session's first frame. A camera stamps frames with the
+// machine's uptime and an imported dataset (TUM) with Unix times; the idle layers build their
+// motion from time 0 up to the first time they are asked for, so before, the first frame of such
+// a replay built decades of idle motion (hours of work) and a camera's first frame paid 1 s per
+// 7 h of uptime. The same frames stamped from 0 and from 1.7e9 s must animate alike.
+TEST(AnimationClock, ARecordingStampedWithUnixTimesAnimatesAsOneStampedFromZero) {
+  ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+  const fs::path room = SharedRoom();
+  const fs::path dir = fs::temp_directory_path() / ("arview_animation_clock_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  constexpr int kFrames = 12;
+  constexpr double kUnixTime = 1.7e9;
+  for (const auto& [name, offset] : {std::pair<std::string, double>{"zero", 0.0}, {"unix", kUnixTime}}) {
+    fs::create_directories(dir / name / "frames");
+    fs::copy_file(room / "camera.yaml", dir / name / "camera.yaml");
+    std::ofstream list(dir / name / "frames.txt");
+    list << "# timestamp path\n";
+    for (int i = 0; i < kFrames; ++i) {
+      char file[32];
+      std::snprintf(file, sizeof file, "%06d.png", i);
+      fs::copy_file(room / "frames" / file, dir / name / "frames" / file);
+      list << std::fixed << offset + i / 30.0 << " frames/" << file << "\n";
+    }
+  }
+  testing::WriteRandomMap(calib::LoadCamera(room / "camera.yaml"), dir / "map");
+  std::ofstream(dir / "scene.yaml") << "characters:\n  - name: figure\n    asset: builtin:figure\n    anchor:\n"
+                                       "      position: [0, 0, 0]\n      rotation_deg: [90, 0, 0]\n    keys:\n"
+                                       "      - viewpoint: [0, 0, 1]\n        clip: Idle\n";
+  std::vector<nlohmann::json> stats;
+  for (const std::string name : {"zero", "unix"}) {
+    const auto r = testing::RunArview({"replay", (dir / name).string(), "--map", (dir / "map").string(), "--scene",
+                                       (dir / "scene.yaml").string(), "--out", "null", "--stats",
+                                       (dir / (name + ".json")).string()});
+    ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
+    stats.push_back(nlohmann::json::parse(ReadWholeFile((dir / (name + ".json")).string())));
+  }
+  ASSERT_EQ(stats[0]["frames"].size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(stats[1]["frames"].size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_EQ(stats[0]["frames"][i]["idle_weight"], stats[1]["frames"][i]["idle_weight"]) << "frame " << i;
+  }
+  // Building 1.7e9 s of idle motion took far longer than this; from the first frame it is nothing.
+  EXPECT_LT(stats[1]["stages"]["animate"]["max_ms"].get<double>(), 1000.0) << stats[1]["stages"]["animate"];
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
