@@ -267,3 +267,50 @@ TEST(Cli, EvalRefusesPositionsAtOnePointOrOverflowing) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: an empty --align-with file was blamed on the estimate and the ground truth ("est.txt
+// against gt.txt: alignment: only 0 poses share a timestamp"). The file that is empty, or that
+// shares no timestamp with the ground truth, is the one named.
+TEST(Cli, EvalNamesAnEmptyOrUnmatchedAlignWithFile) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_align_with_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream estimate(dir / "est.txt"), groundtruth(dir / "gt.txt"), later(dir / "later.txt");
+    std::ofstream(dir / "empty.txt").close();
+    std::ofstream(dir / "comments.txt") << "# timestamp tx ty tz qx qy qz qw\n\n";
+    for (int i = 0; i < 20; ++i) {
+      char line[160];
+      std::snprintf(line, sizeof line, "%.3f %.6f %.6f %.6f 0 0 0 1\n", i * 0.1, std::cos(i * 0.3), std::sin(i * 0.3),
+                    0.05 * i);
+      estimate << line;
+      groundtruth << line;
+      std::snprintf(line, sizeof line, "%.3f %.6f %.6f %.6f 0 0 0 1\n", 100 + i * 0.1, std::cos(i * 0.3),
+                    std::sin(i * 0.3), 0.05 * i);
+      later << line;
+    }
+  }
+  const std::string est = (dir / "est.txt").string(), gt = (dir / "gt.txt").string();
+  for (const std::string file : {"empty.txt", "comments.txt"}) {
+    const auto r = testing::RunArview({"eval", est, gt, "--align-with", (dir / file).string()});
+    EXPECT_NE(r.exit_code, 0) << r.out;
+    EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("arview: " + (dir / file).string() + ": holds no poses"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("est.txt"), std::string::npos) << r.err;
+  }
+  const auto r = testing::RunArview({"eval", est, gt, "--align-with", (dir / "later.txt").string()});
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find((dir / "later.txt").string() + " (--align-with) against " + gt + ": alignment: only 0 poses"),
+            std::string::npos)
+      << r.err;
+  // The same files without --align-with are scored.
+  EXPECT_EQ(testing::RunArview({"eval", est, gt}).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
