@@ -1,6 +1,7 @@
 #include "map/map_file.h"
 
 #include "base/atomic_file.h"
+#include "base/point_spread.h"
 #include "base/input_guard.h"
 #include "base/stats.h"
 
@@ -308,6 +309,13 @@ Map LoadMap(const fs::path& path) {
   Map map = ReadPayload(body);
   ValidateMap(map, file.string());
   return map;
+}
+
+std::optional<std::string> DegeneratePoints(const Map& map) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(map.points.size());
+  for (const MapPoint& p : map.points) points.push_back(p.xyz);
+  return WhyNotAPlane(points, "points");
 }
 
 MapStats ComputeStats(const Map& map) {

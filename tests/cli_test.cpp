@@ -4,12 +4,15 @@
 
 #include <unistd.h>
 
-#include <filesystem>
-#include <fstream>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <regex>
 
+#include "map/map_file.h"
+#include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
 
@@ -309,6 +312,69 @@ TEST(Cli, EvalNamesAnEmptyOrUnmatchedAlignWithFile) {
       << r.err;
   // The same files without --align-with are scored.
   EXPECT_EQ(testing::RunArview({"eval", est, gt}).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: `arview place` on a map whose points are degenerate said "no floor-like plane ...
+// holds 3 or more of the map's points" without naming the map, and `map info` said nothing.
+// Now place refuses naming the map folder and what is degenerate, and map info warns.
+TEST(Cli, PlaceRefusesADegenerateMapNamingItAndMapInfoWarns) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_degenerate_map_" + std::to_string(::getpid()));
+  calib::Camera camera;
+  camera.width = 640, camera.height = 480, camera.fx = camera.fy = 500, camera.cx = 319.5, camera.cy = 239.5;
+  testing::WriteRandomMap(camera, dir / "random");
+  const map::Map random = map::LoadMap(dir / "random");
+  struct Case {
+    std::string name;
+    std::function<void(map::Map&)> degrade;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"one_spot", [](map::Map& m) { for (auto& p : m.points) p.xyz = Eigen::Vector3d(1, 2, 3); },
+       "lie at one point, (1, 2, 3)"},
+      {"one_line",
+       [](map::Map& m) {
+         for (std::size_t i = 0; i < m.points.size(); ++i) m.points[i].xyz = Eigen::Vector3d(0.01 * i, 0.02 * i, 3);
+       },
+       "lie on one line"},
+      {"scaled_1e-300",
+       [](map::Map& m) {
+         for (auto& p : m.points) p.xyz *= 1e-300;
+         for (auto& k : m.keyframes) k.pose.t_cw *= 1e-300;
+       },
+       "below 1e-100"},
+  };
+  for (const Case& c : cases) {
+    map::Map degraded = random;
+    c.degrade(degraded);
+    const std::filesystem::path map_dir = dir / c.name;
+    std::filesystem::create_directories(map_dir);
+    map::SaveMap(degraded, map_dir / map::kMapFileName);
+    const auto placed = RunArview({"place", map_dir.string(), "--character", "builtin:figure", "--no-light", "--out",
+                                   (dir / "scene.yaml").string()});
+    EXPECT_NE(placed.exit_code, 0) << c.name;
+    EXPECT_EQ(LineCount(placed.err), 1) << placed.err;
+    EXPECT_NE(placed.err.find("arview: " + map_dir.string() + ": the map's points cannot hold a floor: all 400 points"),
+              std::string::npos)
+        << placed.err;
+    EXPECT_NE(placed.err.find(c.says), std::string::npos) << placed.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "scene.yaml"));
+    const auto info = RunArview({"map", "info", map_dir.string()});
+    EXPECT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("warning:             the map's points cannot hold a floor"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find(c.says), std::string::npos) << info.out;
+  }
+  // The random map's points span a volume: no warning.
+  const auto info = RunArview({"map", "info", (dir / "random").string()});
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_EQ(info.out.find("cannot hold a floor"), std::string::npos) << info.out;
   std::filesystem::remove_all(dir);
 }
 

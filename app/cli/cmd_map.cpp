@@ -184,6 +184,10 @@ void RunInfo(const std::string& dir, bool recheck) {
       std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
                 << " is written by arview map since issue 17)\n";
     }
+    if (const auto why = map::DegeneratePoints(map)) {
+      std::cout << "warning:             the map's points cannot hold a floor ('arview place' refuses the map): " << *why
+                << "\n";
+    }
   } catch (const map::MapError& e) {
     throw CommandError(e.what());
   }
