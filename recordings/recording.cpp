@@ -60,6 +60,16 @@ std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
     if (e.path.empty()) {
       throw RecordingError(file.string() + ":" + std::to_string(line_no) + ": frame path missing");
     }
+    // A NUL byte cut every message that quoted the path ("arview: rec/frames/"), and no file name
+    // holds one; other control characters have no place in a frame's name either.
+    const auto control = std::find_if(e.path.begin(), e.path.end(), [](char c) {
+      return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+    });
+    if (control != e.path.end()) {
+      throw RecordingError(file.string() + ":" + std::to_string(line_no) + ": the frame path '" +
+                           PrintableForMessage(e.path) + "' holds the control character " +
+                           PrintableForMessage(std::string(1, *control)) + " (a frame path is printable text)");
+    }
     if (!frames.empty() && e.timestamp <= frames.back().timestamp) {
       throw RecordingError(file.string() + ":" + std::to_string(line_no) +
                            ": timestamps must increase strictly");
