@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "base/input_guard.h"
+#include "base/opencv_matrix.h"
 
 #include "base/atomic_file.h"
 
@@ -139,9 +140,9 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& source, const c
   if (node.empty()) throw CameraError(source + ": field " + name + " is missing");
   cv::Mat m;
   try {
-    node >> m;
-  } catch (const cv::Exception&) {
-    throw CameraError(source + ": field " + name + " is not an OpenCV matrix");
+    ReadOpenCvMatrix(node, m, source + ": field " + name);
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
   }
   if (m.empty()) throw CameraError(source + ": field " + name + " is empty or not a matrix");
   m.convertTo(m, CV_64F);
