@@ -116,8 +116,15 @@ void Camera::Validate(const std::string& source) const {
   // Bounds far beyond any real camera, so that no later pixel arithmetic overflows.
   if (width > 65536) fail("image_width", "is larger than 65536 (is " + std::to_string(width) + ")");
   if (height > 65536) fail("image_height", "is larger than 65536 (is " + std::to_string(height) + ")");
-  if (!(std::isfinite(fx) && fx > 0 && fx <= 1e7)) fail("camera_matrix", "fx must be a positive number up to 1e7");
-  if (!(std::isfinite(fy) && fy > 0 && fy <= 1e7)) fail("camera_matrix", "fy must be a positive number up to 1e7");
+  auto value = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  if (!(std::isfinite(fx) && fx > 0 && fx <= 1e7))
+    fail("camera_matrix", "fx must be a positive number up to 1e7 (is " + value(fx) + ")");
+  if (!(std::isfinite(fy) && fy > 0 && fy <= 1e7))
+    fail("camera_matrix", "fy must be a positive number up to 1e7 (is " + value(fy) + ")");
   if (!(std::isfinite(cx) && cx >= 0 && cx <= width)) {
     fail("camera_matrix", "principal point cx=" + std::to_string(cx) + " lies outside the image width " +
                               std::to_string(width));
@@ -128,7 +135,7 @@ void Camera::Validate(const std::string& source) const {
   }
   for (double d : dist) {
     if (!std::isfinite(d) || std::abs(d) > 1e6) {
-      fail("distortion_coefficients", "holds a value that is not a finite number of at most 1e6");
+      fail("distortion_coefficients", "holds " + value(d) + ", not a finite number of at most 1e6 in magnitude");
     }
   }
 }

@@ -380,3 +380,49 @@ TEST(Cli, PlaceRefusesADegenerateMapNamingItAndMapInfoWarns) {
 
 }  // namespace
 }  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: `render --pose "1e308 0 0 0 0 0 1"` wrote an image, exit 0; a camera with fx = 1e308
+// was refused without its value. Both are one line naming the flag or file, the value and the
+// limit, and no image is written; a pose within the limit renders.
+TEST(Cli, RenderRefusesAPoseOrACameraNoMapCanHold) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_render_limits_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "scene.yaml").string(), good = (dir / "camera.yaml").string(),
+                    huge = (dir / "huge_fx.yaml").string(), out = (dir / "out.png").string();
+  std::ofstream(scene) << "characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    keys:\n"
+                          "      - azimuth: 0\n        generate: lookat\n";
+  const std::string camera_text =
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n"
+      "   rows: 3\n   cols: 3\n   dt: d\n   data: [ FX, 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n";
+  std::ofstream(good) << std::regex_replace(camera_text, std::regex("FX"), "60.");
+  std::ofstream(huge) << std::regex_replace(camera_text, std::regex("FX"), "1e308");
+  auto render = [&](const std::string& camera, const std::string& pose) {
+    return RunArview({"render", "--scene", scene, "--camera", camera, "--pose", pose, "--out", out});
+  };
+  for (const std::string pose : {"1e308 0 0 0 0 0 1", "0 -2e6 0 0 0 0 1"}) {
+    const auto r = render(good, pose);
+    EXPECT_NE(r.exit_code, 0) << pose;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("arview: --pose: the camera position ("), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(pose[0] == '1' ? "1e+308, 0, 0" : "0, -2e+06, 0"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("lies beyond 1e+06 map units"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  const auto r = render(huge, "0 0 -3 0 0 0 1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(huge + ": camera_matrix fx must be a positive number up to 1e7 (is 1e+308)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const auto rendered = render(good, "0 1 -3 0 0 0 1");
+  EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
+  EXPECT_TRUE(std::filesystem::exists(out));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
