@@ -1,5 +1,7 @@
 #include "anim_authoring/scene.h"
 
+#include "base/library_errors.h"
+
 #include "anim_authoring/yaml.h"
 #include "anim/view_sphere.h"
 
@@ -581,9 +583,18 @@ Scene ParseScene(const std::string& text, const fs::path& file) {
   return SceneReader(file.string()).Read(root, file);
 }
 
-Scene LoadScene(const fs::path& path) {
+namespace {
+
+Scene LoadSceneFile(const fs::path& path) {
   const Node root = yaml::ParseFile(path);  // errors name the file
   return SceneReader(path.string()).Read(root, path);
+}
+
+}  // namespace
+
+Scene LoadScene(const fs::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<anim::Error>(path.string(), [&] { return LoadSceneFile(path); });
 }
 
 Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what) {

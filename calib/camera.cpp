@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 #include "base/opencv_matrix.h"
 
 #include "base/atomic_file.h"
@@ -249,7 +250,9 @@ void RequirePinholeMatrix(const cv::Mat& K, const std::string& source) {
 
 }  // namespace
 
-Camera LoadCamera(const std::filesystem::path& path) {
+namespace {
+
+Camera LoadCameraFile(const std::filesystem::path& path) {
   const std::string source = path.string();
   std::string text;
   try {
@@ -288,6 +291,13 @@ Camera LoadCamera(const std::filesystem::path& path) {
   RefuseUnknownKeys(fs, source);
   c.Validate(source);
   return c;
+}
+
+}  // namespace
+
+Camera LoadCamera(const std::filesystem::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<CameraError>(path.string(), [&] { return LoadCameraFile(path); });
 }
 
 void SaveCamera(const Camera& camera, const std::filesystem::path& path) {

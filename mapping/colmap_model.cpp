@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 #include "map/map_file.h"
 
 namespace arview::mapping {
@@ -32,7 +33,7 @@ class BinaryReader {
   // end), in chunks that look at `cancel`.
   BinaryReader(const fs::path& path, const CancellationToken& cancel) : path_(path) {
     try {
-      data_ = ReadFileUpTo(path, kMaxBinaryFileBytes, cancel);
+      data_ = NamingInput<map::MapError>(path.string(), [&] { return ReadFileUpTo(path, kMaxBinaryFileBytes, cancel); });
     } catch (const InputError& e) {
       throw map::MapError(e.what());
     }
@@ -463,7 +464,9 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
   return result;
 }
 
-map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+namespace {
+
+map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
                   const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
                   bool check_values) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
@@ -576,6 +579,17 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
   if (keypoints) *keypoints = AllKeypoints(images);
   if (check_values) RequireModelValuesInRange(map, sparse_dir);
   return map;
+}
+
+}  // namespace
+
+map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+                  const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
+                  bool check_values) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<map::MapError>(sparse_dir.string(), [&] {
+    return ReadColmapModel(sparse_dir, database, frames, cancel, keypoints, check_values);
+  });
 }
 
 void RequireModelValuesInRange(const map::Map& map, const fs::path& sparse_dir) {

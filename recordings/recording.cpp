@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 
 namespace arview::recordings {
 
@@ -35,7 +36,9 @@ cv::Mat Recording::ReadImage(size_t index) const {
   }
 }
 
-std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
+namespace {
+
+std::vector<FrameEntry> ReadFrameListFile(const fs::path& file) {
   // A FIFO or a device (a link to /dev/zero) would never end: only a regular file of sane size.
   std::istringstream in;
   try {
@@ -80,7 +83,16 @@ std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
   return frames;
 }
 
-Recording LoadRecording(const fs::path& root) {
+}  // namespace
+
+std::vector<FrameEntry> ReadFrameList(const fs::path& file) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<RecordingError>(file.string(), [&] { return ReadFrameListFile(file); });
+}
+
+namespace {
+
+Recording LoadRecordingFolder(const fs::path& root) {
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw RecordingError(root.string() + ": recording folder does not exist");
   Recording r;
@@ -117,6 +129,13 @@ Recording LoadRecording(const fs::path& root) {
   const fs::path gt = root / "groundtruth.txt";
   if (fs::exists(gt, ec)) r.groundtruth = ReadTum(gt);
   return r;
+}
+
+}  // namespace
+
+Recording LoadRecording(const fs::path& root) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<RecordingError>(root.string(), [&] { return LoadRecordingFolder(root); });
 }
 
 void PrepareRecordingFolder(const fs::path& out_dir, bool overwrite) {

@@ -1,5 +1,7 @@
 #include "recordings/trajectory.h"
 
+#include "base/library_errors.h"
+
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
 
@@ -18,7 +20,9 @@ std::string ReadRecordingText(const std::filesystem::path& file) {
   }
 }
 
-Trajectory ReadTum(const std::filesystem::path& path) {
+namespace {
+
+Trajectory ReadTumFile(const std::filesystem::path& path) {
   std::istringstream in(ReadRecordingText(path));
   Trajectory out;
   std::string line;
@@ -48,6 +52,13 @@ Trajectory ReadTum(const std::filesystem::path& path) {
     out.push_back({v[0], calib::Pose::FromCameraToWorld(q_wc, {v[1], v[2], v[3]})});
   }
   return out;
+}
+
+}  // namespace
+
+Trajectory ReadTum(const std::filesystem::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<RecordingError>(path.string(), [&] { return ReadTumFile(path); });
 }
 
 void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,

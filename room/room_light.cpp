@@ -12,6 +12,7 @@
 
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 #include "base/opencv_matrix.h"
 
 namespace arview::room {
@@ -274,7 +275,9 @@ void SaveRoomLight(const RoomLight& light, const std::filesystem::path& file) {
   }
 }
 
-RoomLight LoadRoomLight(const std::filesystem::path& file) {
+namespace {
+
+RoomLight LoadRoomLightFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw LightError(file.string() + ": no such room light file");
   // A regular file of bounded size, and the checks OpenCV's reader lacks, before it sees it.
   std::string text;
@@ -347,12 +350,15 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
     throw LightError(e.what());
   } catch (const cv::Exception& e) {
     throw LightError(file.string() + ": unreadable room light file (" + e.msg + ")");
-  } catch (const LightError&) {
-    throw;
-  } catch (const std::exception& e) {  // any other library failure, named by the file
-    throw LightError(file.string() + ": unreadable room light file (" + e.what() + ")");
   }
   return light;
+}
+
+}  // namespace
+
+RoomLight LoadRoomLight(const std::filesystem::path& file) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<LightError>(file.string(), [&] { return LoadRoomLightFile(file); });
 }
 
 ExposureFollower::ExposureFollower(std::vector<KeyframeThumbnail> thumbnails,
