@@ -4,6 +4,7 @@
 
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
+#include "base/point_spread.h"
 
 #include <cmath>
 #include <fstream>
@@ -48,6 +49,13 @@ Trajectory ReadTumFile(const std::filesystem::path& path) {
     if (std::abs(q_wc.norm() - 1.0) > 1e-3) {
       throw RecordingError(path.string() + ":" + std::to_string(line_no) +
                            ": quaternion is not of unit length");
+    }
+    // Beyond kMaxPositionNorm the squares of every error overflow (eval printed an ATE of inf).
+    if (Eigen::Vector3d(v[1], v[2], v[3]).norm() > kMaxPositionNorm) {
+      std::ostringstream message;
+      message << path.string() << ":" << line_no << ": the position (" << v[1] << ", " << v[2] << ", " << v[3]
+              << ") lies beyond " << kMaxPositionNorm << " of the origin";
+      throw RecordingError(message.str());
     }
     out.push_back({v[0], calib::Pose::FromCameraToWorld(q_wc, {v[1], v[2], v[3]})});
   }
