@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <iomanip>
 #include <numeric>
+#include <sstream>
 
 namespace arview::anim {
 namespace {
@@ -27,16 +29,42 @@ double Wrap2Pi(double a) {
 
 }  // namespace
 
+Eigen::Vector3d UnitDirection(const Eigen::Vector3d& v) {
+  auto say = [&](const std::string& problem) {
+    std::ostringstream s;
+    s << std::setprecision(6) << '(' << v.x() << ", " << v.y() << ", " << v.z() << ") " << problem;
+    return Error(s.str());
+  };
+  if (!v.allFinite()) throw say("is not finite");
+  // Scaled by its largest component first: the norm of (1e300, 1e300, 1e300) overflows.
+  const double largest = v.cwiseAbs().maxCoeff();
+  const double length = largest > 0 ? largest * (v / largest).norm() : 0.0;
+  std::ostringstream figure;
+  figure << std::setprecision(3) << length;
+  if (length > kMaxDirectionLength) {
+    std::ostringstream limit;
+    limit << kMaxDirectionLength;
+    throw say("is " + figure.str() + " long, beyond " + limit.str() + " (a direction such as [0, 0, 1] is expected)");
+  }
+  if (!(length >= kMinDirectionLength)) {
+    std::ostringstream limit;
+    limit << kMinDirectionLength;
+    throw say("is " + figure.str() + " long, below " + limit.str() + ": too short to give a direction");
+  }
+  return v / length;
+}
+
 ViewSphere::ViewSphere(std::vector<Eigen::Vector3d> keys, const ViewSphereOptions& options)
     : keys_(std::move(keys)), options_(options) {
   if (keys_.empty()) throw Error("view sphere: no key viewpoints");
   if (!(options_.alpha > 0) || !std::isfinite(options_.alpha))
     throw Error("view sphere: alpha must be positive, got " + std::to_string(options_.alpha));
   for (std::size_t k = 0; k < keys_.size(); ++k) {
-    const double n = keys_[k].norm();
-    if (!(n > 1e-9) || !std::isfinite(n))
-      throw Error("view sphere: key viewpoint " + std::to_string(k) + " has zero length");
-    keys_[k] /= n;
+    try {
+      keys_[k] = UnitDirection(keys_[k]);
+    } catch (const Error& e) {
+      throw Error("view sphere: key viewpoint " + std::to_string(k) + " " + e.what());
+    }
   }
   // Distinct directions; keys sharing one split its weight.
   for (std::size_t k = 0; k < keys_.size(); ++k) {

@@ -36,6 +36,18 @@ struct ViewSphereOptions {
   double alpha = 3.0;
 };
 
+// A direction as a user gives it (a scene's key viewpoint, `--viewpoint`, a character's
+// forward): any vector whose length, measured without overflow, lies within
+// [kMinDirectionLength, kMaxDirectionLength]. Beyond them its norm overflows or its components
+// are denormal: (1e300, 1e300, 1e300) normalised to (0, 0, 0) and was reported as "zero length".
+inline constexpr double kMinDirectionLength = 1e-9;
+inline constexpr double kMaxDirectionLength = 1e12;
+
+// The unit vector of `v`; throws Error saying why there is none: "(1e+300, 0, 0) is 1e+300
+// long, beyond 1e+12 ...", "... is 4.94e-324 long, below 1e-09: too short to give a direction",
+// "... is not finite". The caller puts the what and where before it.
+Eigen::Vector3d UnitDirection(const Eigen::Vector3d& v);
+
 class ViewSphere {
  public:
   // `keys` are normalised here; throws Error if one has (near) zero length, if there are none,

@@ -118,7 +118,9 @@ TEST(ViewSphere, ZeroLengthKeyIsAnError) {
     ViewSphere s({Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero()});
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key viewpoint 1 has zero length"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("key viewpoint 1 (0, 0, 0) is 0 long, below 1e-09: too short to give a direction"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(ViewSphere({}), Error);
   EXPECT_THROW(ViewSphere(Ring(3), {WeightingMode::kInverseDistance, DistanceKind::kGeodesic, 0.0}), Error);
@@ -190,6 +192,31 @@ TEST(ViewSphere, AzimuthElevation) {
   EXPECT_LT((DirectionFromAzimuthElevation(0, 0) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
   EXPECT_LT((DirectionFromAzimuthElevation(90, 0) - Eigen::Vector3d::UnitX()).norm(), 1e-12);
   EXPECT_LT((DirectionFromAzimuthElevation(0, 90) - Eigen::Vector3d::UnitY()).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace arview::anim
+
+namespace arview::anim {
+namespace {
+
+// Issue 41: a key 1e300 long normalised to (0, 0, 0) and was called "zero length"; a denormal
+// one was too. Each is said for what it is; huge and tiny ordinary lengths are directions.
+TEST(UnitDirection, SaysWhyAVectorGivesNoDirection) {
+  auto why = [](const Eigen::Vector3d& v) -> std::string {
+    try {
+      UnitDirection(v);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(why({1e300, 1e300, 1e300}), "(1e+300, 1e+300, 1e+300) is 1.73e+300 long, beyond 1e+12 (a direction such as [0, 0, 1] is expected)");
+  EXPECT_EQ(why({5e-324, 0, 0}), "(4.94066e-324, 0, 0) is 4.94e-324 long, below 1e-09: too short to give a direction");
+  EXPECT_EQ(why({0, std::nan(""), 0}), "(0, nan, 0) is not finite");
+  EXPECT_LT((UnitDirection({0, 1e12, 0}) - Eigen::Vector3d::UnitY()).norm(), 1e-15);
+  EXPECT_LT((UnitDirection({-1e-9, 0, 0}) + Eigen::Vector3d::UnitX()).norm(), 1e-15);
+  EXPECT_NEAR(UnitDirection({3, 4, 12}).norm(), 1.0, 1e-15);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include "anim_authoring/import.h"
 
+#include "base/library_errors.h"
+
 #include "anim_authoring/gltf_check.h"
 
 #include <assimp/Importer.hpp>
@@ -389,7 +391,9 @@ bool IsBuiltinAsset(const fs::path& asset) { return asset.native().rfind(kBuilti
 
 void SetBuiltinCharacterProvider(BuiltinCharacterProvider provider) { builtin_provider = provider; }
 
-anim::Character LoadCharacter(const fs::path& path) {
+namespace {
+
+anim::Character LoadCharacterFile(const fs::path& path) {
   const std::string file = path.string();
   if (IsBuiltinAsset(path)) {
     const BuiltinCharacterProvider provider = builtin_provider.load();
@@ -417,6 +421,13 @@ anim::Character LoadCharacter(const fs::path& path) {
     throw anim::Error(file + ": cannot read as a 3D asset" + (why.empty() ? std::string() : ": " + why));
   }
   return Importer(scene, path).Run();
+}
+
+}  // namespace
+
+anim::Character LoadCharacter(const fs::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<anim::Error>(path.string(), [&] { return LoadCharacterFile(path); });
 }
 
 }  // namespace arview::authoring

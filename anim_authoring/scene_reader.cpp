@@ -1,8 +1,13 @@
 #include "anim_authoring/scene.h"
 
+#include "base/library_errors.h"
+
 #include "anim_authoring/yaml.h"
+#include "anim/view_sphere.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cstdio>
 #include <cmath>
 #include <set>
@@ -64,10 +69,14 @@ class SceneReader {
     return {v[0], v[1], v[2]};
   }
 
+  // A direction (anim::UnitDirection): its own line named, and why it gives none.
   Eigen::Vector3d Direction(const Node& n, const std::string& what) const {
     const Eigen::Vector3d v = Vec3(n, what);
-    if (v.norm() < 1e-9) Fail(n, what + " has zero length");
-    return v.normalized();
+    try {
+      return anim::UnitDirection(v);
+    } catch (const anim::Error& e) {
+      Fail(n, what + " " + e.what());
+    }
   }
 
   template <class E>
@@ -508,9 +517,7 @@ class SceneReader {
     const Node* el = n.Find("elevation");
     if (vp && (az || el)) Fail(n, "a key gives either viewpoint or azimuth/elevation, not both");
     if (vp) {
-      const Eigen::Vector3d v = Vec3(*vp, "viewpoint");
-      if (!(v.norm() > 1e-9)) Fail(*vp, "key viewpoint has zero length");
-      k.viewpoint = v.normalized();
+      k.viewpoint = Direction(*vp, "key viewpoint");
     } else if (az || el) {
       const double a = az ? Number(*az, "azimuth") : 0.0;
       const double e = el ? Number(*el, "elevation") : 0.0;
@@ -576,9 +583,18 @@ Scene ParseScene(const std::string& text, const fs::path& file) {
   return SceneReader(file.string()).Read(root, file);
 }
 
-Scene LoadScene(const fs::path& path) {
+namespace {
+
+Scene LoadSceneFile(const fs::path& path) {
   const Node root = yaml::ParseFile(path);  // errors name the file
   return SceneReader(path.string()).Read(root, path);
+}
+
+}  // namespace
+
+Scene LoadScene(const fs::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<anim::Error>(path.string(), [&] { return LoadSceneFile(path); });
 }
 
 Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what) {
@@ -589,25 +605,23 @@ Eigen::Vector3d ParseViewpoint(const std::string& text, const std::string& what)
   Eigen::Vector3d v;
   for (int i = 0; i < 3; ++i) {
     std::string word;
-    std::size_t used = 0;
-    bool ok = static_cast<bool>(in >> word);
-    if (ok) {
-      try {
-        v[i] = std::stod(word, &used);
-      } catch (const std::exception&) {
-        ok = false;
-      }
+    if (!(in >> word)) throw anim::Error(what + ": expected three numbers \"x,y,z\", got \"" + text + "\"");
+    // strtod, not stod: stod refuses a denormal such as 5e-324 as out of range, which was then
+    // reported as "expected three numbers"; the length check below says what is wrong with it.
+    errno = 0;
+    char* end = nullptr;
+    v[i] = std::strtod(word.c_str(), &end);
+    if (end != word.c_str() + word.size() || !std::isfinite(v[i]) || (errno == ERANGE && std::abs(v[i]) > 1)) {
+      throw anim::Error(what + ": '" + word + "' in \"" + text + "\" is not a finite number (expected three numbers \"x,y,z\")");
     }
-    if (!ok || used != word.size() || !std::isfinite(v[i]))
-      throw anim::Error(what + ": expected three numbers \"x,y,z\", got \"" + text + "\"");
   }
   std::string extra;
   if (in >> extra) throw anim::Error(what + ": more than three numbers in \"" + text + "\"");
-  // Scaled by its largest component first: the norm of (1e308, 1e308, 1e308) overflows to
-  // infinity and normalizing by it gave (0, 0, 0).
-  const double largest = v.cwiseAbs().maxCoeff();
-  if (!(largest > 1e-12)) throw anim::Error(what + ": zero-length viewpoint \"" + text + "\" has no direction");
-  return (v / largest).normalized();
+  try {
+    return anim::UnitDirection(v);
+  } catch (const anim::Error& e) {
+    throw anim::Error(what + ": the viewpoint " + e.what());
+  }
 }
 
 anim::Placement CharacterSpec::placement() const { return {anchor, scale, forward, up}; }

@@ -90,7 +90,7 @@ void ExpectSceneError(const std::string& text, const std::string& message) {
 
 TEST(Scene, ParseErrors) {
   ExpectSceneError("characters:\n  - asset: a.glb\n    keys:\n      - viewpoint: [0, 0, 0]\n        clip: x\n",
-                   "bad.yaml:4: key viewpoint has zero length");
+                   "bad.yaml:4: key viewpoint (0, 0, 0) is 0 long, below 1e-09: too short to give a direction");
   ExpectSceneError("characters:\n  - asset: a.glb\n    keys:\n      - azimuth: 0\n", "bad.yaml:4: a key needs exactly one");
   ExpectSceneError("characters:\n  - asset: a.glb\n    colour: red\n    keys:\n      - azimuth: 0\n        clip: x\n",
                    "bad.yaml:3: unknown key 'colour'");
@@ -109,16 +109,38 @@ TEST(Scene, ParseViewpoint) {
   EXPECT_THROW(ParseViewpoint("1,2"), anim::Error);
   EXPECT_THROW(ParseViewpoint("1,2,3,4"), anim::Error);
   // Issue 17: the norm of (1e308, 1e308, 1e308) overflowed and the direction became (0, 0, 0).
-  EXPECT_LT((ParseViewpoint("1e308,1e308,1e308") - Eigen::Vector3d::Ones().normalized()).norm(), 1e-12);
-  EXPECT_LT((ParseViewpoint("-1e308,0,0") + Eigen::Vector3d::UnitX()).norm(), 1e-12);
+  // Issue 41: such a vector is refused, saying how long it is and the limit (anim::UnitDirection).
+  EXPECT_LT((ParseViewpoint("1e11,1e11,1e10") - Eigen::Vector3d(10, 10, 1).normalized()).norm(), 1e-12);
   EXPECT_THROW(ParseViewpoint("1,x,3"), anim::Error);
   EXPECT_THROW(ParseViewpoint("1,nan,3"), anim::Error);
-  try {
-    ParseViewpoint("0,0,0", "--viewpoint");
-    FAIL();
-  } catch (const anim::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--viewpoint: zero-length viewpoint"), std::string::npos) << e.what();
-  }
+  auto error_of = [](const std::string& text) -> std::string {
+    try {
+      ParseViewpoint(text, "--viewpoint");
+    } catch (const anim::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error_of("0,0,0"), "--viewpoint: the viewpoint (0, 0, 0) is 0 long, below 1e-09: too short to give a direction");
+  // 5e-324 was refused as "expected three numbers": stod refuses a denormal as out of range.
+  EXPECT_EQ(error_of("5e-324,0,0"),
+            "--viewpoint: the viewpoint (4.94066e-324, 0, 0) is 4.94e-324 long, below 1e-09: too short to give a direction");
+  EXPECT_EQ(error_of("1e308,1e308,1e308"),
+            "--viewpoint: the viewpoint (1e+308, 1e+308, 1e+308) is 1.73e+308 long, beyond 1e+12 (a direction such as "
+            "[0, 0, 1] is expected)");
+  EXPECT_EQ(error_of("1e400,0,0"),
+            "--viewpoint: '1e400' in \"1e400,0,0\" is not a finite number (expected three numbers \"x,y,z\")");
+}
+
+// Issue 41: a key viewpoint 1e300 long was refused as "zero length" and pointed at the
+// character's line; it is refused at the key's own line, saying how long it is.
+TEST(Scene, AKeyViewpointTooLongOrTooShortIsRefusedAtItsLine) {
+  ExpectSceneError("characters:\n  - asset: a.glb\n    keys:\n      - azimuth: 0\n        clip: x\n"
+                   "      - viewpoint: [1e300, 1e300, 1e300]\n        clip: x\n",
+                   "bad.yaml:6: key viewpoint (1e+300, 1e+300, 1e+300) is 1.73e+300 long, beyond 1e+12");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    forward: [0, 0, 1e-300]\n    keys:\n      - azimuth: 0\n"
+                   "        clip: x\n",
+                   "bad.yaml:3: forward (0, 0, 1e-300) is 1e-300 long, below 1e-09: too short to give a direction");
 }
 
 TEST(Scene, MissingClipIsAnError) {

@@ -1,5 +1,7 @@
 #include "base/image_file.h"
 
+#include "base/library_errors.h"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <zlib.h>
@@ -204,9 +206,18 @@ std::string_view OtherAcceptedFormat(std::string_view bytes) {
 
 }  // namespace
 
-cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
+namespace {
+
+cv::Mat ReadImageFileBytes(const std::filesystem::path& file, int imread_flags) {
   const std::string bytes = ReadFileUpTo(file, kMaxImageFileBytes);  // regular files only (InputError)
   return DecodeImageBytes(bytes, file.string(), imread_flags);
+}
+
+}  // namespace
+
+cv::Mat ReadImageFile(const std::filesystem::path& file, int imread_flags) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<Error>(file.string(), [&] { return ReadImageFileBytes(file, imread_flags); });
 }
 
 cv::Mat DecodeImageBytes(std::string_view bytes, const std::string& name, int imread_flags) {

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "base/error.h"
+#include "base/point_spread.h"
 #include "base/stats.h"
 
 namespace arview {
@@ -54,6 +55,7 @@ Plane RefitPlane(const std::vector<Eigen::Vector3d>& points, const Plane& guess,
 
 Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& all_points, const PlaneFitOptions& o) {
   if (all_points.size() < 3) throw Error("the map has fewer than 3 points: no plane to stand on");
+  if (const auto why = WhyNotAPlane(all_points, "points")) throw Error("no plane to stand on: " + *why);
   const Eigen::Vector3d middle = ComponentMedian(all_points);
   const double extent = 2 * MedianDistance(all_points, middle);
   std::vector<Eigen::Vector3d> points;
@@ -73,7 +75,7 @@ Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& all_points, const Pla
     const Eigen::Vector3d& b = points[pick(rng)];
     const Eigen::Vector3d& c = points[pick(rng)];
     const Eigen::Vector3d n = (b - a).cross(c - a);
-    if (n.norm() < 1e-12) continue;
+    if (!(n.norm() > 1e-12 * extent * extent)) continue;  // collinear, at any scale of map
     Plane h;
     h.normal = n.normalized();
     if (o.up_prior && std::abs(h.normal.dot(*o.up_prior)) < cos_max_tilt) continue;

@@ -8,6 +8,8 @@
 #include <sstream>
 
 #include "base/input_guard.h"
+#include "base/library_errors.h"
+#include "base/opencv_matrix.h"
 
 #include "base/atomic_file.h"
 
@@ -115,8 +117,15 @@ void Camera::Validate(const std::string& source) const {
   // Bounds far beyond any real camera, so that no later pixel arithmetic overflows.
   if (width > 65536) fail("image_width", "is larger than 65536 (is " + std::to_string(width) + ")");
   if (height > 65536) fail("image_height", "is larger than 65536 (is " + std::to_string(height) + ")");
-  if (!(std::isfinite(fx) && fx > 0 && fx <= 1e7)) fail("camera_matrix", "fx must be a positive number up to 1e7");
-  if (!(std::isfinite(fy) && fy > 0 && fy <= 1e7)) fail("camera_matrix", "fy must be a positive number up to 1e7");
+  auto value = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  if (!(std::isfinite(fx) && fx > 0 && fx <= 1e7))
+    fail("camera_matrix", "fx must be a positive number up to 1e7 (is " + value(fx) + ")");
+  if (!(std::isfinite(fy) && fy > 0 && fy <= 1e7))
+    fail("camera_matrix", "fy must be a positive number up to 1e7 (is " + value(fy) + ")");
   if (!(std::isfinite(cx) && cx >= 0 && cx <= width)) {
     fail("camera_matrix", "principal point cx=" + std::to_string(cx) + " lies outside the image width " +
                               std::to_string(width));
@@ -127,7 +136,7 @@ void Camera::Validate(const std::string& source) const {
   }
   for (double d : dist) {
     if (!std::isfinite(d) || std::abs(d) > 1e6) {
-      fail("distortion_coefficients", "holds a value that is not a finite number of at most 1e6");
+      fail("distortion_coefficients", "holds " + value(d) + ", not a finite number of at most 1e6 in magnitude");
     }
   }
 }
@@ -139,9 +148,9 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& source, const c
   if (node.empty()) throw CameraError(source + ": field " + name + " is missing");
   cv::Mat m;
   try {
-    node >> m;
-  } catch (const cv::Exception&) {
-    throw CameraError(source + ": field " + name + " is not an OpenCV matrix");
+    ReadOpenCvMatrix(node, m, source + ": field " + name);
+  } catch (const InputError& e) {
+    throw CameraError(e.what());
   }
   if (m.empty()) throw CameraError(source + ": field " + name + " is empty or not a matrix");
   m.convertTo(m, CV_64F);
@@ -241,7 +250,9 @@ void RequirePinholeMatrix(const cv::Mat& K, const std::string& source) {
 
 }  // namespace
 
-Camera LoadCamera(const std::filesystem::path& path) {
+namespace {
+
+Camera LoadCameraFile(const std::filesystem::path& path) {
   const std::string source = path.string();
   std::string text;
   try {
@@ -280,6 +291,13 @@ Camera LoadCamera(const std::filesystem::path& path) {
   RefuseUnknownKeys(fs, source);
   c.Validate(source);
   return c;
+}
+
+}  // namespace
+
+Camera LoadCamera(const std::filesystem::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<CameraError>(path.string(), [&] { return LoadCameraFile(path); });
 }
 
 void SaveCamera(const Camera& camera, const std::filesystem::path& path) {

@@ -184,6 +184,21 @@ TEST(Camera, HugeFocalLengthsAndSizesAreRefused) {
   EXPECT_NE(LoadError(huge).find("fx must be a positive number up to"), std::string::npos);
 }
 
+// Issue 41: a camera_matrix without its `dt` line made OpenCV throw std::length_error, and the
+// user saw "arview: basic_string::_M_create". Each of the matrix's keys missing is named.
+TEST(Camera, AMatrixWithoutOneOfItsKeysIsRefusedNamingTheFileAndTheKey) {
+  for (const std::string key : {"rows", "cols", "dt", "data"}) {
+    std::string bad = kGood;
+    const size_t line = bad.find("   " + key + ":");
+    bad.erase(line, bad.find('\n', line) + 1 - line);
+    const std::string m = LoadError(bad);
+    EXPECT_NE(m.find("arview_camera_bad.yaml: field camera_matrix: the matrix has no '" + key + "' key"),
+              std::string::npos)
+        << key << ": " << m;
+    EXPECT_EQ(m.find("basic_string"), std::string::npos) << m;
+  }
+}
+
 TEST(Camera, DevicesFifosAndDirectoriesAreNotReadAsCameraFiles) {
   const auto dir = std::filesystem::temp_directory_path() / ("arview_camera_special_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

@@ -1,7 +1,9 @@
 #include "map/map_file.h"
 
 #include "base/atomic_file.h"
+#include "base/point_spread.h"
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 #include "base/stats.h"
 
 #include <algorithm>
@@ -271,7 +273,9 @@ void SaveMap(const Map& map, const fs::path& file) {
   WriteFileAtomically(file, bytes);
 }
 
-Map LoadMap(const fs::path& path) {
+namespace {
+
+Map LoadMapFile(const fs::path& path) {
   std::error_code ec;
   const fs::path file = fs::is_directory(path, ec) ? path / kMapFileName : path;
   if (!fs::exists(file, ec)) throw MapError(file.string() + ": map file missing (run 'arview map' first)");
@@ -308,6 +312,20 @@ Map LoadMap(const fs::path& path) {
   Map map = ReadPayload(body);
   ValidateMap(map, file.string());
   return map;
+}
+
+}  // namespace
+
+Map LoadMap(const fs::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<MapError>(path.string(), [&] { return LoadMapFile(path); });
+}
+
+std::optional<std::string> DegeneratePoints(const Map& map) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(map.points.size());
+  for (const MapPoint& p : map.points) points.push_back(p.xyz);
+  return WhyNotAPlane(points, "points");
 }
 
 MapStats ComputeStats(const Map& map) {

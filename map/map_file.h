@@ -9,6 +9,7 @@
 // on load; any mismatch throws MapError naming the file.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "map/map.h"
@@ -32,6 +33,11 @@ void ValidateMap(const Map& map, const std::string& source);
 // that a value out of range is reported against the COLMAP file that holds it).
 inline constexpr double kMaxCoordinate = 1e6;  // map units: far beyond any mapped room or square
 inline constexpr float kMaxPixel = 1e6f;
+
+// Why the map's points cannot hold a floor (base/geometry.h WhyNotAPlane: all at one point, on
+// one line, spread below 1e-100 map units, not finite), or nothing. `arview place` refuses such
+// a map and `arview map info` warns about it.
+std::optional<std::string> DegeneratePoints(const Map& map);
 
 struct MapStats {
   std::size_t keyframes = 0;

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "base/input_guard.h"
+#include "base/library_errors.h"
 #include "map/map_file.h"
 
 namespace arview::mapping {
@@ -32,7 +33,7 @@ class BinaryReader {
   // end), in chunks that look at `cancel`.
   BinaryReader(const fs::path& path, const CancellationToken& cancel) : path_(path) {
     try {
-      data_ = ReadFileUpTo(path, kMaxBinaryFileBytes, cancel);
+      data_ = NamingInput<map::MapError>(path.string(), [&] { return ReadFileUpTo(path, kMaxBinaryFileBytes, cancel); });
     } catch (const InputError& e) {
       throw map::MapError(e.what());
     }
@@ -85,6 +86,20 @@ class BinaryReader {
   std::string data_;
   std::size_t pos_ = 0;
 };
+
+// A value as read, for messages (nan and inf spelled out, 6 significant digits).
+std::string Number(double value) {
+  std::ostringstream s;
+  s << std::setprecision(6) << value;
+  return s.str();
+}
+
+// "(a, b, c)" of Number()s.
+std::string Tuple(std::initializer_list<double> values) {
+  std::string text = "(";
+  for (const double v : values) text += (text.size() > 1 ? ", " : "") + Number(v);
+  return text + ")";
+}
 
 int NumParams(int model_id) {
   switch (model_id) {
@@ -156,6 +171,13 @@ std::unordered_map<std::uint32_t, calib::Camera> ReadCameras(const fs::path& fil
     }
     std::vector<double> params(static_cast<size_t>(np));
     for (double& v : params) v = r.Read<double>("camera parameters");
+    for (std::size_t k = 0; k < params.size(); ++k) {
+      if (!std::isfinite(params[k])) {
+        r.Fail("camera " + std::to_string(id) + "'s parameter " + std::to_string(k) + " (of " +
+               std::to_string(params.size()) + ", model " + std::to_string(model) + ") is " + Number(params[k]) +
+               ": every camera parameter must be a finite number");
+      }
+    }
     if (!cameras.emplace(id, ToCamera(model, width, height, params, file)).second) {
       r.Fail("camera id " + std::to_string(id) + " appears twice");
     }
@@ -189,7 +211,9 @@ std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToke
     const Eigen::Quaterniond quat(q[0], q[1], q[2], q[3]);
     if (!std::isfinite(quat.norm()) || std::abs(quat.norm() - 1.0) > 1e-3 ||
         !Eigen::Vector3d(t[0], t[1], t[2]).allFinite()) {
-      r.Fail("image " + std::to_string(im.id) + " ('" + PrintableForMessage(im.name) + "') has an invalid pose");
+      r.Fail("image " + std::to_string(im.id) + " ('" + PrintableForMessage(im.name) + "') has the rotation (qw, qx, qy, qz) " +
+             Tuple({q[0], q[1], q[2], q[3]}) + " and the translation " + Tuple({t[0], t[1], t[2]}) +
+             ": a pose needs a unit quaternion and a finite translation");
     }
     im.pose.q_cw = quat.normalized();
     im.pose.t_cw = Eigen::Vector3d(t[0], t[1], t[2]);
@@ -199,6 +223,12 @@ std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToke
     for (std::uint64_t k = 0; k < np; ++k) {
       const double x = r.Read<double>("2D point x");
       const double y = r.Read<double>("2D point y");
+      // Refused here, naming the value: a NaN pixel went on to fail the map's own validation as
+      // "keyframe 13 has an observation with an index out of range".
+      if (!std::isfinite(x) || !std::isfinite(y)) {
+        r.Fail("image " + std::to_string(im.id) + " ('" + PrintableForMessage(im.name) + "') has its 2D point " +
+               std::to_string(k) + " at " + Tuple({x, y}) + ": pixel coordinates must be finite numbers");
+      }
       im.xy[k] = {x, y};
       im.point3d_ids[k] = r.Read<std::uint64_t>("2D point's 3D point id");
     }
@@ -231,7 +261,9 @@ std::vector<ColmapPoint> ReadPoints(const fs::path& file, const CancellationToke
     for (int k = 0; k < 3; ++k) p.point.rgb[static_cast<size_t>(k)] = r.Read<std::uint8_t>("3D point colour");
     p.point.reprojection_error = r.Read<double>("3D point error");
     if (!p.point.xyz.allFinite() || !std::isfinite(p.point.reprojection_error)) {
-      r.Fail("3D point " + std::to_string(p.id) + " is not finite");
+      r.Fail("3D point " + std::to_string(p.id) + " has the position " +
+             Tuple({p.point.xyz.x(), p.point.xyz.y(), p.point.xyz.z()}) + " and the error " +
+             Number(p.point.reprojection_error) + ": both must be finite numbers");
     }
     const auto len = r.ReadCount("track length", 8);
     if (len == 0) r.Fail("3D point " + std::to_string(p.id) + " has an empty track");
@@ -432,7 +464,9 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
   return result;
 }
 
-map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+namespace {
+
+map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
                   const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
                   bool check_values) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
@@ -547,37 +581,43 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
   return map;
 }
 
+}  // namespace
+
+map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+                  const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
+                  bool check_values) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<map::MapError>(sparse_dir.string(), [&] {
+    return ReadColmapModel(sparse_dir, database, frames, cancel, keypoints, check_values);
+  });
+}
+
 void RequireModelValuesInRange(const map::Map& map, const fs::path& sparse_dir) {
   const fs::path images_file = sparse_dir / "images.bin";
   const fs::path points_file = sparse_dir / "points3D.bin";
-  auto big = [](double v) {
-    std::ostringstream s;
-    s << std::setprecision(3) << v;
-    return s;
-  };
   for (const map::Keyframe& k : map.keyframes) {
     const double t = k.pose.t_cw.cwiseAbs().maxCoeff();
     if (t > map::kMaxCoordinate)
       throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + PrintableForMessage(k.name) +
-                          "') has a translation of " + big(t).str() + ", beyond " + big(map::kMaxCoordinate).str() +
+                          "') has a translation of " + Number(t) + ", beyond " + Number(map::kMaxCoordinate) +
                           " (a degenerate registration in COLMAP's model)");
     for (const map::KeyframeObservation& o : k.observations)
       if (o.pixel.cwiseAbs().maxCoeff() > map::kMaxPixel)
         throw map::MapError(images_file.string() + ": image " + std::to_string(k.colmap_image_id) + " ('" + PrintableForMessage(k.name) +
-                            "') has a 2D point at (" + big(o.pixel.x()).str() + ", " + big(o.pixel.y()).str() +
-                            "), beyond " + big(map::kMaxPixel).str() + " pixels");
+                            "') has a 2D point at (" + Number(o.pixel.x()) + ", " + Number(o.pixel.y()) +
+                            "), beyond " + Number(map::kMaxPixel) + " pixels");
   }
   for (std::size_t i = 0; i < map.points.size(); ++i) {
     const map::MapPoint& p = map.points[i];
     const double c = p.xyz.cwiseAbs().maxCoeff();
     if (c > map::kMaxCoordinate)
       throw map::MapError(points_file.string() + ": 3D point " + std::to_string(i + 1) + " of " +
-                          std::to_string(map.points.size()) + " lies at a coordinate of " + big(c).str() + ", beyond " +
-                          big(map::kMaxCoordinate).str() + " (a degenerate triangulation in COLMAP's model)");
+                          std::to_string(map.points.size()) + " lies at a coordinate of " + Number(c) + ", beyond " +
+                          Number(map::kMaxCoordinate) + " (a degenerate triangulation in COLMAP's model)");
     if (p.reprojection_error < 0 || p.reprojection_error > map::kMaxPixel)
       throw map::MapError(points_file.string() + ": 3D point " + std::to_string(i + 1) + " of " +
                           std::to_string(map.points.size()) + " has a reprojection error of " +
-                          big(p.reprojection_error).str() + " pixels");
+                          Number(p.reprojection_error) + " pixels");
   }
 }
 

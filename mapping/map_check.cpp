@@ -2,6 +2,8 @@
 
 #include "mapping/map_check.h"
 
+#include "base/library_errors.h"
+
 #include <Eigen/SVD>
 #include <nlohmann/json.hpp>
 
@@ -264,9 +266,15 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
   WriteFileAtomically(file, j.dump(2) + "\n");
 }
 
-std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
+namespace {
+
+std::optional<MapCheck> ReadMapCheckFile(const fs::path& file) {
   std::error_code ec;
-  if (!fs::exists(file, ec)) return std::nullopt;
+  if (!fs::exists(file, ec)) {
+    // Absent: a map from before the check. A name too long, a folder that cannot be searched: said.
+    if (ec) throw map::MapError(file.string() + ": cannot be looked up (" + ec.message() + ")");
+    return std::nullopt;
+  }
   try {
     const json j = json::parse(ReadFileUpTo(file, 1 << 20));
     MapCheck c;
@@ -289,6 +297,13 @@ std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
   } catch (const InputError& e) {
     throw map::MapError(e.what());
   }
+}
+
+}  // namespace
+
+std::optional<MapCheck> ReadMapCheck(const fs::path& file) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<map::MapError>(file.string(), [&] { return ReadMapCheckFile(file); });
 }
 
 }  // namespace arview::mapping

@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/point_spread.h"
+
 namespace arview::recordings {
 
 calib::Pose Transform(const Sim3& transform, const calib::Pose& pose) {
@@ -92,6 +94,18 @@ Trajectory TransformTrajectory(const Trajectory& trajectory, const Sim3& transfo
   return out;
 }
 
+void RequirePositionsInRange(const Trajectory& trajectory, const std::string& what) {
+  for (const StampedPose& p : trajectory) {
+    const Eigen::Vector3d c = p.pose.Center();
+    if (!c.allFinite() || c.norm() > kMaxPositionNorm) {
+      std::ostringstream message;
+      message << what << ": the pose at " << p.timestamp << " s is at (" << c.x() << ", " << c.y() << ", " << c.z()
+              << "), beyond " << kMaxPositionNorm << " of the origin";
+      throw RecordingError(message.str());
+    }
+  }
+}
+
 double RotationErrorDeg(const calib::Pose& a, const calib::Pose& b) {
   return a.q_cw.angularDistance(b.q_cw) * 180.0 / M_PI;
 }
@@ -122,12 +136,18 @@ AccuracyReport EvaluateTrajectory(const Trajectory& estimate, const Trajectory& 
   r.estimate_poses = static_cast<int>(estimate.size());
   r.groundtruth_poses = static_cast<int>(groundtruth.size());
   r.rpe_delta = options.rpe_delta;
+  RequirePositionsInRange(estimate, "evaluation: the estimate");
+  RequirePositionsInRange(groundtruth, "evaluation: the ground truth");
+  if (options.align_with) RequirePositionsInRange(*options.align_with, "evaluation: the trajectory the alignment is fitted on");
   const Trajectory& fit_on = options.align_with ? *options.align_with : estimate;
   r.alignment = FitAlignment(fit_on, groundtruth, options.align, options.max_dt);
   if (options.align != AlignMode::kNone) {
     r.alignment_pairs = static_cast<int>(AssociateByTimestamp(fit_on, groundtruth, options.max_dt).size());
   }
   r.aligned_estimate = TransformTrajectory(estimate, r.alignment);
+  // A scale fitted on other poses (--align-with, or the associated ones) can carry the others far.
+  RequirePositionsInRange(r.aligned_estimate, "evaluation: the estimate aligned with a scale of " +
+                                                  std::to_string(r.alignment.scale));
   r.pairs = AssociateByTimestamp(estimate, groundtruth, options.max_dt);
   if (r.pairs.empty()) {
     throw RecordingError("evaluation: no estimated pose has a ground-truth pose within " +

@@ -57,6 +57,11 @@ Sim3 FitAlignment(const Trajectory& from, const Trajectory& to, AlignMode mode, 
 
 Trajectory TransformTrajectory(const Trajectory& trajectory, const Sim3& transform);
 
+// Throws RecordingError("<what>: the pose at <t> s is at (x, y, z), beyond 1e+100 of the origin")
+// unless every camera centre is finite and within kMaxPositionNorm (base/point_spread.h): beyond
+// it the errors' squares overflow (a centre at 8.7e306 with --align none gave an ATE of inf).
+void RequirePositionsInRange(const Trajectory& trajectory, const std::string& what);
+
 // rmse, mean, median, max, count (and percentiles) by base/stats.h's one definition.
 using ErrorStats = arview::Summary;
 

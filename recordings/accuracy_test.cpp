@@ -263,7 +263,53 @@ TEST(Tum, MalformedLinesAreNamedWithFileAndLine) {
   EXPECT_NE(error_for("1 0 0 0 0 0 0 2\n").find(":1: quaternion"), std::string::npos);
   EXPECT_NE(error_for("1 0 nan 0 0 0 0 1\n").find(":1:"), std::string::npos);
   EXPECT_EQ(error_for("\n# only comments\n1 0 0 0 0 0 0 1\n"), "");
+  // Issue 41, found by fuzz_eval: a centre at 8.7e306 was read, and `eval --align none` printed
+  // "ATE rmse inf" and an RPE of -nan, exit 0.
+  EXPECT_NE(error_for("1 0 0 0 0 0 0 1\n1.2 0.0871e308 -0.99 0.6 0 0 0.564642 0.825336\n")
+                .find(":2: the position (8.71e+306, -0.99, 0.6) lies beyond 1e+100 of the origin"),
+            std::string::npos);
+  EXPECT_EQ(error_for("1 1e99 0 0 0 0 0 1\n"), "");
   fs::remove(file);
+}
+
+// Trajectories made in code are held to the same limit, and so is the estimate once aligned: a
+// scale fitted on other poses must not carry it beyond what the errors' squares can hold.
+TEST(EvaluateTrajectory, RefusesPositionsWhoseErrorsWouldOverflow) {
+  const Trajectory gt = Orbit(20);
+  Trajectory far = gt;
+  far[7].pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 1e200, 0));
+  for (const AlignMode mode : {AlignMode::kNone, AlignMode::kSE3, AlignMode::kSim3}) {
+    AccuracyOptions o;
+    o.align = mode;
+    for (const bool far_estimate : {true, false}) {
+      try {
+        EvaluateTrajectory(far_estimate ? far : gt, far_estimate ? gt : far, o);
+        ADD_FAILURE() << "scored a pose at 1e200";
+      } catch (const RecordingError& e) {
+        EXPECT_NE(std::string(e.what()).find(std::string("evaluation: the ") +
+                                             (far_estimate ? "estimate" : "ground truth") + ": the pose at 7 s is at ("),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("1e+200"), std::string::npos) << e.what();
+      }
+    }
+  }
+  // Fitted on keyframes a thousand times smaller than the estimate, far poses of the estimate
+  // (not among the keyframes) are carried beyond the limit.
+  Trajectory keyframes, estimate = Orbit(20);
+  for (const StampedPose& p : gt) {
+    keyframes.push_back({p.timestamp, calib::Pose::FromCameraToWorld(p.pose.CameraToWorldRotation(), 1e-60 * p.pose.Center())});
+  }
+  estimate[5].pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond::Identity(), Eigen::Vector3d(9e99, 0, 0));
+  keyframes.erase(keyframes.begin() + 5);
+  AccuracyOptions o;
+  o.align_with = &keyframes;
+  try {
+    EvaluateTrajectory(estimate, gt, o);
+    ADD_FAILURE() << "scored an estimate carried to 1e160";
+  } catch (const RecordingError& e) {
+    EXPECT_NE(std::string(e.what()).find("evaluation: the estimate aligned with a scale of"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "recordings/frame_source.h"
 
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -196,6 +198,31 @@ TEST(LoadRecording, FramePathsOutsideTheFolderAreRefused) {
     } catch (const RecordingError& e) {
       EXPECT_NE(std::string(e.what()).find("points outside"), std::string::npos) << bad << ": " << e.what();
       EXPECT_NE(std::string(e.what()).find("frames.txt"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Issue 41: a NUL byte in a frame path cut the message to "arview: rec/frames/". It is refused
+// naming frames.txt and the line, the whole path shown with the NUL escaped; other control
+// characters alike.
+TEST(LoadRecording, AControlCharacterInAFramePathIsRefusedWithTheLineAndThePathEscaped) {
+  TempDir dir("nul");
+  MakeStillRecording(dir.path() / "rec", 2);
+  const fs::path frames_txt = dir.path() / "rec" / "frames.txt";
+  for (const char control : {'\0', '\x1b', '\x7f'}) {
+    {
+      std::ofstream out(frames_txt, std::ios::binary | std::ios::trunc);
+      out << "# timestamp path\n0 frames/100.png\n1 frames/" << control << "evil.png\n";
+    }
+    char escaped[8];
+    std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned char>(control));
+    try {
+      LoadRecording(dir.path() / "rec");
+      ADD_FAILURE() << "a path holding " << escaped << " was accepted";
+    } catch (const RecordingError& e) {
+      const std::string message = e.what();  // what() is read up to its first NUL, as main prints it
+      EXPECT_EQ(message, frames_txt.string() + ":3: the frame path 'frames/" + escaped +
+                             "evil.png' holds the control character " + escaped + " (a frame path is printable text)");
     }
   }
 }

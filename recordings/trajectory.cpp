@@ -1,7 +1,10 @@
 #include "recordings/trajectory.h"
 
+#include "base/library_errors.h"
+
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
+#include "base/point_spread.h"
 
 #include <cmath>
 #include <fstream>
@@ -18,7 +21,9 @@ std::string ReadRecordingText(const std::filesystem::path& file) {
   }
 }
 
-Trajectory ReadTum(const std::filesystem::path& path) {
+namespace {
+
+Trajectory ReadTumFile(const std::filesystem::path& path) {
   std::istringstream in(ReadRecordingText(path));
   Trajectory out;
   std::string line;
@@ -45,9 +50,23 @@ Trajectory ReadTum(const std::filesystem::path& path) {
       throw RecordingError(path.string() + ":" + std::to_string(line_no) +
                            ": quaternion is not of unit length");
     }
+    // Beyond kMaxPositionNorm the squares of every error overflow (eval printed an ATE of inf).
+    if (Eigen::Vector3d(v[1], v[2], v[3]).norm() > kMaxPositionNorm) {
+      std::ostringstream message;
+      message << path.string() << ":" << line_no << ": the position (" << v[1] << ", " << v[2] << ", " << v[3]
+              << ") lies beyond " << kMaxPositionNorm << " of the origin";
+      throw RecordingError(message.str());
+    }
     out.push_back({v[0], calib::Pose::FromCameraToWorld(q_wc, {v[1], v[2], v[3]})});
   }
   return out;
+}
+
+}  // namespace
+
+Trajectory ReadTum(const std::filesystem::path& path) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<RecordingError>(path.string(), [&] { return ReadTumFile(path); });
 }
 
 void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,

@@ -270,6 +270,39 @@ TEST(RoomLight, SavesAndLoadsAndRejectsBadFiles) {
   fs::remove_all(dir);
 }
 
+// Issue 41: a matrix without its `dt` line made OpenCV throw std::length_error, and what reached
+// the user was "basic_string::_M_create". Each key of each matrix is named when missing.
+TEST(RoomLight, AMatrixWithoutOneOfItsKeysIsRefusedNamingTheFileAndTheKey) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_light_keys_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  SaveRoomLight(AnalyticEstimate(), dir / "a.light.yml");
+  std::string saved;
+  {
+    std::ifstream in(dir / "a.light.yml");
+    saved.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  for (const std::string matrix : {"sh_rgb", "image"}) {
+    for (const std::string key : {"rows", "cols", "dt", "data"}) {
+      std::string text = saved;
+      const size_t at = text.find("   " + key + ":", text.find(matrix + ":"));
+      ASSERT_NE(at, std::string::npos) << matrix << " " << key;
+      const size_t line = text.rfind('\n', at) + 1;
+      const size_t last = key == "data" ? text.find(']', at) : at;  // data runs over several lines
+      text.erase(line, text.find('\n', last) + 1 - line);
+      { std::ofstream(dir / "l.light.yml") << text; }
+      try {
+        LoadRoomLight(dir / "l.light.yml");
+        ADD_FAILURE() << matrix << " without " << key << " loaded";
+      } catch (const LightError& e) {
+        const std::string where = (dir / "l.light.yml").string() + ": " + (matrix == "image" ? "a thumbnail's image" : matrix);
+        EXPECT_EQ(std::string(e.what()), where + ": the matrix has no '" + key +
+                                             "' key (an !!opencv-matrix needs rows, cols, dt and data)");
+      }
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // What OpenCV's reader would hang on, allocate gigabytes for or recurse into too deeply is
 // refused before it, with one line naming the file.
 TEST(RoomLight, TextsThatHangOrExhaustOpenCvsReaderAreRefusedFirst) {

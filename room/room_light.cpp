@@ -12,6 +12,8 @@
 
 #include "base/atomic_file.h"
 #include "base/input_guard.h"
+#include "base/library_errors.h"
+#include "base/opencv_matrix.h"
 
 namespace arview::room {
 namespace {
@@ -273,7 +275,9 @@ void SaveRoomLight(const RoomLight& light, const std::filesystem::path& file) {
   }
 }
 
-RoomLight LoadRoomLight(const std::filesystem::path& file) {
+namespace {
+
+RoomLight LoadRoomLightFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw LightError(file.string() + ": no such room light file");
   // A regular file of bounded size, and the checks OpenCV's reader lacks, before it sees it.
   std::string text;
@@ -299,7 +303,7 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
     };
     light.position = vec3("position");
     cv::Mat sh;
-    fs["sh_rgb"] >> sh;
+    ReadOpenCvMatrix(fs["sh_rgb"], sh, file.string() + ": sh_rgb");
     if (sh.rows != 9 || sh.cols != 3 || sh.type() != CV_64F || !cv::checkRange(sh)) {
       throw LightError(file.string() + ": sh_rgb must be a finite 9x3 matrix");
     }
@@ -326,7 +330,7 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
           thumb.image_size.width <= 0 || thumb.image_size.height <= 0) {
         throw LightError(file.string() + ": a thumbnail's camera is not valid");
       }
-      t["image"] >> thumb.linear_bgr;
+      ReadOpenCvMatrix(t["image"], thumb.linear_bgr, file.string() + ": a thumbnail's image");
       if (thumb.linear_bgr.type() != CV_32FC3 || thumb.linear_bgr.empty()) {
         throw LightError(file.string() + ": a thumbnail image is not a float BGR image");
       }
@@ -334,7 +338,7 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
     }
     auto read_triangles = [&](const char* key, std::vector<Eigen::Vector3f>& corners) {
       cv::Mat tris;
-      fs[key] >> tris;
+      ReadOpenCvMatrix(fs[key], tris, file.string() + ": " + key);
       if (!tris.empty() && (tris.cols != 3 || tris.type() != CV_32F || tris.rows % 3 != 0 || !cv::checkRange(tris))) {
         throw LightError(file.string() + ": " + key + " must be finite rows of 3 floats, 3 rows a triangle");
       }
@@ -342,10 +346,19 @@ RoomLight LoadRoomLight(const std::filesystem::path& file) {
     };
     read_triangles("scene_vertices", light.scene_triangles);
     read_triangles("occluder_vertices", light.occluder_triangles);
+  } catch (const InputError& e) {
+    throw LightError(e.what());
   } catch (const cv::Exception& e) {
     throw LightError(file.string() + ": unreadable room light file (" + e.msg + ")");
   }
   return light;
+}
+
+}  // namespace
+
+RoomLight LoadRoomLight(const std::filesystem::path& file) {
+  // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
+  return NamingInput<LightError>(file.string(), [&] { return LoadRoomLightFile(file); });
 }
 
 ExposureFollower::ExposureFollower(std::vector<KeyframeThumbnail> thumbnails,

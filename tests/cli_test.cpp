@@ -4,12 +4,15 @@
 
 #include <unistd.h>
 
-#include <filesystem>
-#include <fstream>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
 #include <regex>
 
+#include "map/map_file.h"
+#include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
 
@@ -262,6 +265,162 @@ TEST(Cli, EvalRefusesPositionsAtOnePointOrOverflowing) {
       EXPECT_EQ(r.out.find("ATE"), std::string::npos) << r.out;
     }
   }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: an empty --align-with file was blamed on the estimate and the ground truth ("est.txt
+// against gt.txt: alignment: only 0 poses share a timestamp"). The file that is empty, or that
+// shares no timestamp with the ground truth, is the one named.
+TEST(Cli, EvalNamesAnEmptyOrUnmatchedAlignWithFile) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_align_with_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream estimate(dir / "est.txt"), groundtruth(dir / "gt.txt"), later(dir / "later.txt");
+    std::ofstream(dir / "empty.txt").close();
+    std::ofstream(dir / "comments.txt") << "# timestamp tx ty tz qx qy qz qw\n\n";
+    for (int i = 0; i < 20; ++i) {
+      char line[160];
+      std::snprintf(line, sizeof line, "%.3f %.6f %.6f %.6f 0 0 0 1\n", i * 0.1, std::cos(i * 0.3), std::sin(i * 0.3),
+                    0.05 * i);
+      estimate << line;
+      groundtruth << line;
+      std::snprintf(line, sizeof line, "%.3f %.6f %.6f %.6f 0 0 0 1\n", 100 + i * 0.1, std::cos(i * 0.3),
+                    std::sin(i * 0.3), 0.05 * i);
+      later << line;
+    }
+  }
+  const std::string est = (dir / "est.txt").string(), gt = (dir / "gt.txt").string();
+  for (const std::string file : {"empty.txt", "comments.txt"}) {
+    const auto r = testing::RunArview({"eval", est, gt, "--align-with", (dir / file).string()});
+    EXPECT_NE(r.exit_code, 0) << r.out;
+    EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("arview: " + (dir / file).string() + ": holds no poses"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("est.txt"), std::string::npos) << r.err;
+  }
+  const auto r = testing::RunArview({"eval", est, gt, "--align-with", (dir / "later.txt").string()});
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_EQ(testing::LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find((dir / "later.txt").string() + " (--align-with) against " + gt + ": alignment: only 0 poses"),
+            std::string::npos)
+      << r.err;
+  // The same files without --align-with are scored.
+  EXPECT_EQ(testing::RunArview({"eval", est, gt}).exit_code, 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: `arview place` on a map whose points are degenerate said "no floor-like plane ...
+// holds 3 or more of the map's points" without naming the map, and `map info` said nothing.
+// Now place refuses naming the map folder and what is degenerate, and map info warns.
+TEST(Cli, PlaceRefusesADegenerateMapNamingItAndMapInfoWarns) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_degenerate_map_" + std::to_string(::getpid()));
+  calib::Camera camera;
+  camera.width = 640, camera.height = 480, camera.fx = camera.fy = 500, camera.cx = 319.5, camera.cy = 239.5;
+  testing::WriteRandomMap(camera, dir / "random");
+  const map::Map random = map::LoadMap(dir / "random");
+  struct Case {
+    std::string name;
+    std::function<void(map::Map&)> degrade;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"one_spot", [](map::Map& m) { for (auto& p : m.points) p.xyz = Eigen::Vector3d(1, 2, 3); },
+       "lie at one point, (1, 2, 3)"},
+      {"one_line",
+       [](map::Map& m) {
+         for (std::size_t i = 0; i < m.points.size(); ++i) m.points[i].xyz = Eigen::Vector3d(0.01 * i, 0.02 * i, 3);
+       },
+       "lie on one line"},
+      {"scaled_1e-300",
+       [](map::Map& m) {
+         for (auto& p : m.points) p.xyz *= 1e-300;
+         for (auto& k : m.keyframes) k.pose.t_cw *= 1e-300;
+       },
+       "below 1e-100"},
+  };
+  for (const Case& c : cases) {
+    map::Map degraded = random;
+    c.degrade(degraded);
+    const std::filesystem::path map_dir = dir / c.name;
+    std::filesystem::create_directories(map_dir);
+    map::SaveMap(degraded, map_dir / map::kMapFileName);
+    const auto placed = RunArview({"place", map_dir.string(), "--character", "builtin:figure", "--no-light", "--out",
+                                   (dir / "scene.yaml").string()});
+    EXPECT_NE(placed.exit_code, 0) << c.name;
+    EXPECT_EQ(LineCount(placed.err), 1) << placed.err;
+    EXPECT_NE(placed.err.find("arview: " + map_dir.string() + ": the map's points cannot hold a floor: all 400 points"),
+              std::string::npos)
+        << placed.err;
+    EXPECT_NE(placed.err.find(c.says), std::string::npos) << placed.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "scene.yaml"));
+    const auto info = RunArview({"map", "info", map_dir.string()});
+    EXPECT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("warning:             the map's points cannot hold a floor"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find(c.says), std::string::npos) << info.out;
+  }
+  // The random map's points span a volume: no warning.
+  const auto info = RunArview({"map", "info", (dir / "random").string()});
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_EQ(info.out.find("cannot hold a floor"), std::string::npos) << info.out;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 41: `render --pose "1e308 0 0 0 0 0 1"` wrote an image, exit 0; a camera with fx = 1e308
+// was refused without its value. Both are one line naming the flag or file, the value and the
+// limit, and no image is written; a pose within the limit renders.
+TEST(Cli, RenderRefusesAPoseOrACameraNoMapCanHold) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_render_limits_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "scene.yaml").string(), good = (dir / "camera.yaml").string(),
+                    huge = (dir / "huge_fx.yaml").string(), out = (dir / "out.png").string();
+  std::ofstream(scene) << "characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    keys:\n"
+                          "      - azimuth: 0\n        generate: lookat\n";
+  const std::string camera_text =
+      "%YAML:1.0\n---\nimage_width: 64\nimage_height: 48\ncamera_matrix: !!opencv-matrix\n"
+      "   rows: 3\n   cols: 3\n   dt: d\n   data: [ FX, 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n";
+  std::ofstream(good) << std::regex_replace(camera_text, std::regex("FX"), "60.");
+  std::ofstream(huge) << std::regex_replace(camera_text, std::regex("FX"), "1e308");
+  auto render = [&](const std::string& camera, const std::string& pose) {
+    return RunArview({"render", "--scene", scene, "--camera", camera, "--pose", pose, "--out", out});
+  };
+  for (const std::string pose : {"1e308 0 0 0 0 0 1", "0 -2e6 0 0 0 0 1"}) {
+    const auto r = render(good, pose);
+    EXPECT_NE(r.exit_code, 0) << pose;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("arview: --pose: the camera position ("), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(pose[0] == '1' ? "1e+308, 0, 0" : "0, -2e+06, 0"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("lies beyond 1e+06 map units"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  const auto r = render(huge, "0 0 -3 0 0 0 1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(huge + ": camera_matrix fx must be a positive number up to 1e7 (is 1e+308)"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const auto rendered = render(good, "0 1 -3 0 0 0 1");
+  EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
+  EXPECT_TRUE(std::filesystem::exists(out));
   std::filesystem::remove_all(dir);
 }
 

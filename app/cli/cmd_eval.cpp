@@ -54,6 +54,9 @@ void RunEval(const EvalArgs& args) {
         throw CommandError("--align-with needs --align se3 or sim3");
       }
       align_with = recordings::ReadTum(args.align_with);
+      if (align_with->empty()) {
+        throw CommandError(args.align_with + ": holds no poses (--align-with fits the alignment on its poses)");
+      }
       options.align_with = &*align_with;
     }
     if (options.align != recordings::AlignMode::kNone) {
@@ -69,8 +72,12 @@ void RunEval(const EvalArgs& args) {
       if (!args.plot.empty()) std::cout << "plot        " << args.plot << "\n";
     }
   } catch (const recordings::RecordingError& e) {
-    // The alignment's and association's errors concern the pair: both files are named.
+    // The alignment's and association's errors concern a pair: both files are named. The
+    // alignment is fitted on the --align-with file when there is one, not on the estimate.
     const std::string message = e.what();
+    if (message.rfind("alignment", 0) == 0 && !args.align_with.empty()) {
+      throw CommandError(args.align_with + " (--align-with) against " + args.groundtruth + ": " + message);
+    }
     if (message.rfind("alignment", 0) == 0 || message.rfind("evaluation", 0) == 0) {
       throw CommandError(args.estimate + " against " + args.groundtruth + ": " + message);
     }

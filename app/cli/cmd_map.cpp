@@ -151,7 +151,8 @@ void RunMap(const MapArgs& args) {
 void RunInfo(const std::string& dir, bool recheck) {
   try {
     // Before anything is printed, so that a folder without COLMAP's model fails with one line.
-    if (recheck) mapping::RecheckMap(fs::is_regular_file(dir) ? fs::path(dir).parent_path() : fs::path(dir));
+    std::error_code ec;  // a name too long or a folder that cannot be searched: LoadMap says so, naming it
+    if (recheck) mapping::RecheckMap(fs::is_regular_file(dir, ec) ? fs::path(dir).parent_path() : fs::path(dir));
     const auto start = std::chrono::steady_clock::now();
     const map::Map map = map::LoadMap(dir);
     const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -175,7 +176,7 @@ void RunInfo(const std::string& dir, bool recheck) {
               << "descriptors:         " << s.descriptors << " (128 x uint8, "
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
-    const fs::path folder = fs::is_directory(dir) ? fs::path(dir) : fs::path(dir).parent_path();
+    const fs::path folder = fs::is_directory(dir, ec) ? fs::path(dir) : fs::path(dir).parent_path();
     if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
       std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
       for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
@@ -183,6 +184,10 @@ void RunInfo(const std::string& dir, bool recheck) {
     } else {
       std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
                 << " is written by arview map since issue 17)\n";
+    }
+    if (const auto why = map::DegeneratePoints(map)) {
+      std::cout << "warning:             the map's points cannot hold a floor ('arview place' refuses the map): " << *why
+                << "\n";
     }
   } catch (const map::MapError& e) {
     throw CommandError(e.what());

@@ -64,7 +64,18 @@ void AddPlaceCommand(CLI::App& app) {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
     RequireBaseClip(a->character, a->options.base_clip);
     const map::Map map = map::LoadMap(a->map_dir);
-    ScenePlacement placed = PlaceCharacter(map, a->character, a->options);
+    // Said of the map folder: the plane fit alone said "no floor-like plane ... holds 3 or more
+    // of the map's points" of a map whose points were all at one spot.
+    if (const auto why = map::DegeneratePoints(map)) {
+      throw CommandError(a->map_dir + ": the map's points cannot hold a floor: " + *why);
+    }
+    ScenePlacement placed = [&] {
+      try {
+        return PlaceCharacter(map, a->character, a->options);
+      } catch (const PlacementError& e) {
+        throw CommandError(a->map_dir + ": " + e.what());
+      }
+    }();
     placed.comment = "character " + placed.asset.filename().string() + " on the dominant plane of " + a->map_dir;
     WriteSceneFile(placed, a->out);
     const Anchor& anchor = placed.anchor;

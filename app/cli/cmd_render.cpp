@@ -6,7 +6,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -16,6 +18,7 @@
 #include "app/cli/gl_flags.h"
 #include "app/placement/scene_lighting.h"
 #include "calib/camera.h"
+#include "map/map_file.h"
 #include "render/ar_renderer.h"
 #include "render/prt_cache.h"
 
@@ -51,6 +54,15 @@ calib::Pose ParsePose(const std::string& text) {
   }
   for (double x : v) {
     if (!std::isfinite(x)) throw CommandError("--pose has a non-finite number: \"" + text + "\"");
+  }
+  // A camera no map can hold (maps keep their points and cameras within map::kMaxCoordinate):
+  // at 1e308 the projection overflowed and an image was written, exit 0.
+  const double farthest = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (farthest > map::kMaxCoordinate) {
+    char message[160];
+    std::snprintf(message, sizeof message, "--pose: the camera position (%g, %g, %g) lies beyond %g map units of the "
+                  "origin, the limit of a map's coordinates", v[0], v[1], v[2], map::kMaxCoordinate);
+    throw CommandError(message);
   }
   return calib::Pose::FromCameraToWorld(q.normalized(), {v[0], v[1], v[2]});
 }

@@ -1,5 +1,6 @@
 #include "app/cli/numeric_flags.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -32,12 +33,30 @@ std::string CheckNotBlank(std::string& text) {
   return "";
 }
 
+// CLI11 reads an integer written with a leading zero as octal: `--seed 042` ran with seed 34
+// (found by fuzz_flags). Every flag is documented in decimal, so the zeros are dropped before
+// CLI11 converts the text (0x, 0o and 0b prefixes are left to it: they say what they are).
+std::string LeadingZerosAsDecimal(std::string& text) {
+  const size_t first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  const size_t digits = first + (text[first] == '-' || text[first] == '+' ? 1 : 0);
+  const size_t end = text.find_last_not_of(" \t") + 1;
+  if (end <= digits + 1 || text[digits] != '0') return "";
+  if (text.find_first_not_of("0123456789", digits) < end) return "";  // not plain decimal digits
+  const size_t significant = std::min(text.find_first_not_of('0', digits), end - 1);
+  text.erase(digits, significant - digits);
+  return "";
+}
+
 void Guard(CLI::App& app) {
   for (CLI::Option* option : app.get_options()) {
     const std::string type = option->get_type_name();
     // An empty description keeps --help's type column as it was.
     if (type.rfind("FLOAT", 0) == 0) option->check(CLI::Validator(CheckFinite, ""));
     if (type.rfind("UINT", 0) == 0) option->check(CLI::Validator(CheckNotNegative, ""));
+    if (type.rfind("UINT", 0) == 0 || type.rfind("INT", 0) == 0) {
+      option->transform(CLI::Validator(LeadingZerosAsDecimal, ""));  // first, before any range check
+    }
     if (type.rfind("FLOAT", 0) == 0 || type.rfind("UINT", 0) == 0 || type.rfind("INT", 0) == 0)
       option->check(CLI::Validator(CheckNotBlank, ""));
   }

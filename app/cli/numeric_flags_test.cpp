@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <string>
+#include <vector>
+
 namespace arview::app {
 namespace {
 
@@ -25,6 +29,38 @@ TEST(FrameSize, CheckKeepsBothDimensionsInTheirRange) {
     EXPECT_NE(message.find("between 160x120 and 3840x2160"), std::string::npos) << bad << ": " << message;
     EXPECT_NE(message.find(bad), std::string::npos) << message;
   }
+}
+
+}  // namespace
+}  // namespace arview::app
+
+namespace arview::app {
+namespace {
+
+// Issue 41, found by fuzz_flags: CLI11 read "042" as octal, so `--seed 042` ran with seed 34.
+// Decimal digits are decimal; CLI11's 0x, 0o and 0b prefixes keep their meaning.
+TEST(GuardNumericOptions, LeadingZerosAreDecimalNotOctal) {
+  auto parse = [](std::vector<std::string> words, std::uint64_t& seed, int& keys) {
+    CLI::App app("test");
+    app.add_option("--seed", seed);
+    app.add_option("--keys", keys)->check(CLI::Range(2, 64));
+    GuardNumericOptions(app);
+    std::vector<const char*> argv{"test"};
+    for (const auto& w : words) argv.push_back(w.c_str());
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  };
+  std::uint64_t seed = 7;
+  int keys = 8;
+  parse({"--seed", "042", "--keys", "010"}, seed, keys);
+  EXPECT_EQ(seed, 42u);
+  EXPECT_EQ(keys, 10);
+  parse({"--seed", "000", "--keys", "064"}, seed, keys);
+  EXPECT_EQ(seed, 0u);
+  EXPECT_EQ(keys, 64);
+  parse({"--seed=0x10"}, seed, keys);
+  EXPECT_EQ(seed, 16u);
+  EXPECT_THROW(parse({"--keys", "065"}, seed, keys), CLI::ValidationError);  // 65, not octal 53
+  EXPECT_THROW(parse({"--seed", "-042"}, seed, keys), CLI::ValidationError);
 }
 
 }  // namespace

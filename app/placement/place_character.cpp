@@ -16,6 +16,8 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
       authoring::IsBuiltinAsset(asset_path) ? asset_path : std::filesystem::absolute(asset_path);
   const anim::Character character = authoring::LoadCharacter(asset);
   const double height = anim::RestHeight(character, Eigen::Vector3d::UnitY());
+  // Named here, by the asset (a PlacementError is said of the map).
+  if (!(height > 0)) throw Error(asset.string() + ": the character has no height (empty or flat bind pose)");
 
   std::vector<Eigen::Vector3d> points, centres, up_axes;
   points.reserve(map.points.size());

@@ -35,7 +35,13 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
   PlaneFitOptions plane_options = o.plane;
   if (!plane_options.up_prior) plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
-  Plane plane = FitDominantPlane(points, plane_options);
+  Plane plane = [&] {
+    try {
+      return FitDominantPlane(points, plane_options);
+    } catch (const Error& e) {  // the map's points, said as a placement error (the caller names the map)
+      throw PlacementError(e.what());
+    }
+  }();
 
   // Up is the side of the plane the cameras are on.
   double side = 0;
