@@ -1,5 +1,6 @@
-// Soak (issue 17): a long replay of a looped recording. Resident memory stays flat after the
-// warm-up (no growth beyond 5%), and every frame read is either processed or reported dropped.
+// Soak (issue 17): a long replay of a looped recording, with --stats. Resident memory stays flat
+// after the warm-up (no growth beyond 5%), and every frame read is either processed or reported
+// dropped.
 // The 10,000-frame version runs here (label slow); ARVIEW_SOAK_PASSES=1000 makes it the
 // 100,000-frame run whose figures are in docs/reliability.md.
 //
@@ -10,15 +11,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "calib/camera.h"
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
+#include "tests/support/spawn_command.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -57,23 +63,35 @@ std::vector<MemorySample> ResidentMemoryLines(const std::string& err) {
   return samples;
 }
 
+size_t LineCount(const fs::path& file) {
+  const std::string text = testing::ReadWholeFile(file.string());
+  return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// The small room, rendered once per machine.
+void MakeSmallRoom() {
+  if (fs::exists(SmallRoom() / "frames.txt")) return;
+  const fs::path rendering = SmallRoom().string() + ".rendering_" + std::to_string(::getpid());
+  const auto r = testing::RunArview({"synth", "room", "--out", rendering.string(), "--frames",
+                                     std::to_string(kRoomFrames), "--size", "160x120", "--seed", "3", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::error_code ec;
+  fs::rename(rendering, SmallRoom(), ec);  // a parallel test may have got there first
+  fs::remove_all(rendering, ec);
+}
+
 TEST(Soak, TenThousandFramesKeepMemoryFlatAndLoseNoFrame) {
   ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
-  if (!fs::exists(SmallRoom() / "frames.txt")) {
-    const fs::path rendering = SmallRoom().string() + ".rendering_" + std::to_string(::getpid());
-    const auto r = testing::RunArview({"synth", "room", "--out", rendering.string(), "--frames",
-                                       std::to_string(kRoomFrames), "--size", "160x120", "--seed", "3", "--quiet"});
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    std::error_code ec;
-    fs::rename(rendering, SmallRoom(), ec);  // a parallel test may have got there first
-    fs::remove_all(rendering, ec);
-  }
+  ASSERT_NO_FATAL_FAILURE(MakeSmallRoom());
   const fs::path work = fs::temp_directory_path() / ("arview_soak_" + std::to_string(::getpid()));
   testing::WriteRandomMap(calib::LoadCamera(SmallRoom() / "camera.yaml"), work / "map");
 
   const int passes = Passes();
+  // With --stats: its per-frame records go to disk as they come, and memory stays flat all the
+  // same (issue 41).
+  const fs::path stats = work / "stats.json";
   const auto r = testing::RunArview({"replay", SmallRoom().string(), "--map", (work / "map").string(), "--out", "null",
-                                     "--loop", std::to_string(passes)});
+                                     "--loop", std::to_string(passes), "--stats", stats.string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const int total = kRoomFrames * passes;
 
@@ -101,6 +119,40 @@ TEST(Soak, TenThousandFramesKeepMemoryFlatAndLoseNoFrame) {
       EXPECT_LE(s.resident_mib, warm * 1.05) << "at " << s.frames << " frames";
     }
   }
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadWholeFile(stats.string()));
+  EXPECT_EQ(j.at("frames").size(), static_cast<size_t>(total));
+  EXPECT_EQ(j.at("frames_processed").get<long>(), total);
+  fs::remove_all(work);
+}
+
+// Issue 41: --stats is written as the frames come. A long replay into null stopped by Ctrl-C
+// partway (as a soak or a measurement is ended) leaves a complete stats file: valid JSON, every
+// frame processed in it, the summary of those frames, and no partial file. While it runs, only
+// the partial file exists, and it does not parse (it cannot pass for a finished one).
+TEST(LiveStatsFile, AReplayStoppedByCtrlCPartwayLeavesAValidFileOfTheFramesItRan) {
+  ARVIEW_REQUIRE_DATA_PATH("/usr/share/doc/opencv-doc/examples/data/left01.jpg", "Debian package opencv-doc");
+  ASSERT_NO_FATAL_FAILURE(MakeSmallRoom());
+  const fs::path work = fs::temp_directory_path() / ("arview_soak_sigint_" + std::to_string(::getpid()));
+  testing::WriteRandomMap(calib::LoadCamera(SmallRoom() / "camera.yaml"), work / "map");
+  const fs::path stats = work / "stats.json", partial = work / "stats.partial.json";
+  testing::SpawnedArview run({"replay", SmallRoom().string(), "--map", (work / "map").string(), "--out", "null", "--loop",
+                              "1000", "--stats", stats.string()},
+                             work / "log");
+  ASSERT_TRUE(run.WaitFor([&] { return LineCount(partial) > 300; }, std::chrono::seconds(120))) << run.Stderr();
+  EXPECT_FALSE(fs::exists(stats));
+  EXPECT_FALSE(nlohmann::json::accept(testing::ReadWholeFile(partial.string())));
+
+  ASSERT_GE(run.SignalAndTimeExit(SIGINT, std::chrono::seconds(30)), 0) << "still running 30 s after Ctrl-C";
+  EXPECT_EQ(run.exit_code(), 0) << run.Stderr();
+  EXPECT_FALSE(fs::exists(partial));
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadWholeFile(stats.string()));
+  const size_t processed = j.at("frames_processed").get<size_t>();
+  EXPECT_GE(processed, 300u);
+  EXPECT_LT(processed, static_cast<size_t>(kRoomFrames) * 1000);
+  ASSERT_EQ(j.at("frames").size(), processed);
+  for (size_t i = 0; i < processed; ++i) ASSERT_EQ(j["frames"][i]["index"], static_cast<int>(i % kRoomFrames)) << i;
+  EXPECT_EQ(j.at("stages").at("sink").at("count").get<size_t>(), processed);
+  run.RemoveLogs();
   fs::remove_all(work);
 }
 

@@ -55,18 +55,21 @@ void AddReplayCommand(CLI::App& app) {
 
     SessionOptions o;
     ApplySessionFlags(a->session, o);
-    // Per-frame records only for the files that need them: a long run's memory stays flat.
-    o.pipeline.keep_frame_logs = !o.stats_out.empty();
+    // No per-frame record kept (--stats streams them to disk) and the trajectory only for
+    // --trajectory: a long run's memory stays flat.
+    o.pipeline.keep_frame_logs = false;
     o.pipeline.keep_trajectory = !o.trajectory_out.empty();
     o.pipeline.drop_frames = a->paced;
     o.expected_frames = expected;
     o.sink_fps = MedianFrameRate(recording.frames);
     o.cancel = signals.token();
     o.output_name = a->out;
-    // Shown in a window, Ctrl-C is how a person ends a replay, as Esc is: the report, the
-    // trajectory and the stats are written. To a file, it leaves no partial video.
+    // Shown in a window, Ctrl-C is how a person ends a replay, as Esc is, and so it is for a
+    // replay into null (a soak or a measurement, which has no video to leave half written): the
+    // report, the trajectory and the stats of the frames so far are written. To a file, it
+    // leaves no partial video, and no trajectory or stats.
     const bool to_window = video::IsWindowTarget(a->out);
-    o.cancel_ends_normally = to_window;
+    o.cancel_ends_normally = to_window || a->out == "null";
 
     // A video or a PNG folder is written under a temporary name and renamed when complete.
     const bool to_file = !to_window && a->out != "null";

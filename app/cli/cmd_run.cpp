@@ -50,8 +50,9 @@ void AddRunCommand(CLI::App& app) {
     SessionOptions o;
     o.command_start = Clock::now();
     ApplySessionFlags(a->session, o);
-    // Per-frame records only for the files that need them: a long run's memory stays flat.
-    o.pipeline.keep_frame_logs = !o.stats_out.empty();
+    // No per-frame record kept (--stats streams them to disk) and the trajectory only for
+    // --trajectory: a long run's memory stays flat.
+    o.pipeline.keep_frame_logs = false;
     o.pipeline.keep_trajectory = !o.trajectory_out.empty();
     o.sink = a->out;
     o.pipeline.drop_frames = true;  // live: never fall behind the camera

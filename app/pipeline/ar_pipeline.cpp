@@ -323,6 +323,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       log.timeline.output = item->MsSinceCapture();
       stats.Record("latency", log.timeline.output);
       recent.Add(written, log.timeline.output);
+      if (options.on_frame_log) options.on_frame_log(log);  // outside the lock: it writes to disk
       std::lock_guard lock(report_mutex);
       ++report.frames_processed;
       if (log.track.status != tracker::TrackStatus::kLost) ++report.frames_localized;
@@ -331,8 +332,11 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       report.source = source.Counts();
       report.recent_fps = recent.Fps();
       report.recent_latency_ms = recent.MedianLatencyMs();
-      report.briefs.push_back({static_cast<float>(log.track.times.total_ms),
-                               log.gaze_error_deg ? static_cast<float>(*log.gaze_error_deg) : -1.0f, log.track.status});
+      report.track_ms_by_status[ToString(log.track.status)].Add(log.track.times.total_ms);
+      if (log.gaze_error_deg) {
+        report.gaze_error_deg.Add(*log.gaze_error_deg);
+        report.gaze_within_20_deg += *log.gaze_error_deg <= 20.0;
+      }
       if (options.keep_frame_logs) report.frames.push_back(std::move(log));
       if (on_frame) on_frame(report);
     }

@@ -52,6 +52,8 @@ class FrameCompositor {
   virtual std::function<void(cv::Mat&)> DeferredOverlay(const FrameToCompose& /*input*/) { return {}; }
 };
 
+struct FrameLog;
+
 struct PipelineOptions {
   // Live sources: a slower stage makes the older waiting frame drop, and each queue holds one
   // frame (the freshest). Replays: every frame, through queues of `queue_capacity`.
@@ -65,19 +67,16 @@ struct PipelineOptions {
   // well below the rate it kept at first (a camera halving its rate in dim light), and when it
   // recovers.
   std::function<void(const std::string&)> on_source_note;
-  // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for --stats and the
-  // demo's figures) and `trajectory` (80 bytes a localized frame). A long run that writes
-  // neither turns them off, so that its memory stays flat (the soak test, docs/reliability.md);
-  // `briefs` (12 bytes a frame, for the text summary) are always kept.
+  // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for the demo's
+  // figures) and `trajectory` (80 bytes a localized frame, for --trajectory). `replay` and `run`
+  // keep no frames (--stats streams them through `on_frame_log`) and the trajectory only for
+  // --trajectory, so that their memory stays flat (the soak test, docs/reliability.md). What the
+  // summaries need is kept in constant memory whatever these say.
   bool keep_frame_logs = true;
   bool keep_trajectory = true;
-};
-
-// What the text summary needs of each frame.
-struct FrameBrief {
-  float track_ms = 0;
-  float gaze_error_deg = -1;  // < 0: none
-  tracker::TrackStatus status = tracker::TrackStatus::kLost;
+  // Called on the sink's thread with each frame's record as the frame reaches the sink: --stats
+  // writes it to disk then (pipeline_report.h, StatsFileWriter), so that it is not kept.
+  std::function<void(const FrameLog&)> on_frame_log;
 };
 
 // A frame's way through the pipeline, in milliseconds since its capture.
@@ -127,7 +126,12 @@ struct PipelineReport {
   // (capture → the capture thread has it: a camera's decode and buffering)
   std::map<std::string, TimingSummary> stages;
   std::vector<FrameLog> frames;                 // in processing order (PipelineOptions::keep_frame_logs)
-  std::vector<FrameBrief> briefs;               // in processing order, always
+  // The summaries of the tracker's time by status ("tracking", "relocalized", "lost") and of the
+  // gaze error (first character), in constant memory (base/stats.h: exact for the first 8,192
+  // values, then the quantiles within 1%), always.
+  std::map<std::string, StreamingSummary> track_ms_by_status;
+  StreamingSummary gaze_error_deg;
+  size_t gaze_within_20_deg = 0;
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 

@@ -1,55 +1,35 @@
 #include "app/pipeline/pipeline_report.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <thread>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
+
+#include "base/error.h"
 
 namespace arview::app {
 
 GazeSummary SummarizeGaze(const PipelineReport& report) {
-  // From the full per-frame logs when they were kept (exact), else from the briefs.
-  std::vector<double> errors;
-  for (const FrameLog& f : report.frames) {
-    if (f.gaze_error_deg) errors.push_back(*f.gaze_error_deg);
-  }
-  if (report.frames.empty())
-    for (const FrameBrief& f : report.briefs)
-      if (f.gaze_error_deg >= 0) errors.push_back(f.gaze_error_deg);
+  const Summary s = report.gaze_error_deg.Get();
   GazeSummary g;
-  g.frames = errors.size();
-  if (errors.empty()) return g;
-  const Summary s = Summarize(errors);
+  g.frames = s.count;
   g.median_deg = s.median;
   g.max_deg = s.max;
-  g.within_20_deg = std::count_if(errors.begin(), errors.end(), [](double e) { return e <= 20.0; });
+  g.within_20_deg = report.gaze_within_20_deg;
   return g;
 }
-
-namespace {
-
-}  // namespace
 
 nlohmann::ordered_json TimingJson(const TimingSummary& s) {
   return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"p99_ms", s.p99}, {"mean_ms", s.mean}, {"max_ms", s.max}};
 }
 
-namespace {
-
-std::map<std::string, TimingSummary> TrackTimesByStatus(const PipelineReport& report) {
-  std::map<std::string, std::vector<double>> samples;
-  for (const FrameLog& f : report.frames) samples[ToString(f.track.status)].push_back(f.track.times.total_ms);
-  if (report.frames.empty())
-    for (const FrameBrief& f : report.briefs) samples[ToString(f.status)].push_back(f.track_ms);
-  std::map<std::string, TimingSummary> out;
-  for (auto& [status, v] : samples) out[status] = Summarize(v);
-  return out;
-}
-
-}  // namespace
-
-std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_description, const render::RendererInfo& gl) {
+nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& r, const std::string& gl_description,
+                                           const render::RendererInfo& gl) {
   nlohmann::ordered_json j;
   j["frames_read"] = r.frames_read;
   j["frames_processed"] = r.frames_processed;
@@ -69,41 +49,84 @@ std::string PipelineReportJson(const PipelineReport& r, const std::string& gl_de
   nlohmann::ordered_json& stages = j["stages"] = nlohmann::ordered_json::object();
   for (const auto& [stage, s] : r.stages) stages[stage] = TimingJson(s);
   nlohmann::ordered_json& by_status = j["tracker_time_by_status"] = nlohmann::ordered_json::object();
-  for (const auto& [status, s] : TrackTimesByStatus(r)) by_status[status] = TimingJson(s);
+  for (const auto& [status, s] : r.track_ms_by_status) by_status[status] = TimingJson(s.Get());
   const GazeSummary g = SummarizeGaze(r);
   j["gaze"] = {{"frames", g.frames},
                {"median_error_deg", g.median_deg},
                {"max_error_deg", g.max_deg},
                {"frames_within_20_deg", g.within_20_deg}};
-  nlohmann::ordered_json& frames = j["frames"] = nlohmann::ordered_json::array();
-  for (const FrameLog& f : r.frames) {
-    const FrameTimeline& t = f.timeline;
-    nlohmann::ordered_json frame = {{"index", f.index},
-                                    {"timestamp", f.timestamp},
-                                    {"captured_s", f.captured_s},
-                                    {"latency_ms", t.output},
-                                    {"timeline_ms", {{"arrived", t.arrived},
-                                                     {"track_start", t.track_start},
-                                                     {"track_end", t.track_end},
-                                                     {"render_start", t.render_start},
-                                                     {"render_end", t.render_end},
-                                                     {"sink_start", t.sink_start},
-                                                     {"output", t.output}}},
-                                    {"waited_ms", {{"before_track", t.WaitBeforeTrack()},
-                                                   {"before_render", t.WaitBeforeRender()},
-                                                   {"before_sink", t.WaitBeforeSink()}}},
-                                    {"status", ToString(f.track.status)},
-                                    {"inliers", f.track.inliers},
-                                    {"rms_px", f.track.rms_px},
-                                    {"track_ms", f.track.times.total_ms},
-                                    {"idle_weight", f.idle_weight}};
-    if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
-    if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
-    if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
-    if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
-    frames.push_back(std::move(frame));
+  return j;
+}
+
+nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
+  const FrameTimeline& t = f.timeline;
+  nlohmann::ordered_json frame = {{"index", f.index},
+                                  {"timestamp", f.timestamp},
+                                  {"captured_s", f.captured_s},
+                                  {"latency_ms", t.output},
+                                  {"timeline_ms", {{"arrived", t.arrived},
+                                                   {"track_start", t.track_start},
+                                                   {"track_end", t.track_end},
+                                                   {"render_start", t.render_start},
+                                                   {"render_end", t.render_end},
+                                                   {"sink_start", t.sink_start},
+                                                   {"output", t.output}}},
+                                  {"waited_ms", {{"before_track", t.WaitBeforeTrack()},
+                                                 {"before_render", t.WaitBeforeRender()},
+                                                 {"before_sink", t.WaitBeforeSink()}}},
+                                  {"status", ToString(f.track.status)},
+                                  {"inliers", f.track.inliers},
+                                  {"rms_px", f.track.rms_px},
+                                  {"track_ms", f.track.times.total_ms},
+                                  {"idle_weight", f.idle_weight}};
+  if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
+  if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
+  if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
+  if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
+  return frame;
+}
+
+StatsFileWriter::StatsFileWriter(const std::filesystem::path& file) : pending_(file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(pending_.final_path(), ec)) {
+    throw Error(pending_.final_path().string() + ": is a folder, not a file for --stats (give a file path)");
   }
-  return j.dump(2) + "\n";
+  file_ = std::fopen(pending_.partial().c_str(), "w");
+  if (file_ == nullptr) {
+    throw Error(pending_.final_path().string() + ": cannot write here (" + std::strerror(errno) + ")");
+  }
+  Write("{\n  \"frames\": [");
+}
+
+StatsFileWriter::~StatsFileWriter() {
+  if (file_ != nullptr) std::fclose(file_);  // not finished: PendingOutput removes the partial file
+}
+
+void StatsFileWriter::Write(const std::string& text) {
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0) {
+    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(errno) + ")");
+  }
+}
+
+void StatsFileWriter::Add(const FrameLog& frame) {
+  Write((frames_ == 0 ? "\n    " : ",\n    ") + FrameLogJson(frame).dump());
+  ++frames_;
+}
+
+void StatsFileWriter::Finish(const PipelineReport& report, const std::string& gl_description,
+                             const render::RendererInfo& gl) {
+  // The summary's own braces dropped: its keys follow "frames" in the one object.
+  const std::string summary = PipelineSummaryJson(report, gl_description, gl).dump(2);
+  Write("\n  ]," + summary.substr(1) + "\n");
+  // On disk before the rename makes it the file (as WriteFileAtomically).
+  const bool synced = ::fsync(::fileno(file_)) == 0;
+  const int sync_error = errno;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!synced || !closed) {
+    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(synced ? errno : sync_error) + ")");
+  }
+  pending_.Commit();
 }
 
 std::string PipelineReportText(const PipelineReport& r) {
@@ -136,7 +159,8 @@ std::string PipelineReportText(const PipelineReport& r) {
     std::snprintf(line, sizeof(line), "%-14s %9.2f %8.2f\n", stage.c_str(), s.median, s.p95);
     out += line;
   }
-  for (const auto& [status, s] : TrackTimesByStatus(r)) {
+  for (const auto& [status, summary] : r.track_ms_by_status) {
+    const TimingSummary s = summary.Get();
     std::snprintf(line, sizeof(line), "tracker, %-12s %5zu frames, median %.2f ms, p95 %.2f ms\n", status.c_str(), s.count,
                   s.median, s.p95);
     out += line;

@@ -1,11 +1,14 @@
 #pragma once
 // stats.json and the console summary of a pipeline run.
 
+#include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "app/pipeline/ar_pipeline.h"
+#include "base/atomic_file.h"
 #include "render/offscreen.h"
 
 namespace arview::app {
@@ -20,9 +23,56 @@ struct GazeSummary {
 GazeSummary SummarizeGaze(const PipelineReport& report);
 // The timing object of stats.json: {count, median_ms, p95_ms, mean_ms, max_ms}.
 nlohmann::ordered_json TimingJson(const TimingSummary& summary);
-// `gl`: what rendered (stats.json's "gl": backend, device, vendor, renderer, version, software).
-std::string PipelineReportJson(const PipelineReport& report, const std::string& gl_description,
-                               const render::RendererInfo& gl = {});
+// stats.json's summary: every key but "frames" (counts, timings, "stages",
+// "tracker_time_by_status", "gaze", "renderer"; `gl`: what rendered, its "gl": backend, device,
+// vendor, renderer, version, software).
+nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& report, const std::string& gl_description,
+                                           const render::RendererInfo& gl = {});
+// One element of stats.json's "frames": the frame's way through the stages and its tracking.
+nlohmann::ordered_json FrameLogJson(const FrameLog& frame);
 std::string PipelineReportText(const PipelineReport& report);
+
+// --stats, written while the session runs, so that a session that runs all day keeps no frame
+// in memory. The file is one JSON object, its per-frame part first, one frame a line:
+//
+//   {
+//     "frames": [
+//       {"index":0,"timestamp":0.0,...},
+//       {"index":1,...}
+//     ],
+//     "frames_read": 2, ... the summary (PipelineSummaryJson) ...
+//   }
+//
+// While running it is "stats.partial.json" beside the final name (PendingOutput), each frame's
+// line flushed to it as the frame reaches the sink; Finish writes the summary after the frames,
+// fsyncs and renames it into place. So stats.json is complete or absent: an interrupted run
+// whose outputs are dropped (a replay into a video stopped by Ctrl-C, an error) removes the
+// partial file, and one killed outright (SIGKILL, power) leaves only the partial file, its
+// frames readable line by line and no summary, which says it is not complete. A run whose
+// Ctrl-C or SIGTERM is its normal end (`arview run`, a replay into a window or null) and one
+// whose camera was unplugged finish it with the summary of the frames they ran.
+class StatsFileWriter {
+ public:
+  // Throws arview::Error naming `file` when it cannot be written (before the session starts).
+  explicit StatsFileWriter(const std::filesystem::path& file);
+  ~StatsFileWriter();
+  StatsFileWriter(const StatsFileWriter&) = delete;
+  StatsFileWriter& operator=(const StatsFileWriter&) = delete;
+
+  // One frame's line, flushed (to the kernel; Finish fsyncs). From one thread at a time (the
+  // pipeline's sink thread).
+  void Add(const FrameLog& frame);
+  // The summary after the frames; then the file is renamed into place. Throws arview::Error
+  // naming the file when a write fails.
+  void Finish(const PipelineReport& report, const std::string& gl_description, const render::RendererInfo& gl = {});
+  std::size_t frames() const { return frames_; }
+
+ private:
+  void Write(const std::string& text);
+
+  PendingOutput pending_;
+  std::FILE* file_ = nullptr;
+  std::size_t frames_ = 0;
+};
 
 }  // namespace arview::app

@@ -1,13 +1,14 @@
 #pragma once
 // Per-stage timings of the real-time pipeline: each stage records how long it took for each
 // frame; the summary (base/stats.h) gives the median and 95th percentile that stats.json and the
-// console show.
+// console show. Constant memory (base/stats.h, StreamingSummary): exact figures for the first
+// 8,192 frames of a stage, then count, mean and max exact and the quantiles within 1%, so that
+// a session that runs all day holds no more than one that ran a few minutes.
 
 #include <chrono>
 #include <map>
 #include <mutex>
 #include <string>
-#include <vector>
 
 #include "base/stats.h"
 
@@ -24,7 +25,7 @@ class StageStats {
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::string, std::vector<double>> samples_;
+  std::map<std::string, StreamingSummary> summaries_;
 };
 
 class ScopedStageTimer {

@@ -23,12 +23,8 @@ double StatsJsonStageMedian() {
   for (double v : kNumbers) stats.Record("track", v);
   PipelineReport report;
   report.stages = stats.Summaries();
-  for (double v : kNumbers) {
-    FrameLog f;
-    f.gaze_error_deg = v;
-    report.frames.push_back(f);
-  }
-  const nlohmann::json j = nlohmann::json::parse(PipelineReportJson(report, "test"));
+  for (double v : kNumbers) report.gaze_error_deg.Add(v);
+  const nlohmann::json j = nlohmann::json::parse(PipelineSummaryJson(report, "test").dump());
   EXPECT_DOUBLE_EQ(j["gaze"]["median_error_deg"].get<double>(), j["stages"]["track"]["median_ms"].get<double>());
   return j["stages"]["track"]["median_ms"].get<double>();
 }

@@ -12,7 +12,6 @@
 #include <optional>
 #include <thread>
 
-#include "base/atomic_file.h"
 #include "app/pipeline/pipeline_report.h"
 #include "base/progress.h"
 #include "video/sinks.h"
@@ -64,6 +63,13 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   // loads.
   std::unique_ptr<video::FrameSink> sink =
       video::OpenSink(o.sink, ArCompositor::OutputSizeFor(map.camera, o.compositor), o.sink_fps, o.window);
+  // --stats: each frame's record goes to disk as it comes (pipeline_report.h), none is kept.
+  std::optional<StatsFileWriter> stats;
+  PipelineOptions pipeline = o.pipeline;
+  if (!o.stats_out.empty()) {
+    stats.emplace(o.stats_out);
+    pipeline.on_frame_log = [&stats](const FrameLog& frame) { stats->Add(frame); };
+  }
   Clock::time_point step = Clock::now();
   const auto seconds_of_step = [&step] {
     const Clock::time_point now = Clock::now();
@@ -132,7 +138,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::size_t rss_read_at = 0;
   Clock::time_point status_at{};
   PipelineReport report = RunPipeline(
-      source, *tracker, animator_ptrs, compositor, *sink, o.pipeline,
+      source, *tracker, animator_ptrs, compositor, *sink, pipeline,
       [&](const PipelineReport& r) {
         // On the sink's thread, which owns the window: its title twice a second.
         if (const Clock::time_point now = Clock::now(); now - status_at > std::chrono::milliseconds(500)) {
@@ -171,7 +177,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
-  if (!o.stats_out.empty()) WriteFileAtomically(o.stats_out, PipelineReportJson(result.report, result.renderer, result.renderer_info));
+  if (stats) stats->Finish(result.report, result.renderer, result.renderer_info);
   return result;
 }
 

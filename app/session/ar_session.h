@@ -24,14 +24,15 @@ struct SessionOptions {
   video::WindowPlacement window;             // for a window sink: its output, fullscreen
   double sink_fps = 30;
   std::filesystem::path trajectory_out;      // optional TUM file
-  std::filesystem::path stats_out;           // optional stats.json
+  std::filesystem::path stats_out;           // optional stats.json, written as the frames come
   CompositorOptions compositor;
   FadeOptions fade;
   PipelineOptions pipeline;
   tracker::TrackerOptions tracker;
   long expected_frames = 0;                  // for the progress line (0: unknown)
-  // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory, no stats) and
-  // RunSession throws CancelledError saying so; the caller removes its partial video.
+  // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory; the stats written
+  // so far are removed) and RunSession throws CancelledError saying so; the caller removes its
+  // partial video.
   CancellationToken cancel;
   std::string output_name;                   // what the sink's output is called, for that message
   // Live sessions (`arview run`) end by Ctrl-C: then a cancellation is the normal end, and the
