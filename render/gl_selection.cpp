@@ -5,12 +5,13 @@
 
 namespace arview::render {
 
-bool EglDeviceInfo::software() const {
-  // Extension names are whole words of a space-separated list: EGL_MESA_device_software_x would
-  // not be this one.
-  const std::string padded = " " + extensions + " ";
-  return padded.find(" EGL_MESA_device_software ") != std::string::npos;
+bool HasExtension(const char* list, const char* name) {
+  if (list == nullptr) return false;
+  const std::string padded = " " + std::string(list) + " ";
+  return padded.find(" " + std::string(name) + " ") != std::string::npos;
 }
+
+bool EglDeviceInfo::software() const { return HasExtension(extensions.c_str(), "EGL_MESA_device_software"); }
 
 std::string GlCandidate::Name() const {
   switch (kind) {

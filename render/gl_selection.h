@@ -35,6 +35,10 @@ constexpr auto EnumNames(GlBackend) {
 // (Back: arview::ToString.)
 GlBackend ParseGlBackend(const std::string& name);
 
+// Whether a space-separated extension list (EGL's strings) holds `name` as a whole word:
+// EGL_EXT_device_drm is not EGL_EXT_device_drm_render_node. A null list holds nothing.
+bool HasExtension(const char* list, const char* name);
+
 // What EGL says of one device before a display is made from it.
 struct EglDeviceInfo {
   int index = 0;           // position in eglQueryDevicesEXT's list: what --gl-device names

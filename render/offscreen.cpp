@@ -56,12 +56,6 @@ void SetThreadsOnce(bool osmesa, int threads) {
   fixed[osmesa] = threads;
 }
 
-bool HasWord(const char* list, const char* word) {
-  if (list == nullptr) return false;
-  const std::string padded = " " + std::string(list) + " ";
-  return padded.find(" " + std::string(word) + " ") != std::string::npos;
-}
-
 class OsMesaContext final : public OffscreenContext {
  public:
   explicit OsMesaContext(int threads) : OffscreenContext(GlBackend::kOsMesa, -1, threads) {
@@ -173,10 +167,10 @@ struct EglLibrary {
     egl.client_extensions = client != nullptr ? client : "";
     egl.get_platform_display =
         reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(egl.get_proc("eglGetPlatformDisplayEXT"));
-    if (HasWord(client, "EGL_EXT_device_enumeration") || HasWord(client, "EGL_EXT_device_base")) {
+    if (HasExtension(client, "EGL_EXT_device_enumeration") || HasExtension(client, "EGL_EXT_device_base")) {
       egl.query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(egl.get_proc("eglQueryDevicesEXT"));
     }
-    if (HasWord(client, "EGL_EXT_device_query") || HasWord(client, "EGL_EXT_device_base")) {
+    if (HasExtension(client, "EGL_EXT_device_query") || HasExtension(client, "EGL_EXT_device_base")) {
       egl.query_device_string =
           reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(egl.get_proc("eglQueryDeviceStringEXT"));
       egl.query_device_attrib =
@@ -203,7 +197,7 @@ const EglDevices& ListEglDevices() {
         out.failure = "EGL offers no device enumeration (EGL_EXT_device_enumeration, EGL_EXT_device_query)";
         return out;
       }
-      if (egl.get_platform_display == nullptr || !HasWord(egl.client_extensions.c_str(), "EGL_EXT_platform_device")) {
+      if (egl.get_platform_display == nullptr || !HasExtension(egl.client_extensions.c_str(), "EGL_EXT_platform_device")) {
         out.failure = "EGL offers no device platform (EGL_EXT_platform_device)";
         return out;
       }
@@ -218,14 +212,14 @@ const EglDevices& ListEglDevices() {
         d.index = i;
         const char* extensions = egl.query_device_string(handles[i], EGL_EXTENSIONS);
         d.extensions = extensions != nullptr ? extensions : "";
-        if (HasWord(extensions, "EGL_EXT_device_drm_render_node")) {
+        if (HasExtension(extensions, "EGL_EXT_device_drm_render_node")) {
           if (const char* node = egl.query_device_string(handles[i], EGL_DRM_RENDER_NODE_FILE_EXT)) d.drm_node = node;
         }
-        if (d.drm_node.empty() && HasWord(extensions, "EGL_EXT_device_drm")) {
+        if (d.drm_node.empty() && HasExtension(extensions, "EGL_EXT_device_drm")) {
           if (const char* node = egl.query_device_string(handles[i], EGL_DRM_DEVICE_FILE_EXT)) d.drm_node = node;
         }
         EGLAttrib cuda = -1;
-        if (HasWord(extensions, "EGL_NV_device_cuda") && egl.query_device_attrib != nullptr &&
+        if (HasExtension(extensions, "EGL_NV_device_cuda") && egl.query_device_attrib != nullptr &&
             egl.query_device_attrib(handles[i], EGL_CUDA_DEVICE_NV, &cuda)) {
           d.cuda_device = static_cast<int>(cuda);
         }
@@ -260,7 +254,7 @@ class EglContext final : public OffscreenContext {
         egl_(EglLibrary::Get()) {
     if (egl_.get_platform_display == nullptr) throw RenderError("EGL lacks eglGetPlatformDisplayEXT");
     if (device < 0) {
-      if (!HasWord(egl_.client_extensions.c_str(), "EGL_MESA_platform_surfaceless")) {
+      if (!HasExtension(egl_.client_extensions.c_str(), "EGL_MESA_platform_surfaceless")) {
         throw RenderError("EGL has no EGL_MESA_platform_surfaceless (not Mesa, or too old)");
       }
       SetThreadsOnce(false, threads);
@@ -285,9 +279,9 @@ class EglContext final : public OffscreenContext {
     // Configless (EGL_KHR_no_config_context) and surfaceless (EGL_KHR_surfaceless_context): no
     // pbuffer, drawing goes to framebuffer objects. A driver without them gets a chosen config
     // and a 1x1 pbuffer to be current on.
-    const bool configless = !with_config_and_pbuffer && (HasWord(display_extensions, "EGL_KHR_no_config_context") ||
-                                                         HasWord(display_extensions, "EGL_MESA_configless_context"));
-    const bool surfaceless = !with_config_and_pbuffer && HasWord(display_extensions, "EGL_KHR_surfaceless_context");
+    const bool configless = !with_config_and_pbuffer && (HasExtension(display_extensions, "EGL_KHR_no_config_context") ||
+                                                         HasExtension(display_extensions, "EGL_MESA_configless_context"));
+    const bool surfaceless = !with_config_and_pbuffer && HasExtension(display_extensions, "EGL_KHR_surfaceless_context");
     EGLConfig config = EGL_NO_CONFIG_KHR;
     if (!configless || !surfaceless) config = ChooseConfig();
     const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
