@@ -438,11 +438,50 @@ std::vector<std::vector<Eigen::Vector2f>> AllKeypoints(const std::vector<ColmapI
   return keypoints;
 }
 
+// What `frames` says of image `im` (nothing known when `frames` is empty); an image that is not
+// one of them is refused, naming `images_file`.
+FrameInfo FrameOf(const ColmapImage& im, const FrameLookup& frames, const fs::path& images_file) {
+  if (frames.empty()) return FrameInfo{};
+  const auto it = frames.find(im.name);
+  if (it == frames.end()) {
+    throw map::MapError(images_file.string() + ": image '" + PrintableForMessage(im.name) + "' is not a frame of the recording");
+  }
+  return it->second;
+}
+
+// Image `im` as a keyframe, without its observations.
+map::Keyframe KeyframeOf(const ColmapImage& im, const FrameInfo& info) {
+  map::Keyframe kf;
+  kf.colmap_image_id = im.id;
+  kf.name = im.name;
+  kf.frame_index = info.frame_index;
+  kf.timestamp = info.timestamp;
+  kf.pose = im.pose;
+  return kf;
+}
+
+// The keyframes' order: by frame index, then name.
+void SortByFrame(std::vector<ColmapImage>& images, const FrameLookup& frames, const fs::path& images_file) {
+  std::sort(images.begin(), images.end(), [&](const ColmapImage& a, const ColmapImage& b) {
+    const int fa = FrameOf(a, frames, images_file).frame_index, fb = FrameOf(b, frames, images_file).frame_index;
+    return fa != fb ? fa < fb : a.name < b.name;
+  });
+}
+
 }  // namespace
 
 std::uint64_t CountRegisteredImages(const fs::path& sparse_dir) {
   BinaryReader r(sparse_dir / "images.bin", CancellationToken{});
   return r.Read<std::uint64_t>("registered image count");
+}
+
+std::vector<map::Keyframe> ReadColmapCameraPath(const fs::path& sparse_dir, const FrameLookup& frames) {
+  const fs::path images_file = sparse_dir / "images.bin";
+  std::vector<ColmapImage> images = ReadImages(images_file, CancellationToken{});
+  SortByFrame(images, frames, images_file);
+  std::vector<map::Keyframe> keyframes;
+  for (const ColmapImage& im : images) keyframes.push_back(KeyframeOf(im, FrameOf(im, frames, images_file)));
+  return keyframes;
 }
 
 std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, const map::Map& map) {
@@ -481,32 +520,14 @@ map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, c
   map::Map map;
   map.camera = TheOneCamera(cameras, images, cameras_file, images_file);
 
-  auto frame_of = [&](const ColmapImage& im) {
-    if (frames.empty()) return FrameInfo{};
-    const auto it = frames.find(im.name);
-    if (it == frames.end()) {
-      throw map::MapError(images_file.string() + ": image '" + PrintableForMessage(im.name) + "' is not a frame of the recording");
-    }
-    return it->second;
-  };
-  std::sort(images.begin(), images.end(), [&](const ColmapImage& a, const ColmapImage& b) {
-    const int fa = frame_of(a).frame_index, fb = frame_of(b).frame_index;
-    return fa != fb ? fa < fb : a.name < b.name;
-  });
+  SortByFrame(images, frames, images_file);
 
   std::unordered_map<std::uint32_t, std::uint32_t> keyframe_of_image;
   for (const auto& im : images) {
     if (!keyframe_of_image.emplace(im.id, static_cast<std::uint32_t>(map.keyframes.size())).second) {
       throw map::MapError(images_file.string() + ": image id " + std::to_string(im.id) + " appears twice");
     }
-    const FrameInfo info = frame_of(im);
-    map::Keyframe kf;
-    kf.colmap_image_id = im.id;
-    kf.name = im.name;
-    kf.frame_index = info.frame_index;
-    kf.timestamp = info.timestamp;
-    kf.pose = im.pose;
-    map.keyframes.push_back(std::move(kf));
+    map.keyframes.push_back(KeyframeOf(im, FrameOf(im, frames, images_file)));
   }
 
   std::unordered_map<std::uint64_t, std::uint32_t> point_index;  // COLMAP id → index

@@ -42,6 +42,11 @@ map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::files
                   const FrameLookup& frames = {}, const CancellationToken& cancel = {},
                   std::vector<std::vector<Eigen::Vector2f>>* keypoints = nullptr, bool check_values = true);
 
+// The registered images of a sparse model as keyframes without observations (images.bin alone,
+// ordered as ReadColmapMap orders them): for looking at a model's camera path when its database
+// is gone. Throws MapError as ReadColmapMap does.
+std::vector<map::Keyframe> ReadColmapCameraPath(const std::filesystem::path& sparse_dir, const FrameLookup& frames = {});
+
 // The two-view geometries COLMAP verified between the map's keyframes (its database's
 // two_view_geometries), for mapping/map_check.h. Pairs with an unregistered frame are left out;
 // a database without the table gives none. Throws MapError when the database cannot be opened.

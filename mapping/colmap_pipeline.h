@@ -53,11 +53,13 @@ struct MapBuildOptions {
   bool quadratic_overlap = true;     // SequentialMatching.quadratic_overlap: loop-like long links
   std::vector<std::string> extra_mapper_args;  // appended to the mapper's command line
   // When the self-check finds a fold (mapping/map_check.h: part of the path registered at wrong
-  // rotations), matching and the mapper run again, up to this many times, and the model that
-  // disagrees least with the frames' two-view geometry is kept. COLMAP 3.8's matches differ from
-  // run to run (its kd-trees are shuffled by std::random_device), and with them the model: on
-  // phone-fox, fresh builds of a folded map's frames were right twice in two.
+  // rotations), COLMAP's mapper runs again on the same matches, up to this many times, each time
+  // started from a keyframe the check found right (a fold starts at the mapper's initial pair: on
+  // phone-fox two of four default builds began with frames 2 and 10 and folded frames 0-8). A map
+  // still folded after them is refused (BuildMap throws MapError, check.json says why) unless
+  // keep_folded: then the least folded model is written, with the warning.
   int fold_retries = 2;
+  bool keep_folded = false;
 
   // `arview map --preset fast`: 850 features and one orientation per keypoint, fewer bundle
   // adjustments (chosen on templeRing: a third less CPU, about twice the tracking error).
@@ -108,7 +110,7 @@ struct MapBuildResult {
   int models = 0;                    // models COLMAP produced
   std::filesystem::path model_dir;   // the one kept (the largest)
   MapCheck check;                    // what the map looks like as a whole (also in <out>/check.json)
-  int fold_retries = 0;              // times matching and the mapper ran again for a fold
+  int fold_retries = 0;              // times the mapper ran again for a fold
 };
 
 // Runs everything and writes the map directory. Throws MapError (or ColmapStageError,

@@ -25,16 +25,16 @@ std::string Percent(double fraction) {
   return s.str();
 }
 
-namespace {
-
-namespace fs = std::filesystem;
-using json = nlohmann::json;
-
 std::string Fixed(double v, int digits) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(digits) << v;
   return s.str();
 }
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
 
 // Keypoints of one image in a grid of `radius`-sized cells, for "is one within radius of p".
 class KeypointGrid {
@@ -117,32 +117,79 @@ double SceneDepth(const map::Map& map) {
   return Median(per_keyframe);
 }
 
-// The map's camera rotations against the pairs' two-view geometry (map_check.h).
-void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
-                             const MapCheckLimits& limits, MapCheck& c) {
-  std::vector<int> compared(map.keyframes.size(), 0), disagreeing(map.keyframes.size(), 0);
-  int pairs = 0, disagree = 0;
+// One keyframe pair's rotation in the map against its own two-view geometry.
+struct PairDisagreement {
+  int a = 0, b = 0;  // indices into Map::keyframes
+  double deg = 0;
+};
+
+// The pairs matched well enough to be compared (limits.two_view_min_inliers), with their
+// disagreement in degrees.
+std::vector<PairDisagreement> ComparablePairs(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
+                                              const MapCheckLimits& limits) {
+  const int n = static_cast<int>(map.keyframes.size());
+  std::vector<PairDisagreement> pairs;
   for (const TwoViewGeometry& g : two_view) {
-    const int n = static_cast<int>(map.keyframes.size());
     if (g.inliers < limits.two_view_min_inliers || g.keyframe_a < 0 || g.keyframe_b < 0 || g.keyframe_a >= n ||
         g.keyframe_b >= n || g.keyframe_a == g.keyframe_b)
       continue;
     const Eigen::Matrix3d rotation_ab = map.keyframes[g.keyframe_b].pose.R() * map.keyframes[g.keyframe_a].pose.R().transpose();
-    const std::optional<double> off_deg = RotationDisagreementDeg(g.essential, rotation_ab);
-    if (!off_deg) continue;
-    const bool differs = *off_deg > limits.two_view_max_disagreement_deg;
-    ++pairs;
-    disagree += differs;
-    for (int k : {g.keyframe_a, g.keyframe_b}) {
-      ++compared[k];
-      disagreeing[k] += differs;
-    }
+    if (const std::optional<double> off_deg = RotationDisagreementDeg(g.essential, rotation_ab))
+      pairs.push_back({g.keyframe_a, g.keyframe_b, *off_deg});
   }
-  c.two_view_pairs = pairs;
-  c.disagreeing_fraction = pairs > 0 ? static_cast<double>(disagree) / pairs : 0;
-  // Keyframes most of whose (at least three) pairs disagree: where the fold is.
-  for (std::size_t k = 0; k < map.keyframes.size(); ++k)
-    if (compared[k] >= 3 && 2 * disagreeing[k] > compared[k]) c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
+  return pairs;
+}
+
+// The map's camera rotations against the pairs' two-view geometry (map_check.h): the fraction of
+// pairs that disagree by more than two_view_max_disagreement_deg, and the keyframes whose own
+// pairs disagree by more than the map's typical pair does.
+void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
+                             const MapCheckLimits& limits, MapCheck& c) {
+  const std::vector<PairDisagreement> pairs = ComparablePairs(map, two_view, limits);
+  std::vector<std::vector<double>> per_keyframe(map.keyframes.size());
+  std::vector<double> all;
+  int disagree = 0;
+  for (const PairDisagreement& p : pairs) {
+    disagree += p.deg > limits.two_view_max_disagreement_deg;
+    all.push_back(p.deg);
+    per_keyframe[p.a].push_back(p.deg);
+    per_keyframe[p.b].push_back(p.deg);
+  }
+  c.two_view_pairs = static_cast<int>(pairs.size());
+  c.disagreeing_fraction = pairs.empty() ? 0 : static_cast<double>(disagree) / static_cast<double>(pairs.size());
+  c.median_disagreement_deg = Median(all);
+  c.keyframe_off_deg = std::clamp(limits.keyframe_off_factor * c.median_disagreement_deg, limits.keyframe_min_off_deg,
+                                  std::max(limits.keyframe_min_off_deg, limits.two_view_max_disagreement_deg));
+  c.keyframe_disagreement_deg.assign(map.keyframes.size(), -1.0);
+  c.keyframe_agreeing_pairs.assign(map.keyframes.size(), 0);
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    const std::vector<double>& own = per_keyframe[k];
+    if (own.empty()) continue;
+    c.keyframe_disagreement_deg[k] = Median(own);
+    c.keyframe_agreeing_pairs[k] =
+        static_cast<int>(std::count_if(own.begin(), own.end(), [&](double d) { return d <= c.keyframe_off_deg; }));
+    if (static_cast<int>(own.size()) >= limits.keyframe_min_pairs && c.keyframe_disagreement_deg[k] > c.keyframe_off_deg)
+      c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
+  }
+}
+
+// What a fold looks like, in the map's own figures, and what to do.
+std::string FoldWarning(const MapCheck& c, const MapCheckLimits& limits) {
+  std::string where;
+  for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
+    where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
+  if (c.disagreeing_frames.size() > 12) where += ", ...";
+  std::string what = "its camera rotations differ from it by more than " +
+                     Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees in " + Percent(c.disagreeing_fraction) +
+                     " of " + std::to_string(c.two_view_pairs) + " well-matched keyframe pairs";
+  if (!where.empty())
+    what += "; the pairs of frames " + where + " disagree by a median of more than " + Fixed(c.keyframe_off_deg, 1) +
+            " degrees, where the map's median pair disagrees by " + Fixed(c.median_disagreement_deg, 1);
+  return "disagrees with the frames' own two-view geometry (" + what +
+         "): COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
+         "and tracking there will be off. Map other frames (--frames), or film that part again moving the camera "
+         "sideways (arview map maps such a model again from another start, --fold-retries, and refuses it "
+         "unless --keep-folded)";
 }
 
 void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
@@ -165,28 +212,42 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
     c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
                          " of the frames' features: the scene changed while it was filmed, or most of what was "
                          "filmed moved. Record a still scene");
-  if (Folded(c, limits)) {
-    std::string where;
-    for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
-      where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
-    if (c.disagreeing_frames.size() > 12) where += ", ...";
-    c.warnings.push_back(
-        "disagrees with the frames' own two-view geometry: its camera rotations differ from it in " +
-        Percent(c.disagreeing_fraction) + " of " + std::to_string(c.two_view_pairs) +
-        " well-matched keyframe pairs (by more than " + Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees" +
-        (where.empty() ? std::string(")") : "; most of all frames " + where + ")") +
-        ": COLMAP registered part of the path wrongly (a fold, seen when the first frames film a flat scene), "
-        "and tracking there will be off. Build the map afresh into a new --out folder (COLMAP's matches, and "
-        "with them its model, differ from one build to the next; its mapper run again on the same matches "
-        "gives the same model; `arview map` matches again up to --fold-retries times before it keeps a folded "
-        "map), or map other frames");
-  }
+  if (Folded(c, limits)) c.warnings.push_back(FoldWarning(c, limits));
 }
 
 }  // namespace
 
 bool Folded(const MapCheck& check, const MapCheckLimits& limits) {
-  return check.two_view_pairs > 0 && check.disagreeing_fraction > limits.max_disagreeing_fraction;
+  return check.two_view_pairs > 0 &&
+         (check.disagreeing_fraction > limits.max_disagreeing_fraction ||
+          static_cast<int>(check.disagreeing_frames.size()) >= limits.min_off_keyframes);
+}
+
+std::optional<int> KeyframeToStartFrom(const map::Map& map, const MapCheck& check,
+                                       const std::vector<std::uint32_t>& excluded) {
+  const int n = static_cast<int>(map.keyframes.size());
+  if (static_cast<int>(check.keyframe_agreeing_pairs.size()) != n) return std::nullopt;
+  std::vector<int> off;  // keyframe indices
+  for (int k = 0; k < n; ++k)
+    if (std::find(check.disagreeing_frames.begin(), check.disagreeing_frames.end(), map.keyframes[k].frame_index) !=
+        check.disagreeing_frames.end())
+      off.push_back(k);
+  const auto distance_to_off = [&](int k) {
+    int d = n;
+    for (int o : off) d = std::min(d, std::abs(o - k));
+    return d;
+  };
+  std::optional<int> best;
+  for (int k = 0; k < n; ++k) {
+    if (check.keyframe_agreeing_pairs[k] == 0 || distance_to_off(k) == 0 ||
+        std::find(excluded.begin(), excluded.end(), map.keyframes[k].colmap_image_id) != excluded.end())
+      continue;
+    if (!best || check.keyframe_agreeing_pairs[k] > check.keyframe_agreeing_pairs[*best] ||
+        (check.keyframe_agreeing_pairs[k] == check.keyframe_agreeing_pairs[*best] &&
+         distance_to_off(k) > distance_to_off(*best)))
+      best = k;
+  }
+  return best;
 }
 
 std::optional<double> RotationDisagreementDeg(const Eigen::Matrix3d& essential, const Eigen::Matrix3d& rotation_ab) {
@@ -245,7 +306,9 @@ std::string DescribeMapCheck(const MapCheck& c) {
          Fixed(c.median_triangulation_deg, 1) + " deg; features staying still " + Percent(c.still_fraction) +
          " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)" +
          (c.two_view_pairs > 0 ? "; rotations disagree with the two-view geometry in " + Percent(c.disagreeing_fraction) +
-                                     " of " + std::to_string(c.two_view_pairs) + " pairs"
+                                     " of " + std::to_string(c.two_view_pairs) + " pairs (median pair " +
+                                     Fixed(c.median_disagreement_deg, 2) + " deg; keyframes off: " +
+                                     std::to_string(c.disagreeing_frames.size()) + ")"
                                : std::string());
 }
 
@@ -260,6 +323,8 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
                   {"still_fraction", c.still_fraction},
                   {"two_view_pairs", c.two_view_pairs},
                   {"disagreeing_fraction", c.disagreeing_fraction},
+                  {"median_disagreement_deg", c.median_disagreement_deg},
+                  {"keyframe_off_deg", c.keyframe_off_deg},
                   {"disagreeing_frames", c.disagreeing_frames},
                   {"flagged", c.flagged()},
                   {"warnings", c.warnings}};
@@ -289,6 +354,9 @@ std::optional<MapCheck> ReadMapCheckFile(const fs::path& file) {
     // Absent from check files written before the two-view comparison (2026-12-03).
     c.two_view_pairs = j.value("two_view_pairs", 0);
     c.disagreeing_fraction = j.value("disagreeing_fraction", 0.0);
+    // Absent from check files written before keyframes were judged by their own pairs (2026-12-04).
+    c.median_disagreement_deg = j.value("median_disagreement_deg", 0.0);
+    c.keyframe_off_deg = j.value("keyframe_off_deg", 0.0);
     c.disagreeing_frames = j.value("disagreeing_frames", std::vector<int>{});
     c.warnings = j.at("warnings").get<std::vector<std::string>>();
     return c;

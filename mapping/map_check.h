@@ -20,12 +20,19 @@
 //   Its rotation agrees with the map's relative rotation within a degree or two for a
 //   well-matched pair; a part of the path that COLMAP registered wrongly (a fold: on phone-fox a
 //   default map once put frames 0-8 at rotations 10-35 degrees off, all else right, with a
-//   normal reprojection error) disagrees with most of its pairs.
+//   normal reprojection error) disagrees with most of its pairs. A milder fold (frames 0-8 off by
+//   3-10 degrees, keyframe centres off by up to 0.5 of the path's width) disagrees by less than
+//   the 10 degrees that count a pair as disagreeing, so each keyframe is also judged by the
+//   median disagreement of its own pairs against the map's typical one: on 1080x1920 phone frames
+//   a right map's keyframes stay within 1 degree (the essential matrices are that precise), the
+//   folded ones are 3-10 degrees off; on 640x480 renders a right map's keyframes reach 2.8 degrees
+//   where its median pair is at 0.9 (docs/mapping.md, "The map's self-check").
 // The verdict is a list of warnings, each saying what it saw and what to do; the map is still
 // written (a warning, not a refusal: docs/mapping.md, "The map's self-check").
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -46,6 +53,14 @@ struct MapCheckLimits {
   int two_view_min_inliers = 300;        // pairs matched at least this well are compared
   double two_view_max_disagreement_deg = 10.0;
   double max_disagreeing_fraction = 0.15;   // more of the compared pairs disagreeing: a fold
+  // A keyframe is "off" when the median disagreement of its pairs (at least
+  // keyframe_min_pairs of them) exceeds keyframe_off_factor x the median over all the map's
+  // pairs, clamped to [keyframe_min_off_deg, two_view_max_disagreement_deg]; this many off
+  // keyframes make a fold (one alone may be a frame whose pairs are all poorly matched).
+  int keyframe_min_pairs = 3;
+  double keyframe_off_factor = 5.0;
+  double keyframe_min_off_deg = 2.0;
+  int min_off_keyframes = 2;
 };
 
 // COLMAP's two-view geometry of two keyframes: the essential matrix of their matches alone.
@@ -73,14 +88,27 @@ struct MapCheck {
   double still_fraction = 0;         // median over those pairs
   int two_view_pairs = 0;            // keyframe pairs compared with their two-view geometry
   double disagreeing_fraction = 0;      // the fraction of those whose rotations disagree
-  std::vector<int> disagreeing_frames;  // frame indices of keyframes most of whose pairs disagree
+  double median_disagreement_deg = 0;   // over the compared pairs
+  double keyframe_off_deg = 0;          // the limit a keyframe's own median was held to
+  std::vector<int> disagreeing_frames;  // frame indices of the keyframes that are off (MapCheckLimits)
+  // Per keyframe (Map::keyframes order): the median disagreement of its compared pairs, and how
+  // many pairs agree within keyframe_off_deg; -1 and 0 without compared pairs. Not in check.json.
+  std::vector<double> keyframe_disagreement_deg;
+  std::vector<int> keyframe_agreeing_pairs;
   std::vector<std::string> warnings;
   bool flagged() const { return !warnings.empty(); }
 };
 
 // Whether `check` found a fold: its rotations disagree with the two-view geometry in more of the
-// compared pairs than `limits` allow.
+// compared pairs than `limits` allow, or at least limits.min_off_keyframes keyframes are off.
 bool Folded(const MapCheck& check, const MapCheckLimits& limits = {});
+
+// The keyframe (index into map.keyframes) a new mapper run should start from when `check` found a
+// fold: one that is not off, not in `excluded` (COLMAP image ids of earlier starts), with the
+// most pairs agreeing with the map; among equals, the one furthest (in keyframes) from an off one.
+// Nothing when no keyframe qualifies (no two-view comparison).
+std::optional<int> KeyframeToStartFrom(const map::Map& map, const MapCheck& check,
+                                       const std::vector<std::uint32_t>& excluded);
 
 // `keypoints[k]`: every keypoint COLMAP found in keyframe k (OpenCV pixels), observations or not.
 // `two_view`: the keyframes' two-view geometries (mapping/colmap_model.h); none: not compared.
@@ -96,6 +124,8 @@ std::optional<MapCheck> ReadMapCheck(const std::filesystem::path& file);
 
 // A fraction as the check's messages write it: "28%", "5.8%".
 std::string Percent(double fraction);
+// A number with `digits` decimals, as the check's messages write it: "3.2".
+std::string Fixed(double value, int digits);
 
 // One line of figures ("explains 34% of the features, ...").
 std::string DescribeMapCheck(const MapCheck& check);

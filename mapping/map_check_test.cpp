@@ -218,6 +218,71 @@ TEST(MapCheck, APartOfThePathRegisteredAtWrongRotationsIsFlaggedWithItsFrames) {
   EXPECT_FALSE(HasWarning(weak, "two-view geometry"));
 }
 
+// Every pair's geometry from the true poses with its rotation off by 0.1-0.5 degrees (pseudo-random
+// axes): what COLMAP's essential matrices look like on real frames.
+std::vector<TwoViewGeometry> NoisyGeometries(const map::Map& truth, int inliers) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1, 1), size(0.1, 0.5);
+  std::vector<TwoViewGeometry> g = TrueGeometries(truth, inliers);
+  for (TwoViewGeometry& pair : g) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+    const Eigen::Matrix3d noise = Eigen::AngleAxisd(size(rng) * M_PI / 180, axis).toRotationMatrix();
+    pair.essential = noise * pair.essential;  // [t]x R -> N [t]x R: the pair's rotation turned by N, near enough
+  }
+  return g;
+}
+
+// phone-fox's second folded default map: frames 0-8 turned 3-10 degrees, under the 10 degrees that
+// count a pair as disagreeing. Their own pairs' median shows it; one keyframe off alone does not
+// make a fold.
+TEST(MapCheck, AMildFoldIsFlaggedByTheKeyframesOwnPairs) {
+  const map::Map truth = TurningPath(12);
+  const MapCheck right = CheckMap(truth, {}, NoisyGeometries(truth, 300));
+  EXPECT_FALSE(Folded(right)) << DescribeMapCheck(right);
+  EXPECT_TRUE(right.disagreeing_frames.empty());
+  EXPECT_GT(right.median_disagreement_deg, 0.1);
+  EXPECT_LT(right.median_disagreement_deg, 0.5);
+  EXPECT_DOUBLE_EQ(right.keyframe_off_deg, 2.0);  // 5 x the median pair, at least 2 degrees
+
+  map::Map folded = truth;
+  for (int k = 0; k < 3; ++k)
+    folded.keyframes[k].pose.q_cw = Eigen::Quaterniond(Eigen::AngleAxisd(4 * M_PI / 180, Eigen::Vector3d::UnitX())) *
+                                    folded.keyframes[k].pose.q_cw;
+  const MapCheck c = CheckMap(folded, {}, NoisyGeometries(truth, 300));
+  EXPECT_EQ(c.disagreeing_fraction, 0);  // no pair beyond 10 degrees
+  EXPECT_EQ(c.disagreeing_frames, (std::vector<int>{0, 2, 4}));
+  EXPECT_TRUE(Folded(c));
+  EXPECT_TRUE(HasWarning(c, "the pairs of frames 0, 2, 4 disagree by a median of more than"))
+      << ::testing::PrintToString(c.warnings);
+
+  map::Map one_off = truth;
+  one_off.keyframes[5].pose.q_cw =
+      Eigen::Quaterniond(Eigen::AngleAxisd(4 * M_PI / 180, Eigen::Vector3d::UnitX())) * one_off.keyframes[5].pose.q_cw;
+  const MapCheck one = CheckMap(one_off, {}, NoisyGeometries(truth, 300));
+  EXPECT_EQ(one.disagreeing_frames, (std::vector<int>{10}));
+  EXPECT_FALSE(Folded(one));
+}
+
+// A new mapper run starts from a keyframe that is right, far from the fold, and not one an earlier
+// run started from.
+TEST(MapCheck, ARetryStartsFromARightKeyframeFarFromTheFold) {
+  map::Map folded = TurningPath(12);
+  const map::Map truth = folded;
+  for (int k = 0; k < 12; ++k) folded.keyframes[k].colmap_image_id = static_cast<std::uint32_t>(100 + k);
+  for (int k = 0; k < 3; ++k)
+    folded.keyframes[k].pose.q_cw = Eigen::Quaterniond(Eigen::AngleAxisd(4 * M_PI / 180, Eigen::Vector3d::UnitX())) *
+                                    folded.keyframes[k].pose.q_cw;
+  const MapCheck c = CheckMap(folded, {}, NoisyGeometries(truth, 300));
+  ASSERT_TRUE(Folded(c));
+  // Keyframes 3-11 each agree with their 8 pairs outside the fold: the furthest from it wins.
+  EXPECT_EQ(KeyframeToStartFrom(folded, c, {}), 11);
+  EXPECT_EQ(KeyframeToStartFrom(folded, c, {111}), 10);
+  std::vector<std::uint32_t> all;
+  for (int k = 3; k < 12; ++k) all.push_back(static_cast<std::uint32_t>(100 + k));
+  EXPECT_FALSE(KeyframeToStartFrom(folded, c, all));  // the fold's own keyframes are never chosen
+  EXPECT_FALSE(KeyframeToStartFrom(folded, CheckMap(folded, {}, {}), {}));  // nothing compared
+}
+
 TEST(MapCheck, TheTwoViewFiguresSurviveTheCheckFile) {
   const map::Map truth = TurningPath(6);
   map::Map folded = truth;

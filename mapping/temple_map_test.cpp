@@ -280,7 +280,8 @@ TEST_F(TempleMapTest, FailingStageCarriesTheLogTail) {
 
 // A COLMAP that is the real one, except that its mapper's n-th run turns the first k images (by
 // id) of the model it made by 30 degrees about their own x axis, centres kept, for the n-th entry
-// k > 0 of `turned` (a fold, as COLMAP once made on phone-fox), and fails for k < 0.
+// k > 0 of `turned` (a fold, as COLMAP once made on phone-fox), and fails for k < 0. Every
+// command line goes to <dir>/calls, one per line.
 fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned) {
   fs::create_directories(dir);
   {
@@ -292,6 +293,7 @@ fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned
   std::ofstream out(script);
   // World-to-camera q, t -> turn * q, turn * t (turn: 30 degrees about x; cos 15, sin 15 degrees).
   out << "#!/bin/sh\n"
+         "echo \"$*\" >> '" << (dir / "calls").string() << "'\n"
          "colmap \"$@\" || exit $?\n"
          "[ \"$1\" = mapper ] || exit 0\n"
          "n=$(cat '" << runs << "' 2>/dev/null || echo 0); n=$((n + 1)); echo $n > '" << runs << "'\n"
@@ -318,10 +320,11 @@ fs::path ColmapFoldingModels(const fs::path& dir, const std::vector<int>& turned
 // `arview map`'s pipeline on 16 of templeRing's frames (under half the pairs of the fixture's 24
 // to match) through ColmapFoldingModels(turned), with notes collected.
 MapBuildResult BuildFolding(const recordings::Recording& recording, const fs::path& out, const std::vector<int>& turned,
-                            int retries, std::vector<std::string>* notes) {
+                            int retries, bool keep_folded, std::vector<std::string>* notes) {
   MapBuildOptions options;
   options.frames_spec = "0-30:2";
   options.fold_retries = retries;
+  options.keep_folded = keep_folded;
   options.colmap = ColmapFoldingModels(out.string() + "_colmap", turned).string();
   MapBuildCallbacks cb;
   cb.note = [notes](const std::string& n) { notes->push_back(n); };
@@ -332,58 +335,76 @@ bool Said(const std::vector<std::string>& notes, const std::string& text) {
   return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
 }
 
-// A folded model is matched and mapped again; the first model that is not folded is kept, and
-// nothing of the tries is left in the folder.
-TEST_F(TempleMapTest, AFoldedModelIsMatchedAgainUntilItIsNotFolded) {
+// The COLMAP command lines ColmapFoldingModels saw for `out`.
+std::vector<std::string> ColmapCalls(const fs::path& out) {
+  std::ifstream in(out.string() + "_colmap/calls");
+  std::vector<std::string> calls;
+  for (std::string line; std::getline(in, line);) calls.push_back(line);
+  return calls;
+}
+
+int CountStarting(const std::vector<std::string>& calls, const std::string& command) {
+  return static_cast<int>(
+      std::count_if(calls.begin(), calls.end(), [&](const std::string& c) { return c.rfind(command, 0) == 0; }));
+}
+
+// A folded model is mapped again on the same matches, from a keyframe the check found right; the
+// first model that is not folded is kept, and nothing of the tries is left in the folder.
+TEST_F(TempleMapTest, AFoldedModelIsMappedAgainFromAnotherStartUntilItIsNotFolded) {
   std::vector<std::string> notes;
   const fs::path out = scratch_ / "repaired";
-  const MapBuildResult repaired = BuildFolding(*recording_, out, {4, 0}, 2, &notes);
+  const MapBuildResult repaired = BuildFolding(*recording_, out, {4, 0}, 2, false, &notes);
   EXPECT_EQ(repaired.fold_retries, 1);
   EXPECT_FALSE(Folded(repaired.check)) << DescribeMapCheck(repaired.check);
   EXPECT_TRUE(Said(notes, "looks folded")) << ::testing::PrintToString(notes);
+  EXPECT_TRUE(Said(notes, "mapping again from frame")) << ::testing::PrintToString(notes);
   EXPECT_TRUE(Said(notes, "is not folded")) << ::testing::PrintToString(notes);
+  const std::vector<std::string> calls = ColmapCalls(out);
+  EXPECT_EQ(CountStarting(calls, "exhaustive_matcher"), 1) << ::testing::PrintToString(calls);
+  ASSERT_EQ(CountStarting(calls, "mapper"), 2) << ::testing::PrintToString(calls);
+  EXPECT_NE(calls.back().find("--Mapper.init_image_id1"), std::string::npos) << calls.back();
   EXPECT_FALSE(fs::exists(out / "fold-tries"));
   EXPECT_FALSE(Folded(*ReadMapCheck(out / kMapCheckFileName)));
   EXPECT_EQ(map::LoadMap(out).keyframes.size(), repaired.map.keyframes.size());
 }
 
-// Folded twice (2, then 8 frames turned; which disagrees more depends on COLMAP's matches), out
-// of retries: the model that disagrees least is kept, with its own matches.
-TEST_F(TempleMapTest, AllTriesFoldedKeepsTheOneThatDisagreesLeast) {
+// Folded twice (2, then 8 frames turned), out of retries: the map is refused with one line, the
+// check beside it says why, and no map file is written. The same command with --keep-folded then
+// writes the least folded model (the first) without running COLMAP's stages again.
+TEST_F(TempleMapTest, AMapStillFoldedIsRefusedUnlessKept) {
   std::vector<std::string> notes;
-  const fs::path out = scratch_ / "kept";
-  const MapBuildResult kept = BuildFolding(*recording_, out, {2, 8}, 1, &notes);
-  EXPECT_EQ(kept.fold_retries, 1);
-  EXPECT_TRUE(Folded(kept.check)) << DescribeMapCheck(kept.check);
-  EXPECT_TRUE(kept.check.flagged());
-  ASSERT_GE(notes.size(), 2u);
-  const std::string& last = notes.back();
-  EXPECT_TRUE(Said({last}, "kept the one that disagrees least")) << last;
-  // "... (the models disagree in A%, B% of the pairs); kept ... (K% of N pairs, the first|try 1)"
-  const std::string tag = "the models disagree in ";
-  const auto at = last.find(tag);
-  ASSERT_NE(at, std::string::npos) << last;
-  double first = 0, second = 0;
-  ASSERT_EQ(std::sscanf(last.c_str() + at + tag.size(), "%lf%%, %lf%%", &first, &second), 2) << last;
-  const std::string kept_percent = Percent(kept.check.disagreeing_fraction);
-  EXPECT_NEAR(100 * kept.check.disagreeing_fraction, std::min(first, second), 0.51) << last;
-  EXPECT_TRUE(Said({last}, "(" + kept_percent + " of " + std::to_string(kept.check.two_view_pairs) + " pairs, " +
-                               (first <= second ? "the first" : "try 1") + ")"))
-      << last;
-  EXPECT_FALSE(fs::exists(out / "fold-tries"));
-  // The first model's figures, as its note gave them, and the model in the folder is the kept one.
-  if (first <= second) {
-    EXPECT_TRUE(Said({notes.front()}, "in " + kept_percent + " of ")) << notes.front();
+  const fs::path out = scratch_ / "refused";
+  try {
+    BuildFolding(*recording_, out, {2, 8}, 1, false, &notes);
+    FAIL() << "a folded map was accepted";
+  } catch (const map::MapError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("the map is folded and was not written"), std::string::npos) << what;
+    EXPECT_NE(what.find("--keep-folded"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
-  EXPECT_NEAR(ReadMapCheck(out / kMapCheckFileName)->disagreeing_fraction, kept.check.disagreeing_fraction, 1e-12);
+  EXPECT_TRUE(Said({notes.back()}, "the least folded model is the first")) << notes.back();
+  EXPECT_FALSE(fs::exists(out / map::kMapFileName));
+  EXPECT_FALSE(fs::exists(out / "fold-tries"));
+  const std::optional<MapCheck> check = ReadMapCheck(out / kMapCheckFileName);
+  ASSERT_TRUE(check);
+  EXPECT_TRUE(Folded(*check));
+
+  notes.clear();
+  fs::remove(out.string() + "_colmap/calls");
+  const MapBuildResult kept = BuildFolding(*recording_, out, {}, 0, true, &notes);
+  EXPECT_TRUE(Folded(kept.check));
+  EXPECT_EQ(kept.check.disagreeing_frames, check->disagreeing_frames);
+  EXPECT_TRUE(fs::exists(out / map::kMapFileName));
+  EXPECT_EQ(CountStarting(ColmapCalls(out), "mapper"), 0);  // its own calls: every stage skipped
 }
 
-// Folded, then the mapper fails on the new matches: the first model is put back, with its stages
-// recorded (a re-run skips them, then tries again).
+// Folded, then the mapper fails from the new start: the first model is put back, with its stages
+// recorded (a re-run skips them, then tries again), and kept with --keep-folded.
 TEST_F(TempleMapTest, AFailedTryPutsTheFoldedModelBack) {
   std::vector<std::string> notes;
   const fs::path out = scratch_ / "after_failure";
-  const MapBuildResult after_failure = BuildFolding(*recording_, out, {4, -1}, 2, &notes);
+  const MapBuildResult after_failure = BuildFolding(*recording_, out, {4, -1}, 2, true, &notes);
   EXPECT_EQ(after_failure.fold_retries, 1);
   EXPECT_TRUE(Folded(after_failure.check));
   EXPECT_TRUE(Said(notes, "try 1 failed: COLMAP mapper")) << ::testing::PrintToString(notes);

@@ -1,6 +1,6 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
-//            [--fold-retries N]
+//            [--fold-retries N] [--keep-folded]
 // arview map info <map-dir>
 
 #include <unistd.h>
@@ -37,6 +37,7 @@ struct MapArgs {
   std::string preset = "quality";
   int max_features = 0;  // 0: the preset's
   int fold_retries = mapping::MapBuildOptions().fold_retries;
+  bool keep_folded = false;
   std::string info_dir;
   bool info_recheck = false;
 };
@@ -79,11 +80,7 @@ class ProgressBar {
   int last_quarter_ = -1;
 };
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream ss;
-  ss << std::fixed << std::setprecision(digits) << v;
-  return ss.str();
-}
+using mapping::Fixed;
 
 void RunMap(const MapArgs& args) {
   if (args.recording.empty()) throw CommandError("map: the recording folder is required (arview map <recording> --out <map-dir>)", 2);
@@ -97,6 +94,7 @@ void RunMap(const MapArgs& args) {
   if (args.preset == "fast") options.UseFastPreset();
   if (args.max_features > 0) options.max_num_features = args.max_features;
   options.fold_retries = args.fold_retries;
+  options.keep_folded = args.keep_folded;
   const ScopedSignalCancellation signals;
   options.cancel = signals.token();
   ProgressBar bar;
@@ -222,11 +220,14 @@ void AddMapCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"quality", "fast"}));
   cmd->add_option("--fold-retries", args->fold_retries,
-                  "When the self-check finds part of the path registered at wrong rotations (a fold), match and "
-                  "map again up to this many times and keep the model that agrees best with the frames' two-view "
-                  "geometry (COLMAP's matches differ from run to run; 0: keep the first model)")
+                  "When the self-check finds part of the path registered at wrong rotations (a fold), run COLMAP's "
+                  "mapper again on the same matches up to this many times, each time starting from a keyframe the "
+                  "check found right; a map still folded after them is refused (see --keep-folded)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10));
+  cmd->add_flag("--keep-folded", args->keep_folded,
+                "Write the map even when it is still folded after --fold-retries (the least folded model, with "
+                "the warning); by default such a map is refused");
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();
