@@ -452,7 +452,12 @@ std::vector<std::string> MatchArgs(const MapBuildOptions& options, const fs::pat
                                 "--database_path", database.string(),
                                 "--SiftMatching.use_gpu", "0",
                                 "--SiftMatching.num_threads", std::to_string(options.threads)};
-  if (!exhaustive) {
+  if (exhaustive) {
+    // Four blocks a side (COLMAP's default is one block of 50 images): the same pairs, matched in
+    // 16 steps that each print "Matching block [a/A, b/B]", so that the longest stage shows
+    // progress and a time left.
+    args.insert(args.end(), {"--ExhaustiveMatching.block_size", std::to_string(std::max(2, (frames + 3) / 4))});
+  } else {
     args.insert(args.end(), {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
                              "--SequentialMatching.quadratic_overlap", options.quadratic_overlap ? "1" : "0"});
   }

@@ -162,14 +162,18 @@ void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeome
                                   std::max(limits.keyframe_min_off_deg, limits.two_view_max_disagreement_deg));
   c.keyframe_disagreement_deg.assign(map.keyframes.size(), -1.0);
   c.keyframe_agreeing_pairs.assign(map.keyframes.size(), 0);
+  int previous_off_index = -2;  // of the last keyframe found off
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     const std::vector<double>& own = per_keyframe[k];
     if (own.empty()) continue;
     c.keyframe_disagreement_deg[k] = Median(own);
     c.keyframe_agreeing_pairs[k] =
         static_cast<int>(std::count_if(own.begin(), own.end(), [&](double d) { return d <= c.keyframe_off_deg; }));
-    if (static_cast<int>(own.size()) >= limits.keyframe_min_pairs && c.keyframe_disagreement_deg[k] > c.keyframe_off_deg)
+    if (static_cast<int>(own.size()) >= limits.keyframe_min_pairs && c.keyframe_disagreement_deg[k] > c.keyframe_off_deg) {
       c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
+      c.off_neighbours += previous_off_index == static_cast<int>(k) - 1;
+      previous_off_index = static_cast<int>(k);
+    }
   }
 }
 
@@ -220,7 +224,7 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
 bool Folded(const MapCheck& check, const MapCheckLimits& limits) {
   return check.two_view_pairs > 0 &&
          (check.disagreeing_fraction > limits.max_disagreeing_fraction ||
-          static_cast<int>(check.disagreeing_frames.size()) >= limits.min_off_keyframes);
+          check.off_neighbours > 0);
 }
 
 std::optional<int> KeyframeToStartFrom(const map::Map& map, const MapCheck& check,
@@ -325,6 +329,7 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
                   {"disagreeing_fraction", c.disagreeing_fraction},
                   {"median_disagreement_deg", c.median_disagreement_deg},
                   {"keyframe_off_deg", c.keyframe_off_deg},
+                  {"off_neighbours", c.off_neighbours},
                   {"disagreeing_frames", c.disagreeing_frames},
                   {"flagged", c.flagged()},
                   {"warnings", c.warnings}};
@@ -357,6 +362,7 @@ std::optional<MapCheck> ReadMapCheckFile(const fs::path& file) {
     // Absent from check files written before keyframes were judged by their own pairs (2026-12-04).
     c.median_disagreement_deg = j.value("median_disagreement_deg", 0.0);
     c.keyframe_off_deg = j.value("keyframe_off_deg", 0.0);
+    c.off_neighbours = j.value("off_neighbours", 0);
     c.disagreeing_frames = j.value("disagreeing_frames", std::vector<int>{});
     c.warnings = j.at("warnings").get<std::vector<std::string>>();
     return c;

@@ -55,12 +55,13 @@ struct MapCheckLimits {
   double max_disagreeing_fraction = 0.15;   // more of the compared pairs disagreeing: a fold
   // A keyframe is "off" when the median disagreement of its pairs (at least
   // keyframe_min_pairs of them) exceeds keyframe_off_factor x the median over all the map's
-  // pairs, clamped to [keyframe_min_off_deg, two_view_max_disagreement_deg]; this many off
-  // keyframes make a fold (one alone may be a frame whose pairs are all poorly matched).
+  // pairs, clamped to [keyframe_min_off_deg, two_view_max_disagreement_deg]. Two neighbouring
+  // keyframes off make a fold: a fold is a stretch of the path, while the imprecise essential
+  // matrices of small frames put single keyframes here and there over the limit (a right
+  // templeRing map at 640x480: keyframes 0 and 28 at 2.8 and 3.8 degrees, its median pair 0.7).
   int keyframe_min_pairs = 3;
   double keyframe_off_factor = 5.0;
   double keyframe_min_off_deg = 2.0;
-  int min_off_keyframes = 2;
 };
 
 // COLMAP's two-view geometry of two keyframes: the essential matrix of their matches alone.
@@ -91,6 +92,7 @@ struct MapCheck {
   double median_disagreement_deg = 0;   // over the compared pairs
   double keyframe_off_deg = 0;          // the limit a keyframe's own median was held to
   std::vector<int> disagreeing_frames;  // frame indices of the keyframes that are off (MapCheckLimits)
+  int off_neighbours = 0;               // consecutive keyframe pairs both off
   // Per keyframe (Map::keyframes order): the median disagreement of its compared pairs, and how
   // many pairs agree within keyframe_off_deg; -1 and 0 without compared pairs. Not in check.json.
   std::vector<double> keyframe_disagreement_deg;
@@ -100,7 +102,7 @@ struct MapCheck {
 };
 
 // Whether `check` found a fold: its rotations disagree with the two-view geometry in more of the
-// compared pairs than `limits` allow, or at least limits.min_off_keyframes keyframes are off.
+// compared pairs than `limits` allow, or two neighbouring keyframes are off.
 bool Folded(const MapCheck& check, const MapCheckLimits& limits = {});
 
 // The keyframe (index into map.keyframes) a new mapper run should start from when `check` found a

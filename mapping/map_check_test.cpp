@@ -251,6 +251,7 @@ TEST(MapCheck, AMildFoldIsFlaggedByTheKeyframesOwnPairs) {
   const MapCheck c = CheckMap(folded, {}, NoisyGeometries(truth, 300));
   EXPECT_EQ(c.disagreeing_fraction, 0);  // no pair beyond 10 degrees
   EXPECT_EQ(c.disagreeing_frames, (std::vector<int>{0, 2, 4}));
+  EXPECT_EQ(c.off_neighbours, 2);
   EXPECT_TRUE(Folded(c));
   EXPECT_TRUE(HasWarning(c, "the pairs of frames 0, 2, 4 disagree by a median of more than"))
       << ::testing::PrintToString(c.warnings);
@@ -261,6 +262,15 @@ TEST(MapCheck, AMildFoldIsFlaggedByTheKeyframesOwnPairs) {
   const MapCheck one = CheckMap(one_off, {}, NoisyGeometries(truth, 300));
   EXPECT_EQ(one.disagreeing_frames, (std::vector<int>{10}));
   EXPECT_FALSE(Folded(one));
+
+  // Two keyframes off apart from each other: poorly matched frames, not a stretch of the path.
+  map::Map two_apart = one_off;
+  two_apart.keyframes[9].pose.q_cw =
+      Eigen::Quaterniond(Eigen::AngleAxisd(4 * M_PI / 180, Eigen::Vector3d::UnitY())) * two_apart.keyframes[9].pose.q_cw;
+  const MapCheck apart = CheckMap(two_apart, {}, NoisyGeometries(truth, 300));
+  EXPECT_EQ(apart.disagreeing_frames, (std::vector<int>{10, 18}));
+  EXPECT_EQ(apart.off_neighbours, 0);
+  EXPECT_FALSE(Folded(apart));
 }
 
 // A new mapper run starts from a keyframe that is right, far from the fold, and not one an earlier
@@ -296,6 +306,9 @@ TEST(MapCheck, TheTwoViewFiguresSurviveTheCheckFile) {
   EXPECT_EQ(back->two_view_pairs, c.two_view_pairs);
   EXPECT_DOUBLE_EQ(back->disagreeing_fraction, c.disagreeing_fraction);
   EXPECT_EQ(back->disagreeing_frames, c.disagreeing_frames);
+  EXPECT_DOUBLE_EQ(back->median_disagreement_deg, c.median_disagreement_deg);
+  EXPECT_DOUBLE_EQ(back->keyframe_off_deg, c.keyframe_off_deg);
+  EXPECT_EQ(back->off_neighbours, c.off_neighbours);
   EXPECT_EQ(back->warnings, c.warnings);
 }
 
