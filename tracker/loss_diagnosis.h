@@ -20,20 +20,25 @@
 
 namespace arview::tracker {
 
-// Measured on a grey copy at most 640 px wide (the scale map building's frame selection
-// measures sharpness at), so that the figures of frames of different sizes compare.
+// Measured on a grey copy at most 640 px wide, so that the figures of frames of different sizes
+// compare.
 struct ImageStats {
   double brightness = 0;  // mean grey level, 0-255
-  double sharpness = 0;   // variance of the Laplacian
+  // 0 (sharp) to 1 (smeared): Crete et al.'s re-blur measure, the worse of the two axes. It
+  // reads the image's own falloff of detail, so a smooth scene is not taken for a blurred one
+  // (the variance of the Laplacian was: a sharp photo of fruit measured 15% of the graffiti's,
+  // a 31-px smear of the graffiti 5%). Measured: sharp frames 0.32-0.43 (the graffiti, OpenCV's
+  // sample photos, templeRing), smeared ones 0.70-0.80 (a 9- to 41-px smear of the graffiti,
+  // a 20-px smear of templeRing's).
+  double blur = 0;
 };
 ImageStats MeasureImage(const cv::Mat& image);
 
 // What the frames the map was built from look like: the medians over some of its keyframes'
-// images. images == 0: none could be read; then brightness is judged against an absolute floor
-// and sharpness is not judged.
+// images. images == 0: none could be read; then the frame's figures are judged on fixed floors.
 struct AppearanceReference {
   double brightness = 0;
-  double sharpness = 0;
+  double blur = 0;
   int images = 0;
 };
 AppearanceReference ReferenceFromImages(std::span<const cv::Mat> images);
@@ -59,11 +64,10 @@ struct LossThresholds {
   // still relocalized at 14 (13%) and was lost at 9 (8.5%).
   double dark_ratio = 0.25;
   double dark_floor = 20;  // without keyframe images: a mean grey level below this is dark
-  // Less sharp than this fraction of the keyframes' median sharpness. There, a horizontal smear
-  // of 27 px (sharpness 6% of the keyframes') still relocalized and one of 31 px (5%) was lost,
-  // while a sharp photo of a smoother scene (fruits.jpg) measured 15%: a view of something
-  // else must not be called blurred.
-  double blur_ratio = 0.1;
+  // More blurred than the keyframes' median by this much (ImageStats::blur), or without
+  // keyframe images above blur_floor.
+  double blur_margin = 0.2;
+  double blur_floor = 0.6;
   // The frame's camera differs from the map's when a focal length or the principal point is
   // off by more than this fraction (of the focal length; of the image's width or height).
   double camera_tolerance = 0.02;
