@@ -50,20 +50,13 @@ std::string WindowStatus(const PipelineReport& r) {
 }
 
 // Said before the first frame: a camera that differs from the map's loses frames whatever they
-// show, and without the keyframes' images darkness and blur are judged on fixed floors.
-std::vector<std::string> DiagnosisNotes(const tracker::LossDiagnoser& diagnoser, cv::Size frame_size,
-                                        const std::string& map_name) {
-  std::vector<std::string> notes;
-  if (const auto difference = diagnoser.CameraDifference(frame_size)) {
-    notes.push_back("the frames' camera differs from the map's (" + *difference +
-                    "): they are tracked with the map's camera, and few will localize");
-  }
-  if (diagnoser.reference().images == 0) {
-    notes.push_back("the keyframes' images of " + map_name +
-                    " were not found (its images/ folder, or the recording it was built from): a lost frame is called "
-                    "dark or blurred against fixed floors, not against the map's own frames");
-  }
-  return notes;
+// show. (Missing keyframe images are not said: the fixed floors then used show in the numbers of
+// each lost frame's cause.)
+std::optional<std::string> CameraNote(const tracker::LossDiagnoser& diagnoser, cv::Size frame_size) {
+  const auto difference = diagnoser.CameraDifference(frame_size);
+  if (!difference) return std::nullopt;
+  return "the frames' camera differs from the map's (" + *difference +
+         "): they are tracked with the map's camera, and few will localize";
 }
 
 }  // namespace
@@ -150,9 +143,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (tracker_error) std::rethrow_exception(tracker_error);
   seconds_of_step();
   if (!o.quiet && !tracker->index_note().empty()) std::cerr << "note: " << tracker->index_note() << "\n";
-  if (!o.quiet) {
-    for (const std::string& note : DiagnosisNotes(*diagnoser, source_size, map_name)) std::cerr << "note: " << note << "\n";
-  }
+  if (const auto note = CameraNote(*diagnoser, source_size); note && !o.quiet) std::cerr << "note: " << *note << "\n";
   pipeline.diagnoser = &*diagnoser;
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
