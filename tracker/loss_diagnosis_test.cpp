@@ -121,6 +121,24 @@ TEST_F(LossDiagnosisTest, AFrameOfTheMapsSizeFromAnotherFocalLengthDiffers) {
   EXPECT_NE(LossDiagnoser(map().camera, map().camera, reference_).Diagnose(frame, lost).cause, LossCause::kCameraDiffers);
 }
 
+TEST_F(LossDiagnosisTest, ABrightSharpViewWhoseMatchesAgreeOnNoPoseIsNotCalledOutsideTheMap) {
+  // The solver's verdict decides between the two causes of a good-looking frame: too few matches
+  // (outside the map), or enough that did not agree (degenerate, not refined, RMS too high).
+  const cv::Mat view = RenderMappedView();
+  const LossDiagnoser diagnoser(map().camera, map().camera, reference_);
+  FrameResult lost;
+  lost.keypoints = 2000;
+  lost.matches = 60;
+  for (const PoseFailure failure : {PoseFailure::kDegenerate, PoseFailure::kRefinementFailed, PoseFailure::kRmsTooHigh}) {
+    lost.relocalization_failure = failure;
+    const LossDiagnosis d = diagnoser.Diagnose(view, lost);
+    EXPECT_EQ(d.cause, LossCause::kNoConsistentPose) << ToString(failure);
+    EXPECT_EQ(d.detail, "60 matches of 2000 keypoints, " + ToString(failure));
+  }
+  lost.relocalization_failure = PoseFailure::kTooFewInliers;
+  EXPECT_EQ(diagnoser.Diagnose(view, lost).cause, LossCause::kOutsideMap);
+}
+
 TEST(LossSummary, GroupsByCauseMostFrequentFirstAndNamesTheMapsPicture) {
   LossSummary summary;
   EXPECT_TRUE(summary.Advice("room-map").empty());
