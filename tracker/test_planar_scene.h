@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "calib/pose.h"
 #include "map/map.h"
 #include "tracker/features.h"
+#include "tracker/test_scene.h"
 
 namespace arview::tracker::testing {
 
@@ -114,5 +116,31 @@ class PlanarWorld {
   double scale_;
   cv::Mat bearings_;
 };
+
+inline constexpr const char* kGraffitiTexture = "/usr/share/doc/opencv-doc/examples/data/graf1.png";
+
+// The four keyframes ~0.9 m from the plane that the tracker's tests map the graffiti from.
+inline std::vector<calib::Pose> GraffitiKeyframes() {
+  return {LookAt({0, 0, -0.9}, {0, 0, 0}), LookAt({0.3, 0, -0.85}, {0.05, 0, 0}),
+          LookAt({-0.3, 0.1, -0.85}, {-0.05, 0, 0}), LookAt({0, -0.25, -0.85}, {0, -0.05, 0})};
+}
+
+// The graffiti texture on a 1.2 m x 0.96 m plane seen by TestCamera(), mapped from
+// GraffitiKeyframes(): built once per test binary; null without the texture (opencv-doc).
+struct GraffitiPlane {
+  cv::Mat texture;
+  PlanarWorld world;
+  map::Map map;
+};
+inline const GraffitiPlane* SharedGraffitiPlane() {
+  static const std::unique_ptr<GraffitiPlane> plane = []() -> std::unique_ptr<GraffitiPlane> {
+    const cv::Mat texture = cv::imread(kGraffitiTexture);
+    if (texture.empty()) return nullptr;
+    PlanarWorld world(texture, TestCamera(), 0.0015);
+    map::Map map = world.MakeMap(GraffitiKeyframes(), SiftExtractor());
+    return std::make_unique<GraffitiPlane>(GraffitiPlane{texture, std::move(world), std::move(map)});
+  }();
+  return plane.get();
+}
 
 }  // namespace arview::tracker::testing

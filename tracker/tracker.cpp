@@ -536,6 +536,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
         inliers = {};  // nothing to follow: the next frame starts from guided matching
       } else {
         result.status = TrackStatus::kLost;
+        result.relocalization_failure = reloc.pose.failure;
       }
     }
   }

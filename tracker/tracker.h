@@ -161,6 +161,9 @@ struct FrameResult {
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
+  // Lost: what relocalization's pose solver failed at (kNone: it did not run, e.g. a frame of
+  // the wrong size); tracker/loss_diagnosis.h turns it and the frame's numbers into a cause.
+  PoseFailure relocalization_failure = PoseFailure::kNone;
   StageTimes times;
 };
 

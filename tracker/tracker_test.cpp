@@ -30,10 +30,7 @@ class PlanarTrackerTest : public ::testing::Test {
     if (texture.empty()) return;
     world_ = std::make_unique<PlanarWorld>(texture, TestCamera(), 0.0015);
     const SiftExtractor sift;
-    map_ = std::make_unique<map::Map>(world_->MakeMap(
-        {LookAt({0, 0, -0.9}, {0, 0, 0}), LookAt({0.3, 0, -0.85}, {0.05, 0, 0}),
-         LookAt({-0.3, 0.1, -0.85}, {-0.05, 0, 0}), LookAt({0, -0.25, -0.85}, {0, -0.05, 0})},
-        sift));
+    map_ = std::make_unique<map::Map>(world_->MakeMap(testing::GraffitiKeyframes(), sift));
   }
   static void TearDownTestSuite() {
     map_.reset();

@@ -80,11 +80,13 @@ void AddReplayCommand(CLI::App& app) {
     } else {
       o.sink = a->out;
     }
+    o.frame_camera = recording.camera;
+    o.recording = &recording;
     recordings::RecordingSource source(recording, replay);
     const map::Map map = map::LoadMap(a->map_dir);
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();
-    std::printf("%s", PipelineReportText(result.report).c_str());
+    std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
     std::printf("%s %s\n", to_window ? "shown in" : "wrote",
                 to_window ? result.output.c_str() : a->out.c_str());
   });

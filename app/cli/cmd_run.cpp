@@ -85,7 +85,7 @@ void AddRunCommand(CLI::App& app) {
                    SizeText(calibrated.Size()).c_str(), SizeText(source.size()).c_str(), calibrated.fx, map.camera.fx);
     }
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
-    std::printf("%s", PipelineReportText(result.report).c_str());
+    std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
     std::printf("output: %s\n", result.output.c_str());
     if (result.seconds_to_first_output >= 0) {
       std::printf("first frame shown %.2f s after the command started (start-up: the tracker %.2f s beside the "

@@ -17,12 +17,14 @@
 #include "base/progress.h"
 #include "app/cli/session_flags.h"
 #include "app/pipeline/stage_stats.h"
+#include "app/session/keyframe_appearance.h"
 #include "base/cancellation.h"
 #include "base/atomic_file.h"
 #include "map/map_file.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
 #include "recordings/trajectory.h"
+#include "tracker/loss_diagnosis.h"
 #include "tracker/tracker.h"
 
 namespace arview::app {
@@ -108,6 +110,7 @@ struct FrameRecord {
   int index = 0;
   double timestamp = 0;
   tracker::FrameResult result;
+  std::optional<tracker::LossDiagnosis> loss;  // lost: why (tracker/loss_diagnosis.h)
 };
 
 nlohmann::ordered_json FrameJson(const FrameRecord& f) {
@@ -129,6 +132,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
   j["ms"] = {{"flow", r.times.flow_ms},       {"extract", r.times.extract_ms}, {"match", r.times.match_ms},
              {"ransac", r.times.ransac_ms},   {"refine", r.times.refine_ms},   {"total", r.times.total_ms},
              {"cpu", r.times.cpu_ms}};
+  if (f.loss) j["cause"] = {{"kind", ToString(f.loss->cause)}, {"numbers", f.loss->detail}};
   if (r.status != tracker::TrackStatus::kLost) {
     j["center"] = {r.center[0], r.center[1], r.center[2]};
     j["smoothed_center"] = {r.smoothed_center[0], r.smoothed_center[1], r.smoothed_center[2]};
@@ -216,6 +220,8 @@ void RunTrack(const TrackArgs& args) {
   }
   tracker->WarmUp();  // the first frame's timing is then a relocalization's, not a process start's
 
+  const tracker::LossDiagnoser diagnoser(map.camera, rec.camera, KeyframeAppearance(map, MapFolder(args.map), &rec));
+  tracker::LossSummary losses;
   recordings::RecordingSource source(std::move(rec), replay);
   std::vector<FrameRecord> frames;
   recordings::Trajectory trajectory;
@@ -225,9 +231,13 @@ void RunTrack(const TrackArgs& args) {
     while (!signals.token().IsCancelled() && source.Next(frame)) {
       // A frame after a gap in --frames has no valid motion prior.
       if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
-      FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp)};
-      if (record.result.status != tracker::TrackStatus::kLost)
+      FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp), {}};
+      if (record.result.status != tracker::TrackStatus::kLost) {
         trajectory.push_back({record.timestamp, record.result.pose});
+      } else {
+        record.loss = diagnoser.Diagnose(frame.image, record.result);
+        losses.Add(*record.loss);
+      }
       frames.push_back(std::move(record));
       if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
                       ToString(frames.back().result.status));
@@ -268,8 +278,9 @@ void RunTrack(const TrackArgs& args) {
               << " ms, p95 " << s.wall.p95 << " ms wall; median " << s.cpu.median << " ms, p95 "
               << s.cpu.p95 << " ms CPU (" << s.wall.count << " frames)\n";
   for (const auto& f : frames)
-    if (f.result.status == tracker::TrackStatus::kLost)
-      std::cout << "  lost frame " << f.index << ": " << f.result.reason << "\n";
+    if (f.loss) std::cout << "  lost frame " << f.index << ": " << f.result.reason << " — " << tracker::LossHeadline(*f.loss) << "\n";
+  const std::vector<std::string> advice = losses.Advice(MapFolder(args.map).string());
+  for (size_t i = 0; i < advice.size(); ++i) std::cout << (i == 0 ? "" : "  ") << advice[i] << "\n";
   std::cout << "trajectory: " << args.out << (args.stats.empty() ? "" : ", statistics: " + args.stats) << "\n";
 }
 

@@ -274,10 +274,12 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   recordings::ReplayOptions replay;
   for (int i = half; i < o.frames; ++i) replay.frames.push_back(i);
   const recordings::Recording replayed = WithUncompressedFrames(walk, half, work / "replay-frames", cancel);
+  session.frame_camera = walk.camera;
+  session.recording = &walk;  // the walk the map was built from: its keyframes' images
   recordings::RecordingSource source(replayed, replay);
   SessionResult result = RunSession(source, walk.camera.Size(), map, (work / "map").string(), session);
   video.Commit();
-  std::printf("%s", PipelineReportText(result.report).c_str());
+  std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
   return result;
 }
 

@@ -42,7 +42,9 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
                 ToString(input.track->status).c_str(), composed_.PerSecond());
   std::vector<std::string> status = {line};
   if (input.track->status == tracker::TrackStatus::kLost) {
-    status.push_back("lost: the character is hidden until the camera is found again");
+    // Why, while it happens: what the user can change now (light, speed, where the camera points).
+    if (input.loss) status.push_back("lost: " + tracker::LossHeadline(*input.loss));
+    if (!characters_.empty()) status.push_back("lost: the character is hidden until the camera is found again");
   } else if (!input.animations.empty()) {
     std::snprintf(line, sizeof line, "idle weight %.2f", input.animations.front()->idle_weight());
     status.push_back(line);
@@ -51,7 +53,8 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
 }
 
 ArCompositor::HudDraw ArCompositor::MakeHud(const FrameToCompose& input) {
-  if (!hud_visible_ || characters_.empty()) return {};
+  // Without a character the HUD still says what the tracker does (and, when lost, why).
+  if (!hud_visible_) return {};
   // Everything the drawing needs is copied now: the animations' frames change with the next one.
   std::vector<render::HudSphere> spheres;
   const bool localized = input.track->status != tracker::TrackStatus::kLost;

@@ -149,7 +149,7 @@ void AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animato
   FrameLog& log = item.log;
   log.track = item.track;
   const bool localized = item.track.status != tracker::TrackStatus::kLost;
-  FrameToCompose compose{&item.frame, &item.track, {}};
+  FrameToCompose compose{&item.frame, &item.track, {}, log.loss ? &*log.loss : nullptr};
   if (!animators.empty()) {
     const Clock::time_point t0 = Clock::now();
     std::optional<Eigen::Vector3d> centre;
@@ -267,6 +267,9 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
           const Clock::time_point t0 = Clock::now();
           item->log.timeline.track_start = item->MsSinceCapture();
           item->track = tracker.Track(item->frame.image, item->frame.timestamp);
+          if (options.diagnoser && item->track.status == tracker::TrackStatus::kLost) {
+            item->log.loss = options.diagnoser->Diagnose(item->frame.image, item->track);
+          }
           stats.Record("track", MsSince(t0));
           item->log.timeline.track_end = item->MsSinceCapture();
           if (!to_render.Push(std::move(*item))) break;
@@ -327,6 +330,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       std::lock_guard lock(report_mutex);
       ++report.frames_processed;
       if (log.track.status != tracker::TrackStatus::kLost) ++report.frames_localized;
+      if (log.loss) report.losses.Add(*log.loss);
       if (!report.first_output) report.first_output = written;
       report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
       report.source = source.Counts();

@@ -21,6 +21,7 @@
 #include "recordings/frame_source.h"
 #include "recordings/trajectory.h"
 #include "video/sinks.h"
+#include "tracker/loss_diagnosis.h"
 #include "tracker/tracker.h"
 
 namespace arview::app {
@@ -32,6 +33,7 @@ struct FrameToCompose {
   const recordings::Frame* frame = nullptr;
   const tracker::FrameResult* track = nullptr;
   std::vector<const anim::AnimatorFrame*> animations;  // one per character (none: no character)
+  const tracker::LossDiagnosis* loss = nullptr;  // a lost frame's cause (PipelineOptions::diagnoser)
 };
 
 class FrameCompositor {
@@ -77,6 +79,10 @@ struct PipelineOptions {
   // Called on the sink's thread with each frame's record as the frame reaches the sink: --stats
   // writes it to disk then (pipeline_report.h, StatsFileWriter), so that it is not kept.
   std::function<void(const FrameLog&)> on_frame_log;
+  // Gives each lost frame its cause (on the track thread, in its `track` time: 1.8 ms a 640x480
+  // frame, 3.4 ms a 1920x1080 one): the HUD shows it, the report counts the causes. Null: lost
+  // frames have no cause.
+  const tracker::LossDiagnoser* diagnoser = nullptr;
 };
 
 // A frame's way through the pipeline, in milliseconds since its capture.
@@ -98,6 +104,7 @@ struct FrameLog {
   double captured_s = 0;    // capture time, seconds since the pipeline started (< 0: before)
   FrameTimeline timeline;
   tracker::FrameResult track;
+  std::optional<tracker::LossDiagnosis> loss;  // lost, with PipelineOptions::diagnoser: why
   double idle_weight = 0;
   std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
   int actions_triggered = 0;  // first character: distance-triggered actions started (a greeting)
@@ -132,6 +139,7 @@ struct PipelineReport {
   std::map<std::string, StreamingSummary> track_ms_by_status;
   StreamingSummary gaze_error_deg;
   size_t gaze_within_20_deg = 0;
+  tracker::LossSummary losses;                  // the lost frames' causes (PipelineOptions::diagnoser)
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 

@@ -55,6 +55,10 @@ nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& r, const std::s
                {"median_error_deg", g.median_deg},
                {"max_error_deg", g.max_deg},
                {"frames_within_20_deg", g.within_20_deg}};
+  nlohmann::ordered_json& lost_by_cause = j["lost_by_cause"] = nlohmann::ordered_json::object();
+  for (const auto& [cause, name] : EnumNames(tracker::LossCause{})) {
+    if (r.losses.count(cause) > 0) lost_by_cause[std::string(name)] = r.losses.count(cause);
+  }
   return j;
 }
 
@@ -83,6 +87,7 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
   if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
   if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
   if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
+  if (f.loss) frame["cause"] = {{"kind", ToString(f.loss->cause)}, {"numbers", f.loss->detail}};
   return frame;
 }
 
@@ -171,6 +176,13 @@ std::string PipelineReportText(const PipelineReport& r) {
                   g.median_deg, g.max_deg, g.within_20_deg, g.frames);
     out += line;
   }
+  return out;
+}
+
+std::string LossAdviceText(const PipelineReport& report, const std::string& map_folder) {
+  std::string out;
+  const std::vector<std::string> lines = report.losses.Advice(map_folder);
+  for (size_t i = 0; i < lines.size(); ++i) out += (i == 0 ? "" : "  ") + lines[i] + "\n";
   return out;
 }
 

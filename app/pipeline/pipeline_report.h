@@ -31,6 +31,9 @@ nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& report, const s
 // One element of stats.json's "frames": the frame's way through the stages and its tracking.
 nlohmann::ordered_json FrameLogJson(const FrameLog& frame);
 std::string PipelineReportText(const PipelineReport& report);
+// The lost frames grouped by cause, with advice (tracker/loss_diagnosis.h), one line each after
+// "lost N frames:"; empty when none was lost or no cause was given. `map_folder` names map.png.
+std::string LossAdviceText(const PipelineReport& report, const std::string& map_folder);
 
 // --stats, written while the session runs, so that a session that runs all day keeps no frame
 // in memory. The file is one JSON object, its per-frame part first, one frame a line:

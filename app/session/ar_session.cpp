@@ -2,6 +2,7 @@
 
 #include "anim_authoring/character_builder.h"
 #include "app/session/character_setup.h"
+#include "app/session/keyframe_appearance.h"
 #include "base/stats.h"
 
 #include <cstdio>
@@ -48,6 +49,16 @@ std::string WindowStatus(const PipelineReport& r) {
   return status;
 }
 
+// Said before the first frame: a camera that differs from the map's loses frames whatever they
+// show. (Missing keyframe images are not said: the fixed floors then used show in the numbers of
+// each lost frame's cause.)
+std::optional<std::string> CameraNote(const tracker::LossDiagnoser& diagnoser, cv::Size frame_size) {
+  const auto difference = diagnoser.CameraDifference(frame_size);
+  if (!difference) return std::nullopt;
+  return "the frames' camera differs from the map's (" + *difference +
+         "): they are tracked with the map's camera, and few will localize";
+}
+
 }  // namespace
 
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
@@ -84,12 +95,15 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.compositor.gl);
   const double context_seconds = seconds_of_step();
   std::optional<tracker::Tracker> tracker;
+  std::optional<tracker::LossDiagnoser> diagnoser;
   std::exception_ptr tracker_error;
   double tracker_seconds = 0;
   std::thread tracker_start([&] {
     try {
       const Clock::time_point t0 = Clock::now();
       tracker.emplace(map, o.tracker);
+      diagnoser.emplace(map.camera, o.frame_camera.value_or(map.camera),
+                        KeyframeAppearance(map, MapFolder(map_name), o.recording));
       tracker->WarmUp();  // before the first frame, so that its latency is a relocalization's only
       tracker_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     } catch (...) {
@@ -129,6 +143,8 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (tracker_error) std::rethrow_exception(tracker_error);
   seconds_of_step();
   if (!o.quiet && !tracker->index_note().empty()) std::cerr << "note: " << tracker->index_note() << "\n";
+  if (const auto note = CameraNote(*diagnoser, source_size); note && !o.quiet) std::cerr << "note: " << *note << "\n";
+  pipeline.diagnoser = &*diagnoser;
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
   });
@@ -178,6 +194,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
   if (stats) stats->Finish(result.report, result.renderer, result.renderer_info);
+  result.loss_advice = LossAdviceText(result.report, map_name);
   return result;
 }
 

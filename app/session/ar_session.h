@@ -29,6 +29,12 @@ struct SessionOptions {
   FadeOptions fade;
   PipelineOptions pipeline;
   tracker::TrackerOptions tracker;
+  // For the cause of each lost frame (tracker/loss_diagnosis.h). The camera the frames come
+  // from: a replay's camera.yaml; nothing: the map's (a live camera is calibrated as the map's,
+  // scaled to its size). `recording`: a replay's, which may hold a still-image map's keyframe
+  // images (app/session/keyframe_appearance.h); null for a live camera.
+  std::optional<calib::Camera> frame_camera;
+  const recordings::Recording* recording = nullptr;
   long expected_frames = 0;                  // for the progress line (0: unknown)
   // Ctrl-C / SIGTERM: the pipeline stops, nothing is written (no trajectory; the stats written
   // so far are removed) and RunSession throws CancelledError saying so; the caller removes its
@@ -53,6 +59,8 @@ struct SessionResult {
   // descriptor index) and its warm-up, the characters, the renderer (GL context, PRT).
   // The tracker's start runs beside the renderer's warm-up (a first draw of the characters).
   double tracker_seconds = 0, characters_seconds = 0, renderer_seconds = 0, warmup_seconds = 0;
+  // The lost frames by cause with advice (LossAdviceText), for the command's summary.
+  std::string loss_advice{};
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10
