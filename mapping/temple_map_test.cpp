@@ -124,7 +124,7 @@ TEST_F(TempleMapTest, ProgressFollowsEveryStageToItsEnd) {
     if (const auto p = ParseColmapProgress(line, 24)) last[command] = *p;
   }
   EXPECT_EQ(last["feature_extractor"], std::make_pair(24, 24));
-  EXPECT_EQ(last["exhaustive_matcher"], std::make_pair(1, 1));  // one block of 24 images
+  EXPECT_EQ(last["exhaustive_matcher"], std::make_pair(16, 16));  // 4 x 4 blocks of 6 images
   EXPECT_EQ(last["mapper"], std::make_pair(24, 24));            // every frame registered
   EXPECT_EQ(ParseColmapProgress("Matching block [2/3, 1/3] in 1.2s", 0), std::make_pair(4, 9));
   EXPECT_EQ(ParseColmapProgress("Matching image [5/40] in 0.5s", 0), std::make_pair(5, 40));
