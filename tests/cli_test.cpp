@@ -12,6 +12,7 @@
 #include <regex>
 
 #include "map/map_file.h"
+#include "mapping/map_check.h"
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
@@ -421,6 +422,39 @@ TEST(Cli, RenderRefusesAPoseOrACameraNoMapCanHold) {
   const auto rendered = render(good, "0 1 -3 0 0 0 1");
   EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
   EXPECT_TRUE(std::filesystem::exists(out));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace arview
+
+namespace arview {
+namespace {
+
+// Issue 38: a folder where `arview map` refused a folded map has its check.json but no map file;
+// `map info` says the map was refused and why, in one line, not "map file missing".
+TEST(Cli, MapInfoOnARefusedMapSaysWhy) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("arview_cli_refused_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  mapping::MapCheck folded;
+  folded.two_view_pairs = 104;
+  folded.disagreeing_frames = {0, 2, 4, 8};
+  folded.off_neighbours = 2;
+  folded.warnings = {"disagrees with the frames' own two-view geometry (frames 0, 2, 4, 8)"};
+  ASSERT_TRUE(mapping::Folded(folded));
+  mapping::WriteMapCheck(folded, dir / mapping::kMapCheckFileName);
+  const auto info = RunArview({"map", "info", dir.string()});
+  EXPECT_NE(info.exit_code, 0);
+  EXPECT_EQ(LineCount(info.err), 1) << info.err;
+  EXPECT_NE(info.err.find("no map file: arview map refused the map it built here, which disagrees with the frames' "
+                          "own two-view geometry (frames 0, 2, 4, 8)"),
+            std::string::npos)
+      << info.err;
+  // A folder with neither: the plain message.
+  std::filesystem::remove(dir / mapping::kMapCheckFileName);
+  const auto empty = RunArview({"map", "info", dir.string()});
+  EXPECT_NE(empty.err.find("map file missing"), std::string::npos) << empty.err;
   std::filesystem::remove_all(dir);
 }
 

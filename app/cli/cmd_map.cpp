@@ -168,8 +168,20 @@ void RunMap(const MapArgs& args) {
   }
 }
 
+// A folder where `arview map` refused a folded map holds its check.json but no map file: say
+// why, rather than "map file missing".
+void RequireMapNotRefused(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec) || fs::exists(fs::path(dir) / map::kMapFileName, ec)) return;
+  const auto check = mapping::ReadMapCheck(fs::path(dir) / mapping::kMapCheckFileName);
+  if (!check || !mapping::Folded(*check)) return;
+  throw CommandError((fs::path(dir) / map::kMapFileName).string() +
+                     ": no map file: arview map refused the map it built here, which " + check->warnings.back());
+}
+
 void RunInfo(const std::string& dir, bool recheck) {
   try {
+    RequireMapNotRefused(dir);
     // Before anything is printed, so that a folder without COLMAP's model fails with one line.
     std::error_code ec;  // a name too long or a folder that cannot be searched: LoadMap says so, naming it
     if (recheck) mapping::RecheckMap(fs::is_regular_file(dir, ec) ? fs::path(dir).parent_path() : fs::path(dir));
