@@ -348,6 +348,17 @@ class Database {
     return pairs;
   }
 
+  std::uint32_t ImageId(const std::string& name) {
+    Statement st(*this, "SELECT image_id FROM images WHERE name = ?");
+    sqlite3_bind_text(st.get(), 1, name.c_str(), -1, SQLITE_TRANSIENT);
+    const int rc = sqlite3_step(st.get());
+    if (rc == SQLITE_DONE) Fail("no image named " + name);
+    if (rc != SQLITE_ROW) Fail("reading the id of image " + name);
+    const sqlite3_int64 id = sqlite3_column_int64(st.get(), 0);
+    if (id <= 0 || id > 2147483647) Fail("image " + name + " has the id " + std::to_string(id) + ", not one COLMAP gives");
+    return static_cast<std::uint32_t>(id);
+  }
+
   std::string ImageName(std::uint32_t image_id) {
     Statement st(*this, "SELECT name FROM images WHERE image_id = ?");
     sqlite3_bind_int64(st.get(), 1, image_id);
@@ -482,6 +493,18 @@ std::vector<map::Keyframe> ReadColmapCameraPath(const fs::path& sparse_dir, cons
   std::vector<map::Keyframe> keyframes;
   for (const ColmapImage& im : images) keyframes.push_back(KeyframeOf(im, FrameOf(im, frames, images_file)));
   return keyframes;
+}
+
+std::vector<cv::Mat> ReadImageDescriptors(const fs::path& database, const std::vector<std::string>& names,
+                                          const CancellationToken& cancel) {
+  Database db(database);
+  std::vector<cv::Mat> descriptors;
+  descriptors.reserve(names.size());
+  for (const std::string& name : names) {
+    cancel.ThrowIfCancelled("reading the frames' descriptors");
+    descriptors.push_back(db.Descriptors(db.ImageId(name)));
+  }
+  return descriptors;
 }
 
 std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, const map::Map& map) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "base/cancellation.h"
 #include "map/map.h"
@@ -46,6 +47,12 @@ map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::files
 // ordered as ReadColmapMap orders them): for looking at a model's camera path when its database
 // is gone. Throws MapError as ReadColmapMap does.
 std::vector<map::Keyframe> ReadColmapCameraPath(const std::filesystem::path& sparse_dir, const FrameLookup& frames = {});
+
+// The SIFT descriptors COLMAP extracted for the named images (one rows x 128 CV_8U matrix each,
+// in the order of `names`). Throws MapError naming the database and the image that is missing
+// or malformed.
+std::vector<cv::Mat> ReadImageDescriptors(const std::filesystem::path& database, const std::vector<std::string>& names,
+                                          const CancellationToken& cancel = {});
 
 // The two-view geometries COLMAP verified between the map's keyframes (its database's
 // two_view_geometries), for mapping/map_check.h. Pairs with an unregistered frame are left out;

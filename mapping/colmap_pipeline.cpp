@@ -8,7 +8,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <mutex>
+#include <thread>
 #include <fstream>
 #include <cstdio>
 #include <sstream>
@@ -16,6 +19,7 @@
 #include "base/process.h"
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
+#include "mapping/pair_matching.h"
 #include "recordings/trajectory.h"
 
 namespace arview::mapping {
@@ -24,6 +28,10 @@ namespace fs = std::filesystem;
 
 MatcherKind ParseMatcherKind(const std::string& text) {
   return ParseEnum<MatcherKind, map::MapError>(text, "--matcher");
+}
+
+MatchEngine ParseMatchEngine(const std::string& text) {
+  return ParseEnum<MatchEngine, map::MapError>(text, "--match-engine");
 }
 
 namespace {
@@ -108,10 +116,15 @@ class ColmapRunner {
   }
 
   void Run(const std::string& stage, const std::vector<std::string>& args, int total) {
+    ProgressParser parser(stage, total, cb_);
+    Run(stage, args, log_, std::ref(parser));
+  }
+  // The same with its own log file and line handler (several at once: the verifying processes).
+  void Run(const std::string& stage, const std::vector<std::string>& args, const fs::path& log,
+           const std::function<void(const std::string&)>& on_line) {
     std::vector<std::string> argv{options_.colmap};
     argv.insert(argv.end(), args.begin(), args.end());
-    ProgressParser parser(stage, total, cb_);
-    const ProcessResult r = RunProcess(argv, log_, std::ref(parser), options_.cancel);
+    const ProcessResult r = RunProcess(argv, log, on_line, options_.cancel);
     if (!r.ok()) {
       const std::string how = r.signaled ? "was killed by signal " + std::to_string(r.signal)
                                          : "exited with code " + std::to_string(r.exit_code);
@@ -119,11 +132,11 @@ class ColmapRunner {
       // times: the cause, found here, is the one line worth printing.
       if (const std::string full = NoRoomToWrite(log_.parent_path()); !full.empty()) {
         throw map::MapError(log_.parent_path().string() + ": no room to write (" + full + "): COLMAP " + args.front() +
-                            " (" + stage + " stage) " + how + "; its output is in " + log_.string());
+                            " (" + stage + " stage) " + how + "; its output is in " + log.string());
       }
       throw ColmapStageError("COLMAP " + args.front() + " (" + stage + " stage) " + how + "; its output is in " +
-                                 log_.string(),
-                             stage, log_, r.tail);
+                                 log.string(),
+                             stage, log, r.tail);
     }
   }
   const fs::path& log() const { return log_; }
@@ -431,6 +444,10 @@ std::string FoldRefusal(const fs::path& out_dir, const MapBuildResult& result) {
          "map anyway with --keep-folded (figures in " + (out_dir / kMapCheckFileName).string() + ")";
 }
 
+bool FramesDoubled(const calib::Camera& camera, const MapBuildOptions& options) {
+  return options.double_frames_below_px <= 0 || std::max(camera.width, camera.height) < options.double_frames_below_px;
+}
+
 // COLMAP's command lines for the three stages. Each stage's inputs include the previous
 // stage's, so that a change re-runs everything after it.
 std::vector<std::string> ExtractArgs(const calib::Camera& camera, const MapBuildOptions& options, const fs::path& database,
@@ -442,12 +459,17 @@ std::vector<std::string> ExtractArgs(const calib::Camera& camera, const MapBuild
           "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
           "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", std::to_string(options.threads),
           "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
-          "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations)};
+          "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations),
+          "--SiftExtraction.first_octave", FramesDoubled(camera, options) ? "-1" : "0"};
+}
+
+bool ExhaustivePairsWanted(const MapBuildOptions& options, int frames) {
+  return options.matcher == MatcherKind::kExhaustive ||
+         (options.matcher == MatcherKind::kAuto && frames <= options.auto_exhaustive_limit);
 }
 
 std::vector<std::string> MatchArgs(const MapBuildOptions& options, const fs::path& database, int frames) {
-  const bool exhaustive = options.matcher == MatcherKind::kExhaustive ||
-                          (options.matcher == MatcherKind::kAuto && frames <= options.auto_exhaustive_limit);
+  const bool exhaustive = ExhaustivePairsWanted(options, frames);
   std::vector<std::string> args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
                                 "--database_path", database.string(),
                                 "--SiftMatching.use_gpu", "0",
@@ -462,6 +484,158 @@ std::vector<std::string> MatchArgs(const MapBuildOptions& options, const fs::pat
                              "--SequentialMatching.quadratic_overlap", options.quadratic_overlap ? "1" : "0"});
   }
   return args;
+}
+
+// arview's matching (mapping/pair_matching.h) needs image names COLMAP's match list can hold:
+// matches_importer splits a pair's line at the first space.
+bool NamesFitAMatchList(const std::vector<std::string>& names) {
+  return std::none_of(names.begin(), names.end(), [](const std::string& name) {
+    return name.empty() || name.find_first_of(" \t\r\n") != std::string::npos;
+  });
+}
+
+std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, int frames) {
+  return ExhaustivePairsWanted(options, frames)
+             ? ExhaustivePairs(frames)
+             : SequentialPairs(frames, options.sequential_overlap, options.quadratic_overlap);
+}
+
+int VerifyingProcesses(const MapBuildOptions& options) {
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::max(1, options.threads <= 0 ? cores : options.threads);
+}
+
+// What decides arview's matches, for the stage record.
+std::string ArviewMatchInputs(const MapBuildOptions& options, int frames) {
+  const PairMatchingOptions& m = options.pair_matching;
+  std::ostringstream ss;
+  ss << "arview pair matching\n"
+     << (ExhaustivePairsWanted(options, frames) ? "exhaustive" : "sequential " + std::to_string(options.sequential_overlap) +
+                                                                    (options.quadratic_overlap ? " quadratic" : ""))
+     << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
+     << m.trees << " checks " << m.checks << "\nmatches_importer raw\n";
+  return ss.str();
+}
+
+// A consistent copy of a COLMAP database (VACUUM INTO: whatever its journal holds is in the copy).
+void CopyDatabase(const fs::path& database, const fs::path& copy) {
+  RemoveDatabase(copy);
+  sqlite3* db = nullptr;
+  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
+  sqlite3_stmt* st = nullptr;
+  const bool ok = rc == SQLITE_OK && sqlite3_prepare_v2(db, "VACUUM INTO ?", -1, &st, nullptr) == SQLITE_OK &&
+                  sqlite3_bind_text(st, 1, copy.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
+                  sqlite3_step(st) == SQLITE_DONE;
+  const std::string why = db ? sqlite3_errmsg(db) : "out of memory";
+  sqlite3_finalize(st);
+  if (!ok) {
+    RemoveDatabase(copy);
+    throw map::MapError(database.string() + ": cannot copy it to " + copy.string() + " for verification (" + why + ")");
+  }
+}
+
+// The candidate matches in `lists` verified by COLMAP (matches_importer --match_type raw), one
+// process per list: the first in `database` itself, the others in copies of it whose verified
+// pairs are then added to it. COLMAP verifies raw matches one pair after another on one core.
+void VerifyMatches(ColmapRunner& colmap, const fs::path& database, const std::vector<fs::path>& lists,
+                   int pairs_listed, const MapBuildCallbacks& cb) {
+  std::vector<fs::path> databases{database};
+  for (size_t k = 1; k < lists.size(); ++k) {
+    databases.push_back(database.string() + ".verify-" + std::to_string(k));
+    CopyDatabase(database, databases.back());
+  }
+  const auto remove_copies = [&] {
+    for (size_t k = 1; k < databases.size(); ++k) RemoveDatabase(databases[k]);
+  };
+  std::mutex mutex;
+  int verified = 0;
+  // matches_importer prints each pair as "<name1> - <name2>" when it starts on it.
+  const auto on_line = [&](const std::string& line) {
+    if (line.find(" - ") == std::string::npos || !cb.progress) return;
+    const std::lock_guard lock(mutex);
+    verified = std::min(verified + 1, pairs_listed);
+    cb.progress("verify", verified, pairs_listed);
+  };
+  std::vector<std::exception_ptr> failures(lists.size());
+  std::vector<fs::path> logs(lists.size());
+  std::vector<std::thread> workers;
+  for (size_t k = 0; k < lists.size(); ++k) {
+    logs[k] = colmap.log().string() + ".verify-" + std::to_string(k);
+    std::error_code ec;
+    fs::remove(logs[k], ec);
+    workers.emplace_back([&, k] {
+      try {
+        colmap.Run("verify",
+                   {"matches_importer", "--database_path", databases[k].string(), "--match_list_path", lists[k].string(),
+                    "--match_type", "raw", "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", "1"},
+                   logs[k], on_line);
+      } catch (...) {
+        failures[k] = std::current_exception();
+      }
+    });
+  }
+  for (auto& w : workers) w.join();
+  // The processes' output into colmap.log, one after another, as if they had run in turn.
+  {
+    std::ofstream log(colmap.log(), std::ios::app);
+    for (const fs::path& l : logs) {
+      std::ifstream in(l);
+      log << in.rdbuf();
+      std::error_code ec;
+      fs::remove(l, ec);
+    }
+  }
+  for (const auto& f : failures) {
+    if (!f) continue;
+    remove_copies();
+    std::rethrow_exception(f);
+  }
+  try {
+    for (size_t k = 1; k < databases.size(); ++k) MergeVerifiedPairs(database, databases[k]);
+  } catch (...) {
+    remove_copies();
+    throw;
+  }
+  remove_copies();
+}
+
+// arview's matching: the pairs matched with a kd-tree per frame, then verified by COLMAP.
+// `timings` gets the two steps.
+void MatchWithArview(ColmapRunner& colmap, const fs::path& database, const fs::path& out_dir,
+                     const std::vector<std::string>& names, const MapBuildOptions& options, const MapBuildCallbacks& cb,
+                     std::vector<StageTiming>* timings) {
+  auto t0 = std::chrono::steady_clock::now();
+  const std::vector<cv::Mat> descriptors = ReadImageDescriptors(database, names, options.cancel);
+  const std::vector<ImagePair> pairs = PairsToMatch(options, static_cast<int>(names.size()));
+  PairMatchingOptions matching = options.pair_matching;
+  matching.threads = options.threads;
+  const std::vector<PairMatches> matches = MatchImagePairs(
+      descriptors, pairs, matching,
+      [&](int done, int total) {
+        if (cb.progress) cb.progress("match", done, total);
+      },
+      options.cancel);
+  const int processes = VerifyingProcesses(options);
+  std::vector<fs::path> lists;
+  for (int k = 0; k < processes; ++k) lists.push_back(out_dir / ("matches-" + std::to_string(k) + ".txt"));
+  WriteMatchLists(names, matches, lists);
+  timings->push_back({"match", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), false});
+  t0 = std::chrono::steady_clock::now();
+  const int listed = static_cast<int>(
+      std::count_if(matches.begin(), matches.end(), [](const PairMatches& m) { return !m.matches.empty(); }));
+  const auto remove_lists = [&] {
+    std::error_code ec;
+    for (const fs::path& l : lists) fs::remove(l, ec);
+  };
+  try {
+    VerifyMatches(colmap, database, lists, listed, cb);
+  } catch (...) {
+    remove_lists();
+    throw;
+  }
+  remove_lists();
+  timings->push_back({"verify", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), false});
 }
 
 std::vector<std::string> MapperArgs(const MapBuildOptions& options, const fs::path& database, const fs::path& image_root,
@@ -566,8 +740,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
 
   // `discard` removes what a failed or interrupted run of the stage left half written (a database
   // of some of the frames, a partial model), so that nothing unfinished looks like COLMAP's output.
+  // `run` does the stage's work; it may time its own steps into `steps` (else the stage is one).
   auto stage = [&](const std::string& name, const std::string& stage_inputs, const std::function<void()>& prepare,
-                   const std::vector<std::string>& args, bool outputs_exist, const std::function<void()>& discard) {
+                   const std::function<void(std::vector<StageTiming>* steps)>& run, bool outputs_exist,
+                   const std::function<void()>& discard) {
     t0 = std::chrono::steady_clock::now();
     if (outputs_exist && stages.Matches(name, stage_inputs)) {
       if (cb.note) cb.note(name + ": inputs unchanged since the last run, skipped");
@@ -576,8 +752,9 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     }
     stages.Forget(name);
     prepare();
+    std::vector<StageTiming> steps;
     try {
-      colmap.Run(name, args, n);
+      run(&steps);
     } catch (const CancelledError& e) {
       if (discard) discard();
       throw CancelledError(InterruptedStageMessage(options.cancel, name, result.timings), e.signal_number());
@@ -586,17 +763,30 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
       throw;
     }
     stages.Save(name, stage_inputs);
-    result.timings.push_back({name, Seconds(t0), false});
+    if (steps.empty()) steps.push_back({name, Seconds(t0), false});
+    result.timings.insert(result.timings.end(), steps.begin(), steps.end());
+  };
+  const auto colmap_stage = [&](const std::string& name, const std::vector<std::string>& args) {
+    return [&colmap, name, args, n](std::vector<StageTiming>*) { colmap.Run(name, args, n); };
   };
 
   const auto remove_database = [&] { RemoveDatabase(database); };
-  stage("extract", inputs, remove_database, extract_args, fs::exists(database), remove_database);
+  stage("extract", inputs, remove_database, colmap_stage("extract", extract_args), fs::exists(database),
+        remove_database);
 
+  const bool arview_matches = options.match_engine == MatchEngine::kArview && NamesFitAMatchList(images.names);
+  if (options.match_engine == MatchEngine::kArview && !arview_matches && cb.note)
+    cb.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
   const std::vector<std::string> match_args = MatchArgs(options, database, n);
-  inputs += "--\n" + Joined(match_args);
+  inputs += "--\n" + (arview_matches ? ArviewMatchInputs(options, n) : Joined(match_args));
   const std::string match_inputs = inputs;
+  const std::function<void(std::vector<StageTiming>*)> run_match =
+      arview_matches ? std::function<void(std::vector<StageTiming>*)>([&](std::vector<StageTiming>* steps) {
+        MatchWithArview(colmap, database, out_dir, images.names, options, cb, steps);
+      })
+                     : colmap_stage("match", match_args);
   // Half-written matches stay until the next run clears them (clearing needs room to write).
-  const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, match_args, true, nullptr); };
+  const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
 
   const std::vector<std::string> mapper_args = MapperArgs(options, database, images.root, sparse);
   inputs += "--\n" + Joined(mapper_args);
@@ -611,7 +801,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
           fs::remove_all(sparse, ec);
           fs::create_directories(sparse);
         },
-        args, fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
+        colmap_stage("map", args), fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
   };
   // The largest model read and looked at as a whole (first, so that a degenerate model is
   // refused with the reason too).

@@ -19,6 +19,7 @@
 #include "map/map.h"
 #include "mapping/frame_selection.h"
 #include "mapping/map_check.h"
+#include "mapping/pair_matching.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -30,6 +31,15 @@ constexpr auto EnumNames(MatcherKind) {
                                     {MatcherKind::kExhaustive, "exhaustive"}}};
 }
 MatcherKind ParseMatcherKind(const std::string& text);  // throws MapError; back: arview::ToString
+
+// Who matches the frames' features: arview (mapping/pair_matching.h: a kd-tree per frame, then
+// COLMAP's geometric verification) or COLMAP's own matcher (a kd-tree per pair). The same pairs
+// either way (MatcherKind).
+enum class MatchEngine { kArview, kColmap };
+constexpr auto EnumNames(MatchEngine) {
+  return EnumTable<MatchEngine, 2>{{{MatchEngine::kArview, "arview"}, {MatchEngine::kColmap, "colmap"}}};
+}
+MatchEngine ParseMatchEngine(const std::string& text);  // throws MapError
 
 struct MapBuildOptions {
   std::string frames_spec;  // recordings::ParseFrameSpec syntax; empty: every frame
@@ -46,6 +56,14 @@ struct MapBuildOptions {
   // descriptors per image.
   int max_num_features = 8192;       // SiftExtraction.max_num_features
   int max_num_orientations = 2;      // SiftExtraction.max_num_orientations
+  // COLMAP's SIFT first doubles each frame (SiftExtraction.first_octave -1) to find the finest
+  // features. Frames this long or longer are not doubled: a 1080x1920 phone frame doubled is
+  // 8 megapixels, extraction took 3.5 s a frame, and the features it added were the ones the
+  // 8,192 cap then dropped; not doubling took extraction from 60 s to 24 s on phone-fox with a
+  // map as exact (docs/mapping.md, "Matching"). 0: every frame is doubled, as COLMAP does.
+  int double_frames_below_px = 1600;
+  MatchEngine match_engine = MatchEngine::kArview;
+  PairMatchingOptions pair_matching;  // MatchEngine::kArview (its threads are `threads`)
   double ba_global_ratio = 1.1;      // Mapper.ba_global_images_ratio and _points_ratio
   int ba_global_max_iterations = 50; // Mapper.ba_global_max_num_iterations
   int ba_local_max_iterations = 25;  // Mapper.ba_local_max_num_iterations
@@ -88,7 +106,8 @@ struct ColmapStageError : map::MapError {
 };
 
 struct MapBuildCallbacks {
-  // Stage progress: stage is "select", "extract", "match" or "map"; total may be 0 (unknown).
+  // Stage progress: stage is "select", "extract", "match", "verify" or "map"; total may be 0
+  // (unknown).
   std::function<void(const std::string& stage, int done, int total)> progress;
   // Things the user should know (a skipped stage, several models, dropped frames).
   std::function<void(const std::string& message)> note;
