@@ -513,7 +513,7 @@ std::string ArviewMatchInputs(const MapBuildOptions& options, int frames) {
      << (ExhaustivePairsWanted(options, frames) ? "exhaustive" : "sequential " + std::to_string(options.sequential_overlap) +
                                                                     (options.quadratic_overlap ? " quadratic" : ""))
      << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
-     << m.trees << " checks " << m.checks << "\nmatches_importer raw\n";
+     << m.trees << " checks " << m.checks << " at least " << m.min_matches << "\nmatches_importer raw\n";
   return ss.str();
 }
 

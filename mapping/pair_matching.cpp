@@ -83,6 +83,7 @@ PairMatches MatchPair(const std::vector<cv::Mat>& descriptors, const std::vector
     if (o.cross_check && backward[static_cast<size_t>(m)] != static_cast<int>(r)) continue;
     out.matches.emplace_back(static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(m));
   }
+  if (static_cast<int>(out.matches.size()) < o.min_matches) out.matches.clear();
   return out;
 }
 

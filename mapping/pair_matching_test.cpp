@@ -109,6 +109,15 @@ TEST(PairMatching, FindsTheSharedFeaturesAndNothingElse) {
     EXPECT_TRUE(std::binary_search(k.truth.begin(), k.truth.end(), m)) << m.first << " " << m.second;
 }
 
+// COLMAP cannot verify a pair with fewer matches than it needs inliers: it is given none.
+TEST(PairMatching, APairWithTooFewMatchesToVerifyGetsNone) {
+  const KnownMatches k = MakeKnownMatches(10, 300, 11);
+  PairMatchingOptions o;
+  EXPECT_TRUE(MatchImagePairs(k.descriptors, {{0, 1}}, o)[0].matches.empty());
+  o.min_matches = 5;
+  EXPECT_GE(MatchImagePairs(k.descriptors, {{0, 1}}, o)[0].matches.size(), 9u);
+}
+
 TEST(PairMatching, TheSameMatchesWithAnyNumberOfThreads) {
   std::vector<cv::Mat> descriptors;
   for (unsigned seed = 1; seed <= 3; ++seed) {
