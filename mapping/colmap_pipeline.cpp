@@ -428,10 +428,7 @@ void RetryFoldedMap(int retries, const fs::path& out_dir, const fs::path& log, c
 // The one line `arview map` refuses a folded map with.
 std::string FoldRefusal(const fs::path& out_dir, const MapBuildResult& result) {
   const MapCheck& c = result.check;
-  std::string frames;
-  for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
-    frames += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
-  if (c.disagreeing_frames.size() > 12) frames += ", ...";
+  const std::string frames = OffFrameList(c);
   const std::string models = std::to_string(result.fold_retries + 1) + (result.fold_retries == 0 ? " model" : " models");
   const std::string what =
       frames.empty() ? Percent(c.disagreeing_fraction) + " of " + std::to_string(c.two_view_pairs) +

@@ -31,6 +31,15 @@ std::string Fixed(double v, int digits) {
   return s.str();
 }
 
+std::string OffFrameList(const MapCheck& check) {
+  constexpr std::size_t kShown = 12;
+  std::string list;
+  for (std::size_t i = 0; i < check.disagreeing_frames.size() && i < kShown; ++i)
+    list += (i ? ", " : "") + std::to_string(check.disagreeing_frames[i]);
+  if (check.disagreeing_frames.size() > kShown) list += ", ...";
+  return list;
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -160,16 +169,15 @@ void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeome
   c.median_disagreement_deg = Median(all);
   c.keyframe_off_deg = std::clamp(limits.keyframe_off_factor * c.median_disagreement_deg, limits.keyframe_min_off_deg,
                                   std::max(limits.keyframe_min_off_deg, limits.two_view_max_disagreement_deg));
-  c.keyframe_disagreement_deg.assign(map.keyframes.size(), -1.0);
   c.keyframe_agreeing_pairs.assign(map.keyframes.size(), 0);
   int previous_off_index = -2;  // of the last keyframe found off
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     const std::vector<double>& own = per_keyframe[k];
     if (own.empty()) continue;
-    c.keyframe_disagreement_deg[k] = Median(own);
+    const double own_median_deg = Median(own);
     c.keyframe_agreeing_pairs[k] =
         static_cast<int>(std::count_if(own.begin(), own.end(), [&](double d) { return d <= c.keyframe_off_deg; }));
-    if (static_cast<int>(own.size()) >= limits.keyframe_min_pairs && c.keyframe_disagreement_deg[k] > c.keyframe_off_deg) {
+    if (static_cast<int>(own.size()) >= limits.keyframe_min_pairs && own_median_deg > c.keyframe_off_deg) {
       c.disagreeing_frames.push_back(map.keyframes[k].frame_index);
       c.off_neighbours += previous_off_index == static_cast<int>(k) - 1;
       previous_off_index = static_cast<int>(k);
@@ -179,10 +187,7 @@ void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeome
 
 // What a fold looks like, in the map's own figures, and what to do.
 std::string FoldWarning(const MapCheck& c, const MapCheckLimits& limits) {
-  std::string where;
-  for (std::size_t i = 0; i < c.disagreeing_frames.size() && i < 12; ++i)
-    where += (i ? ", " : "") + std::to_string(c.disagreeing_frames[i]);
-  if (c.disagreeing_frames.size() > 12) where += ", ...";
+  const std::string where = OffFrameList(c);
   std::string what = "its camera rotations differ from it by more than " +
                      Fixed(limits.two_view_max_disagreement_deg, 0) + " degrees in " + Percent(c.disagreeing_fraction) +
                      " of " + std::to_string(c.two_view_pairs) + " well-matched keyframe pairs";

@@ -97,9 +97,8 @@ struct MapCheck {
   double keyframe_off_deg = 0;          // the limit a keyframe's own median was held to
   std::vector<int> disagreeing_frames;  // frame indices of the keyframes that are off (MapCheckLimits)
   int off_neighbours = 0;               // consecutive keyframe pairs both off
-  // Per keyframe (Map::keyframes order): the median disagreement of its compared pairs, and how
-  // many pairs agree within keyframe_off_deg; -1 and 0 without compared pairs. Not in check.json.
-  std::vector<double> keyframe_disagreement_deg;
+  // Per keyframe (Map::keyframes order): how many of its compared pairs agree within
+  // keyframe_off_deg (0 without compared pairs), for KeyframeToStartFrom. Not in check.json.
   std::vector<int> keyframe_agreeing_pairs;
   std::vector<std::string> warnings;
   bool flagged() const { return !warnings.empty(); }
@@ -132,6 +131,8 @@ std::optional<MapCheck> ReadMapCheck(const std::filesystem::path& file);
 std::string Percent(double fraction);
 // A number with `digits` decimals, as the check's messages write it: "3.2".
 std::string Fixed(double value, int digits);
+// The off frames of a check for a message: "2, 4, 8", the first 12 and ", ..." after them.
+std::string OffFrameList(const MapCheck& check);
 
 // One line of figures ("explains 34% of the features, ...").
 std::string DescribeMapCheck(const MapCheck& check);
