@@ -771,8 +771,10 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   stage("extract", inputs, remove_database, colmap_stage("extract", extract_args), fs::exists(database),
         remove_database);
 
-  const bool arview_matches = options.match_engine == MatchEngine::kArview && NamesFitAMatchList(images.names);
-  if (options.match_engine == MatchEngine::kArview && !arview_matches && cb.note)
+  const bool arview_wanted = options.match_engine == MatchEngine::kArview ||
+                             (options.match_engine == MatchEngine::kAuto && !FramesDoubled(recording.camera, options));
+  const bool arview_matches = arview_wanted && NamesFitAMatchList(images.names);
+  if (arview_wanted && !arview_matches && cb.note)
     cb.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
   const std::vector<std::string> match_args = MatchArgs(options, database, n);
   inputs += "--\n" + (arview_matches ? ArviewMatchInputs(options, n) : Joined(match_args));

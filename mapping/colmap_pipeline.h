@@ -34,10 +34,16 @@ MatcherKind ParseMatcherKind(const std::string& text);  // throws MapError; back
 
 // Who matches the frames' features: arview (mapping/pair_matching.h: a kd-tree per frame, then
 // COLMAP's geometric verification) or COLMAP's own matcher (a kd-tree per pair). The same pairs
-// either way (MatcherKind).
-enum class MatchEngine { kArview, kColmap };
+// either way (MatcherKind). kAuto: arview for frames too large to be doubled
+// (MapBuildOptions::double_frames_below_px), COLMAP for smaller ones. On phone-fox's 1080x1920
+// frames arview's matching was 3.3x faster with keyframes as exact; on templeRing's 640x480
+// frames its kd-trees' approximate search (32 leaves per query) left the map at 1.56 mm against
+// COLMAP's 1.19 mm, and 128 leaves (1.29 mm) were no faster than COLMAP (docs/mapping.md,
+// "Matching").
+enum class MatchEngine { kAuto, kArview, kColmap };
 constexpr auto EnumNames(MatchEngine) {
-  return EnumTable<MatchEngine, 2>{{{MatchEngine::kArview, "arview"}, {MatchEngine::kColmap, "colmap"}}};
+  return EnumTable<MatchEngine, 3>{
+      {{MatchEngine::kAuto, "auto"}, {MatchEngine::kArview, "arview"}, {MatchEngine::kColmap, "colmap"}}};
 }
 MatchEngine ParseMatchEngine(const std::string& text);  // throws MapError
 
@@ -62,7 +68,7 @@ struct MapBuildOptions {
   // 8,192 cap then dropped; not doubling took extraction from 60 s to 24 s on phone-fox with a
   // map as exact (docs/mapping.md, "Matching"). 0: every frame is doubled, as COLMAP does.
   int double_frames_below_px = 1600;
-  MatchEngine match_engine = MatchEngine::kArview;
+  MatchEngine match_engine = MatchEngine::kAuto;
   PairMatchingOptions pair_matching;  // MatchEngine::kArview (its threads are `threads`)
   double ba_global_ratio = 1.1;      // Mapper.ba_global_images_ratio and _points_ratio
   int ba_global_max_iterations = 50; // Mapper.ba_global_max_num_iterations

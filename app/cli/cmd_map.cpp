@@ -1,4 +1,4 @@
-// arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine arview|colmap]
+// arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
 //            [--fold-retries N] [--keep-folded]
 // arview map info <map-dir>
@@ -31,7 +31,7 @@ struct MapArgs {
   std::string out;
   std::string frames;
   std::string matcher = "auto";
-  std::string match_engine = "arview";
+  std::string match_engine = "auto";
   int max_frames = 300;
   bool refine_intrinsics = false;
   int threads = 2;
@@ -239,7 +239,8 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_option("--matcher", args->matcher, "auto (exhaustive up to 100 frames, else sequential), sequential or exhaustive")
       ->capture_default_str();
   cmd->add_option("--match-engine", args->match_engine,
-                  "arview (a kd-tree per frame, COLMAP verifies; about 3x faster) or colmap (COLMAP's own matcher)")
+                  "auto (arview for frames 1600 px or longer, else colmap), arview (a kd-tree per frame, COLMAP verifies: "
+                  "3.3x faster on phone video) or colmap (COLMAP's own matcher)")
       ->capture_default_str();
   cmd->add_option("--max-frames", args->max_frames, "At most this many frames go to COLMAP (0: no cap)")
       ->capture_default_str()
