@@ -199,7 +199,13 @@ void RequireOpenCvYamlShape(std::string_view text, int max_depth, const std::str
     }
     if (line.substr(0, 3) == "...") {
       // The document's end: what follows starts a new top level, held to the same shape ("...",
-      // then an indented "   - 1." loops forever too; found by fuzz_room_light).
+      // then an indented "   - 1." loops forever too; found by fuzz_room_light). Text after the
+      // marker on its own line, other than a comment, is refused: "...   - 0." kept OpenCV's
+      // reader busy for over 10 s (fuzz_room_light in CI, 2026-12-05).
+      const size_t after = line.find_first_not_of(" \t\r", 3);
+      if (after != std::string_view::npos && line[after] != '#') {
+        fail("'" + Excerpt(line) + "' is not the document end marker '...'");
+      }
       top_level_seen = false;
       continue;
     }
