@@ -173,7 +173,8 @@ TEST_F(Camera, RunScalesTheMapsCameraToASizeOfTheSameAspect) {
   const fs::path map = dir_ / "map";
   testing::WriteRandomMap(calib::Camera::Pinhole(1280, 960, 1000, 1000, 639.5, 479.5), map);
   const CommandResult r = RunWithCamera(
-      {"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--size", "640x480"}, {}, {0, 0}, 3);
+      {"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--size", "640x480"}, {}, {0, 0},
+      3 * testing::kSanitizerSlowdown);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("640x480"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("note: the map's camera, calibrated at 1280x960, is scaled exactly to 640x480 (fx 1000.0 -> 500.0)"),
@@ -216,6 +217,10 @@ TEST_F(Camera, RecordPlaysARealRecordingAt640x480InMjpegAndYuyv) {
 // A reader stopped for half a second: the four buffers fill, the frames after find none and are
 // dropped by the driver; the summary says how many.
 TEST_F(Camera, RecordReportsTheFramesTheDriverDropped) {
+  if (testing::kSanitizerSlowdown > 1) {
+    GTEST_SKIP() << "the pause must fall while the camera streams, 1 s after the start: under a sanitizer the "
+                    "recorder is not streaming yet (the release suite runs it)";
+  }
   const fs::path rec = dir_ / "rec";
   const CommandResult r =
       RunWithCamera({"record", "--device", kDevice, "--out", rec.string(), "--size", "64x48", "--seconds", "2.5"}, {},
