@@ -329,6 +329,7 @@ cv::Mat ArRenderer::Render(const cv::Mat& background, const calib::Pose& pose,
 }
 
 void ArRenderer::WarmUp(const calib::Pose& pose, std::span<const anim::AnimatorFrame* const> frames) {
+  target_.ReserveWholeImage();
   UpdateCastShadows(frames);
   cv::Mat frame = PrepareBackground(cv::Mat());
   Compose(frame, pose, frames);

@@ -295,6 +295,8 @@ namespace {
 
 // llvmpipe bins and clears in tiles of 64 x 64 pixels.
 constexpr int kTile = 64;
+// RegionTarget's frames with a small rectangle before its target is made smaller (1 s at 30 fps).
+constexpr int kShrinkAfterFrames = 30;
 int RoundUpToTile(int pixels) { return (pixels + kTile - 1) / kTile * kTile; }
 
 }  // namespace
@@ -317,7 +319,15 @@ void RegionTarget::Begin(const cv::Rect& rect) {
                         std::min(RoundUpToTile(in_target_.y + in_target_.height), image_.height - origin_.y));
   const cv::Size have = target_size();
   const bool fits = needed.width <= have.width && needed.height <= have.height;
-  if (!fits || 2 * needed.area() < have.area()) target_ = std::make_unique<RenderTarget>(*gl_, needed.width, needed.height, samples_);
+  small_in_a_row_ = fits && 2 * needed.area() < have.area() ? small_in_a_row_ + 1 : 0;
+  if (!fits || small_in_a_row_ > kShrinkAfterFrames) {
+    // Room to grow: a character walking closer needs a larger rectangle every few frames.
+    // Growing keeps the other side's room; the image's own size always suffices.
+    const int width = std::max(RoundUpToTile(needed.width * 5 / 4), fits ? 0 : have.width);
+    const int height = std::max(RoundUpToTile(needed.height * 5 / 4), fits ? 0 : have.height);
+    target_ = std::make_unique<RenderTarget>(*gl_, std::min(width, image_.width), std::min(height, image_.height), samples_);
+    small_in_a_row_ = 0;
+  }
   const GlApi& gl = *gl_;
   target_->Bind();
   gl.Viewport(-origin_.x, -origin_.y, image_.width, image_.height);
@@ -326,6 +336,13 @@ void RegionTarget::Begin(const cv::Rect& rect) {
   gl.ClearDepth(1.0);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   target_->Scissor(TargetRect());
+}
+
+void RegionTarget::ReserveWholeImage() {
+  target_ = std::make_unique<RenderTarget>(*gl_, image_.width, image_.height, samples_);
+  small_in_a_row_ = 0;
+  Begin(cv::Rect(cv::Point(0, 0), image_));  // its memory touched by a clear
+  rect_ = {};
 }
 
 cv::Rect RegionTarget::TargetRect() const {

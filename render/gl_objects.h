@@ -135,14 +135,20 @@ class RenderTarget {
 // shift: the same rasterisation). Why: llvmpipe clears a whole target with its fast path (a fill
 // per 64-pixel tile), while a scissored clear is drawn as a quad at every sample; for the
 // character's rectangle at 4x MSAA that was ~1 ms of the frame (docs/render.md).
-// The target is sized up to whole 64-pixel tiles and kept while rectangles fit in it; it is made
-// again for a rectangle that does not fit, or one with less than half its area.
+// The target is sized up to whole 64-pixel tiles with a quarter more on each side, and kept while
+// rectangles fit in it; it is made again for a rectangle that does not fit, or after
+// 30 rectangles in a row that each had less than half its area. Making a
+// target costs 1-46 ms on llvmpipe (its memory is touched anew; the room's lap at 640x480, 4x
+// MSAA): made for every other size, as before, it was the render thread's longest frames.
 class RegionTarget {
  public:
   RegionTarget(const GlApi& gl, cv::Size image, int samples);
   // Binds a target for `rect` (image coordinates, row 0 at the top; clipped to the image),
   // clears it (colour 0, depth 1) and limits drawing to the rectangle. Empty rect: nothing bound.
   void Begin(const cv::Rect& rect);
+  // Makes the target the whole image's size now (a warm-up), so that the first rectangles do not
+  // make it again; it shrinks as any target does.
+  void ReserveWholeImage();
   // The rectangle of the last Begin, resolved and read back (CV_8UC4, row 0 at the top); the
   // scissor test is off again.
   cv::Mat ReadBgra() const;
@@ -165,6 +171,7 @@ class RegionTarget {
   cv::Rect in_target_;  // rect_ in the target, OpenGL's rows
   std::unique_ptr<RenderTarget> target_;
   std::unique_ptr<PixelReadback> readback_;
+  int small_in_a_row_ = 0;  // rectangles in a row with under half the target's area
 };
 
 }  // namespace arview::render

@@ -120,6 +120,7 @@ LossDiagnosis LossDiagnoser::Classify(cv::Size frame_size, const ImageStats& sta
     return {LossCause::kBlurred, referenced ? Format("blur %.2f against %.2f in the map's keyframes", stats.blur, reference_.blur)
                                             : Format("blur %.2f, sharp frames 0.3-0.45", stats.blur)};
   }
+  if (lost.awaiting_relocalization) return {LossCause::kRelocalizing, "the relocalization had not finished"};
   const std::string matched = Format("%d matches of %d keypoints", lost.matches, lost.keypoints);
   if (TooFewMatches(lost.relocalization_failure)) return {LossCause::kOutsideMap, matched};
   return {LossCause::kNoConsistentPose, matched + ", " + ToString(lost.relocalization_failure)};
@@ -151,13 +152,17 @@ std::string LossAdvice(LossCause cause, std::size_t count, const std::string& de
       return n + "matched the map but no pose agreed" + numbers +
              ": the view is repetitive or nearly flat, or the room changed since it was mapped — keep more of the "
              "mapped room in view";
+    case LossCause::kRelocalizing:
+      return n + "came while the relocalization ran in the background" + numbers +
+             ": the session's first frames and those after a loss are shown with the video alone until it finishes";
   }
   return n + ToString(cause);
 }
 
 std::string LossHeadline(const LossDiagnosis& diagnosis) {
   constexpr std::array<const char*, kLossCauses> kWords = {"camera differs from the map's", "too dark", "motion blur",
-                                                           "outside the mapped area", "no pose agreed"};
+                                                           "outside the mapped area", "no pose agreed",
+                                                           "relocalizing"};
   return std::string(kWords[static_cast<std::size_t>(diagnosis.cause)]) + " (" + diagnosis.detail + ")";
 }
 

@@ -43,15 +43,18 @@ struct AppearanceReference {
 };
 AppearanceReference ReferenceFromImages(std::span<const cv::Mat> images);
 
-enum class LossCause { kCameraDiffers, kTooDark, kBlurred, kOutsideMap, kNoConsistentPose };
+// kRelocalizing: a live session's frame that came while the relocalization ran on the tracker's
+// worker (TrackingOptions::background): it was not tried against the map.
+enum class LossCause { kCameraDiffers, kTooDark, kBlurred, kOutsideMap, kNoConsistentPose, kRelocalizing };
 constexpr auto EnumNames(LossCause) {
-  return EnumTable<LossCause, 5>{{{LossCause::kCameraDiffers, "camera_differs"},
+  return EnumTable<LossCause, 6>{{{LossCause::kCameraDiffers, "camera_differs"},
                                   {LossCause::kTooDark, "too_dark"},
                                   {LossCause::kBlurred, "blurred"},
                                   {LossCause::kOutsideMap, "outside_map"},
-                                  {LossCause::kNoConsistentPose, "no_consistent_pose"}}};
+                                  {LossCause::kNoConsistentPose, "no_consistent_pose"},
+                                  {LossCause::kRelocalizing, "relocalizing"}}};
 }
-inline constexpr std::size_t kLossCauses = 5;
+inline constexpr std::size_t kLossCauses = 6;
 
 struct LossDiagnosis {
   LossCause cause = LossCause::kOutsideMap;

@@ -45,6 +45,7 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
   relocalization_keypoints_followed_ = ActiveFeatures(resolution_.work(), options.relocalization).contrast_threshold >=
                                        options.tracking.guided_contrast_threshold;
   prefetch_extractor_ = std::make_unique<SiftExtractor>(guided_features);
+  if (options.tracking.background || options.tracking.prefetch_below > 0) worker_ = std::make_unique<Worker>();
   point_stamp_.assign(map.points.size(), 0);
   point_keyframes_.resize(map.points.size());
   for (size_t k = 0; k < map.keyframes.size(); ++k)
@@ -62,7 +63,12 @@ void Tracker::WarmUp() {
 }
 
 void Tracker::Reset() {
-  prefetch_.reset();  // waits for a pending extraction
+  recovery_.reset();  // its result, when it comes, is dropped with the future
+  ForgetPrior();
+}
+
+void Tracker::ForgetPrior() {
+  prefetch_.reset();
   feature_centres_.Clear();
   has_pose_ = false;
   has_velocity_ = false;
@@ -99,26 +105,49 @@ struct Tracker::Prefetch {
     Features features;
     double cpu_ms = 0;  // the worker's CPU time
   };
-  std::future<Extracted> extracted;
+  std::future<Extracted> extracted;  // run by worker_
   std::int64_t frame = 0;  // frames_tracked_ of the frame
   calib::Pose pose;        // its pose (working camera)
   std::vector<cv::Mat> pyramid;
   std::vector<std::uint32_t> tracked_points;  // its followed inliers' map points (covisibility)
 };
 
-Tracker::~Tracker() = default;  // a pending extraction is waited for (std::future of std::async)
+// A relocalization running on the worker (TrackingOptions::background), and the frame it works on.
+struct Tracker::Recovery {
+  struct Outcome {
+    RelocalizationResult relocalization;
+    std::vector<cv::Mat> pyramid;  // the frame's, for following the inliers into a later frame
+    double cpu_ms = 0;             // the worker's CPU time
+  };
+  std::future<Outcome> outcome;  // run by worker_
+  std::int64_t frame = 0;        // frames_tracked_ of the frame
+};
+
+namespace {
+template <typename T>
+bool Ready(const std::future<T>& future) {
+  return future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+}  // namespace
+
+Tracker::~Tracker() = default;  // worker_, destroyed first, finishes a running job
 
 void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
   const TrackingOptions& opt = options_.tracking;
-  if (opt.prefetch_below <= 0 || prefetch_ || result.status != TrackStatus::kTracking) return;
-  if (static_cast<int>(last_inliers_.pixels.size()) >= opt.prefetch_below || last_pyramid_.empty()) return;
+  if (opt.prefetch_below <= 0 || prefetch_ || recovery_ || result.status == TrackStatus::kLost) return;
+  // After a relocalization always: its inliers are relocalization's keypoints, which flow
+  // follows less exactly (relocalization_keypoints_followed_), and it may be followed only thinly.
+  const bool fresh_tracks_wanted = opt.background && result.status == TrackStatus::kRelocalized;
+  if (result.status != TrackStatus::kTracking && !fresh_tracks_wanted) return;
+  if (!fresh_tracks_wanted && static_cast<int>(last_inliers_.pixels.size()) >= opt.prefetch_below) return;
+  if (last_pyramid_.empty()) return;
   auto prefetch = std::make_unique<Prefetch>();
   prefetch->frame = frames_tracked_;
   prefetch->pose = result.pose;
   prefetch->pyramid = last_pyramid_;  // shares the images: the next frame builds its own
   prefetch->tracked_points = last_inliers_.points;
   // The caller may reuse the frame's buffer once Track() returns.
-  prefetch->extracted = std::async(std::launch::async, [this, image = gray.clone()] {
+  prefetch->extracted = worker_->Submit<Prefetch::Extracted>([this, image = gray.clone()] {
     const double cpu_start = ThreadCpuMilliseconds();
     Prefetch::Extracted out;
     out.features = relocalizer_->Extract(image, *prefetch_extractor_);
@@ -231,9 +260,13 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // pose the surviving tracks give (closer than the prediction after a large or sudden
   // motion), or with the prediction and a wider radius when too few tracks survive.
   // A prefetched frame is used `prefetch_lag_frames` after it, or as soon as the tracks thin out.
+  // With `background` it is used as soon as it is done, and nothing is extracted here.
   const bool prefetch_due =
-      prefetch_ && (frames_tracked_ - prefetch_->frame >= opt.prefetch_lag_frames || result->flow_tracks < opt.replenish_below);
-  if (prefetch_due || result->flow_tracks < opt.replenish_below) {
+      prefetch_ && (opt.background ? Ready(prefetch_->extracted)
+                                   : frames_tracked_ - prefetch_->frame >= opt.prefetch_lag_frames ||
+                                         result->flow_tracks < opt.replenish_below);
+  const bool extract_here = !opt.background && result->flow_tracks < opt.replenish_below;
+  if (prefetch_due || extract_here) {
     calib::Pose projecting = predicted;
     double radius = opt.guided_radius_predicted_px;
     if (result->flow_tracks >= opt.min_inliers) {
@@ -478,6 +511,122 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
   last_inliers_ = SpreadTracks(DropDriftedTracks(inliers, result.pose), opt.max_flow_tracks, opt.flow_grid_cell_px, resolution_.work().Size());
 }
 
+Track2D3D Tracker::TrackWithoutWaiting(const cv::Mat& gray, double timestamp, FrameResult* result) {
+  Track2D3D inliers;
+  // 1. A relocalization the worker finished, followed into this frame.
+  if (recovery_ && Ready(recovery_->outcome)) {
+    if (FinishRecovery(gray, result, &inliers)) {
+      result->status = TrackStatus::kRelocalized;
+      return inliers;
+    }
+    inliers = {};
+  }
+  // 2. The prior: flow, and the guided matches extracted ahead when they are done.
+  if (has_pose_) {
+    const std::vector<cv::Mat> reference_pyramid = last_pyramid_;  // the last posed frame's (shared)
+    std::optional<Features> none;  // nothing is extracted on this thread
+    if (TrackWithPrior(gray, timestamp, result, &none, &inliers)) {
+      result->status = TrackStatus::kTracking;
+      result->reason.clear();
+      return inliers;
+    }
+    inliers = {};
+    // 3. A whip-pan: the rotation by image alignment while the worker relocalises.
+    if (TrackByAlignment(reference_pyramid, gray, timestamp, result)) {
+      result->status = TrackStatus::kTracking;
+      result->inliers = 0;
+      result->rms_px = 0;
+      StartRecovery(gray);
+      return inliers;
+    }
+  }
+  // 4. Lost: relocalised on the worker; this frame is not waited for.
+  StartRecovery(gray);
+  result->status = TrackStatus::kLost;
+  result->inliers = 0;
+  result->awaiting_relocalization = result->relocalization_failure == PoseFailure::kNone;
+  std::ostringstream msg;
+  msg << (result->reason.empty() ? "" : "; ") << "relocalization running in the background since "
+      << frames_tracked_ - recovery_->frame << " frame(s) ago";
+  result->reason += msg.str();
+  return inliers;
+}
+
+void Tracker::StartRecovery(const cv::Mat& gray) {
+  if (recovery_) return;
+  prefetch_.reset();  // its features would come after the relocalization's
+  auto recovery = std::make_unique<Recovery>();
+  recovery->frame = frames_tracked_;
+  // The caller may reuse the frame's buffer once Track() returns.
+  recovery->outcome = worker_->Submit<Recovery::Outcome>([this, image = gray.clone()] {
+    const double cpu_start = ThreadCpuMilliseconds();
+    Recovery::Outcome out;
+    out.relocalization = relocalizer_->Relocalize(image);
+    if (out.relocalization.pose.ok) out.pyramid = FlowPyramid(image);
+    out.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
+    return out;
+  });
+  recovery_ = std::move(recovery);
+}
+
+bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D* inliers) {
+  const std::unique_ptr<Recovery> recovery = std::move(recovery_);
+  const Recovery::Outcome outcome = recovery->outcome.get();
+  const RelocalizationResult& reloc = outcome.relocalization;
+  result->keypoints = reloc.keypoints;
+  result->matches = reloc.matches;
+  result->times.extract_ms += reloc.extract_ms;  // the worker's
+  result->times.cpu_ms += outcome.cpu_ms;
+  result->relocalized_frames_ago = static_cast<int>(frames_tracked_ - recovery->frame);
+  if (!reloc.pose.ok) {
+    result->reason = "relocalization failed: " + reloc.pose.reason;
+    result->relocalization_failure = reloc.pose.failure;
+    return false;
+  }
+  // The relocalization's inliers followed from its frame into this one, started where they were:
+  // the camera moved little in the frames it took.
+  const auto flow_start = std::chrono::steady_clock::now();
+  const calib::Camera& camera = resolution_.work();
+  std::vector<cv::Mat> pyramid = FlowPyramid(gray);
+  std::vector<cv::Point2f> followed = reloc.inliers.pixels;
+  const std::vector<unsigned char> status = FollowByLk(outcome.pyramid, pyramid, reloc.inliers.pixels, &followed);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::uint32_t> point_ids;
+  for (size_t i = 0; i < followed.size(); ++i) {
+    const Eigen::Vector2d px(followed[i].x, followed[i].y);
+    if (!status[i] || !camera.InImage(px, 1.0)) continue;
+    pixels.push_back(px);
+    points.push_back(map_.points[reloc.inliers.points[i]].xyz);
+    point_ids.push_back(reloc.inliers.points[i]);
+  }
+  result->flow_tracks = static_cast<int>(pixels.size());
+  result->times.flow_ms += MillisecondsSince(flow_start);
+  AbsolutePoseOptions pose_options = TrackedPoseOptions(options_.tracking.ransac_max_iterations);
+  pose_options.max_rms_px = options_.relocalization.pose.max_rms_px;  // no recent tracked frames to gate by
+  pose_options.prior = reloc.pose.pose;
+  AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+  if (!pose.ok || pose.stats.inliers < options_.tracking.prior_min_inlier_ratio * static_cast<double>(pixels.size())) {
+    pose_options.prior.reset();
+    pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
+  }
+  CopyStats(pose, result);
+  if (!pose.ok) {
+    std::ostringstream msg;
+    msg << "relocalised " << result->relocalized_frames_ago << " frame(s) before, its " << reloc.inliers.pixels.size()
+        << " inliers followed into this frame: " << pose.reason;
+    result->reason = msg.str();
+    return false;
+  }
+  result->pose = pose.pose;
+  for (int i : pose.inliers) {
+    inliers->pixels.emplace_back(pixels[i].x(), pixels[i].y());
+    inliers->points.push_back(point_ids[i]);
+  }
+  last_pyramid_ = std::move(pyramid);
+  return true;
+}
+
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMilliseconds();
@@ -496,6 +645,21 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   }
 
   const cv::Mat gray = resolution_.Reduce(full_gray);
+  if (options_.tracking.background) {
+    const Track2D3D inliers = TrackWithoutWaiting(gray, timestamp, &result);
+    if (result.status == TrackStatus::kLost) {
+      ForgetPrior();
+    } else {
+      RefineOnFullCamera(inliers, &result);
+      Remember(result, timestamp, inliers);
+      MaybePrefetch(gray, result);
+      result.center = result.pose.Center();
+      result.smoothed_center = smoother_.Filter(result.center, timestamp);
+    }
+    result.times.total_ms = MillisecondsSince(start);
+    result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;
+    return result;
+  }
   const std::vector<cv::Mat> reference_pyramid = last_pyramid_;  // the last posed frame's (shared)
   bool tracked = false;
   std::string tracking_reason;

@@ -23,6 +23,7 @@
 #include "tracker/relocalizer.h"
 #include "tracker/residual_gate.h"
 #include "tracker/rotation_aligner.h"
+#include "tracker/worker.h"
 #include "tracker/working_resolution.h"
 
 namespace arview::tracker {
@@ -77,7 +78,16 @@ struct TrackingOptions {
   int prefetch_below = 0;
   // Frames after which features extracted ahead are used (sooner when the flow tracks fall below
   // replenish_below); the frame that uses them waits for them, so results do not depend on timing.
+  // Not with `background`, which never waits.
   int prefetch_lag_frames = 6;
+  // A live source: nothing on the tracking thread waits for SIFT or a relocalization. Guided
+  // matching's SIFT is extracted ahead (below prefetch_below flow tracks) and used by the first
+  // frame that finds it done; meanwhile, and when it is late, frames are posed on flow alone.
+  // A relocalization (the first frame, a loss) runs on the worker too: frames meanwhile are lost
+  // (or posed by image alignment), and the first frame that finds it done follows its inliers by
+  // LK from the relocalised frame. Poses then depend on timing; false: every step in line
+  // (docs/tracker.md, "The tracking worker").
+  bool background = false;
   // The pose is first refined from the constant-velocity prediction; it is kept when its inliers
   // are at least this fraction of the correspondences, else a short RANSAC runs.
   double prior_min_inlier_ratio = 0.5;
@@ -109,6 +119,10 @@ struct TrackingOptions {
   double align_max_from_prediction_deg = 15;  // the most an aligned rotation may turn
   RotationAlignerOptions align;               // tracker/rotation_aligner.h
 };
+// TrackingOptions::prefetch_below of a live session (TrackingOptions::background), where guided
+// matching's SIFT is only ever extracted ahead (docs/tracker.md, "The tracking worker").
+inline constexpr int kBackgroundPrefetchBelow = 200;
+
 // FLANN's default 64 leaves per query, halved: on templeRing and the synthetic room the same
 // frames localise with the same accuracy, and global matching is ~1.5x faster.
 inline map::IndexParams DefaultIndexParams() {
@@ -161,6 +175,10 @@ struct FrameResult {
   int keypoints = 0;       // SIFT keypoints extracted (0 when SIFT did not run)
   int matches = 0;         // global matches (relocalization)
   std::string reason;      // why the frame is lost, or why tracking fell back
+  // Lost because the relocalization running on the worker (TrackingOptions::background) has not
+  // finished: the frame was not tried against the map.
+  bool awaiting_relocalization = false;
+  int relocalized_frames_ago = 0;  // relocalized from the worker's result: on this many frames before
   // Lost: what relocalization's pose solver failed at (kNone: it did not run, e.g. a frame of
   // the wrong size); tracker/loss_diagnosis.h turns it and the frame's numbers into a cause.
   PoseFailure relocalization_failure = PoseFailure::kNone;
@@ -193,6 +211,7 @@ class Tracker {
 
  private:
   struct Prefetch;
+  struct Recovery;
   struct GuidedCandidate {  // a map point where a pose projects it, for guided matching
     static constexpr std::uint32_t kEveryDescriptor = 0xffffffffu;
     Eigen::Vector2d pixel;
@@ -226,6 +245,16 @@ class Tracker {
   // Starts extracting this frame's guided features on a worker thread when its flow tracks are
   // thinning (TrackingOptions::prefetch_below).
   void MaybePrefetch(const cv::Mat& gray, const FrameResult& result);
+  // TrackingOptions::background: one frame, with no step that waits for SIFT or relocalization.
+  // Returns the correspondences the pose rests on (empty when lost or aligned).
+  Track2D3D TrackWithoutWaiting(const cv::Mat& gray, double timestamp, FrameResult* result);
+  // Starts relocalising `gray` on the worker, unless a relocalization is already pending.
+  void StartRecovery(const cv::Mat& gray);
+  // The worker's relocalization, its inliers followed by LK into `gray`, posed; false when it
+  // failed (result->reason says why).
+  bool FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D* inliers);
+  // Forgets the prior, keeping a pending relocalization.
+  void ForgetPrior();
   // The map points of the keyframes covisible with `tracked_points` (without any, the nearest to
   // `pose`) that `pose` projects into the working image and that no step of this frame gathered
   // yet (they are stamped now): what guided matching matches keypoints against.
@@ -262,6 +291,7 @@ class Tracker {
   bool relocalization_keypoints_followed_ = true;
   std::unique_ptr<SiftExtractor> prefetch_extractor_;  // the worker's own, the same settings
   std::unique_ptr<Prefetch> prefetch_;                 // an extraction ahead, pending or done
+  std::unique_ptr<Recovery> recovery_;                 // a relocalization on the worker, pending or done
   std::int64_t frames_tracked_ = 0;                    // Track() calls, for the prefetch's lag
   OneEuroFilter smoother_;
 
@@ -279,5 +309,7 @@ class Tracker {
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
+  // Last: destroyed first, so that a running job finishes while the members it uses still exist.
+  std::unique_ptr<Worker> worker_;
 };
 }  // namespace arview::tracker

@@ -5,8 +5,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <chrono>
 #include <memory>
 #include <random>
+#include <thread>
 
 #include "tests/support/test_data.h"
 #include "tracker/test_planar_scene.h"
@@ -273,6 +275,73 @@ TEST_F(PlanarTrackerTest, FeaturesExtractedAheadAreUsedOnScheduleAndKeepThePoseE
     EXPECT_EQ(r.pose.t_cw, second[i].pose.t_cw) << "frame " << i;
     EXPECT_EQ(r.pose.q_cw.coeffs(), second[i].pose.q_cw.coeffs()) << "frame " << i;
   }
+}
+
+// A live source (TrackingOptions::background): the first frame's relocalization runs on the
+// worker while frames keep coming (a camera held still), and the first frame that finds it done
+// follows its inliers into itself; then guided matching's SIFT is only ever extracted ahead, and
+// frames use it when it is done, without waiting. Frames come at 30 fps, as from a camera.
+TEST_F(PlanarTrackerTest, InTheBackgroundNoFrameWaitsForSiftOrRelocalization) {
+  TrackerOptions options;
+  options.tracking.background = true;
+  options.tracking.prefetch_below = 100000;  // every tracked frame without one pending starts one
+  Tracker tracker(*map_, options);
+  auto at_camera_rate = [next = std::chrono::steady_clock::now()]() mutable {
+    next += std::chrono::microseconds(33333);
+    std::this_thread::sleep_until(next);
+  };
+  const cv::Mat still = world_->Render(PathPose(0));
+  FrameResult first = tracker.Track(still, 0);
+  EXPECT_EQ(first.status, TrackStatus::kLost);
+  EXPECT_TRUE(first.awaiting_relocalization) << first.reason;
+  EXPECT_EQ(first.keypoints, 0) << "the first frame extracted SIFT itself";
+  int waited = 0;
+  FrameResult r = first;
+  while (r.status == TrackStatus::kLost && waited < 300) {  // 10 s at 30 fps
+    at_camera_rate();
+    ++waited;
+    r = tracker.Track(still, waited / 30.0);
+  }
+  ASSERT_EQ(r.status, TrackStatus::kRelocalized) << "after " << waited << " frames: " << r.reason;
+  EXPECT_GE(r.relocalized_frames_ago, 1);
+  EXPECT_GT(r.flow_tracks, 30) << "the relocalization's inliers followed into the frame that used it";
+  ExpectNear(r, PathPose(0), 0.003, 0.2);
+
+  int frames_using_features_extracted_ahead = 0;
+  for (int i = 1; i <= 45; ++i) {
+    at_camera_rate();
+    r = tracker.Track(world_->Render(PathPose(i)), (waited + i) / 30.0);
+    ASSERT_EQ(r.status, TrackStatus::kTracking) << "frame " << i << ": " << r.reason;
+    ExpectNear(r, PathPose(i), 0.003, 0.2);
+    // Guided matches come only from features extracted ahead; the wide search (SIFT in line) never runs.
+    EXPECT_EQ(r.guided_matches, r.prefetched_matches) << "frame " << i;
+    EXPECT_EQ(r.wide_matches, 0) << "frame " << i;
+    if (r.prefetched_matches > 0) ++frames_using_features_extracted_ahead;
+  }
+  EXPECT_GE(frames_using_features_extracted_ahead, 2);
+}
+
+// Frames of a scene the map does not hold, in the background: each is lost at once while the
+// worker tries; the tracker is destroyed with a relocalization running.
+TEST_F(PlanarTrackerTest, InTheBackgroundAnUnknownSceneIsLostWithoutWaiting) {
+  TrackerOptions options;
+  options.tracking.background = true;
+  options.tracking.prefetch_below = 200;
+  auto tracker = std::make_unique<Tracker>(*map_, options);
+  cv::Mat noise(map_->camera.Size(), CV_8U);
+  cv::randu(noise, 0, 255);
+  cv::GaussianBlur(noise, noise, cv::Size(5, 5), 1.5);
+  bool a_relocalization_failed = false;
+  for (int i = 0; i < 60; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(33));
+    const FrameResult r = tracker->Track(noise, i / 30.0);
+    ASSERT_EQ(r.status, TrackStatus::kLost) << "frame " << i;
+    EXPECT_EQ(r.keypoints > 0, r.relocalization_failure != PoseFailure::kNone) << "frame " << i << ": " << r.reason;
+    if (r.relocalization_failure != PoseFailure::kNone) a_relocalization_failed = true;
+  }
+  EXPECT_TRUE(a_relocalization_failed) << "no relocalization finished in 2 s";
+  tracker->Track(noise, 2.0);  // starts another
+  tracker.reset();
 }
 
 // A whip-pan: the camera pans slowly, then turns 8 degrees a frame for three frames, each smeared

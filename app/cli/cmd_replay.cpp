@@ -54,7 +54,7 @@ void AddReplayCommand(CLI::App& app) {
                                                            : static_cast<long>(replay.frames.size()));
 
     SessionOptions o;
-    ApplySessionFlags(a->session, o);
+    ApplySessionFlags(a->session, /*live_source=*/a->paced, o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

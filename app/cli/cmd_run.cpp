@@ -49,7 +49,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->callback([a] {
     SessionOptions o;
     o.command_start = Clock::now();
-    ApplySessionFlags(a->session, o);
+    ApplySessionFlags(a->session, /*live_source=*/true, o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

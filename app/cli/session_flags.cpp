@@ -37,10 +37,17 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--hud", f.hud, "Draw the view-sphere overlay: key viewpoints coloured by weight, the current viewpoint");
   AddGlFlags(cmd, f.gl);
-  cmd->add_option("--prefetch-below", f.prefetch_below,
-                  "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive, so "
-                  "that its frame does not stall the pipeline (a live camera that drops frames then); 0: off")
+  cmd->add_option("--tracking-worker", f.tracking_worker,
+                  "on: guided matching's SIFT and relocalization run on a worker thread and the tracking thread "
+                  "never waits for them (frames meanwhile are posed on optical flow, or shown with the video "
+                  "alone while relocalising); off: every step in line, results independent of timing; auto: on "
+                  "for a live source (run, replay --paced)")
       ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "on", "off"}));
+  cmd->add_option("--prefetch-below", f.prefetch_below,
+                  "Extract guided matching's SIFT ahead, on the worker thread, when fewer flow tracks survive; 0: "
+                  "off (default: " + std::to_string(tracker::kBackgroundPrefetchBelow) +
+                      " with the tracking worker, else off)")
       ->check(CLI::Range(0, 100000));
   AddAlignMaxSecondsOption(cmd, f.align_max_seconds);
   cmd->add_option("--aa", f.aa, "Antialiasing of the character: msaa (4x multisampling) or none (cheaper on a CPU renderer)")
@@ -58,7 +65,7 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
       ->check(CLI::Range(0.0, 60.0));
 }
 
-void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
+void ApplySessionFlags(const SessionFlags& f, bool live_source, SessionOptions& o) {
   o.scene_file = f.scene;
   o.trajectory_out = f.trajectory;
   o.stats_out = f.stats;
@@ -70,7 +77,12 @@ void ApplySessionFlags(const SessionFlags& f, SessionOptions& o) {
   o.window = {f.window_output, f.fullscreen};
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
-  o.tracker.tracking.prefetch_below = f.prefetch_below;
+  const bool worker = f.tracking_worker == "on" || (f.tracking_worker == "auto" && live_source);
+  o.tracker.tracking.background = worker;
+  o.tracker.tracking.prefetch_below = f.prefetch_below >= 0 ? f.prefetch_below : worker ? tracker::kBackgroundPrefetchBelow : 0;
+  if (worker && o.tracker.tracking.prefetch_below == 0)
+    throw CommandError("--prefetch-below 0 needs --tracking-worker off: with the worker, guided matching's SIFT is "
+                       "extracted only ahead");
   o.tracker.tracking.align_max_seconds = f.align_max_seconds;
   o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
   o.fade = {f.hold, f.fade};

@@ -17,14 +17,19 @@ struct SessionFlags {
   std::string hmd_profile, window_output;
   bool fullscreen = false;
   double ipd = 0.064, hold = 0.5, fade = 1.0;
-  int prefetch_below = 0;  // tracker::TrackingOptions::prefetch_below
+  // tracker::TrackingOptions::prefetch_below; -1: tracker::kBackgroundPrefetchBelow with the
+  // tracking worker, else 0 (off)
+  int prefetch_below = -1;
+  std::string tracking_worker = "auto";  // auto (on for a live source), on, off
   double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
 };
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
 // --align-max-seconds (tracker::TrackingOptions::align_max_seconds), shared with `arview track`.
 void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds);
-// Fills the session options these flags control (throws on a bad --gl value).
-void ApplySessionFlags(const SessionFlags& flags, SessionOptions& options);
+// Fills the session options these flags control (throws on a bad --gl value). live_source: frames
+// come at the camera's rate whether or not the pipeline keeps up (`run`, `replay --paced`), which
+// turns the tracking worker on under --tracking-worker auto.
+void ApplySessionFlags(const SessionFlags& flags, bool live_source, SessionOptions& options);
 
 }  // namespace arview::app

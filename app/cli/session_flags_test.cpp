@@ -9,7 +9,7 @@ namespace arview::app {
 namespace {
 
 // Parses `args` (without the program name) as `arview replay` would its session flags.
-SessionOptions Parse(std::vector<std::string> args) {
+SessionOptions Parse(std::vector<std::string> args, bool live_source = false) {
   CLI::App cmd;
   SessionFlags flags;
   AddSessionFlags(&cmd, flags);
@@ -18,7 +18,7 @@ SessionOptions Parse(std::vector<std::string> args) {
   for (const std::string& a : args) argv.push_back(a.c_str());
   cmd.parse(static_cast<int>(argv.size()), argv.data());
   SessionOptions options;
-  ApplySessionFlags(flags, options);
+  ApplySessionFlags(flags, live_source, options);
   return options;
 }
 
@@ -29,6 +29,23 @@ TEST(SessionFlags, TrackerFlagsReachTheTrackerOptions) {
   const SessionOptions set = Parse({"--prefetch-below", "190", "--align-max-seconds", "0"});
   EXPECT_EQ(set.tracker.tracking.prefetch_below, 190);
   EXPECT_EQ(set.tracker.tracking.align_max_seconds, 0.0);
+}
+
+TEST(SessionFlags, TheTrackingWorkerIsOnForALiveSourceUnlessTurnedOff) {
+  const SessionOptions recorded = Parse({});
+  EXPECT_FALSE(recorded.tracker.tracking.background);
+  const SessionOptions live = Parse({}, /*live_source=*/true);
+  EXPECT_TRUE(live.tracker.tracking.background);
+  EXPECT_EQ(live.tracker.tracking.prefetch_below, tracker::kBackgroundPrefetchBelow);
+  const SessionOptions off = Parse({"--tracking-worker", "off"}, true);
+  EXPECT_FALSE(off.tracker.tracking.background);
+  EXPECT_EQ(off.tracker.tracking.prefetch_below, 0);
+  const SessionOptions on = Parse({"--tracking-worker", "on", "--prefetch-below", "180"});
+  EXPECT_TRUE(on.tracker.tracking.background);
+  EXPECT_EQ(on.tracker.tracking.prefetch_below, 180);
+  // With the worker, guided matching's features come only from extraction ahead.
+  EXPECT_THROW(Parse({"--prefetch-below", "0"}, true), CommandError);
+  EXPECT_THROW(Parse({"--tracking-worker", "sometimes"}), CLI::ValidationError);
 }
 
 TEST(SessionFlags, OutOfRangeTrackerFlagsAreRefused) {

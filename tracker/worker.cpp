@@ -1,0 +1,58 @@
+#include "tracker/worker.h"
+
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+namespace arview::tracker {
+
+Worker::Worker(int nice_increment) : thread_([this, nice_increment] { Run(nice_increment); }) {}
+
+Worker::~Worker() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    waiting_ = nullptr;  // destroys its packaged_task: the future sees a broken promise
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+void Worker::Post(std::function<void()> job) {
+  std::function<void()> dropped;  // destroyed outside the lock
+  {
+    std::lock_guard lock(mutex_);
+    dropped = std::move(waiting_);
+    waiting_ = std::move(job);
+  }
+  wake_.notify_one();
+}
+
+bool Worker::Busy() const {
+  std::lock_guard lock(mutex_);
+  return running_ || waiting_;
+}
+
+void Worker::Run(int nice_increment) {
+  pthread_setname_np(pthread_self(), "arview-trackwk");  // shown by top -H
+  // On Linux a thread's nice value is its own (setpriority on its thread id). Failing to lower
+  // it costs only the priority, so the result is not checked.
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  (void)setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + nice_increment);
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return stopping_ || waiting_; });
+    if (stopping_) return;
+    std::function<void()> job = std::move(waiting_);
+    waiting_ = nullptr;
+    running_ = true;
+    lock.unlock();
+    job();
+    job = nullptr;
+    lock.lock();
+    running_ = false;
+  }
+}
+
+}  // namespace arview::tracker
