@@ -24,6 +24,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/camera.h"
+#include "tests/support/emulated_camera.h"
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
@@ -100,7 +101,9 @@ class LiveWindow : public testing::XSessionTest<::testing::TestWithParam<Case>> 
       const calib::Camera camera = calib::Camera::Pinhole(64, 48, 60, 60, 32, 24);
       testing::WriteRandomMap(camera, dir_ / "map");
       window = camera.Size();
-      line = "exec env LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) + " " + ShellQuote(bin) +
+      // The preloaded camera comes before AddressSanitizer's runtime in the asan preset's build.
+      line = "exec env LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
+             " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\" " + ShellQuote(bin) +
              " run --device /dev/video-arview-fake --map " + ShellQuote((dir_ / "map").string()) + outputs;
     }
     line += " 2>" + ShellQuote((dir_ / "stderr.txt").string());
@@ -167,7 +170,7 @@ TEST_P(LiveWindow, ShowsFramesAndEndsPromptlyWithItsOutputs) {
   ASSERT_GE(status, 0) << "still running 10 s after it was asked to end";
   std::printf("[live window] %s ended %.3f s after it was asked\n", CaseName({c, 0}).c_str(), seconds);
   // Issue 35 asks 0.5 s; the bound here leaves room for a machine running other tests.
-  EXPECT_LT(seconds, 1.5);
+  EXPECT_LT(seconds, 1.5 * testing::kSanitizerSlowdown);
   const std::string report = ReadWholeFile(out.string());
   EXPECT_EQ(status, 0) << report << ReadWholeFile((dir_ / "stderr.txt").string());
   std::smatch m;

@@ -169,7 +169,7 @@ class LocalizeOnly : public ::testing::Test {
     const CommandResult live = testing::RunWithEmulatedCamera(
         {"run", "--device", testing::kEmulatedCamera, "--map", map.string(), "--out", "null", "--stats",
          (out / "run.json").string()},
-        {{"ARVIEW_FAKE_CAMERA_RECORDING", views.string()}}, out, {0, 0}, 4.0);
+        {{"ARVIEW_FAKE_CAMERA_RECORDING", views.string()}}, out, {0, 0}, 4.0 * testing::kSanitizerSlowdown);
     EXPECT_EQ(live.exit_code, 0) << label << " run: " << live.err;
     EXPECT_EQ(Differences(before, Take(map)), "") << label << " run changed the map folder";
     EXPECT_TRUE(std::regex_search(live.out, std::regex(R"([1-9]\d* localized)"))) << live.out;

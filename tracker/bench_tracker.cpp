@@ -16,12 +16,14 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <optional>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "map/map_file.h"
 #include "recordings/accuracy.h"
@@ -335,6 +337,53 @@ void BM_TrackContinuous(benchmark::State& state) {
   state.SetLabel(real->source);
 }
 BENCHMARK(BM_TrackContinuous)->Unit(benchmark::kMillisecond);
+
+// The tracking thread's time per frame as a live pipeline sees it: the frames in order, delivered
+// at 30 fps (the wait for the next frame is not timed), the tracker's steps in line (Arg 0:
+// guided matching's SIFT and relocalization on the frame that needs them) or on its worker (Arg
+// 1: TrackingOptions::background, prefetch_below kBackgroundPrefetchBelow). The counters are the
+// distribution of Track()'s wall time over the frames; with the worker its SIFT runs beside the
+// timed calls, on the other core. The first frame's relocalization is part of it.
+void BM_TrackAtCameraRate(benchmark::State& state) {
+  const RealFrames* real = Real();
+  if (!real) return state.SkipWithError("no frames (opencv-doc missing, no --map)");
+  TrackerOptions options;
+  if (state.range(0) == 1) {
+    options.tracking.background = true;
+    options.tracking.prefetch_below = kBackgroundPrefetchBelow;
+  }
+  std::vector<double> track_ms;
+  int tracked = 0, relocalized = 0, lost = 0, extracted_ahead = 0;
+  for (auto _ : state) {
+    Tracker tracker(real->map, options);
+    tracker.WarmUp();
+    track_ms.clear();
+    auto next = std::chrono::steady_clock::now();
+    for (size_t k = 0; k < real->frames.size(); ++k) {
+      state.PauseTiming();
+      next += std::chrono::microseconds(33333);
+      std::this_thread::sleep_until(next);
+      state.ResumeTiming();
+      const auto start = std::chrono::steady_clock::now();
+      const FrameResult r = tracker.Track(real->frames[k], static_cast<double>(k) / 30.0);
+      track_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      tracked += r.status == TrackStatus::kTracking;
+      relocalized += r.status == TrackStatus::kRelocalized;
+      lost += r.status == TrackStatus::kLost;
+      extracted_ahead += r.prefetched_matches > 0;
+    }
+  }
+  const double frames = static_cast<double>(state.iterations()) * static_cast<double>(real->frames.size());
+  state.counters["p50_ms"] = Percentile(track_ms, 0.50);
+  state.counters["p99_ms"] = Percentile(track_ms, 0.99);
+  state.counters["max_ms"] = *std::max_element(track_ms.begin(), track_ms.end());
+  state.counters["tracking_ratio"] = tracked / frames;
+  state.counters["relocalized_ratio"] = relocalized / frames;
+  state.counters["lost_ratio"] = lost / frames;
+  state.counters["ahead_ratio"] = extracted_ahead / frames;
+  state.SetLabel(real->source + (state.range(0) == 1 ? ", worker" : ", in line"));
+}
+BENCHMARK(BM_TrackAtCameraRate)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 // Continuous tracking of the planar scene (graf1.png) rendered at 640x480, 1280x720 and
 // 1920x1080 with the same field of view and distortion: the tracker reduces the larger frames

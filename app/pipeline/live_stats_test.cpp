@@ -182,12 +182,19 @@ TEST(LiveStats, AHundredThousandFramesWithStatsGrowResidentMemoryByAtMostOneByte
               "%.2f -> %.2f MiB (%.3f bytes a frame)\n",
               kWarmUp, kFrames, samples.front().heap_mib, samples.back().heap_mib, heap_bytes, samples.front().resident_mib,
               samples.back().resident_mib, resident_bytes);
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's allocator keeps freed memory in quarantine (256 MB) and is not glibc's, so
+  // neither figure measures what the program keeps there (54 bytes a frame were seen); the
+  // release build asserts them.
+  std::printf("[live stats] memory growth not asserted under AddressSanitizer\n");
+#else
   // What the program keeps: at most a byte a frame (measured 0.17, the frames in flight).
   EXPECT_LE(heap_bytes, 1.0);
   // Resident memory adds the allocator's steps and fragments: measured 0.06 bytes a frame without
   // --stats, 0.19 to 0.82 with it (the writer's per-frame JSON, freed each frame, on the sink's
   // thread), on the shared 2-core machine; two bytes a frame is what this allows.
   EXPECT_LE(resident_bytes, 2.0);
+#endif
 
   // The summaries still count every frame; the file holds every frame, one a line, and the
   // summary, and is valid JSON (checked without building it in memory).
