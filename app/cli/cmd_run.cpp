@@ -89,10 +89,14 @@ void AddRunCommand(CLI::App& app) {
     std::printf("output: %s\n", result.output.c_str());
     if (result.seconds_to_first_output >= 0) {
       std::printf("first frame shown %.2f s after the command started (start-up: the tracker %.2f s beside the "
-                  "characters %.2f s, the renderer %.2f s and its warm-up %.2f s; then the camera's first frame, its "
-                  "relocalization and render)\n",
+                  "characters %.2f s, the renderer %.2f s and its warm-up %.2f s; then the camera's first frame and "
+                  "its render)\n",
                   result.seconds_to_first_output, result.tracker_seconds, result.characters_seconds,
                   result.renderer_seconds, result.warmup_seconds);
+      if (result.seconds_to_first_localized_output >= 0) {
+        std::printf("first frame localized, the characters placed, %.2f s after the command started\n",
+                    result.seconds_to_first_localized_output);
+      }
     }
     if (!result.report.source_fault.empty()) {
       std::string kept = video::IsWindowTarget(a->out) || a->out == "null" ? "" : a->out;

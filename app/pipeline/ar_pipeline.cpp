@@ -332,6 +332,9 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
       if (log.track.status != tracker::TrackStatus::kLost) ++report.frames_localized;
       if (log.loss) report.losses.Add(*log.loss);
       if (!report.first_output) report.first_output = written;
+      if (!report.first_localized_output && log.track.status != tracker::TrackStatus::kLost) {
+        report.first_localized_output = written;
+      }
       report.frames_dropped = to_track.Dropped() + to_render.Dropped() + to_sink.Dropped();
       report.source = source.Counts();
       report.recent_fps = recent.Fps();

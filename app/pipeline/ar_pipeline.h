@@ -123,6 +123,9 @@ struct PipelineReport {
   double recent_fps = 0;
   double recent_latency_ms = 0;  // median
   std::optional<Clock::time_point> first_output;  // when the first frame reached the sink
+  // When the first localized frame (the characters placed) reached it: with the tracker's worker
+  // the first frames are shown with the video alone while it relocalises.
+  std::optional<Clock::time_point> first_localized_output;
   double wall_seconds = 0;
   double fps = 0;  // frames processed per wall-clock second
   // CPU time of the whole process (every thread: the stages, llvmpipe's, the encoder's) per

@@ -189,6 +189,10 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   result.warmup_seconds = warmup_seconds;
   if (result.report.first_output) {
     result.seconds_to_first_output = std::chrono::duration<double>(*result.report.first_output - command_start).count();
+    if (result.report.first_localized_output) {
+      result.seconds_to_first_localized_output =
+          std::chrono::duration<double>(*result.report.first_localized_output - command_start).count();
+    }
   }
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");

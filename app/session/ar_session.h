@@ -55,6 +55,7 @@ struct SessionResult {
   render::RendererInfo renderer_info;
   std::string output;  // the sink's description ("window \"arview\" (MIT-SHM)", a file, ...)
   double seconds_to_first_output = -1;  // from SessionOptions::command_start; < 0: no frame shown
+  double seconds_to_first_localized_output = -1;  // the same for the first frame with its characters placed
   // What the start-up took before the first frame was asked for, in seconds: the tracker (its
   // descriptor index) and its warm-up, the characters, the renderer (GL context, PRT).
   // The tracker's start runs beside the renderer's warm-up (a first draw of the characters).
