@@ -117,6 +117,8 @@ void Camera::Validate(const std::string& source) const {
   // Bounds far beyond any real camera, so that no later pixel arithmetic overflows.
   if (width > 65536) fail("image_width", "is larger than 65536 (is " + std::to_string(width) + ")");
   if (height > 65536) fail("image_height", "is larger than 65536 (is " + std::to_string(height) + ")");
+  if (focus && (*focus < INT32_MIN || *focus > INT32_MAX))
+    fail("focus_absolute", "must be a 32-bit V4L2 control value (is " + std::to_string(*focus) + ")");
   auto value = [](double v) {
     std::ostringstream s;
     s << v;
@@ -222,12 +224,13 @@ void PrecheckCameraText(const std::string& text, const std::string& source) {
 // Every top-level key is either used or known to be informational; anything else (a typo, a
 // field of another camera model) is refused rather than ignored.
 void RefuseUnknownKeys(const cv::FileStorage& fs, const std::string& source) {
-  static const std::set<std::string> used{"image_width", "image_height", "camera_matrix", "distortion_coefficients"};
+  static const std::set<std::string> used{"image_width", "image_height", "camera_matrix", "distortion_coefficients",
+                                          "focus_absolute"};
   const cv::FileNode root = fs.root();
   for (const std::string& key : root.keys()) {
     if (used.count(key) == 0 && InformationalKeys().count(key) == 0) {
       throw CameraError(source + ": unknown key '" + key + "' (a camera file holds image_width, image_height, " +
-                        "camera_matrix, distortion_coefficients)");
+                        "camera_matrix, distortion_coefficients, focus_absolute)");
     }
   }
   const cv::FileNode fisheye = fs["fisheye_model"];
@@ -288,6 +291,7 @@ Camera LoadCameraFile(const std::filesystem::path& path) {
     }
     for (int i = 0; i < n; ++i) c.dist[i] = d.at<double>(i);
   }
+  if (!fs["focus_absolute"].empty()) c.focus = ReadInt(fs, source, "focus_absolute");
   RefuseUnknownKeys(fs, source);
   c.Validate(source);
   return c;
@@ -308,6 +312,8 @@ void SaveCamera(const Camera& camera, const std::filesystem::path& path) {
   fs << "image_height" << camera.height;
   fs << "camera_matrix" << cv::Mat(camera.K());
   fs << "distortion_coefficients" << camera.DistCoeffs();
+  // FileStorage writes 32-bit integers: a V4L2 control's value is one.
+  if (camera.focus) fs << "focus_absolute" << static_cast<int>(*camera.focus);
   WriteFileAtomically(path, fs.releaseAndGetString());
 }
 

@@ -8,6 +8,8 @@
 #include "base/error.h"
 
 #include <array>
+#include <cstdint>
+#include <optional>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -39,6 +41,10 @@ struct Camera {
   int height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::array<double, 5> dist{0, 0, 0, 0, 0};  // k1, k2, p1, p2, k3 (OpenCV order)
+  // The lens focus the calibration holds for: a V4L2 camera's focus position
+  // (V4L2_CID_FOCUS_ABSOLUTE, in the camera's units; camera.yaml's focus_absolute). A camera that
+  // focuses elsewhere has another focal length. Unset: not known.
+  std::optional<std::int64_t> focus;
 
   static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
 

@@ -77,6 +77,11 @@ TEST(Camera, SaveLoadRoundTrip) {
   EXPECT_DOUBLE_EQ(d.fx, c.fx);
   EXPECT_DOUBLE_EQ(d.cy, c.cy);
   for (int i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(d.dist[i], c.dist[i]);
+  EXPECT_FALSE(d.focus.has_value());  // not known unless said
+  Camera focused = c;
+  focused.focus = 250;
+  SaveCamera(focused, path);
+  EXPECT_EQ(LoadCamera(path).focus, std::optional<std::int64_t>(250));
   std::filesystem::remove(path);
   std::error_code ignored;
   std::filesystem::remove(path.parent_path(), ignored);
@@ -106,6 +111,8 @@ const char* kGood =
     "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n";
 
 TEST(Camera, LoadRejectsBadFilesNamingTheField) {
+  EXPECT_NE(LoadError(std::string(kGood) + "focus_absolute: 2.5\n").find("field focus_absolute must be an integer"),
+            std::string::npos);
   EXPECT_EQ(LoadError(kGood), "");
 
   EXPECT_NE(LoadError("not yaml at all {{{").find("arview_camera_bad.yaml"), std::string::npos);

@@ -111,6 +111,8 @@ void WritePayload(const Map& map, Writer& w) {
   w.Put<std::int32_t>(c.height);
   for (double v : {c.fx, c.fy, c.cx, c.cy}) w.Put(v);
   for (double v : c.dist) w.Put(v);
+  w.Put<std::uint8_t>(c.focus ? 1 : 0);
+  w.Put<std::int64_t>(c.focus.value_or(0));
 
   w.Put<std::uint64_t>(map.keyframes.size());
   for (const Keyframe& k : map.keyframes) {
@@ -178,6 +180,12 @@ Map ReadPayload(Reader& r, std::uint32_t version) {
   c.cx = r.Get<double>("camera");
   c.cy = r.Get<double>("camera");
   for (double& d : c.dist) d = r.Get<double>("camera");
+  if (version >= 2) {
+    const auto has_focus = r.Get<std::uint8_t>("camera focus");
+    const auto focus = r.Get<std::int64_t>("camera focus");
+    if (has_focus > 1) r.Fail("camera focus flag " + std::to_string(has_focus));
+    if (has_focus) c.focus = focus;
+  }
 
   map.keyframes.resize(r.GetCount("keyframe count", 4 + 4 + 8 + 56 + 4 + 8));
   for (Keyframe& k : map.keyframes) {

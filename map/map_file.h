@@ -4,7 +4,7 @@
 //
 // Layout (little-endian): magic "ARVMAP\r\n" (8 bytes), uint32 version, uint32 reserved (0),
 // uint64 payload size, uint64 payload checksum (64-bit FNV-1a over 8-byte words, tail bytes
-// one by one), then the payload: camera, keyframes (with their observations), points,
+// one by one), then the payload: camera (version 2: with its focus), keyframes (with their observations), points,
 // descriptor rows, descriptor → point, descriptor → keyframe, and (version 2) the map's frame:
 // scale source, z-up, scale error, its one-line description, COLMAP → map similarity. Every
 // count and index is checked on load; any mismatch throws MapError naming the file. Version 1

@@ -107,7 +107,9 @@ TEST_F(MapFileTest, TheMetricFrameRecordRoundTrips) {
   map.frame.from_colmap.scale = 0.37;
   map.frame.from_colmap.R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   map.frame.from_colmap.t = {1, -2, 0.5};
+  map.camera.focus = 42;
   SaveMap(map, dir_ / kMapFileName);
+  EXPECT_EQ(LoadMap(dir_).camera.focus, std::optional<std::int64_t>(42));
   const MapFrame back = LoadMap(dir_).frame;
   EXPECT_EQ(back.scale_source, ScaleSource::kBoard);
   EXPECT_TRUE(back.z_up);
@@ -129,7 +131,7 @@ TEST_F(MapFileTest, TheMetricFrameRecordRoundTrips) {
 }
 
 // A map written before the frame record (version 1: the same payload without it) loads as
-// COLMAP's frame. The file is made from a version 2 one: the record cut, the version and the
+// COLMAP's frame. The file is made from a version 2 one: the record and the camera's focus cut, the version and the
 // checksum (map_file.h's FNV-1a over 8-byte words) put back.
 TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
   Map map = SmallMap();
@@ -142,6 +144,7 @@ TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
   const std::size_t record = 1 + 1 + 8 + 4 + map.frame.how.size() + 8 + 9 * 8 + 3 * 8;
   bytes.resize(bytes.size() - record);
   const std::size_t header = 32;
+  bytes.erase(header + 4 + 4 + 4 * 8 + 5 * 8, 1 + 8);  // the camera's focus, after its distortion
   const std::uint32_t version = 1;
   const std::uint64_t payload = bytes.size() - header;
   std::uint64_t h = 0xcbf29ce484222325ULL;
@@ -163,6 +166,8 @@ TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
   const Map back = LoadMap(dir_ / "v1.arvmap");
   EXPECT_FALSE(back.frame.metric());
   EXPECT_FALSE(back.frame.z_up);
+  EXPECT_FALSE(back.camera.focus.has_value());
+  EXPECT_EQ(back.camera.fx, map.camera.fx);
   EXPECT_EQ(back.keyframes.size(), map.keyframes.size());
   EXPECT_EQ(back.points.size(), map.points.size());
 }

@@ -51,6 +51,13 @@ std::vector<map::Keyframe> ReadColmapCameraPath(const std::filesystem::path& spa
 // The SIFT descriptors COLMAP extracted for the named images (one rows x 128 CV_8U matrix each,
 // in the order of `names`). Throws MapError naming the database and the image that is missing
 // or malformed.
+// The binary sparse model in `from` moved by `transform` (every image's pose and every point;
+// cameras.bin as it is) written into the folder `to` (created), otherwise byte for byte as
+// COLMAP wrote it. Each file is written atomically; a file that cannot be written is a MapError
+// naming it and the cause ("File too large", "No space left on device"). COLMAP's own
+// model_transformer ignores write errors and leaves a truncated model looking complete.
+void WriteTransformedModel(const std::filesystem::path& from, const std::filesystem::path& to, const Sim3& transform);
+
 std::vector<cv::Mat> ReadImageDescriptors(const std::filesystem::path& database, const std::vector<std::string>& names,
                                           const CancellationToken& cancel = {});
 

@@ -654,29 +654,82 @@ std::vector<std::string> MapperArgs(const MapBuildOptions& options, const fs::pa
   return args;
 }
 
-// The COLMAP model in <model_dir> moved into the metric frame by `colmap model_transformer`
-// (a 4x4 similarity, scale·R | t), written beside it and then put in its place.
-void TransformColmapModel(ColmapRunner& colmap, const fs::path& model_dir, const Sim3& transform) {
+// A COLMAP model that arview moved into a metric frame says so in <model>/arview_frame.txt: the
+// request it was made from and the frame record. A re-run of `arview map` whose COLMAP stages
+// are all skipped reads that model again: with the same request it is taken as it is (the map
+// file comes out byte-identical), with another one the new fit starts from it.
+constexpr const char* kModelFrameFile = "arview_frame.txt";
+
+std::string RequestSignature(const ScaleRequest& r) {
+  switch (r.from) {
+    case ScaleFrom::kNone: return "none";
+    case ScaleFrom::kCameraHeight: return "camera-height";
+    case ScaleFrom::kKnownDistance: return "known-distance";
+    case ScaleFrom::kBoard: {
+      char text[96];
+      std::snprintf(text, sizeof text, "board %dx%d %.17g %s", r.board.inner_corners.width, r.board.inner_corners.height,
+                    r.board.square, r.board.on_floor ? "floor" : "off-floor");
+      return text;
+    }
+  }
+  return "none";
+}
+
+void WriteModelFrame(const fs::path& model_dir, const std::string& signature, const map::MapFrame& f) {
+  std::ostringstream text;
+  text.precision(17);
+  text << "arview map frame 1\nrequest " << signature << "\nsource " << static_cast<int>(f.scale_source) << " "
+       << (f.z_up ? 1 : 0) << " " << f.scale_error << "\nfrom_colmap " << f.from_colmap.scale;
+  for (int i = 0; i < 9; ++i) text << " " << f.from_colmap.R(i / 3, i % 3);
+  for (int i = 0; i < 3; ++i) text << " " << f.from_colmap.t[i];
+  text << "\nhow " << f.how << "\n";
+  WriteFileAtomically(model_dir / kModelFrameFile, text.str());
+}
+
+struct ModelFrame {
+  std::string signature;
+  map::MapFrame frame;
+};
+
+// Nothing when the model has no record (COLMAP's own frame) or an unreadable one.
+std::optional<ModelFrame> ReadModelFrame(const fs::path& model_dir) {
+  std::ifstream in(model_dir / kModelFrameFile);
+  std::string line;
+  if (!in || !std::getline(in, line) || line != "arview map frame 1") return std::nullopt;
+  ModelFrame m;
+  int source = 0, z_up = 0;
+  std::string key;
+  if (!std::getline(in, line) || line.rfind("request ", 0) != 0) return std::nullopt;
+  m.signature = line.substr(8);
+  if (!(in >> key >> source >> z_up >> m.frame.scale_error) || key != "source" || source < 0 || source > 3)
+    return std::nullopt;
+  m.frame.scale_source = static_cast<map::ScaleSource>(source);
+  m.frame.z_up = z_up == 1;
+  if (!(in >> key >> m.frame.from_colmap.scale) || key != "from_colmap") return std::nullopt;
+  for (int i = 0; i < 9; ++i) in >> m.frame.from_colmap.R(i / 3, i % 3);
+  for (int i = 0; i < 3; ++i) in >> m.frame.from_colmap.t[i];
+  in >> std::ws;
+  if (!in || !std::getline(in, line) || line.rfind("how ", 0) != 0) return std::nullopt;
+  m.frame.how = line.substr(4);
+  return m;
+}
+
+// The COLMAP model in <model_dir> moved into the metric frame: written beside it
+// (colmap_model.h's WriteTransformedModel, with its frame record), then put in its place, so that
+// a failed write leaves the model as it was.
+void TransformColmapModel(const fs::path& model_dir, const Sim3& transform, const std::string& signature,
+                          const map::MapFrame& frame) {
   const fs::path staged = model_dir.string() + ".metric", old = model_dir.string() + ".old";
-  const fs::path transform_file = model_dir.string() + ".transform.txt";
   std::error_code ec;
   fs::remove_all(staged, ec);
   fs::remove_all(old, ec);
-  fs::create_directories(staged);
-  std::string matrix;
-  const Eigen::Matrix4d m = transform.Matrix();
-  for (int r = 0; r < 4; ++r) matrix += FormatParams({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}, " ") + "\n";
-  WriteFileAtomically(transform_file, matrix);
   try {
-    colmap.Run("scale", {"model_transformer", "--input_path", model_dir.string(), "--output_path", staged.string(),
-                         "--transform_path", transform_file.string()},
-               0);
+    WriteTransformedModel(model_dir, staged, transform);
+    WriteModelFrame(staged, signature, frame);
   } catch (...) {
     fs::remove_all(staged, ec);
-    fs::remove(transform_file, ec);
     throw;
   }
-  fs::remove(transform_file, ec);
   fs::rename(model_dir, old);
   fs::rename(staged, model_dir);
   fs::remove_all(old, ec);
@@ -731,8 +784,22 @@ MetricFit FitRequested(const map::Map& map, const ScaleRequest& request, const K
 
 // The built map made metric as options.scale asks (a board that fails: the estimate, and
 // result->scale_failure says why), the COLMAP model with it.
-void MakeMetric(ColmapRunner& colmap, const KeyframeImages& images, const MapBuildOptions& options,
-                const MapBuildCallbacks& cb, MapBuildResult* result) {
+// `read_model` reads the moved model back: the map is then exactly what a re-run reads (COLMAP
+// rounds the transformed poses its own way), so that the same command again writes the same bytes.
+void MakeMetric(const KeyframeImages& images, const MapBuildOptions& options,
+                const MapBuildCallbacks& cb, const std::function<map::Map()>& read_model, MapBuildResult* result) {
+  // The model read may be one an earlier run moved already: its frame comes with it.
+  const std::optional<ModelFrame> earlier = ReadModelFrame(result->model_dir);
+  if (earlier) {
+    result->map.frame = earlier->frame;
+    ScaleRequest asked = options.scale;
+    if (earlier->signature == RequestSignature(asked) && asked.from == ScaleFrom::kBoard &&
+        earlier->frame.scale_source != map::ScaleSource::kBoard) {
+      result->scale_failure = "the board could not be used when this model was made (the output of that run of "
+                              "arview map says why)";
+    }
+    if (earlier->signature == RequestSignature(asked) || asked.from == ScaleFrom::kNone) return;
+  }
   if (options.scale.from == ScaleFrom::kNone) return;
   std::optional<MetricFit> fit;
   try {
@@ -752,8 +819,13 @@ void MakeMetric(ColmapRunner& colmap, const KeyframeImages& images, const MapBui
     }
   }
   options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-  TransformColmapModel(colmap, result->model_dir, fit->to_metric);
   ApplyMetricFit(*fit, &result->map);
+  // What is asked is recorded, also when a board fell back to the estimate: the same command
+  // again then takes the model as it is rather than failing on the board a second time.
+  TransformColmapModel(result->model_dir, fit->to_metric, RequestSignature(options.scale), result->map.frame);
+  const map::MapFrame frame = result->map.frame;
+  result->map = read_model();
+  result->map.frame = frame;
   ScaleCheckDistances(fit->to_metric.scale, &result->check);
 }
 
@@ -918,6 +990,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
     std::vector<std::vector<Eigen::Vector2f>> keypoints;
     result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
+    result.map.camera.focus = recording.camera.focus;  // COLMAP's camera has no focus: the calibration's
     result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
   };
   match();
@@ -935,7 +1008,12 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     WriteMapCheck(result.check, out_dir / kMapCheckFileName);
     throw map::MapError(FoldRefusal(out_dir, result));
   }
-  MakeMetric(colmap, KeyframeImagesIn(result.map, {images.root}), options, cb, &result);
+  const auto read_moved_model = [&] {
+    map::Map moved = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, nullptr, false);
+    moved.camera.focus = recording.camera.focus;
+    return moved;
+  };
+  MakeMetric(KeyframeImagesIn(result.map, {images.root}), options, cb, read_moved_model, &result);
   WriteMapFolder(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
@@ -954,10 +1032,9 @@ map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* re
   std::vector<fs::path> roots{map_dir / "images", map_dir};
   if (recording) roots.push_back(recording->root);
   const MetricFit fit = FitRequested(result.map, request, KeyframeImagesIn(result.map, roots), options, cb);
-  ColmapRunner colmap(options, map_dir, cb);
   options.cancel.ThrowIfCancelled("the map was not changed");
-  TransformColmapModel(colmap, result.model_dir, fit.to_metric);
   ApplyMetricFit(fit, &result.map);
+  TransformColmapModel(result.model_dir, fit.to_metric, RequestSignature(request), result.map.frame);
   ScaleCheckDistances(fit.to_metric.scale, &result.check);
   WriteMapFolder(result, map_dir, options, cb);
   if (!check) RecheckMap(map_dir);  // a map from before the check: computed now, in metres

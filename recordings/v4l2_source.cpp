@@ -433,6 +433,7 @@ V4l2Source::V4l2Source(const std::string& device, V4l2Options options, V4l2Io& i
     NegotiateFormat();
     NegotiateFrameRate();
     ApplyFocus();
+    ReadBackFocus();
     ApplyExposure();
     MapBuffers();
   } catch (...) {
@@ -632,6 +633,16 @@ void V4l2Source::ApplyFocus() {
   CheckRange(*absolute, value, "focus");  // before anything changes
   if (automatic != nullptr) WriteControl(*automatic, 0, "focus auto");
   WriteControl(*absolute, value, "focus");
+}
+
+void V4l2Source::ReadBackFocus() {
+  const CameraControl* automatic = FindControl(V4L2_CID_FOCUS_AUTO);
+  const CameraControl* absolute = FindControl(V4L2_CID_FOCUS_ABSOLUTE);
+  int64_t value = 0;
+  if (absolute != nullptr && !(absolute->flags & V4L2_CTRL_FLAG_WRITE_ONLY) && TryReadControl(*absolute, value))
+    focus_position_ = value;
+  int64_t automatic_on = 0;
+  focus_held_ = automatic == nullptr || (TryReadControl(*automatic, automatic_on) && automatic_on == 0);
 }
 
 void V4l2Source::ApplyExposure() {

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -188,6 +189,10 @@ class V4l2Source : public FrameSource {
   const std::vector<CameraControl>& controls() const { return controls_; }
   bool streaming() const { return streaming_; }
   int64_t skipped_frames() const { return corrupt_skipped_.load(); }  // = Counts().corrupt_skipped
+  // The lens focus position after the set-up (V4L2_CID_FOCUS_ABSOLUTE, read back), and whether
+  // auto-focus is off; unset where the camera has no readable focus position.
+  std::optional<int64_t> focus_position() const { return focus_position_; }
+  bool focus_held() const { return focus_held_; }
 
  private:
   struct Buffer {
@@ -201,6 +206,7 @@ class V4l2Source : public FrameSource {
   void NegotiateFormat();
   void NegotiateFrameRate();
   void ApplyFocus();
+  void ReadBackFocus();
   void ApplyExposure();
   const CameraControl* FindControl(uint32_t id) const;
   bool TryReadControl(const CameraControl& control, int64_t& value);  // false: errno says why
@@ -228,6 +234,8 @@ class V4l2Source : public FrameSource {
   CameraCapabilities capabilities_;
   std::vector<CameraControl> controls_;
   std::vector<std::string> notes_;
+  std::optional<int64_t> focus_position_;
+  bool focus_held_ = false;
   uint32_t pixel_format_ = 0;
   int width_ = 0, height_ = 0;
   int stride_ = 0;

@@ -156,6 +156,46 @@ TEST_F(Camera, RunAsksForTheMapsSizeAndSaysWhatTheCameraGranted) {
   EXPECT_EQ(r.err.find("note: "), std::string::npos) << r.err;
 }
 
+// A map whose camera was calibrated at a focus: `run` holds the lens there by default, and says
+// when a --focus of the user's puts it elsewhere or lets it run free (the emulated camera
+// focuses at 40 on its own, 0..250).
+TEST_F(Camera, RunHoldsTheFocusTheMapWasCalibratedAt) {
+  const fs::path map = dir_ / "map";
+  calib::Camera camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  camera.focus = 100;
+  testing::WriteRandomMap(camera, map);
+  const std::vector<std::string> run = {"run", "--device", kDevice, "--map", map.string(), "--out", "null"};
+  CommandResult r = RunWithCamera(run, {}, {0, 0}, 1.5 * testing::kSanitizerSlowdown);
+  EXPECT_NE(r.err.find("note: focus held at 100, where the map's camera was calibrated"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+
+  std::vector<std::string> elsewhere = run;
+  elsewhere.insert(elsewhere.end(), {"--focus", "40"});
+  r = RunWithCamera(elsewhere, {}, {0, 0}, 1.5 * testing::kSanitizerSlowdown);
+  EXPECT_NE(r.err.find("warning: " + std::string(kDevice) + " is focused at 40, but the map " + map.string() +
+                       " was calibrated at focus 100: another focal length (--focus 100 holds it there)"),
+            std::string::npos)
+      << r.err;
+
+  std::vector<std::string> free = run;
+  free.insert(free.end(), {"--focus", "auto"});
+  r = RunWithCamera(free, {}, {0, 0}, 1.5 * testing::kSanitizerSlowdown);
+  EXPECT_NE(r.err.find(std::string(kDevice) + " focuses automatically, but the map"), std::string::npos) << r.err;
+}
+
+// A recording made with a calibration that does not say its focus keeps the focus it was made at
+// in its camera.yaml (the lock's position), so that its map and the sessions on it hold it too.
+TEST_F(Camera, ARecordingSaysTheFocusItWasMadeAt) {
+  const fs::path camera_file = dir_ / "camera.yaml";
+  calib::SaveCamera(calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5), camera_file);
+  const fs::path rec = dir_ / "rec";
+  const CommandResult r = RunWithCamera(
+      {"record", "--device", kDevice, "--out", rec.string(), "--camera", camera_file.string(), "--seconds", "0.5"}, {});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the recording's camera.yaml says the focus it was made at, 40"), std::string::npos) << r.err;
+  EXPECT_EQ(calib::LoadCamera(rec / "camera.yaml").focus, std::optional<std::int64_t>(40));
+}
+
 TEST_F(Camera, RunRefusesASizeOfAnotherAspectThanTheMapsCamera) {
   const fs::path map = dir_ / "map";
   testing::WriteRandomMap(calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5), map);

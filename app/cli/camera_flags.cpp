@@ -49,9 +49,8 @@ void AddCameraFlags(CLI::App* cmd, CameraFlags& flags, const std::string& size_h
       ->capture_default_str();
   cmd->add_option("--focus", flags.focus,
                   "lock (auto-focus off where it is: keeps a calibration valid), auto, keep (as the camera is) or a "
-                  "focus position")
-      ->check(FocusCheck())
-      ->capture_default_str();
+                  "focus position (default: the calibration's focus_absolute where it has one, else lock)")
+      ->check(FocusCheck());
   cmd->add_option("--exposure", flags.exposure,
                   "auto, lock (manual at the current exposure time: dim light cannot lower the frame rate) or an "
                   "exposure time in the camera's units")
@@ -62,8 +61,28 @@ void AddCameraFlags(CLI::App* cmd, CameraFlags& flags, const std::string& size_h
 void ApplyCameraFlags(const CameraFlags& flags, recordings::V4l2Options& options) {
   options.fps = flags.fps;
   options.format = flags.format;
-  options.focus = flags.focus;
+  options.focus = flags.focus.empty() ? "lock" : flags.focus;
   options.exposure = flags.exposure;
+}
+
+std::string SessionFocus(const CameraFlags& flags, const calib::Camera& calibration) {
+  if (!flags.focus.empty()) return flags.focus;
+  return calibration.focus ? std::to_string(*calibration.focus) : "lock";
+}
+
+std::string FocusMismatch(const recordings::V4l2Source& source, const calib::Camera& calibration,
+                          const std::string& whose) {
+  if (!calibration.focus) return "";
+  const std::string wanted = std::to_string(*calibration.focus);
+  if (!source.focus_held()) {
+    return source.Name() + " focuses automatically, but " + whose + " was calibrated at focus " + wanted +
+           ": the focal length changes under it (--focus " + wanted + " holds it there)";
+  }
+  if (source.focus_position() && *source.focus_position() != *calibration.focus) {
+    return source.Name() + " is focused at " + std::to_string(*source.focus_position()) + ", but " + whose +
+           " was calibrated at focus " + wanted + ": another focal length (--focus " + wanted + " holds it there)";
+  }
+  return "";
 }
 
 }  // namespace arview::app

@@ -64,6 +64,7 @@ void RunRecord(const RecordArgs& args) {
   options.width = size.width;
   options.height = size.height;
   ApplyCameraFlags(args.camera_flags, options);
+  if (camera) options.focus = SessionFocus(args.camera_flags, *camera);
   // A recording keeps every frame the buffers hold, in order: the newest-only reading of a live
   // session would leave holes whenever a PNG takes longer to write than a frame period.
   options.newest_only = false;
@@ -80,6 +81,17 @@ void RunRecord(const RecordArgs& args) {
       throw CommandError(args.camera + ": camera is " + std::to_string(camera->width) + "x" +
                          std::to_string(camera->height) + " but " + args.device + " delivers " +
                          std::to_string(source.size().width) + "x" + std::to_string(source.size().height));
+    }
+    if (camera) {
+      if (const std::string mismatch = FocusMismatch(source, *camera, args.camera); !mismatch.empty())
+        std::cerr << "warning: " << mismatch << "\n";
+      // The recording says at which focus its frames were taken, so that a map built from it
+      // and the sessions run on that map hold the camera there too.
+      if (!camera->focus && source.focus_held() && source.focus_position()) {
+        camera->focus = source.focus_position();
+        std::cerr << "note: " << args.camera << " does not say at which focus it was calibrated; the recording's "
+                  << "camera.yaml says the focus it was made at, " << *camera->focus << "\n";
+      }
     }
     recordings::RecordingWriter writer(args.out, camera, args.force);
     std::cerr << "recording into " << args.out << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";

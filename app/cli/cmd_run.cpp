@@ -70,6 +70,7 @@ void AddRunCommand(CLI::App& app) {
     ApplyCameraFlags(a->camera, v4l2);
     v4l2.cancel = signals.token();
     map::Map map = map::LoadMap(a->map_dir);
+    v4l2.focus = SessionFocus(a->camera, map.camera);
     const cv::Size wanted = a->camera.size.empty() ? map.camera.Size() : *ParseFrameSize(a->camera.size);
     RequireSameAspect(map.camera.Size(), wanted, "--size " + a->camera.size, a->map_dir);
     v4l2.width = wanted.width;
@@ -77,6 +78,12 @@ void AddRunCommand(CLI::App& app) {
     recordings::V4l2Source source(a->device, v4l2);
     std::fprintf(stderr, "%s (Ctrl-C stops)\n", source.GrantedLine().c_str());
     for (const std::string& note : source.notes()) std::fprintf(stderr, "note: %s\n", note.c_str());
+    if (const std::string mismatch = FocusMismatch(source, map.camera, "the map " + a->map_dir); !mismatch.empty()) {
+      std::fprintf(stderr, "warning: %s\n", mismatch.c_str());
+    } else if (map.camera.focus && a->camera.focus.empty()) {
+      std::fprintf(stderr, "note: focus held at %lld, where the map's camera was calibrated\n",
+                   static_cast<long long>(*map.camera.focus));
+    }
     if (source.size() != map.camera.Size()) {
       RequireSameAspect(map.camera.Size(), source.size(), a->device + " delivers " + SizeText(source.size()), a->map_dir);
       const calib::Camera calibrated = map.camera;
