@@ -98,6 +98,41 @@ std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_
   return status;
 }
 
+int Tracker::FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                             const std::vector<cv::Point2f>& from, const std::vector<std::uint32_t>& point_ids,
+                             std::vector<cv::Point2f> guesses, Correspondences* out,
+                             const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep) const {
+  if (from.empty()) return 0;
+  const calib::Camera& camera = resolution_.work();
+  const std::vector<unsigned char> status = FollowByLk(from_pyramid, to_pyramid, from, &guesses);
+  int added = 0;
+  for (std::size_t i = 0; i < guesses.size(); ++i) {
+    const Eigen::Vector2d px(guesses[i].x, guesses[i].y);
+    if (!status[i] || !camera.InImage(px, 1.0) || (keep && !keep(i, px))) continue;
+    out->pixels.push_back(px);
+    out->points.push_back(map_.points[point_ids[i]].xyz);
+    out->point_ids.push_back(point_ids[i]);
+    ++added;
+  }
+  return added;
+}
+
+Tracker::PriorPose Tracker::PoseFromPrior(const Correspondences& c, AbsolutePoseOptions options,
+                                          FrameResult* result) const {
+  const calib::Camera& camera = resolution_.work();
+  PriorPose out;
+  out.pose = EstimateAbsolutePose(camera, c.pixels, c.points, options);
+  CopyStats(out.pose, result);
+  if (!out.pose.ok ||
+      out.pose.stats.inliers < options_.tracking.prior_min_inlier_ratio * static_cast<double>(c.pixels.size())) {
+    options.prior.reset();
+    out.pose = EstimateAbsolutePose(camera, c.pixels, c.points, options);
+    CopyStats(out.pose, result);
+    out.prior_dropped = true;
+  }
+  return out;
+}
+
 // A frame's guided features being extracted on a worker thread, with what matching them and
 // following them into a later frame needs of it.
 struct Tracker::Prefetch {
@@ -158,8 +193,7 @@ void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
 }
 
 int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
-                         std::vector<Eigen::Vector2d>* pixels, std::vector<Eigen::Vector3d>* points,
-                         std::vector<std::uint32_t>* point_ids) {
+                         Correspondences* correspondences) {
   const TrackingOptions& opt = options_.tracking;
   const calib::Camera& camera = resolution_.work();
   const std::unique_ptr<Prefetch> prefetch = std::move(prefetch_);
@@ -180,28 +214,19 @@ int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose&
     matched.points.push_back(m.point);
   }
   matched = SpreadTracks(matched, opt.max_flow_tracks, opt.flow_grid_cell_px, camera.Size());
-  std::vector<cv::Point2f> from, to;
+  std::vector<cv::Point2f> to;
   std::vector<Eigen::Vector2d> expected;
   for (size_t i = 0; i < matched.pixels.size(); ++i) {
-    from.push_back(matched.pixels[i]);
     const Eigen::Vector3d pc = projecting.ToCamera(map_.points[matched.points[i]].xyz);
     const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
     expected.push_back(px);
-    to.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : from.back());
+    to.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : matched.pixels[i]);
   }
-  int added = 0;
-  if (!from.empty()) {
-    const std::vector<unsigned char> status = FollowByLk(prefetch->pyramid, pyramid, from, &to);
-    for (size_t i = 0; i < to.size(); ++i) {
-      const Eigen::Vector2d px(to[i].x, to[i].y);
-      // A track that ends far from where the pose puts its point slid onto something else.
-      if (!status[i] || !camera.InImage(px, 1.0) || (px - expected[i]).norm() > opt.guided_radius_predicted_px) continue;
-      pixels->push_back(px);
-      points->push_back(map_.points[matched.points[i]].xyz);
-      point_ids->push_back(matched.points[i]);
-      ++added;
-    }
-  }
+  // A track that ends far from where the pose puts its point slid onto something else.
+  const int added = FollowIntoFrame(prefetch->pyramid, pyramid, matched.pixels, matched.points, std::move(to),
+                                    correspondences, [&](std::size_t i, const Eigen::Vector2d& px) {
+                                      return (px - expected[i]).norm() <= opt.guided_radius_predicted_px;
+                                    });
   result->prefetched_matches = added;
   result->guided_matches += added;
   result->times.match_ms += MillisecondsSince(match_start);
@@ -226,9 +251,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // 1. Pyramidal LK from last frame's inliers, started where the prediction puts them.
   const auto flow_start = std::chrono::steady_clock::now();
   std::vector<cv::Mat> pyramid = FlowPyramid(gray);
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<std::uint32_t> point_ids;
+  Correspondences c;
   ++frame_counter_;
   if (!last_inliers_.pixels.empty() && !last_pyramid_.empty()) {
     std::vector<cv::Point2f> guess;
@@ -238,18 +261,10 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
       guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
     }
-    const std::vector<unsigned char> status = FollowByLk(last_pyramid_, pyramid, last_inliers_.pixels, &guess);
-    for (size_t i = 0; i < guess.size(); ++i) {
-      const Eigen::Vector2d px(guess[i].x, guess[i].y);
-      if (!status[i] || !camera.InImage(px, 1.0)) continue;
-      const std::uint32_t id = last_inliers_.points[i];
-      pixels.push_back(px);
-      points.push_back(map_.points[id].xyz);
-      point_ids.push_back(id);
-      point_stamp_[id] = frame_counter_;
-    }
+    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c);
+    for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
   }
-  result->flow_tracks = static_cast<int>(pixels.size());
+  result->flow_tracks = static_cast<int>(c.pixels.size());
   result->times.flow_ms = MillisecondsSince(flow_start);
 
   AbsolutePoseOptions pose_options = TrackedPoseOptions(opt.ransac_max_iterations);
@@ -270,7 +285,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
     calib::Pose projecting = predicted;
     double radius = opt.guided_radius_predicted_px;
     if (result->flow_tracks >= opt.min_inliers) {
-      const AbsolutePoseResult from_flow = EstimateAbsolutePose(camera, pixels, points, pose_options);
+      const AbsolutePoseResult from_flow = EstimateAbsolutePose(camera, c.pixels, c.points, pose_options);
       result->times.refine_ms += from_flow.stats.refine_ms;
       if (from_flow.ok) {
         projecting = from_flow.pose;
@@ -278,7 +293,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       }
     }
     if (prefetch_due) {
-      UsePrefetch(pyramid, projecting, result, &pixels, &points, &point_ids);
+      UsePrefetch(pyramid, projecting, result, &c);
     } else {
       const auto extract_start = std::chrono::steady_clock::now();
       // Fewer flow tracks than a pose needs (a jump, a blurred frame): the frame is likely to end
@@ -295,13 +310,13 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       result->keypoints = static_cast<int>(features.keypoints.size());
       result->times.extract_ms = MillisecondsSince(extract_start);
       const auto match_start = std::chrono::steady_clock::now();
-      const std::vector<GuidedCandidate> candidates = GuidedCandidates(projecting, point_ids);
+      const std::vector<GuidedCandidate> candidates = GuidedCandidates(projecting, c.point_ids);
       const auto guided = MatchGuided(features, candidates, map_, radius, opt.guided_ratio, gray.size());
       for (const auto& m : guided) {
         const cv::Point2f& p = features.keypoints[m.keypoint].pt;
-        pixels.emplace_back(p.x, p.y);
-        points.push_back(map_.points[m.point].xyz);
-        point_ids.push_back(m.point);
+        c.pixels.emplace_back(p.x, p.y);
+        c.points.push_back(map_.points[m.point].xyz);
+        c.point_ids.push_back(m.point);
       }
       result->guided_matches = static_cast<int>(guided.size());
       result->times.match_ms = MillisecondsSince(match_start);
@@ -310,13 +325,10 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short
   // RANSAC, whose pose must stay near the prediction.
-  AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
-  CopyStats(pose, result);
+  const PriorPose from_prior = PoseFromPrior(c, pose_options, result);
+  const AbsolutePoseResult& pose = from_prior.pose;
   last_pyramid_ = std::move(pyramid);
-  if (!pose.ok || pose.stats.inliers < opt.prior_min_inlier_ratio * static_cast<double>(pixels.size())) {
-    pose_options.prior.reset();
-    pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
-    CopyStats(pose, result);
+  if (from_prior.prior_dropped) {
     if (pose.ok) {
       const double jump_deg = pose.pose.q_cw.angularDistance(predicted.q_cw) * 180.0 / M_PI;
       if (jump_deg > opt.max_rotation_from_prediction_deg) {
@@ -334,8 +346,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   result->pose = pose.pose;
   Track2D3D& inliers = *tracked_inliers;
   for (int i : pose.inliers) {
-    inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
-    inliers.points.push_back(point_ids[i]);
+    inliers.pixels.emplace_back(c.pixels[i].x(), c.pixels[i].y());
+    inliers.points.push_back(c.point_ids[i]);
   }
   return true;
 }
@@ -586,31 +598,15 @@ bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D
   // The relocalization's inliers followed from its frame into this one, started where they were:
   // the camera moved little in the frames it took.
   const auto flow_start = std::chrono::steady_clock::now();
-  const calib::Camera& camera = resolution_.work();
   std::vector<cv::Mat> pyramid = FlowPyramid(gray);
-  std::vector<cv::Point2f> followed = reloc.inliers.pixels;
-  const std::vector<unsigned char> status = FollowByLk(outcome.pyramid, pyramid, reloc.inliers.pixels, &followed);
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<Eigen::Vector3d> points;
-  std::vector<std::uint32_t> point_ids;
-  for (size_t i = 0; i < followed.size(); ++i) {
-    const Eigen::Vector2d px(followed[i].x, followed[i].y);
-    if (!status[i] || !camera.InImage(px, 1.0)) continue;
-    pixels.push_back(px);
-    points.push_back(map_.points[reloc.inliers.points[i]].xyz);
-    point_ids.push_back(reloc.inliers.points[i]);
-  }
-  result->flow_tracks = static_cast<int>(pixels.size());
+  Correspondences c;
+  FollowIntoFrame(outcome.pyramid, pyramid, reloc.inliers.pixels, reloc.inliers.points, reloc.inliers.pixels, &c);
+  result->flow_tracks = static_cast<int>(c.pixels.size());
   result->times.flow_ms += MillisecondsSince(flow_start);
   AbsolutePoseOptions pose_options = TrackedPoseOptions(options_.tracking.ransac_max_iterations);
   pose_options.max_rms_px = options_.relocalization.pose.max_rms_px;  // no recent tracked frames to gate by
   pose_options.prior = reloc.pose.pose;
-  AbsolutePoseResult pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
-  if (!pose.ok || pose.stats.inliers < options_.tracking.prior_min_inlier_ratio * static_cast<double>(pixels.size())) {
-    pose_options.prior.reset();
-    pose = EstimateAbsolutePose(camera, pixels, points, pose_options);
-  }
-  CopyStats(pose, result);
+  const AbsolutePoseResult pose = PoseFromPrior(c, pose_options, result).pose;
   if (!pose.ok) {
     std::ostringstream msg;
     msg << "relocalised " << result->relocalized_frames_ago << " frame(s) before, its " << reloc.inliers.pixels.size()
@@ -620,8 +616,8 @@ bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D
   }
   result->pose = pose.pose;
   for (int i : pose.inliers) {
-    inliers->pixels.emplace_back(pixels[i].x(), pixels[i].y());
-    inliers->points.push_back(point_ids[i]);
+    inliers->pixels.emplace_back(c.pixels[i].x(), c.pixels[i].y());
+    inliers->points.push_back(c.point_ids[i]);
   }
   last_pyramid_ = std::move(pyramid);
   return true;

@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -264,11 +265,31 @@ class Tracker {
   // Pyramidal LK with the tracking options, `to` holding the starting guesses; the status per point.
   std::vector<unsigned char> FollowByLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
                                         const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const;
+  // A frame's 2D-3D correspondences: pixels (working camera), the map points' positions and ids.
+  struct Correspondences {
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<std::uint32_t> point_ids;
+  };
+  // Map points seen at `from` in one frame followed by LK into another, started at `guesses`:
+  // those the flow kept that end inside the image and, given `keep(i, pixel)`, that it accepts,
+  // appended to `out`. The number appended.
+  int FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                      const std::vector<cv::Point2f>& from, const std::vector<std::uint32_t>& point_ids,
+                      std::vector<cv::Point2f> guesses, Correspondences* out,
+                      const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep = {}) const;
+  // The pose from a prior: refined from it, and when that explains fewer than
+  // prior_min_inlier_ratio of the correspondences, RANSAC without it (`prior_dropped`). The
+  // solver's statistics of each attempt go into `result`.
+  struct PriorPose {
+    AbsolutePoseResult pose;
+    bool prior_dropped = false;
+  };
+  PriorPose PoseFromPrior(const Correspondences& c, AbsolutePoseOptions options, FrameResult* result) const;
   // The prefetched frame's keypoints matched to the map and followed by LK into `pyramid`,
   // appended to the frame's correspondences; the number added.
   int UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
-                  std::vector<Eigen::Vector2d>* pixels, std::vector<Eigen::Vector3d>* points,
-                  std::vector<std::uint32_t>* point_ids);
+                  Correspondences* correspondences);
   // The inliers whose reprojection error under `pose` (working camera) is within
   // max_track_residual_scales residual scales.
   Track2D3D DropDriftedTracks(const Track2D3D& inliers, const calib::Pose& pose) const;
