@@ -228,8 +228,6 @@ ImageSet CopyIntoSession(const ImageSet& selected, const fs::path& images_root, 
     std::error_code ec;
     fs::copy_file(selected.root / name, target, fs::copy_options::overwrite_existing, ec);
     if (ec) throw map::MapError(target.string() + ": cannot copy the frame there (" + ec.message() + ")");
-    if (name.find_first_of(" \t\r\n") != std::string::npos)
-      throw map::MapError((selected.root / name).string() + ": a frame's name holds a space, which COLMAP's pair lists cannot hold");
     set.names.push_back(prefixed);
     set.lookup[prefixed] = selected.lookup.at(name);
   }
@@ -287,6 +285,10 @@ std::vector<std::pair<std::string, std::string>> PairsToMatch(const OldMap& old,
 // sixteenth, so that the stage shows progress and a time left (one run prints nothing until done).
 void MatchPairs(const std::vector<std::pair<std::string, std::string>>& pairs, const fs::path& database,
                 const fs::path& work, const MapExtendOptions& options, const MapBuildCallbacks& cb) {
+  for (const auto& [a, b] : pairs)
+    for (const std::string* name : {&a, &b})
+      if (name->empty() || name->find_first_of(" \t\r\n") != std::string::npos)
+        throw map::MapError("'" + *name + "': a frame's name holds a space, which COLMAP's pair lists cannot hold");
   const std::size_t step = std::max<std::size_t>(8, (pairs.size() + 15) / 16);
   const int total = static_cast<int>(pairs.size());
   if (cb.progress) cb.progress("match", 0, total);
@@ -490,6 +492,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     throw map::MapError("COLMAP not found: '" + options_arg.build.colmap + "' cannot be run (install COLMAP: apt-get install colmap)");
   MapExtendOptions options = options_arg;
   if (!options.max_features_set) TakeMapsSiftSettings(map_dir, &options.build);
+  if (old.map.keyframes.empty()) throw map::MapError((map_dir / map::kMapFileName).string() + ": the map has no keyframes");
   const auto names = SqliteFile(old.database, SQLITE_OPEN_READONLY).ImageNames();
   const auto camera = std::find_if(names.begin(), names.end(),
                                    [&](const auto& n) { return n.first == old.map.keyframes.front().name; });
@@ -540,6 +543,10 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     result.points_after = result.map.points.size();
     MeasureDrift(ReadColmapCameraPath(old.model_dir), result.map, &result);
     MeasureSupport(old.map, result.map, result.session, &result);
+    if (result.registered == 0)
+      throw map::MapError("COLMAP registered none of the " + std::to_string(session.names.size()) + " new frames of " +
+                          recording.root.string() + " into the map (too few matches with it: another place, or too "
+                          "little overlap with what the map holds); the map in " + map_dir.string() + " is as it was");
     MapBuildResult files;
     files.map = result.map;
     files.check = result.check;

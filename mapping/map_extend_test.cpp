@@ -245,5 +245,34 @@ TEST_F(ExtendTempleMapTest, ACancelledExtensionLeavesTheMapAsItWas) {
   EXPECT_TRUE(before == Snapshot(dir)) << "the map folder changed";
 }
 
+// Frames of another place (OpenCV's chessboard photos, 640x480 as templeRing) register nowhere:
+// one error saying so, and the map as it was.
+TEST_F(ExtendTempleMapTest, FramesOfAnotherPlaceAreRefusedAndTheMapStaysAsItWas) {
+  const fs::path photos = "/usr/share/doc/opencv-doc/examples/data";
+  if (!fs::exists(photos / "left01.jpg")) GTEST_SKIP() << "needs Debian's opencv-doc (" << photos << ")";
+  const fs::path dir = CopyOfTheMap("elsewhere");
+  const auto before = Snapshot(dir);
+  const fs::path root = scratch_ / "chessboard";
+  recordings::PrepareRecordingFolder(root, true);
+  calib::SaveCamera(recording_->camera, root / "camera.yaml");
+  std::vector<recordings::FrameEntry> frames;
+  for (int i = 1; i <= 4; ++i) {
+    const std::string name = "frames/0" + std::to_string(i) + ".jpg";
+    fs::copy_file(photos / ("left0" + std::to_string(i) + ".jpg"), root / name);
+    frames.push_back({static_cast<double>(i), name});
+  }
+  recordings::WriteFramesTxt(root, frames);
+  try {
+    MapExtendOptions every_photo;
+    every_photo.old_neighbours = 6;
+    ExtendMap(dir, recordings::LoadRecording(root), every_photo);
+    FAIL() << "frames of another place were added";
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("registered none of the 4 new frames"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / kExtendPartialName));
+  EXPECT_TRUE(before == Snapshot(dir)) << "the map folder changed";
+}
+
 }  // namespace
 }  // namespace arview::mapping
