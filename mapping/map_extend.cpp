@@ -481,7 +481,43 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
+// Every keyframe's pose and every point moved by `s` (a similarity: reprojections unchanged).
+void MoveIntoFrame(const Sim3& s, map::Map* map) {
+  for (map::Keyframe& k : map->keyframes) k.pose = calib::Pose::FromRigid(s.TransformPose(k.pose.ToRigid()));
+  for (map::MapPoint& p : map->points) p.xyz = s(p.xyz);
+}
+
 }  // namespace
+
+std::optional<Sim3> MapFileFrameOfModel(const std::vector<map::Keyframe>& model_path, const map::Map& map_file) {
+  const auto in_file = ById(map_file.keyframes);
+  std::vector<Eigen::Vector3d> from, to;
+  double apart = 0, turned = 0, extent = 0;
+  for (const map::Keyframe& k : model_path) {
+    const auto it = in_file.find(k.colmap_image_id);
+    if (it == in_file.end()) continue;
+    from.push_back(k.pose.Center());
+    to.push_back(it->second->pose.Center());
+    apart = std::max(apart, (from.back() - to.back()).norm());
+    turned = std::max(turned, RotationAngleDeg(k.pose, it->second->pose));
+  }
+  for (const auto& a : to)
+    for (const auto& b : to) extent = std::max(extent, (a - b).norm());
+  if (from.empty()) throw map::MapError("map.arvmap holds none of the keyframes of COLMAP's model beside it");
+  if (apart <= 1e-9 * std::max(extent, 1.0) && turned <= 1e-9) return std::nullopt;
+  Sim3 s;
+  try {
+    s = EstimateSim3(from, to, true, "map.arvmap against COLMAP's model");
+  } catch (const Error& e) {
+    throw map::MapError(std::string(e.what()) + ": the map's frame cannot be told");
+  }
+  double off = 0;
+  for (std::size_t i = 0; i < from.size(); ++i) off = std::max(off, (s(from[i]) - to[i]).norm());
+  if (off > 1e-6 * std::max(extent, 1e-300))
+    throw map::MapError("map.arvmap's keyframes are not COLMAP's model's moved by one similarity (" + std::to_string(off) +
+                        " map units apart after the best): the map's frame cannot be told");
+  return s;
+}
 
 MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recording& recording,
                           const MapExtendOptions& options_arg, const MapBuildCallbacks& cb) {
@@ -493,6 +529,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
   MapExtendOptions options = options_arg;
   if (!options.max_features_set) TakeMapsSiftSettings(map_dir, &options.build);
   if (old.map.keyframes.empty()) throw map::MapError((map_dir / map::kMapFileName).string() + ": the map has no keyframes");
+  const std::optional<Sim3> to_map_file = MapFileFrameOfModel(ReadColmapCameraPath(old.model_dir), old.map);
   const auto names = SqliteFile(old.database, SQLITE_OPEN_READONLY).ImageNames();
   const auto camera = std::find_if(names.begin(), names.end(),
                                    [&](const auto& n) { return n.first == old.map.keyframes.front().name; });
@@ -538,10 +575,11 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     for (const map::Keyframe& k : old.map.keyframes) lookup[k.name] = {k.frame_index, k.timestamp};
     std::vector<std::vector<Eigen::Vector2f>> keypoints;
     map::Map model = ReadColmapMap(work / "model", database, lookup, options.build.cancel, &keypoints, false);
+    if (to_map_file) MoveIntoFrame(*to_map_file, &model);
     result.check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
     result.map = CarryFrameRecord(old.map, std::move(model));
     result.points_after = result.map.points.size();
-    MeasureDrift(ReadColmapCameraPath(old.model_dir), result.map, &result);
+    MeasureDrift(old.map.keyframes, result.map, &result);
     MeasureSupport(old.map, result.map, result.session, &result);
     if (result.registered == 0)
       throw map::MapError("COLMAP registered none of the " + std::to_string(session.names.size()) + " new frames of " +

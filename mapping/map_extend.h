@@ -17,6 +17,7 @@
 // partial folder and leaves the map as it was.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,14 @@ MapExtendResult ExtendMap(const std::filesystem::path& map_dir, const recordings
 // model) with every other record `old_map` carries, such as its metric frame: the extension holds
 // the old frame, so whatever says what that frame is stays true.
 map::Map CarryFrameRecord(const map::Map& old_map, map::Map model);
+
+// The similarity from the frame of COLMAP's model to the frame of the map file, found on the
+// keyframes both hold (`model_path`: ReadColmapCameraPath of the model), or nothing when they are
+// the same frame (a map as `arview map` writes it: the file is read from the model). A map file
+// moved into another frame after COLMAP (made metric and z-up, say) while the model stayed has its
+// extension moved the same way. Throws map::MapError when no similarity maps the one onto the
+// other (within 1e-6 of the path's extent).
+std::optional<Sim3> MapFileFrameOfModel(const std::vector<map::Keyframe>& model_path, const map::Map& map_file);
 
 // The scale s and shift c that best map `from` onto `to` (to ≈ s·from + c, least squares, no
 // rotation): what COLMAP's normalisation did to the old keyframes' centres, inverted.

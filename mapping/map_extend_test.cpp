@@ -77,6 +77,38 @@ TEST(CarryFrameRecord, TakesTheModelsCameraKeyframesPointsAndDescriptors) {
   EXPECT_EQ(extended.descriptor_keyframe, model.descriptor_keyframe);
 }
 
+std::vector<map::Keyframe> FourKeyframes() {
+  std::vector<map::Keyframe> keyframes(4);
+  const Eigen::Vector3d centres[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.2}, {0.5, 0.5, 1}};
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    keyframes[i].colmap_image_id = i + 1;
+    keyframes[i].pose.q_cw = Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitY()));
+    keyframes[i].pose.t_cw = -(keyframes[i].pose.q_cw * centres[i]);
+  }
+  return keyframes;
+}
+
+TEST(MapFileFrameOfModel, IsNothingForTheModelsOwnFrameAndTheMoveOtherwise) {
+  const std::vector<map::Keyframe> model = FourKeyframes();
+  map::Map file;
+  file.keyframes = model;
+  EXPECT_FALSE(MapFileFrameOfModel(model, file).has_value());
+
+  Sim3 metric;  // as a map made metric and z-up after COLMAP would be
+  metric.scale = 2.5;
+  metric.R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  metric.t = Eigen::Vector3d(1, -2, 0.5);
+  for (map::Keyframe& k : file.keyframes) k.pose = calib::Pose::FromRigid(metric.TransformPose(k.pose.ToRigid()));
+  const std::optional<Sim3> found = MapFileFrameOfModel(model, file);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_NEAR(found->scale, 2.5, 1e-9);
+  EXPECT_LT((found->R - metric.R).norm(), 1e-9);
+  EXPECT_LT((found->t - metric.t).norm(), 1e-9);
+
+  file.keyframes[2].pose.t_cw += Eigen::Vector3d(0.3, 0, 0);  // no one similarity any more
+  EXPECT_THROW(MapFileFrameOfModel(model, file), map::MapError);
+}
+
 // Each input an extension cannot use is refused with one message naming it, before anything is
 // written into the map folder.
 TEST(ExtendMap, RefusesWhatItCannotExtendNamingIt) {
@@ -178,7 +210,16 @@ std::unique_ptr<recordings::Recording> ExtendTempleMapTest::recording_;
 
 TEST_F(ExtendTempleMapTest, RegistersTheNewFramesAndKeepsTheOldKeyframesAndTheFrame) {
   const fs::path dir = CopyOfTheMap("extended");
-  const map::Map before = map::LoadMap(dir);
+  // The map file in another frame than COLMAP's model, as one made metric and z-up after COLMAP
+  // could be: the extension keeps the file's frame.
+  map::Map before = map::LoadMap(dir);
+  Sim3 moved;
+  moved.scale = 3;
+  moved.R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  moved.t = Eigen::Vector3d(0.5, 4, -1);
+  for (map::Keyframe& k : before.keyframes) k.pose = calib::Pose::FromRigid(moved.TransformPose(k.pose.ToRigid()));
+  for (map::MapPoint& p : before.points) p.xyz = moved(p.xyz);
+  map::SaveMap(before, dir / map::kMapFileName);
   std::map<std::string, std::pair<int, int>> progress;
   MapBuildCallbacks cb;
   cb.progress = [&](const std::string& stage, int done, int total) { progress[stage] = {done, total}; };
@@ -211,7 +252,8 @@ TEST_F(ExtendTempleMapTest, RegistersTheNewFramesAndKeepsTheOldKeyframesAndTheFr
       EXPECT_TRUE(fs::exists(dir / "images" / k.name)) << k.name;
       continue;
     }
-    EXPECT_LT((k.pose.Center() - it->second->pose.Center()).norm(), 1e-9) << k.name;
+    EXPECT_LT((k.pose.Center() - it->second->pose.Center()).norm(), 1e-9 * r.path_extent) << k.name;
+    EXPECT_LT(Eigen::AngleAxisd(k.pose.q_cw.conjugate() * it->second->pose.q_cw).angle(), 1e-9) << k.name;
   }
   // The new keyframes sit where the ground truth says, in the old frame (Sim(3) over all).
   const recordings::Trajectory keyframes = recordings::ReadTum(dir / "keyframes.txt");
