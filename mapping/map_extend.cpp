@@ -76,6 +76,7 @@ OldMap RequireExtendableMap(const fs::path& map_dir) {
     throw map::MapError(map_dir.string() + ": no such map folder (arview map <recording> --out <map-dir> makes one)");
   OldMap old;
   old.map = map::LoadMap(map_dir);  // names map.arvmap when it is missing or damaged
+  if (old.map.keyframes.empty()) throw map::MapError((map_dir / map::kMapFileName).string() + ": the map has no keyframes");
   old.database = map_dir / "database.db";
   if (!fs::is_regular_file(old.database, ec))
     throw map::MapError(old.database.string() +
@@ -487,6 +488,57 @@ void MoveIntoFrame(const Sim3& s, map::Map* map) {
   for (map::MapPoint& p : map->points) p.xyz = s(p.xyz);
 }
 
+// The COLMAP camera id of the map's keyframes, which the new frames share.
+std::int64_t MapCameraId(const OldMap& old, const std::vector<std::pair<std::string, std::int64_t>>& names) {
+  const std::string& first = old.map.keyframes.front().name;
+  const auto camera = std::find_if(names.begin(), names.end(), [&](const auto& n) { return n.first == first; });
+  if (camera == names.end())
+    throw map::MapError(old.database.string() + ": does not hold the map's keyframe '" + first +
+                        "' (the database of another map?)");
+  return camera->second;
+}
+
+// The new frames' SIFT into the work folder's copy of the map's database, with the map's camera.
+void ExtractNewFrames(const OldMap& old, const ImageSet& session, const calib::Camera& camera, std::int64_t camera_id,
+                      const fs::path& work, const MapExtendOptions& options, const MapBuildCallbacks& cb) {
+  const fs::path database = work / "database.db";
+  CopyColmapDatabase(old.database, database);
+  const fs::path list = work / "image_list.txt";
+  std::string listed;
+  for (const std::string& name : session.names) listed += name + "\n";
+  WriteFileAtomically(list, listed);
+  std::vector<std::string> args = ColmapExtractArgs(camera, options.build, database, session.root, list);
+  args.insert(args.end(), {"--ImageReader.existing_camera_id", std::to_string(camera_id)});
+  RunColmap(options.build, work, "extract", args, static_cast<int>(session.names.size()), cb);
+}
+
+// The extended model read as a map in the map file's frame, checked as a whole, with the old
+// map's frame record, and what changed measured.
+void ReadExtendedMap(const OldMap& old, const ImageSet& session, const std::optional<Sim3>& to_map_file,
+                     const fs::path& work, const CancellationToken& cancel, MapExtendResult* result) {
+  const fs::path database = work / "database.db";
+  FrameLookup lookup = session.lookup;
+  for (const map::Keyframe& k : old.map.keyframes) lookup[k.name] = {k.frame_index, k.timestamp};
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  map::Map model = ReadColmapMap(work / "model", database, lookup, cancel, &keypoints, false);
+  if (to_map_file) MoveIntoFrame(*to_map_file, &model);
+  result->check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
+  result->map = CarryFrameRecord(old.map, std::move(model));
+  result->points_after = result->map.points.size();
+  MeasureDrift(old.map.keyframes, result->map, result);
+  MeasureSupport(old.map, result->map, result->session, result);
+}
+
+// A failed COLMAP stage's error, its log moved from the work folder (removed) into the map's.
+ColmapStageError WithMapLog(const ColmapStageError& e, const fs::path& work, const fs::path& map_dir) {
+  AppendLog(work / "colmap.log", map_dir / "colmap.log");
+  std::string message = e.what();
+  const std::string work_log = (work / "colmap.log").string();
+  if (const auto at = message.find(work_log); at != std::string::npos)
+    message.replace(at, work_log.size(), (map_dir / "colmap.log").string());
+  return ColmapStageError(message, e.stage, map_dir / "colmap.log", e.log_tail);
+}
+
 }  // namespace
 
 std::optional<Sim3> MapFileFrameOfModel(const std::vector<map::Keyframe>& model_path, const map::Map& map_file) {
@@ -528,14 +580,9 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     throw map::MapError("COLMAP not found: '" + options_arg.build.colmap + "' cannot be run (install COLMAP: apt-get install colmap)");
   MapExtendOptions options = options_arg;
   if (!options.max_features_set) TakeMapsSiftSettings(map_dir, &options.build);
-  if (old.map.keyframes.empty()) throw map::MapError((map_dir / map::kMapFileName).string() + ": the map has no keyframes");
   const std::optional<Sim3> to_map_file = MapFileFrameOfModel(ReadColmapCameraPath(old.model_dir), old.map);
   const auto names = SqliteFile(old.database, SQLITE_OPEN_READONLY).ImageNames();
-  const auto camera = std::find_if(names.begin(), names.end(),
-                                   [&](const auto& n) { return n.first == old.map.keyframes.front().name; });
-  if (camera == names.end())
-    throw map::MapError(old.database.string() + ": does not hold the map's keyframe '" + old.map.keyframes.front().name +
-                        "' (the database of another map?)");
+  const std::int64_t camera_id = MapCameraId(old, names);
 
   MapExtendResult result;
   result.session = NextSessionName(map_dir, names);
@@ -543,7 +590,6 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
   result.points_before = old.map.points.size();
   const PartialFolder partial(map_dir / kExtendPartialName);
   const fs::path work = partial.dir();
-  const fs::path database = work / "database.db";
   std::string stage = "select";
   auto t0 = std::chrono::steady_clock::now();
   const auto finish_stage = [&](const std::string& next) {
@@ -556,31 +602,14 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     if (selected.names.empty()) throw map::MapError("no frames of " + recording.root.string() + " to add");
     const ImageSet session = CopyIntoSession(selected, work / "images", result.session, options.build.cancel);
     finish_stage("extract");
-    CopyColmapDatabase(old.database, database);
-    const fs::path list = work / "image_list.txt";
-    std::string listed;
-    for (const std::string& name : session.names) listed += name + "\n";
-    WriteFileAtomically(list, listed);
-    std::vector<std::string> extract = ColmapExtractArgs(recording.camera, options.build, database, session.root, list);
-    extract.insert(extract.end(), {"--ImageReader.existing_camera_id", std::to_string(camera->second)});
-    RunColmap(options.build, work, "extract", extract, static_cast<int>(session.names.size()), cb);
+    ExtractNewFrames(old, session, recording.camera, camera_id, work, options, cb);
     finish_stage("match");
-    MatchPairs(PairsToMatch(old, session, database, options), database, work, options, cb);
+    MatchPairs(PairsToMatch(old, session, work / "database.db", options), work / "database.db", work, options, cb);
     finish_stage("register");
-    ContinueModel(old, session, database, work, work / "continued", options, cb);
+    ContinueModel(old, session, work / "database.db", work, work / "continued", options, cb);
     RestoreMapFrame(old.model_dir, work / "continued", work / "model", work, options, cb, &result);
     finish_stage("write");
-
-    FrameLookup lookup = session.lookup;
-    for (const map::Keyframe& k : old.map.keyframes) lookup[k.name] = {k.frame_index, k.timestamp};
-    std::vector<std::vector<Eigen::Vector2f>> keypoints;
-    map::Map model = ReadColmapMap(work / "model", database, lookup, options.build.cancel, &keypoints, false);
-    if (to_map_file) MoveIntoFrame(*to_map_file, &model);
-    result.check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
-    result.map = CarryFrameRecord(old.map, std::move(model));
-    result.points_after = result.map.points.size();
-    MeasureDrift(old.map.keyframes, result.map, &result);
-    MeasureSupport(old.map, result.map, result.session, &result);
+    ReadExtendedMap(old, session, to_map_file, work, options.build.cancel, &result);
     if (result.registered == 0)
       throw map::MapError("COLMAP registered none of the " + std::to_string(session.names.size()) + " new frames of " +
                           recording.root.string() + " into the map (too few matches with it: another place, or too "
@@ -592,13 +621,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     WriteMapFiles(files, work, options.build, cb);  // into the work folder; the commit moves them
     options.build.cancel.ThrowIfCancelled("the extension was not put in place");
   } catch (const ColmapStageError& e) {
-    // The work folder goes: its log joins the map's, where the message sends the user.
-    AppendLog(work / "colmap.log", map_dir / "colmap.log");
-    std::string message = e.what();
-    const std::string work_log = (work / "colmap.log").string();
-    if (const auto at = message.find(work_log); at != std::string::npos)
-      message.replace(at, work_log.size(), (map_dir / "colmap.log").string());
-    throw ColmapStageError(message, e.stage, map_dir / "colmap.log", e.log_tail);
+    throw WithMapLog(e, work, map_dir);
   } catch (const CancelledError& e) {
     throw CancelledError("interrupted (" + SignalName(options.build.cancel.Signal()) + ") during the extension's " +
                              stage + " stage; the map in " + map_dir.string() + " is as it was",
