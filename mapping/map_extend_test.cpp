@@ -316,5 +316,35 @@ TEST_F(ExtendTempleMapTest, FramesOfAnotherPlaceAreRefusedAndTheMapStaysAsItWas)
   EXPECT_TRUE(before == Snapshot(dir)) << "the map folder changed";
 }
 
+// A COLMAP stage that fails: its output's last lines and the map's own colmap.log named (the work
+// folder's log is moved there), every other file as it was.
+TEST_F(ExtendTempleMapTest, AFailingColmapStageNamesTheMapsLogAndLeavesTheMap) {
+  const fs::path dir = CopyOfTheMap("failing");
+  auto before = Snapshot(dir);
+  const fs::path fake = scratch_ / "colmap_failing_to_match.sh";
+  std::ofstream(fake) << "#!/bin/sh\nif [ \"$1\" = matches_importer ]; then echo 'E: the matcher broke'; exit 3; fi\n"
+                         "exec colmap \"$@\"\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  MapExtendOptions options = OddFrames();
+  options.build.colmap = fake.string();
+  try {
+    ExtendMap(dir, *recording_, options);
+    FAIL() << "the failing stage was not reported";
+  } catch (const ColmapStageError& e) {
+    EXPECT_EQ(e.stage, "match");
+    EXPECT_EQ(e.log, dir / "colmap.log");
+    EXPECT_NE(std::string(e.what()).find("its output is in " + (dir / "colmap.log").string()), std::string::npos)
+        << e.what();
+    ASSERT_FALSE(e.log_tail.empty());
+    EXPECT_EQ(e.log_tail.back(), "E: the matcher broke");
+  }
+  auto after = Snapshot(dir);
+  EXPECT_NE(after["colmap.log"].find("E: the matcher broke"), std::string::npos);
+  before.erase("colmap.log");
+  after.erase("colmap.log");
+  EXPECT_TRUE(before == after) << "the map folder changed";
+  EXPECT_FALSE(fs::exists(dir / kExtendPartialName));
+}
+
 }  // namespace
 }  // namespace arview::mapping
