@@ -90,4 +90,25 @@ Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& all_points, const Pla
   return RefitPlane(points, best, threshold);
 }
 
+Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const std::vector<Eigen::Vector3d>& up_axes) {
+  Eigen::Vector3d mean_up = Eigen::Vector3d::Zero();
+  for (const auto& u : up_axes) mean_up += u.normalized();
+  Eigen::Vector3d up = mean_up;
+  if (centres.size() >= 3) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& c : centres) mean += c;
+    mean /= centres.size();
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& c : centres) cov += (c - mean) * (c - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    // A plane of centres: the two larger spreads are comparable, the third much smaller.
+    if (eig.eigenvalues()(1) > 0.05 * eig.eigenvalues()(2) && eig.eigenvalues()(0) < 0.3 * eig.eigenvalues()(1)) {
+      up = eig.eigenvectors().col(0);
+      if (up.dot(mean_up) < 0) up = -up;
+    }
+  }
+  if (up.norm() < 1e-9) throw Error("cannot tell which way is up from the map's cameras");
+  return up.normalized();
+}
+
 }  // namespace arview

@@ -36,4 +36,11 @@ double MedianDistance(const std::vector<Eigen::Vector3d>& points, const Eigen::V
 // Throws arview::Error when there are fewer than 3 points or no plane holds 3 of them.
 Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& options);
 
+// Which way is up, from the cameras: people film a scene walking around it or along it at about
+// the same height, so the normal of the plane the camera centres lie in is up; when the centres
+// do not span a plane (a straight walk), the mean of the cameras' own up axes (−y of the image)
+// is. Signed towards the cameras' side. Throws arview::Error when neither gives a direction.
+Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& camera_centres,
+                              const std::vector<Eigen::Vector3d>& camera_up_axes);
+
 }  // namespace arview

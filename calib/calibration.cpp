@@ -57,11 +57,8 @@ cv::Ptr<cv::aruco::CharucoBoard> MakeCharucoBoard(const CalibrationOptions& o) {
 }
 
 bool DetectChessboard(const cv::Mat& gray, const CalibrationOptions& o, Detection* d) {
-  std::vector<cv::Point2f> corners;
-  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
-  if (!cv::findChessboardCorners(gray, o.board, corners, flags)) return false;
-  cv::cornerSubPix(gray, corners, cv::Size(11, 11), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+  std::vector<cv::Point2f> corners = FindChessboardCorners(gray, o.board);
+  if (corners.empty()) return false;
   d->image_points = corners;
   for (int y = 0; y < o.board.height; ++y) {
     for (int x = 0; x < o.board.width; ++x) {
@@ -120,6 +117,33 @@ PassResult CalibratePass(const std::vector<const Detection*>& views, cv::Size im
 }
 
 }  // namespace
+
+std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners) {
+  std::vector<cv::Point2f> corners;
+  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+  if (!cv::findChessboardCorners(gray, inner_corners, corners, flags)) {
+    // A board seen small or at a slant (a map's keyframes: squares of 6-10 px) that the classic
+    // detector misses: OpenCV's sector-based detector, whose corners are already sub-pixel.
+    corners.clear();
+    if (!cv::findChessboardCornersSB(gray, inner_corners, corners, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) return {};
+    return corners;
+  }
+  // The refinement window must stay inside the corner's four squares: 11 px each way (OpenCV's
+  // sample) on a board seen small or at a slant, whose squares are 6-8 px tall, pulled corners
+  // 2-3 px onto their neighbours' edges. Close-up calibration photos keep the full window.
+  double nearest = 1e9;
+  for (int row = 0; row < inner_corners.height; ++row) {
+    for (int column = 0; column < inner_corners.width; ++column) {
+      const cv::Point2f& p = corners[row * inner_corners.width + column];
+      if (column + 1 < inner_corners.width) nearest = std::min(nearest, cv::norm(p - corners[row * inner_corners.width + column + 1]));
+      if (row + 1 < inner_corners.height) nearest = std::min(nearest, cv::norm(p - corners[(row + 1) * inner_corners.width + column]));
+    }
+  }
+  const int half_window = std::clamp(static_cast<int>(0.45 * nearest), 2, 11);
+  cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+  return corners;
+}
 
 CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const CalibrationOptions& o,
                             const std::function<void(int, int)>& progress) {

@@ -63,6 +63,11 @@ CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const C
 // A picture of the corner coverage (left) and the per-view errors (right).
 cv::Mat DrawCalibrationReport(const CalibrationResult& result);
 
+// The inner corners of a chessboard (`inner_corners`: per row, per column) in a grey image, row
+// after row, refined to sub-pixel as calibration refines them; empty when the board is not found
+// whole.
+std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners);
+
 // Renders a ChArUco board image for printing or for tests.
 cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square);
 

@@ -16,6 +16,7 @@
 #include "calib/pose.h"
 
 #include "base/error.h"
+#include "base/geometry.h"
 
 namespace arview::map {
 
@@ -47,8 +48,33 @@ struct Keyframe {
   std::vector<KeyframeObservation> observations;
 };
 
+// Where the map's scale and "up" come from (docs/mapping.md, "Metric scale and up").
+enum class ScaleSource : std::uint8_t {
+  kNone = 0,          // COLMAP's own frame: arbitrary units, arbitrary orientation
+  kBoard = 1,         // a chessboard of known square size seen in the keyframes
+  kKnownDistance = 2, // the distance between two points the user gave
+  kCameraHeight = 3,  // an estimate: the cameras' height over the floor taken as a typical one
+};
+
+// The map's frame. With a scale source the map is in metres; with z_up, +z points away from the
+// floor (or the board lying on it) and z = 0 is that floor. mapping/ transforms COLMAP's model,
+// the keyframes and the points into this frame; `from_colmap` says how, for whoever compares the
+// map with COLMAP's own output.
+struct MapFrame {
+  ScaleSource scale_source = ScaleSource::kNone;
+  bool z_up = false;
+  double scale_error = 0;   // the scale's likely relative error (0.01: 1 %), as estimated
+  std::string how;          // one line: what the scale and up were taken from, with its figures
+  Sim3 from_colmap;         // COLMAP's mapper frame → this frame
+
+  bool metric() const { return scale_source != ScaleSource::kNone; }
+};
+
+const char* ToString(ScaleSource source);  // "none", "board", "known distance", "camera height"
+
 struct Map {
   calib::Camera camera;  // OpenCV convention
+  MapFrame frame;        // COLMAP's frame unless mapping/ made it metric
   std::vector<Keyframe> keyframes;
   std::vector<MapPoint> points;
   // One row per track element: uint8 SIFT in COLMAP's convention (L1-root, ×512, clamp 255).

@@ -143,9 +143,32 @@ void WritePayload(const Map& map, Writer& w) {
   for (int r = 0; r < map.descriptors.rows; ++r) w.PutBytes(map.descriptors.ptr(r), kDescriptorSize);
   w.PutBytes(map.descriptor_point.data(), map.descriptor_point.size() * sizeof(std::uint32_t));
   w.PutBytes(map.descriptor_keyframe.data(), map.descriptor_keyframe.size() * sizeof(std::uint32_t));
+
+  const MapFrame& f = map.frame;
+  w.Put(static_cast<std::uint8_t>(f.scale_source));
+  w.Put<std::uint8_t>(f.z_up ? 1 : 0);
+  w.Put(f.scale_error);
+  w.PutString(f.how);
+  w.Put(f.from_colmap.scale);
+  for (int i = 0; i < 9; ++i) w.Put(f.from_colmap.R(i / 3, i % 3));
+  for (int i = 0; i < 3; ++i) w.Put(f.from_colmap.t[i]);
 }
 
-Map ReadPayload(Reader& r) {
+void ReadFrame(Reader& r, MapFrame* f) {
+  const auto source = r.Get<std::uint8_t>("map frame");
+  if (source > static_cast<std::uint8_t>(ScaleSource::kCameraHeight)) r.Fail("unknown scale source " + std::to_string(source));
+  f->scale_source = static_cast<ScaleSource>(source);
+  const auto z_up = r.Get<std::uint8_t>("map frame");
+  if (z_up > 1) r.Fail("z-up flag " + std::to_string(z_up));
+  f->z_up = z_up == 1;
+  f->scale_error = r.Get<double>("map frame");
+  f->how = r.GetString("map frame");
+  f->from_colmap.scale = r.Get<double>("map frame");
+  for (int i = 0; i < 9; ++i) f->from_colmap.R(i / 3, i % 3) = r.Get<double>("map frame");
+  for (int i = 0; i < 3; ++i) f->from_colmap.t[i] = r.Get<double>("map frame");
+}
+
+Map ReadPayload(Reader& r, std::uint32_t version) {
   Map map;
   calib::Camera& c = map.camera;
   c.width = r.Get<std::int32_t>("camera");
@@ -191,6 +214,7 @@ Map ReadPayload(Reader& r) {
   r.GetBytes(map.descriptor_point.data(), rows * sizeof(std::uint32_t), "descriptor points");
   map.descriptor_keyframe.resize(rows);
   r.GetBytes(map.descriptor_keyframe.data(), rows * sizeof(std::uint32_t), "descriptor keyframes");
+  if (version >= 2) ReadFrame(r, &map.frame);
   if (!r.AtEnd()) r.Fail("unexpected bytes after the payload");
   return map;
 }
@@ -204,6 +228,12 @@ void ValidateMap(const Map& map, const std::string& source) {
     map.camera.Validate(source + " (camera)");
   } catch (const calib::CameraError& e) {
     throw MapError(e.what());
+  }
+  const MapFrame& f = map.frame;
+  if (!(f.scale_error >= 0 && f.scale_error < 10) || !(f.from_colmap.scale > 0 && f.from_colmap.scale < 1e12) ||
+      !f.from_colmap.R.allFinite() || !f.from_colmap.t.allFinite() ||
+      (f.from_colmap.R.transpose() * f.from_colmap.R - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+    fail("the map's frame record is invalid (scale error, or a COLMAP-to-map transform that is not a similarity)");
   }
   const auto rows = static_cast<std::size_t>(map.descriptors.rows);
   if (rows > 0 && (map.descriptors.type() != CV_8UC1 || map.descriptors.cols != kDescriptorSize)) {
@@ -294,8 +324,8 @@ Map LoadMapFile(const fs::path& path) {
   header.GetBytes(magic, 8, "header");
   if (std::memcmp(magic, kMagic, 8) != 0) throw MapError(file.string() + ": not an arview map file");
   const auto version = header.Get<std::uint32_t>("header");
-  if (version != kMapFileVersion) {
-    throw MapError(file.string() + ": map file version " + std::to_string(version) + ", this arview reads version " +
+  if (version < 1 || version > kMapFileVersion) {
+    throw MapError(file.string() + ": map file version " + std::to_string(version) + ", this arview reads versions 1 to " +
                    std::to_string(kMapFileVersion) + " (rebuild the map with 'arview map')");
   }
   header.Get<std::uint32_t>("header");
@@ -309,7 +339,7 @@ Map LoadMapFile(const fs::path& path) {
     throw MapError(file.string() + ": checksum mismatch (corrupted map file)");
   }
   Reader body(data.data() + kHeaderSize, payload_size, file);
-  Map map = ReadPayload(body);
+  Map map = ReadPayload(body, version);
   ValidateMap(map, file.string());
   return map;
 }
@@ -319,6 +349,16 @@ Map LoadMapFile(const fs::path& path) {
 Map LoadMap(const fs::path& path) {
   // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
   return NamingInput<MapError>(path.string(), [&] { return LoadMapFile(path); });
+}
+
+const char* ToString(ScaleSource source) {
+  switch (source) {
+    case ScaleSource::kNone: return "none";
+    case ScaleSource::kBoard: return "board";
+    case ScaleSource::kKnownDistance: return "known distance";
+    case ScaleSource::kCameraHeight: return "camera height";
+  }
+  return "unknown";
 }
 
 std::optional<std::string> DegeneratePoints(const Map& map) {

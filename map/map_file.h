@@ -5,8 +5,10 @@
 // Layout (little-endian): magic "ARVMAP\r\n" (8 bytes), uint32 version, uint32 reserved (0),
 // uint64 payload size, uint64 payload checksum (64-bit FNV-1a over 8-byte words, tail bytes
 // one by one), then the payload: camera, keyframes (with their observations), points,
-// descriptor rows, descriptor → point, descriptor → keyframe. Every count and index is checked
-// on load; any mismatch throws MapError naming the file.
+// descriptor rows, descriptor → point, descriptor → keyframe, and (version 2) the map's frame:
+// scale source, z-up, scale error, its one-line description, COLMAP → map similarity. Every
+// count and index is checked on load; any mismatch throws MapError naming the file. Version 1
+// files (no frame record) load as COLMAP's frame.
 
 #include <filesystem>
 #include <optional>
@@ -17,7 +19,7 @@
 namespace arview::map {
 
 inline constexpr const char* kMapFileName = "map.arvmap";
-inline constexpr std::uint32_t kMapFileVersion = 1;
+inline constexpr std::uint32_t kMapFileVersion = 2;
 
 // Writes atomically (a temporary file renamed into place). Throws MapError.
 void SaveMap(const Map& map, const std::filesystem::path& file);

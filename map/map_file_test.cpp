@@ -5,7 +5,9 @@
 #include <cmath>
 #include <unistd.h>
 
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <random>
 
 namespace arview::map {
@@ -94,6 +96,75 @@ TEST_F(MapFileTest, RoundTripKeepsEverything) {
   EXPECT_EQ(s.observations, 30u);
   EXPECT_NEAR(s.mean_reprojection_error, 0, 1e-3);
   EXPECT_DOUBLE_EQ(s.mean_track_length, 3);
+}
+
+TEST_F(MapFileTest, TheMetricFrameRecordRoundTrips) {
+  Map map = SmallMap();
+  map.frame.scale_source = ScaleSource::kBoard;
+  map.frame.z_up = true;
+  map.frame.scale_error = 0.004;
+  map.frame.how = "chessboard 9x6 of 0.025 m squares";
+  map.frame.from_colmap.scale = 0.37;
+  map.frame.from_colmap.R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  map.frame.from_colmap.t = {1, -2, 0.5};
+  SaveMap(map, dir_ / kMapFileName);
+  const MapFrame back = LoadMap(dir_).frame;
+  EXPECT_EQ(back.scale_source, ScaleSource::kBoard);
+  EXPECT_TRUE(back.z_up);
+  EXPECT_TRUE(back.metric());
+  EXPECT_EQ(back.scale_error, 0.004);
+  EXPECT_EQ(back.how, map.frame.how);
+  EXPECT_EQ(back.from_colmap.scale, 0.37);
+  EXPECT_EQ(back.from_colmap.R, map.frame.from_colmap.R);
+  EXPECT_EQ(back.from_colmap.t, map.frame.from_colmap.t);
+  EXPECT_STREQ(ToString(ScaleSource::kCameraHeight), "camera height");
+
+  map.frame.from_colmap.R(0, 1) += 0.1;  // no longer a rotation
+  try {
+    SaveMap(map, dir_ / "bad.arvmap");
+    FAIL() << "a frame whose transform is not a similarity was saved";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("frame record"), std::string::npos) << e.what();
+  }
+}
+
+// A map written before the frame record (version 1: the same payload without it) loads as
+// COLMAP's frame. The file is made from a version 2 one: the record cut, the version and the
+// checksum (map_file.h's FNV-1a over 8-byte words) put back.
+TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
+  Map map = SmallMap();
+  SaveMap(map, dir_ / kMapFileName);
+  std::string bytes;
+  {
+    std::ifstream in(dir_ / kMapFileName, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t record = 1 + 1 + 8 + 4 + map.frame.how.size() + 8 + 9 * 8 + 3 * 8;
+  bytes.resize(bytes.size() - record);
+  const std::size_t header = 32;
+  const std::uint32_t version = 1;
+  const std::uint64_t payload = bytes.size() - header;
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  std::size_t i = header;
+  for (; i + 8 <= bytes.size(); i += 8) {
+    std::uint64_t word;
+    std::memcpy(&word, bytes.data() + i, 8);
+    h = (h ^ word) * 0x100000001b3ULL;
+    h ^= h >> 29;
+  }
+  for (; i < bytes.size(); ++i) h = (h ^ static_cast<unsigned char>(bytes[i])) * 0x100000001b3ULL;
+  std::memcpy(bytes.data() + 8, &version, 4);
+  std::memcpy(bytes.data() + 16, &payload, 8);
+  std::memcpy(bytes.data() + 24, &h, 8);
+  {
+    std::ofstream out(dir_ / "v1.arvmap", std::ios::binary);
+    out << bytes;
+  }
+  const Map back = LoadMap(dir_ / "v1.arvmap");
+  EXPECT_FALSE(back.frame.metric());
+  EXPECT_FALSE(back.frame.z_up);
+  EXPECT_EQ(back.keyframes.size(), map.keyframes.size());
+  EXPECT_EQ(back.points.size(), map.points.size());
 }
 
 TEST_F(MapFileTest, EveryTruncationIsAClearError) {

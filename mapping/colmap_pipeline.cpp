@@ -75,10 +75,10 @@ std::string Joined(const std::vector<std::string>& args) {
   return s;
 }
 
-std::string FormatParams(const std::vector<double>& v) {
+std::string FormatParams(const std::vector<double>& v, const char* separator = ",") {
   std::ostringstream ss;
   ss.precision(17);
-  for (size_t i = 0; i < v.size(); ++i) ss << (i ? "," : "") << v[i];
+  for (size_t i = 0; i < v.size(); ++i) ss << (i ? separator : "") << v[i];
   return ss.str();
 }
 
@@ -648,6 +648,109 @@ std::vector<std::string> MapperArgs(const MapBuildOptions& options, const fs::pa
   return args;
 }
 
+// The COLMAP model in <model_dir> moved into the metric frame by `colmap model_transformer`
+// (a 4x4 similarity, scale·R | t), written beside it and then put in its place.
+void TransformColmapModel(ColmapRunner& colmap, const fs::path& model_dir, const Sim3& transform) {
+  const fs::path staged = model_dir.string() + ".metric", old = model_dir.string() + ".old";
+  const fs::path transform_file = model_dir.string() + ".transform.txt";
+  std::error_code ec;
+  fs::remove_all(staged, ec);
+  fs::remove_all(old, ec);
+  fs::create_directories(staged);
+  std::string matrix;
+  const Eigen::Matrix4d m = transform.Matrix();
+  for (int r = 0; r < 4; ++r) matrix += FormatParams({m(r, 0), m(r, 1), m(r, 2), m(r, 3)}, " ") + "\n";
+  WriteFileAtomically(transform_file, matrix);
+  try {
+    colmap.Run("scale", {"model_transformer", "--input_path", model_dir.string(), "--output_path", staged.string(),
+                         "--transform_path", transform_file.string()},
+               0);
+  } catch (...) {
+    fs::remove_all(staged, ec);
+    fs::remove(transform_file, ec);
+    throw;
+  }
+  fs::remove(transform_file, ec);
+  fs::rename(model_dir, old);
+  fs::rename(staged, model_dir);
+  fs::remove_all(old, ec);
+}
+
+// check.json's two distances follow the map into metres.
+void ScaleCheckDistances(double scale, MapCheck* check) {
+  check->path_extent *= scale;
+  check->scene_depth *= scale;
+}
+
+// A keyframe's grey image from the folder the map's frames were given to COLMAP from.
+KeyframeImages KeyframeImagesIn(const map::Map& map, const std::vector<fs::path>& roots) {
+  return [&map, roots](std::size_t k) {
+    for (const fs::path& root : roots) {
+      const fs::path file = root / map.keyframes[k].name;
+      std::error_code ec;
+      if (!fs::is_regular_file(file, ec)) continue;
+      try {
+        return ReadImageFile(file, cv::IMREAD_GRAYSCALE);
+      } catch (const Error&) {
+        return cv::Mat();
+      }
+    }
+    return cv::Mat();
+  };
+}
+
+// The requested fit. Throws MapError when it cannot be made.
+MetricFit FitRequested(const map::Map& map, const ScaleRequest& request, const KeyframeImages& images,
+                       const MapBuildOptions& options, const MapBuildCallbacks& cb) {
+  switch (request.from) {
+    case ScaleFrom::kBoard: {
+      const std::vector<BoardSighting> seen = FindBoard(
+          map, images, request.board.inner_corners,
+          [&](int done, int total) {
+            if (cb.progress) cb.progress("board", done, total);
+          },
+          options.cancel);
+      return FitFromBoard(map, TriangulateBoard(map, seen, request.board.inner_corners), request.board);
+    }
+    case ScaleFrom::kKnownDistance:
+      return FitFromDistance(map, TriangulatePoint(map, request.point_a), TriangulatePoint(map, request.point_b),
+                             request.distance_m);
+    case ScaleFrom::kCameraHeight:
+      return FitFromCameraHeight(map);
+    case ScaleFrom::kNone:
+      break;
+  }
+  throw map::MapError("no scale source requested");
+}
+
+// The built map made metric as options.scale asks (a board that fails: the estimate, and
+// result->scale_failure says why), the COLMAP model with it.
+void MakeMetric(ColmapRunner& colmap, const KeyframeImages& images, const MapBuildOptions& options,
+                const MapBuildCallbacks& cb, MapBuildResult* result) {
+  if (options.scale.from == ScaleFrom::kNone) return;
+  std::optional<MetricFit> fit;
+  try {
+    fit = FitRequested(result->map, options.scale, images, options, cb);
+  } catch (const map::MapError& e) {
+    if (options.scale.from == ScaleFrom::kCameraHeight) {
+      if (cb.note) cb.note(std::string("the map stays in COLMAP's units and orientation: ") + e.what());
+      return;
+    }
+    result->scale_failure = e.what();
+    ScaleRequest estimate;
+    estimate.from = ScaleFrom::kCameraHeight;
+    try {
+      fit = FitRequested(result->map, estimate, images, options, cb);
+    } catch (const map::MapError&) {
+      return;
+    }
+  }
+  options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+  TransformColmapModel(colmap, result->model_dir, fit->to_metric);
+  ApplyMetricFit(*fit, &result->map);
+  ScaleCheckDistances(fit->to_metric.scale, &result->check);
+}
+
 // check.json, the keyframes, the top view, and the map file last: a disk that fills at an
 // earlier file fails the command without a new map.arvmap beside the error (each file is
 // written atomically; a previous map stays whole).
@@ -826,9 +929,33 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     WriteMapCheck(result.check, out_dir / kMapCheckFileName);
     throw map::MapError(FoldRefusal(out_dir, result));
   }
+  MakeMetric(colmap, KeyframeImagesIn(result.map, {images.root}), options, cb, &result);
   WriteMapFolder(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
+}
+
+map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* recording, const ScaleRequest& request,
+                        const MapBuildOptions& options, const MapBuildCallbacks& cb) {
+  MapBuildResult result;
+  result.map = map::LoadMap(map_dir);
+  int models = 0;
+  result.model_dir = LargestModel(map_dir / "sparse", &models, {});
+  if (result.model_dir.empty())
+    throw map::MapError((map_dir / "sparse").string() + ": no COLMAP model (the folder arview map wrote keeps it)");
+  const std::optional<MapCheck> check = ReadMapCheck(map_dir / kMapCheckFileName);
+  if (check) result.check = *check;
+  std::vector<fs::path> roots{map_dir / "images", map_dir};
+  if (recording) roots.push_back(recording->root);
+  const MetricFit fit = FitRequested(result.map, request, KeyframeImagesIn(result.map, roots), options, cb);
+  ColmapRunner colmap(options, map_dir, cb);
+  options.cancel.ThrowIfCancelled("the map was not changed");
+  TransformColmapModel(colmap, result.model_dir, fit.to_metric);
+  ApplyMetricFit(fit, &result.map);
+  ScaleCheckDistances(fit.to_metric.scale, &result.check);
+  WriteMapFolder(result, map_dir, options, cb);
+  if (!check) RecheckMap(map_dir);  // a map from before the check: computed now, in metres
+  return std::move(result.map);
 }
 
 void WriteKeyframesTum(const map::Map& map, const fs::path& file) {

@@ -19,6 +19,7 @@
 #include "map/map.h"
 #include "mapping/frame_selection.h"
 #include "mapping/map_check.h"
+#include "mapping/metric_frame.h"
 #include "mapping/pair_matching.h"
 #include "recordings/recording.h"
 
@@ -46,6 +47,16 @@ constexpr auto EnumNames(MatchEngine) {
       {{MatchEngine::kAuto, "auto"}, {MatchEngine::kArview, "arview"}, {MatchEngine::kColmap, "colmap"}}};
 }
 MatchEngine ParseMatchEngine(const std::string& text);  // throws MapError
+
+// Where a map's metres and up come from (mapping/metric_frame.h).
+enum class ScaleFrom { kNone, kBoard, kKnownDistance, kCameraHeight };
+
+struct ScaleRequest {
+  ScaleFrom from = ScaleFrom::kNone;
+  BoardSpec board;                              // kBoard
+  std::vector<PointSighting> point_a, point_b;  // kKnownDistance: each end's pixels
+  double distance_m = 0;                        // kKnownDistance
+};
 
 struct MapBuildOptions {
   std::string frames_spec;  // recordings::ParseFrameSpec syntax; empty: every frame
@@ -84,6 +95,10 @@ struct MapBuildOptions {
   // keep_folded: then the least folded model is written, with the warning.
   int fold_retries = 2;
   bool keep_folded = false;
+  // The map made metric and upright before it is written (the COLMAP model too). A board that
+  // cannot be used falls back to the camera-height estimate, and MapBuildResult::scale_failure
+  // says why; with kCameraHeight, a map without a floor stays in COLMAP's frame (a note says so).
+  ScaleRequest scale;
 
   // `arview map --preset fast`: 850 features and one orientation per keypoint, fewer bundle
   // adjustments (chosen on templeRing: a third less CPU, about twice the tracking error).
@@ -136,6 +151,7 @@ struct MapBuildResult {
   std::filesystem::path model_dir;   // the one kept (the largest)
   MapCheck check;                    // what the map looks like as a whole (also in <out>/check.json)
   int fold_retries = 0;              // times the mapper ran again for a fold
+  std::string scale_failure;         // why the requested scale source could not be used; empty: it was
 };
 
 // Runs everything and writes the map directory. Throws MapError (or ColmapStageError,
@@ -148,6 +164,15 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const std::files
 // from the COLMAP model and database kept there, and written to its check.json: for maps built
 // before a check existed, or after its limits changed. Throws MapError naming what is missing.
 MapCheck RecheckMap(const std::filesystem::path& map_dir);
+
+// `arview map scale`: a map folder that `arview map` wrote made metric and upright afterwards
+// (map.arvmap, the COLMAP model, keyframes.txt, map.png, check.json's distances), from a board
+// seen in its keyframes or a known distance. `recording` is where a still-image map's keyframe
+// images are (a video map keeps its own in <map-dir>/images; may be null then). Nothing is
+// changed when it fails (MapError says why). Returns the map as written.
+map::Map ScaleMapFolder(const std::filesystem::path& map_dir, const recordings::Recording* recording,
+                        const ScaleRequest& request, const MapBuildOptions& options,
+                        const MapBuildCallbacks& callbacks = {});
 
 // One line of COLMAP 3.8's output as progress (done, total), or nothing: "Processed file [i/N]",
 // "Matching image [i/N]", "Matching block [a/A, b/B]", "Registering image #id (n)" (n of

@@ -59,10 +59,14 @@ TEST(FitScaleAndShift, UndoesAScaleAndAShift) {
   for (std::size_t i = 0; i < old_centres.size(); ++i) EXPECT_LT((back(normalised[i]) - old_centres[i]).norm(), 1e-12);
 }
 
-TEST(CarryFrameRecord, TakesTheModelsCameraKeyframesPointsAndDescriptors) {
+TEST(CarryFrameRecord, TakesTheModelsCameraKeyframesPointsAndDescriptorsAndKeepsTheOldFrame) {
   map::Map old_map;
   old_map.camera = CameraOfSize(640, 480);
   old_map.keyframes.resize(2);
+  old_map.frame.scale_source = map::ScaleSource::kBoard;  // the old map's frame record
+  old_map.frame.z_up = true;
+  old_map.frame.how = "a 9x6 board of 25 mm squares";
+  old_map.frame.from_colmap.scale = 0.37;
   map::Map model;
   model.camera = CameraOfSize(640, 480);
   model.keyframes.resize(5);
@@ -75,6 +79,10 @@ TEST(CarryFrameRecord, TakesTheModelsCameraKeyframesPointsAndDescriptors) {
   EXPECT_EQ(extended.points.size(), 7u);
   EXPECT_EQ(extended.descriptors.rows, 3);
   EXPECT_EQ(extended.descriptor_keyframe, model.descriptor_keyframe);
+  EXPECT_EQ(extended.frame.scale_source, map::ScaleSource::kBoard);
+  EXPECT_TRUE(extended.frame.z_up);
+  EXPECT_EQ(extended.frame.how, old_map.frame.how);
+  EXPECT_EQ(extended.frame.from_colmap.scale, 0.37);
 }
 
 std::vector<map::Keyframe> FourKeyframes() {

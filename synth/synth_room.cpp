@@ -107,6 +107,15 @@ class SceneBuilder {
     render::AppendQuad(paint_, corners, Eigen::Vector4f(0, 0, 1, 1), colour);
   }
 
+  // A rectangle with a texture made here rather than read from a photo (the board).
+  void GeneratedPanel(const std::string& name, const cv::Mat& texture, const Eigen::Vector3d& center,
+                      const Eigen::Vector3d& right, const Eigen::Vector3d& up, double width, double height,
+                      const Eigen::Vector3f& shade) {
+    scene_.textures.push_back(texture);
+    loaded_[name] = static_cast<int>(scene_.textures.size()) - 1;
+    Panel(name.c_str(), center, right, up, width, height, shade);
+  }
+
   double Aspect(const char* image) {
     Texture(image);
     return aspect_.at(image);
@@ -209,6 +218,39 @@ void AddFloorAndCeiling(SceneBuilder& builder, SynthLighting light) {
   }
 }
 
+// The board's picture: (columns + 1) x (rows + 1) squares, black in the top-left corner, in a
+// white margin one square wide. Drawn 16 times larger and averaged down, so that a square's edge
+// that falls inside a texel shades it by the covered share (an exact edge position on average).
+cv::Mat BoardTexture(const FloorBoard& board) {
+  const int columns = board.inner_corners.width + 3, rows = board.inner_corners.height + 3;  // squares with margin
+  constexpr int kSide = 1024, kOversample = 16;
+  cv::Mat fine(kSide * kOversample / 2, kSide * kOversample / 2, CV_8UC3, cv::Scalar::all(255));
+  for (int y = 0; y < fine.rows; ++y) {
+    const int row = y * rows / fine.rows;
+    for (int x = 0; x < fine.cols; ++x) {
+      const int column = x * columns / fine.cols;
+      const bool inside = row > 0 && row < rows - 1 && column > 0 && column < columns - 1;
+      if (inside && (row + column) % 2 == 0) fine.at<cv::Vec3b>(y, x) = cv::Vec3b(20, 20, 20);
+    }
+  }
+  cv::Mat texture;
+  cv::resize(fine, texture, {kSide, kSide}, 0, 0, cv::INTER_AREA);
+  return texture;
+}
+
+// Above the floor's photos (which lie kPanelOffset above the paint), facing up.
+void AddFloorBoard(SceneBuilder& builder, const FloorBoard& board, SynthLighting light) {
+  if (board.empty()) return;
+  const Eigen::Vector3d along(std::cos(board.yaw), std::sin(board.yaw), 0);
+  const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(along);
+  // The texture's top row is the board's row 0: texture "up" points against the rows' order.
+  const Eigen::Vector3d center(board.centre.x(), board.centre.y(), 2 * kPanelOffset);
+  const float shade = light == SynthLighting::kWindow ? 0.6f : 0.95f;
+  builder.GeneratedPanel("generated chessboard", BoardTexture(board), center, along, -across,
+                         (board.inner_corners.width + 3) * board.square, (board.inner_corners.height + 3) * board.square,
+                         Eigen::Vector3f::Constant(shade));
+}
+
 void AddBoxes(SceneBuilder& builder) {
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d light = Eigen::Vector3d(0.5, 0.3, 0).normalized();
@@ -242,10 +284,23 @@ double SmootherStep(double s) {
 
 }  // namespace
 
-RoomScene MakeRoomScene(const fs::path& data_dir, SynthLighting light) {
+std::vector<Eigen::Vector3d> FloorBoard::Corners() const {
+  const Eigen::Vector3d along(std::cos(yaw), std::sin(yaw), 0);
+  const Eigen::Vector3d across = Eigen::Vector3d::UnitZ().cross(along);
+  const Eigen::Vector3d first = Eigen::Vector3d(centre.x(), centre.y(), 2 * kPanelOffset) -
+                                along * square * (inner_corners.width - 1) / 2 + across * square * (inner_corners.height - 1) / 2;
+  std::vector<Eigen::Vector3d> corners;
+  for (int row = 0; row < inner_corners.height; ++row)
+    for (int column = 0; column < inner_corners.width; ++column)
+      corners.push_back(first + along * square * column - across * square * row);
+  return corners;
+}
+
+RoomScene MakeRoomScene(const fs::path& data_dir, SynthLighting light, const FloorBoard& board) {
   SceneBuilder builder(data_dir);
   AddWalls(builder, light);
   AddFloorAndCeiling(builder, light);
+  AddFloorBoard(builder, board, light);
   AddBoxes(builder);
   return builder.Finish();
 }
@@ -324,6 +379,12 @@ void ValidateOptions(const SynthRoomOptions& o) {
   if (!(o.gain_drift >= 0 && o.gain_drift < 1)) fail("--gain-drift must be in [0, 1)");
   if (!(o.rolling_shutter_s >= 0 && o.rolling_shutter_s <= 1.0 / o.fps))
     fail("--rolling-shutter must be in [0, 1/fps] seconds");
+  if (!o.board.empty()) {
+    if (!(o.board.square > 0 && o.board.square <= 1)) fail("--square must be in (0, 1] metres");
+    const double reach = 0.5 * o.board.square * std::hypot(o.board.inner_corners.width + 3, o.board.inner_corners.height + 3);
+    if (std::abs(o.board.centre.x()) + reach > kHalfX || std::abs(o.board.centre.y()) + reach > kHalfY)
+      fail("the board does not fit on the floor there (the room is 7 x 5 m, centred on 0,0)");
+  }
 }
 
 // The walk's frames to render, in order: every one, or the --subset's.
@@ -401,12 +462,22 @@ void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
   noisy.convertTo(image, CV_8UC3);  // saturating
 }
 
+// The board in the ground truth's header: whoever reads the recording learns its size and place.
+std::string BoardText(const FloorBoard& board) {
+  if (board.empty()) return "";
+  char text[160];
+  std::snprintf(text, sizeof text, ", chessboard %dx%d of %.4g m squares on the floor at (%.3f, %.3f), yaw %.1f deg",
+                board.inner_corners.width, board.inner_corners.height, board.square, board.centre.x(), board.centre.y(),
+                board.yaw * 180 / M_PI);
+  return text;
+}
+
 }  // namespace
 
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
   ValidateOptions(o);
   const std::vector<int> indices = FramesToRender(o);
-  const RoomScene scene = MakeRoomScene(o.data_dir, o.light);
+  const RoomScene scene = MakeRoomScene(o.data_dir, o.light, o.board);
   std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.gl);
   PrepareFolder(o);
   const calib::Camera camera = RoomCamera(o.width, o.height);
@@ -454,7 +525,7 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   recordings::WriteFramesTxt(o.out, entries);
   recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
                        "arview synth room, seed " + std::to_string(o.seed) + (o.light == SynthLighting::kWindow ? ", window light" : "") +
-                           ", world: metres, z up, floor z = 0");
+                           BoardText(o.board) + ", world: metres, z up, floor z = 0");
   return {context->Description(), static_cast<int>(indices.size())};
 }
 

@@ -50,8 +50,25 @@ struct RoomScene {
 //            to the window.
 enum class SynthLighting { kEven, kWindow };
 
+// A printed chessboard lying flat on the floor (`arview synth room --board 9x6 --square 0.1`),
+// black and white squares with a white margin one square wide, for maps made metric and upright
+// from a board (`arview map --board`, docs/mapping.md "Metric scale and up"). Its corners are
+// exact: the board is part of the room's geometry.
+struct FloorBoard {
+  cv::Size inner_corners{0, 0};        // inner corners per row and per column; 0x0: no board
+  double square = 0.1;                 // metres
+  Eigen::Vector2d centre{0, 0};        // the board's centre on the floor
+  double yaw = 0;                      // radians: its rows run along (cos yaw, sin yaw)
+
+  bool empty() const { return inner_corners.width <= 0 || inner_corners.height <= 0; }
+  // The inner corners in the world, row after row (x along a row): the order of OpenCV's
+  // findChessboardCorners up to the board's symmetries (which corner it starts from).
+  std::vector<Eigen::Vector3d> Corners() const;
+};
+
 // Loads the photos from `data_dir`; throws RenderError naming a missing or unreadable file.
-RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData, SynthLighting light = SynthLighting::kEven);
+RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData, SynthLighting light = SynthLighting::kEven,
+                        const FloorBoard& board = {});
 
 // The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
 // Other sizes keep the horizontal field of view (f and the principal point offset scale with
@@ -81,6 +98,7 @@ struct SynthRoomOptions {
   RoomWalk walk = RoomWalk::kRoom;
   SynthLighting light = SynthLighting::kEven;
   OrbitWalkOptions orbit;        // for RoomWalk::kOrbit
+  FloorBoard board;              // none by default
   int frames = 300;
   uint64_t seed = 1;
   double fps = 30.0;

@@ -1,7 +1,8 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
-//            [--fold-retries N] [--keep-folded]
+//            [--fold-retries N] [--keep-folded] [--board CxR --square M [--board-off-floor] | --no-metric]
 // arview map info <map-dir>
+// arview map scale <map-dir> [<recording>] (--board CxR --square M [--board-off-floor] | --distance M --from .. --to ..)
 
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 
 #include "app/cli/commands.h"
 #include "app/cli/map_console.h"
+#include "app/cli/numeric_flags.h"
 #include "base/cancellation.h"
 #include "base/process.h"
 #include "map/map_file.h"
@@ -26,6 +28,8 @@ namespace arview::app {
 namespace {
 
 namespace fs = std::filesystem;
+
+using mapping::Fixed;
 
 struct MapArgs {
   std::string recording;
@@ -43,9 +47,50 @@ struct MapArgs {
   bool keep_folded = false;
   std::string info_dir;
   bool info_recheck = false;
+  // Metres and up (mapping/metric_frame.h).
+  std::string board;                 // inner corners, e.g. 9x6
+  double square = 0;                 // metres
+  bool board_off_floor = false;
+  bool no_metric = false;
+  std::string scale_dir, scale_recording;
+  double distance = 0;
+  std::vector<std::string> from, to;  // NAME@X,Y each
 };
 
-using mapping::Fixed;
+mapping::BoardSpec BoardOf(const MapArgs& args) {
+  if (args.square <= 0) throw CommandError("--board needs --square, the side of one of its squares in metres", 2);
+  mapping::BoardSpec spec;
+  spec.inner_corners = *ParseFrameSize(args.board);  // checked by --board's validator
+  spec.square = args.square;
+  spec.on_floor = !args.board_off_floor;
+  return spec;
+}
+
+// "000012.png@312.5,220" → the keyframe's name and the pixel.
+std::vector<mapping::PointSighting> ParseSightings(const std::vector<std::string>& texts, const char* flag) {
+  std::vector<mapping::PointSighting> sightings;
+  for (const std::string& text : texts) {
+    const size_t at = text.rfind('@');
+    double x = 0, y = 0;
+    char tail = 0;
+    if (at == std::string::npos || at == 0 || std::sscanf(text.c_str() + at + 1, "%lf,%lf%c", &x, &y, &tail) != 2 ||
+        !std::isfinite(x) || !std::isfinite(y)) {
+      throw CommandError(std::string(flag) + " '" + text + "' must be KEYFRAME@X,Y, e.g. 000012.png@312.5,220", 2);
+    }
+    sightings.push_back({text.substr(0, at), {x, y}});
+  }
+  if (sightings.size() < 2) throw CommandError(std::string(flag) + " needs the point's pixel in at least two keyframes", 2);
+  return sightings;
+}
+
+// What `map info` and the end of `map` and `map scale` say about the frame.
+std::string DescribeFrame(const map::MapFrame& f) {
+  if (!f.metric()) return "COLMAP's own (arbitrary units, no up): 'arview map scale' makes it metric";
+  std::string text = std::string("metres, +z up, from ") + map::ToString(f.scale_source) + " (likely scale error " +
+                     Fixed(100 * f.scale_error, f.scale_error < 0.01 ? 2 : 1) + "%): " + f.how;
+  return text;
+}
+
 
 void RunMap(const MapArgs& args) {
   if (args.recording.empty()) throw CommandError("map: the recording folder is required (arview map <recording> --out <map-dir>)", 2);
@@ -60,6 +105,13 @@ void RunMap(const MapArgs& args) {
   if (args.max_features > 0) options.max_num_features = args.max_features;
   options.fold_retries = args.fold_retries;
   options.keep_folded = args.keep_folded;
+  if (!args.board.empty()) {
+    if (args.no_metric) throw CommandError("map: --board and --no-metric exclude each other", 2);
+    options.scale.from = mapping::ScaleFrom::kBoard;
+    options.scale.board = BoardOf(args);
+  } else if (!args.no_metric) {
+    options.scale.from = mapping::ScaleFrom::kCameraHeight;
+  }
   const ScopedSignalCancellation signals;
   options.cancel = signals.token();
   ProgressBar bar;
@@ -82,8 +134,16 @@ void RunMap(const MapArgs& args) {
     }
     std::cout << " (total " << Fixed(total, 1) << " s)\n";
     std::cout << "check: " << mapping::DescribeMapCheck(result.check) << "\n";
+    std::cout << "frame: " << DescribeFrame(result.map.frame) << "\n";
     std::cout << "wrote " << args.out << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
               << ", keyframes.txt, map.png, database.db}, COLMAP model " << result.model_dir.string() << "\n";
+    if (!result.scale_failure.empty()) {
+      throw CommandError("the map was written, but not made metric from the board: " + result.scale_failure +
+                         ". Its scale is " + (result.map.frame.metric() ? "the camera-height estimate" : "COLMAP's") +
+                         "; 'arview map scale " + args.out + " ...' sets it once the board is usable");
+    }
+  } catch (const CommandError&) {
+    throw;
   } catch (const mapping::ColmapStageError& e) {
     bar.Finish();
     std::cerr << "last lines of COLMAP's output (" << e.log.string() << "):\n";
@@ -96,6 +156,50 @@ void RunMap(const MapArgs& args) {
     throw CommandError(e.what());
   } catch (const map::MapError& e) {
     throw CommandError(e.what());
+  } catch (const recordings::RecordingError& e) {
+    throw CommandError(e.what());
+  }
+}
+
+void RunScale(const MapArgs& args) {
+  mapping::ScaleRequest request;
+  if (!args.board.empty()) {
+    if (args.distance > 0) throw CommandError("map scale: give --board or --distance, not both", 2);
+    request.from = mapping::ScaleFrom::kBoard;
+    request.board = BoardOf(args);
+  } else if (args.distance > 0) {
+    request.from = mapping::ScaleFrom::kKnownDistance;
+    request.distance_m = args.distance;
+    request.point_a = ParseSightings(args.from, "--from");
+    request.point_b = ParseSightings(args.to, "--to");
+  } else {
+    throw CommandError("map scale: say where the scale comes from: --board CxR --square M, or --distance M --from "
+                       "KEYFRAME@X,Y KEYFRAME@X,Y --to KEYFRAME@X,Y KEYFRAME@X,Y",
+                       2);
+  }
+  mapping::MapBuildOptions options;
+  options.colmap = args.colmap;
+  const ScopedSignalCancellation signals;
+  options.cancel = signals.token();
+  ProgressBar bar;
+  mapping::MapBuildCallbacks callbacks;
+  callbacks.progress = [&](const std::string& stage, int done, int total) {
+    if (!signals.token().IsCancelled()) bar.Update(stage, done, total);
+  };
+  try {
+    std::optional<recordings::Recording> recording;
+    if (!args.scale_recording.empty()) recording = recordings::LoadRecording(args.scale_recording);
+    const map::Map map = mapping::ScaleMapFolder(args.scale_dir, recording ? &*recording : nullptr, request, options, callbacks);
+    bar.Finish();
+    std::cout << "frame: " << DescribeFrame(map.frame) << "\n"
+              << "rewrote " << args.scale_dir << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
+              << ", keyframes.txt, map.png} and the COLMAP model in metres\n";
+  } catch (const mapping::ColmapStageError& e) {
+    throw CommandError(e.what());
+  } catch (const ProcessError& e) {
+    throw CommandError(e.what());
+  } catch (const map::MapError& e) {
+    throw CommandError(args.scale_dir + ": " + e.what() + " (the map was not changed)");
   } catch (const recordings::RecordingError& e) {
     throw CommandError(e.what());
   }
@@ -141,6 +245,7 @@ void RunInfo(const std::string& dir, bool recheck) {
               << "descriptors:         " << s.descriptors << " (128 x uint8, "
               << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
               << "load time:           " << Fixed(load_ms, 1) << " ms\n";
+    std::cout << "frame:               " << DescribeFrame(map.frame) << "\n";
     const fs::path folder = fs::is_directory(dir, ec) ? fs::path(dir) : fs::path(dir).parent_path();
     if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
       std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
@@ -206,9 +311,39 @@ void AddMapCommand(CLI::App& app) {
                  "Run the map's self-check again from the COLMAP model and database in its folder and rewrite "
                  "check.json (maps built before a check existed)");
   info->callback([args] { RunInfo(args->info_dir, args->info_recheck); });
+
+  const auto add_board = [args](CLI::App* c, const std::string& what) {
+    c->add_option("--board", args->board,
+                  "A printed chessboard seen in the frames, its inner corners COLUMNSxROWS (e.g. 9x6 for 10 x 7 "
+                  "squares): " + what)
+        ->check(BoardSizeCheck());
+    c->add_option("--square", args->square, "The board's square side, metres (with --board)")->check(CLI::Range(1e-4, 10.0));
+    c->add_flag("--board-off-floor", args->board_off_floor,
+                "The board is not lying on the floor (on a wall, a table's edge): it gives the scale only, up comes "
+                "from the floor");
+  };
+  add_board(cmd, "the map is made metric from it, with up from its normal when it lies on the floor");
+  cmd->add_flag("--no-metric", args->no_metric,
+                "Keep COLMAP's arbitrary units and orientation (by default a map without --board is scaled by the "
+                "estimate of a 1.45 m camera height over the floor, and stood upright on the floor)");
+  auto* scale = cmd->add_subcommand(
+      "scale", "Make a map metric and upright afterwards: from a board seen in its keyframes, or a known distance");
+  scale->add_option("map-dir", args->scale_dir, "Map directory")->required();
+  scale->add_option("recording", args->scale_recording,
+                    "The recording the map was built from (a still-image map's keyframe images are its frames; a "
+                    "video map keeps its own)");
+  add_board(scale, "the map is made metric from it");
+  scale->add_option("--distance", args->distance, "Metres between the two points given by --from and --to")
+      ->check(CLI::Range(1e-4, 1e4));
+  scale->add_option("--from", args->from, "One end: KEYFRAME@X,Y in two or more keyframes (names as in keyframes.txt "
+                                          "or images/), e.g. 000012.png@312.5,220 000040.png@280,231")
+      ->expected(2, 16);
+  scale->add_option("--to", args->to, "The other end, the same way")->expected(2, 16);
+  scale->add_option("--colmap", args->colmap, "The COLMAP executable")->capture_default_str();
+  scale->callback([args] { RunScale(*args); });
   AddMapExtendCommand(*cmd);
   cmd->callback([args, cmd] {
-    if (!cmd->get_subcommands().empty()) return;  // `map info`, `map extend`: their own callbacks ran
+    if (!cmd->get_subcommands().empty()) return;  // `map info`, `map scale`, `map extend`: their own callbacks ran
     RunMap(*args);
   });
 }

@@ -18,6 +18,7 @@ struct PlaceArgs {
   std::string out;
   PlaceCharacterOptions options;
   std::optional<double> elevation;
+  std::optional<double> height;
   std::string recording;  // where still keyframe images are (video maps keep theirs in <map>/images)
   bool no_light = false;
 };
@@ -47,9 +48,10 @@ void AddPlaceCommand(CLI::App& app) {
   cmd->add_option("--keys", a->options.keys, "Look-at key animations generated around the character")
       ->capture_default_str()
       ->check(CLI::Range(2, 64));
-  cmd->add_option("--height", a->options.height_fraction,
-                  "Character height as a fraction of the median camera distance to it")
-      ->capture_default_str()
+  cmd->add_option("--height", a->height,
+                  "Character height: metres on a metric map (default: the asset's own height when it is 0.1-2.5, "
+                  "glTF's metres, else 1.7), on a map without scale a fraction of the median camera distance to it "
+                  "(default 0.3); 'arview map info' says which the map is")
       ->check(CLI::Range(0.001, 10.0));
   cmd->add_option("--base-clip", a->options.base_clip,
                   "Clip the look-at keys are built on, or 'rest' for the rest pose (default: the first clip)");
@@ -64,6 +66,11 @@ void AddPlaceCommand(CLI::App& app) {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
     RequireBaseClip(a->character, a->options.base_clip);
     const map::Map map = map::LoadMap(a->map_dir);
+    if (map.frame.metric()) {
+      a->options.height_m = a->height;
+    } else if (a->height) {
+      a->options.height_fraction = *a->height;
+    }
     // Said of the map folder: the plane fit alone said "no floor-like plane ... holds 3 or more
     // of the map's points" of a map whose points were all at one spot.
     if (const auto why = map::DegeneratePoints(map)) {
@@ -83,6 +90,14 @@ void AddPlaceCommand(CLI::App& app) {
     std::printf("placed %s at (%.4f, %.4f, %.4f), up (%.3f, %.3f, %.3f), scale %.5g (rest height %.4g units)\n",
                 placed.name.c_str(), anchor.position.x(), anchor.position.y(), anchor.position.z(),
                 up.x(), up.y(), up.z(), anchor.scale, placed.rest_height);
+    if (map.frame.metric()) {
+      std::printf("%.2f m tall (the map is in metres, from %s%s)\n", anchor.scale * placed.rest_height,
+                  map::ToString(map.frame.scale_source),
+                  map.frame.scale_source == map::ScaleSource::kCameraHeight ? ": an estimate" : "");
+    } else {
+      std::printf("%.3g of the median camera distance tall (the map has no scale: 'arview map scale' gives it one)\n",
+                  a->options.height_fraction);
+    }
     std::printf("wrote %s with %d look-at keys at %.1f deg elevation\n", a->out.c_str(), placed.key_count,
                 placed.key_elevation_deg);
     if (!a->no_light) WritePlacedLight(map, a->map_dir, a->recording, placed, a->out);

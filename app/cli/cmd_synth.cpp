@@ -19,8 +19,27 @@ struct SynthArgs {
   std::string data_dir = synth::kOpenCvDocData;
   GlFlags gl{2};
   std::string size = "640x480";
+  std::string board;                     // inner corners, e.g. 9x6; empty: no board
+  std::vector<double> board_at;          // x, y on the floor; empty: the walk's centre
+  double board_yaw_deg = 0;
   bool quiet = false;
 };
+
+// The board lies where the walk looks: round the demo's character spot on an orbit walk, in the
+// middle of the room on the room walk.
+void SetUpBoard(SynthArgs& args) {
+  synth::SynthRoomOptions& o = args.options;
+  if (args.board.empty()) return;
+  o.board.inner_corners = *ParseFrameSize(args.board);  // checked by --board's validator
+  o.board.yaw = args.board_yaw_deg * M_PI / 180;
+  if (args.board_at.size() == 2) {
+    o.board.centre = {args.board_at[0], args.board_at[1]};
+  } else {
+    // Beside the spot rather than under the character, where the first lap sees the whole board.
+    o.board.centre = o.walk == synth::RoomWalk::kOrbit ? Eigen::Vector2d(o.orbit.subject + Eigen::Vector2d(1.1, 0))
+                                                       : Eigen::Vector2d::Zero();
+  }
+}
 
 void RunSynthRoom(SynthArgs& args) {
   synth::SynthRoomOptions& o = args.options;
@@ -29,6 +48,7 @@ void RunSynthRoom(SynthArgs& args) {
   const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
   o.width = size.width;
   o.height = size.height;
+  SetUpBoard(args);
   const auto start = std::chrono::steady_clock::now();
   try {
     o.gl = ToOffscreenOptions(args.gl);
@@ -91,6 +111,22 @@ void AddSynthCommand(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(std::map<std::string, synth::SynthLighting>{{"even", synth::SynthLighting::kEven},
                                                                                     {"window", synth::SynthLighting::kWindow}}))
       ->default_str("even");
+  room->add_option("--board", args->board,
+                   "Lay a printed chessboard flat on the floor: its inner corners, COLUMNSxROWS (e.g. 9x6), for a map "
+                   "made metric and upright with 'arview map --board'")
+      ->check(BoardSizeCheck());
+  room->add_option("--square", o.board.square, "The board's square side, metres")
+      ->default_val(o.board.square)
+      ->check(CLI::Range(0.005, 1.0));
+  room->add_option("--board-at", args->board_at,
+                   "The board's centre on the floor, X,Y in metres (default: 1.1 m beside the orbit's character spot, or the "
+                   "room's centre)")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::Range(-3.0, 3.0));
+  room->add_option("--board-yaw", args->board_yaw_deg, "The board's turn about the vertical, degrees")
+      ->default_val(args->board_yaw_deg)
+      ->check(CLI::Range(-360.0, 360.0));
   room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
   room->add_flag("--quiet", args->quiet, "No progress on stderr");
   room->callback([args] { RunSynthRoom(*args); });

@@ -99,4 +99,14 @@ CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest) {
   return CLI::Validator(check, "WIDTHxHEIGHT");
 }
 
+CLI::Validator BoardSizeCheck() {
+  auto check = [](std::string& text) -> std::string {
+    const std::optional<cv::Size> size = ParseFrameSize(text);
+    if (!size || size->width < 2 || size->height < 2 || size->width > 99 || size->height > 99)
+      return "'" + text + "' must be the board's inner corners COLUMNSxROWS, each 2..99, e.g. 9x6";
+    return "";
+  };
+  return CLI::Validator(check, "COLUMNSxROWS");
+}
+
 }  // namespace arview::app

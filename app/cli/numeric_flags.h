@@ -25,4 +25,8 @@ std::optional<cv::Size> ParseFrameSize(const std::string& text);
 // CLI11 reports its message as "--size: ..." with the usage exit status.
 CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest);
 
+// A chessboard's inner corners written COLUMNSxROWS (as --size), each 2..99: --board's check on
+// `synth room` and `map`.
+CLI::Validator BoardSizeCheck();
+
 }  // namespace arview::app

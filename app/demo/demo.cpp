@@ -36,14 +36,27 @@ namespace fs = std::filesystem;
 constexpr int kSteps = 7;
 void Step(int n, const std::string& what) { std::printf("\n[%d/%d] %s\n", n, kSteps, what.c_str()); std::fflush(stdout); }
 
-// A recording already in `dir` is reused only when it is this walk: the window-lit room (its
-// ground truth's header says so; earlier demos rendered the evenly lit one), same frame count
+// The printed chessboard on the floor beside the character's spot, from which the map takes its
+// metres and its up (`arview map --board`): 9x6 inner corners of 8 cm squares (0.96 x 0.72 m
+// with its margin), 1.1 m along +x from the spot, where the first lap sees it whole.
+synth::FloorBoard DemoBoard(const synth::OrbitWalkOptions& orbit) {
+  synth::FloorBoard board;
+  board.inner_corners = {9, 6};
+  board.square = 0.08;
+  board.centre = orbit.subject + Eigen::Vector2d(1.1, 0);
+  return board;
+}
+constexpr const char* kBoardInHeader = "chessboard 9x6 of 0.08 m squares";
+
+// A recording already in `dir` is reused only when it is this walk: the window-lit room with the
+// board (its ground truth's header says so; earlier demos rendered other rooms), same frame count
 // and the same ground-truth poses (checked on a few frames), so a changed walk is never
 // replayed stale.
 bool HoldsWalk(const recordings::Recording& r, int frames, const synth::OrbitWalk& walk, double fps, cv::Size size) {
   if (r.camera.Size() != size) return false;
   const std::string groundtruth = ReadFileUpTo(r.root / "groundtruth.txt", 1 << 20);
-  if (groundtruth.substr(0, groundtruth.find('\n')).find("window light") == std::string::npos) return false;
+  const std::string header = groundtruth.substr(0, groundtruth.find('\n'));
+  if (header.find("window light") == std::string::npos || header.find(kBoardInHeader) == std::string::npos) return false;
   if (static_cast<int>(r.frames.size()) != frames || !r.groundtruth || static_cast<int>(r.groundtruth->size()) != frames) return false;
   for (int i : {0, frames / 3, frames / 2, frames - 1}) {
     const calib::Pose expected = walk.At(i / fps);
@@ -76,6 +89,7 @@ recordings::Recording RenderWalk(const fs::path& dir, int frames, std::uint64_t 
   o.walk = synth::RoomWalk::kOrbit;
   // Daylight through a window: a light the mapped lap sees, so the character casts a shadow.
   o.light = synth::SynthLighting::kWindow;
+  o.board = DemoBoard(o.orbit);
   o.overwrite = true;
   o.gl = gl;  // Mesa reads the thread count once per process: the same as for the replay
   Progress progress("  rendering");
@@ -121,9 +135,9 @@ recordings::Recording WithUncompressedFrames(const recordings::Recording& walk, 
 
 // The character's anchor in the map: standing on the walk's spot (room coordinates), upright,
 // facing `facing_azimuth` (radians, room frame), `height` metres tall; `to_room` maps the map
-// into the room.
+// into the room (where the spot is), `map_units_per_metre` says how tall that is in the map.
 Anchor AnchorInMap(const recordings::Sim3& to_room, const Eigen::Vector3d& spot, double facing_azimuth, double height,
-                   double asset_height) {
+                   double asset_height, double map_units_per_metre) {
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), forward(std::cos(facing_azimuth), std::sin(facing_azimuth), 0);
   Eigen::Matrix3d in_room;  // character frame (glTF: +X left, +Y up, +Z forward) → room
   in_room << up.cross(forward), up, forward;
@@ -131,7 +145,7 @@ Anchor AnchorInMap(const recordings::Sim3& to_room, const Eigen::Vector3d& spot,
   Anchor a;
   a.position = to_map(spot);
   a.rotation = to_map.R * in_room;
-  a.scale = height / asset_height * to_map.scale;
+  a.scale = height / asset_height * map_units_per_metre;
   return a;
 }
 
@@ -184,6 +198,10 @@ mapping::MapBuildResult MapFirstLap(const recordings::Recording& walk, int half,
   // A rendered room at 640x480 has plenty of texture: 2048 features a frame map it, and keep
   // COLMAP's matching (quadratic in the feature count) to seconds.
   map_options.max_num_features = 2048;
+  // Metres and up from the board on the floor, as a user with a printed board would map a room.
+  const synth::FloorBoard board = DemoBoard(synth::OrbitWalkOptions{});
+  map_options.scale.from = mapping::ScaleFrom::kBoard;
+  map_options.scale.board = {board.inner_corners, board.square, true};
   map_options.cancel = cancel;
   Progress map_progress("  colmap");
   std::string stage_shown;
@@ -204,6 +222,9 @@ mapping::MapBuildResult MapFirstLap(const recordings::Recording& walk, int half,
   for (const auto& t : built.timings) map_seconds += t.seconds;
   std::printf("  %zu of %zu frames registered, %zu points, %.1f s\n", built.map.keyframes.size(),
               built.selected_frames.size(), built.map.points.size(), map_seconds);
+  if (!built.scale_failure.empty()) std::printf("  warning: the board gave no scale: %s\n", built.scale_failure.c_str());
+  std::printf("  frame: %s (%s)\n", built.map.frame.metric() ? "metres, +z up" : "COLMAP's, no scale",
+              built.map.frame.how.c_str());
   return built;
 }
 
@@ -212,7 +233,23 @@ mapping::MapBuildResult MapFirstLap(const recordings::Recording& walk, int half,
 recordings::Sim3 MapToRoom(const map::Map& map, const recordings::Recording& walk) {
   recordings::Trajectory keyframes;
   for (const auto& k : map.keyframes) keyframes.push_back({k.timestamp, k.pose});
-  return recordings::FitAlignment(keyframes, *walk.groundtruth, recordings::AlignMode::kSim3, 1e-3);
+  const recordings::Sim3 to_room = recordings::FitAlignment(keyframes, *walk.groundtruth, recordings::AlignMode::kSim3, 1e-3);
+  // How right the map's own metres and up are: against the room's exact ones (a metric map's
+  // alignment has scale 1 and keeps +z).
+  if (map.frame.metric()) {
+    const double up_error = std::acos(std::clamp((to_room.R * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0)) * 180 / M_PI;
+    std::printf("  the map's metres against the room's exact ones: scale %.4f (%.2f%% off), up %.2f deg off\n",
+                to_room.scale, 100 * std::abs(to_room.scale - 1), up_error);
+  }
+  return to_room;
+}
+
+// Map units per metre: 1 on a metric map (its own scale); otherwise the exact ground truth's,
+// which only a rendered room has, said so.
+double MapUnitsPerMetre(const map::Map& map, const recordings::Sim3& to_room) {
+  if (map.frame.metric()) return 1.0;
+  std::printf("  note: the map has no scale of its own; the character is sized from the room's exact ground truth\n");
+  return to_room.Inverse().scale;
 }
 
 // Step 4: the character stood on the walk's spot, its scene file and its light written.
@@ -232,10 +269,12 @@ DemoCharacter PlaceDemoCharacter(const DemoOptions& o, const map::Map& map, cons
   // floor, so its keys are built on the rest pose; other assets use their first clip.
   if (c.asset.FindClip("Idle")) place_options.base_clip = "Idle";
   else if (o.character.find("BCN_Epileptic") != std::string::npos) place_options.base_clip = "rest";
-  place_options.anchor = AnchorInMap(to_room, orbit.Subject(), orbit.CloseApproachAzimuth(), o.height, asset_height);
+  const double map_units_per_metre = MapUnitsPerMetre(map, to_room);
+  place_options.anchor =
+      AnchorInMap(to_room, orbit.Subject(), orbit.CloseApproachAzimuth(), o.height, asset_height, map_units_per_metre);
   c.placed = PlaceCharacter(map, o.character, place_options);
   c.placed.comment = "arview demo: " + c.placed.asset.filename().string() + " where the demo's walk circles";
-  c.placed.behaviour = DemoBehaviour(c.asset, o.greet_within * to_room.Inverse().scale);
+  c.placed.behaviour = DemoBehaviour(c.asset, o.greet_within * map_units_per_metre);
   WriteSceneFile(c.placed, c.scene);
   // The room's light at the character, from the map's keyframe images (room/room_light.h):
   // SH lighting with per-vertex PRT and the cast shadow in the replay.

@@ -9,6 +9,12 @@
 
 namespace arview::app {
 
+double MetricHeight(const PlaceCharacterOptions& o, double asset_height) {
+  if (o.height_m) return *o.height_m;
+  const bool plausible = asset_height >= kPlausibleAssetHeightMetres[0] && asset_height <= kPlausibleAssetHeightMetres[1];
+  return plausible ? asset_height : kDefaultHeightMetres;
+}
+
 ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& asset_path,
                                const PlaceCharacterOptions& o) {
   // A built-in asset ("builtin:figure") is a name, not a file.
@@ -41,6 +47,8 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
                                             : asset.stem().string();
   placed.asset = asset;
   placed.anchor = o.anchor ? *o.anchor : PlaceOnDominantPlane(points, centres, up_axes, height, options);
+  // A metric map says how tall in metres; otherwise the fraction of the viewing distance stands.
+  if (!o.anchor && map.frame.metric()) placed.anchor.scale = MetricHeight(o, height) / height;
   placed.rest_height = height;
   // Keys on the ring the viewers actually occupy: at the median elevation of the map's cameras
   // seen from the character's eyes (a character on a table is looked at from above; a tall one

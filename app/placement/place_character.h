@@ -12,9 +12,19 @@
 
 namespace arview::app {
 
+// A character's height on a metric map when neither the user nor the asset says one: a person's.
+inline constexpr double kDefaultHeightMetres = 1.7;
+// An asset this tall or shorter, in its own units, is taken to be in metres (glTF's unit).
+inline constexpr double kPlausibleAssetHeightMetres[2] = {0.1, 2.5};
+
 struct PlaceCharacterOptions {
   int keys = 8;
-  double height_fraction = 0.3;  // of the median camera distance to the anchor
+  // The character's height. On a metric map (map.frame.metric()): `height_m` metres, and unset,
+  // the asset's own height when it is a plausible one in metres (glTF's unit) or else
+  // kDefaultHeightMetres. On a map without scale: `height_fraction` of the median camera
+  // distance to the anchor.
+  std::optional<double> height_m;
+  double height_fraction = 0.3;
   std::string base_clip;         // empty: the asset's first clip; "rest": the rest pose
   std::optional<double> key_elevation_deg;  // empty: the median elevation of the map's cameras
   std::uint64_t seed = 1;
@@ -23,6 +33,9 @@ struct PlaceCharacterOptions {
   // map's cameras.
   std::optional<Anchor> anchor;
 };
+
+// The height in metres a character of `asset_height` (its own units) gets on a metric map.
+double MetricHeight(const PlaceCharacterOptions& options, double asset_height);
 
 ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& asset,
                                const PlaceCharacterOptions& options);

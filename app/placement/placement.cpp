@@ -6,27 +6,6 @@
 
 namespace arview::app {
 
-Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const std::vector<Eigen::Vector3d>& up_axes) {
-  Eigen::Vector3d mean_up = Eigen::Vector3d::Zero();
-  for (const auto& u : up_axes) mean_up += u.normalized();
-  Eigen::Vector3d up = mean_up;
-  if (centres.size() >= 3) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const auto& c : centres) mean += c;
-    mean /= centres.size();
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const auto& c : centres) cov += (c - mean) * (c - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    // A plane of centres: the two larger spreads are comparable, the third much smaller.
-    if (eig.eigenvalues()(1) > 0.05 * eig.eigenvalues()(2) && eig.eigenvalues()(0) < 0.3 * eig.eigenvalues()(1)) {
-      up = eig.eigenvectors().col(0);
-      if (up.dot(mean_up) < 0) up = -up;
-    }
-  }
-  if (up.norm() < 1e-9) throw PlacementError("cannot tell which way is up from the map's cameras");
-  return up.normalized();
-}
-
 Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_centres,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
@@ -34,7 +13,13 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
   if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
   PlaneFitOptions plane_options = o.plane;
-  if (!plane_options.up_prior) plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
+  if (!plane_options.up_prior) {
+    try {
+      plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
+    } catch (const Error& e) {
+      throw PlacementError(e.what());
+    }
+  }
   Plane plane = [&] {
     try {
       return FitDominantPlane(points, plane_options);

@@ -26,12 +26,7 @@ struct PlacementOptions {
   double height_fraction = 0.3;
 };
 
-// Which way is up, from the cameras: people film a scene walking around it or along it at about
-// the same height, so the normal of the plane the camera centres lie in is up; when the centres
-// do not span a plane (a straight walk), the mean of the cameras' own up axes (−y of the image)
-// is. Signed towards the cameras' side.
-Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& camera_centres,
-                              const std::vector<Eigen::Vector3d>& camera_up_axes);
+// UpFromCameras (which way is up, from the cameras) is base/plane_fit.h's.
 
 // Character frame convention (glTF): +Y up, +Z forward (the direction the character faces).
 // `character_height` is the height of the character's bind pose in its own units. The floor is

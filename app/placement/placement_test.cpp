@@ -1,4 +1,6 @@
 #include "app/placement/placement.h"
+#include "app/placement/place_character.h"
+#include "tests/support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -71,6 +73,54 @@ TEST(Placement, DegenerateInputsAreClearErrors) {
   for (int i = 0; i < 50; ++i) line.emplace_back(i, 0, 0);
   EXPECT_THROW(FitDominantPlane(line, {}), arview::Error);
   EXPECT_THROW(PlaceOnDominantPlane(MakeScene(false).points, {}, {}, 1.0, {}), PlacementError);
+}
+
+}  // namespace
+}  // namespace arview::app
+
+namespace arview::app {
+namespace {
+
+// On a metric map the character's height is metres: the user's, else the asset's own when it is
+// a plausible height in metres (glTF's unit), else a person's.
+TEST(PlaceCharacterHeight, MetresOnAMetricMap) {
+  PlaceCharacterOptions o;
+  EXPECT_DOUBLE_EQ(MetricHeight(o, 1.72), 1.72);           // the built-in figure, in metres
+  EXPECT_DOUBLE_EQ(MetricHeight(o, 180.0), kDefaultHeightMetres);  // an asset in centimetres
+  EXPECT_DOUBLE_EQ(MetricHeight(o, 0.01), kDefaultHeightMetres);
+  o.height_m = 0.4;
+  EXPECT_DOUBLE_EQ(MetricHeight(o, 180.0), 0.4);
+}
+
+// The same asset on the same map: a fraction of the viewing distance without scale, metres with.
+TEST(PlaceCharacterHeight, AMetricMapSizesTheCharacterInMetres) {
+  const std::filesystem::path asset = testing::SharedData("characters/CesiumMan.glb");
+  ARVIEW_REQUIRE_DATA_PATH(asset, "../shared/data");
+  map::Map map;
+  map.camera = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (int i = 0; i < 300; ++i) map.points.push_back({Eigen::Vector3d(u(rng), u(rng), i % 5 == 0 ? 1 + 0.3 * u(rng) : 0)});
+  for (int k = 0; k < 6; ++k) {
+    map::Keyframe kf;
+    kf.frame_index = k;
+    const double a = k * M_PI / 3;
+    const Eigen::Vector3d centre(3 * std::cos(a), 3 * std::sin(a), 1.5);
+    const Eigen::Vector3d forward = -centre.normalized(), right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+    Eigen::Matrix3d r_wc;
+    r_wc << right, forward.cross(right), forward;
+    kf.pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), centre);
+    map.keyframes.push_back(kf);
+  }
+  PlaceCharacterOptions o;
+  o.key_elevation_deg = 0;
+  const ScenePlacement unscaled = PlaceCharacter(map, asset, o);
+  map.frame.scale_source = map::ScaleSource::kBoard;
+  const ScenePlacement metric = PlaceCharacter(map, asset, o);
+  EXPECT_NEAR(metric.anchor.scale * metric.rest_height, MetricHeight(o, metric.rest_height), 1e-9);
+  EXPECT_NEAR(unscaled.anchor.scale * unscaled.rest_height, 0.3 * MedianDistance({map.keyframes[0].pose.Center()}, unscaled.anchor.position), 0.3);
+  o.height_m = 0.5;
+  EXPECT_NEAR(PlaceCharacter(map, asset, o).anchor.scale * metric.rest_height, 0.5, 1e-9);
 }
 
 }  // namespace

@@ -70,6 +70,12 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                              " was built for a " + std::to_string(map.camera.width) + "x" +
                              std::to_string(map.camera.height) + " camera");
   }
+  // The eyes' disparity is --ipd in map units: metres only on a metric map.
+  if (o.compositor.hmd && o.compositor.stereo_character && !map.frame.metric()) {
+    std::fprintf(stderr, "warning: %s has no scale, so --ipd %.3g is in its arbitrary units and the character's depth "
+                         "is wrong ('arview map scale' makes the map metric)\n",
+                 map_name.c_str(), o.compositor.ipd_m);
+  }
   // The output first: a window without a display, or an unwritable file, is said before anything
   // loads.
   std::unique_ptr<video::FrameSink> sink =

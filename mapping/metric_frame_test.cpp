@@ -1,0 +1,183 @@
+#include "mapping/metric_frame.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+
+namespace arview::mapping {
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+
+// A pose at `centre` looking at `target`, with the world's +z up in the image.
+calib::Pose LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
+  const Eigen::Vector3d forward = (target - centre).normalized();
+  const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  Eigen::Matrix3d r_wc;
+  r_wc << right, down, forward;
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), centre);
+}
+
+// A room in metres, z up: a floor of points, cameras at `height` on a ring round the origin
+// looking at a 9x6 board of 0.05 m squares lying at the origin. Then the whole world is moved by
+// `colmap_frame` (arbitrary scale, rotation, offset), as COLMAP would have it.
+struct Scene {
+  map::Map map;
+  std::vector<Eigen::Vector3d> board;  // true corners, metres, row after row
+  Sim3 colmap_frame;                   // metric → the map's frame
+};
+
+Scene MakeScene(double height = 1.5) {
+  Scene s;
+  s.colmap_frame.scale = 0.27;
+  s.colmap_frame.R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -1, 0.6).normalized()).toRotationMatrix();
+  s.colmap_frame.t = {4, -1, 2.5};
+  s.map.camera = calib::Camera::Pinhole(640, 480, 525, 525, 321.5, 238.5);
+  for (int row = 0; row < 6; ++row)
+    for (int column = 0; column < 9; ++column) s.board.emplace_back(0.05 * column - 0.2, 0.125 - 0.05 * row, 0);
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2 * M_PI * k / 8;
+    map::Keyframe kf;
+    kf.name = "frames/" + std::to_string(k) + ".png";
+    const calib::Pose metric = LookAt(Eigen::Vector3d(1.8 * std::cos(a), 1.8 * std::sin(a), height), Eigen::Vector3d(0, 0, 0.3));
+    kf.pose = calib::Pose::FromRigid(s.colmap_frame.TransformPose(metric.ToRigid()));
+    s.map.keyframes.push_back(kf);
+  }
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (int i = 0; i < 400; ++i) {  // the floor, and some clutter above it
+    map::MapPoint p;
+    const double z = i % 4 == 0 ? std::abs(u(rng)) * 0.8 : 0.0;
+    p.xyz = s.colmap_frame(Eigen::Vector3d(u(rng), u(rng), z));
+    s.map.points.push_back(p);
+  }
+  return s;
+}
+
+std::vector<BoardSighting> Sightings(const Scene& s) {
+  std::vector<BoardSighting> sightings;
+  for (std::size_t k = 0; k < s.map.keyframes.size(); ++k) {
+    BoardSighting sighting{k, {}};
+    for (const Eigen::Vector3d& corner : s.board)
+      sighting.corners.push_back(s.map.camera.Project(s.map.keyframes[k].pose.ToCamera(s.colmap_frame(corner))));
+    sightings.push_back(std::move(sighting));
+  }
+  return sightings;
+}
+
+double UpErrorDeg(const MetricFit& fit, const Scene& s) {
+  // The world's +z, carried into the map and then into the fitted frame, must be +z again.
+  const Eigen::Vector3d up_in_map = s.colmap_frame.R * Eigen::Vector3d::UnitZ();
+  return std::acos(std::clamp((fit.to_metric.R * up_in_map).z(), -1.0, 1.0)) / kDeg;
+}
+
+TEST(MetricFrame, ABoardOnTheFloorGivesMetresUpAndItsCentreAsOrigin) {
+  const Scene s = MakeScene();
+  std::vector<BoardSighting> sightings = Sightings(s);
+  // Found from other corners in some views, as a detector does.
+  std::reverse(sightings[2].corners.begin(), sightings[2].corners.end());
+  for (int row = 0; row < 6; ++row)
+    std::reverse(sightings[5].corners.begin() + 9 * row, sightings[5].corners.begin() + 9 * row + 9);
+  const TriangulatedBoard board = TriangulateBoard(s.map, sightings, {9, 6});
+  EXPECT_EQ(board.keyframes.size(), 8u);
+  EXPECT_LT(board.rms_reprojection_px, 1e-6);
+  EXPECT_GT(board.widest_angle_deg, 90);
+  const MetricFit fit = FitFromBoard(s.map, board, {{9, 6}, 0.05, true});
+  EXPECT_NEAR(fit.to_metric.scale * s.colmap_frame.scale, 1.0, 1e-9);
+  EXPECT_LT(UpErrorDeg(fit, s), 1e-6);
+  EXPECT_LT(fit.to_metric(s.colmap_frame(Eigen::Vector3d(0.0, 0.0, 0))).norm(), 1e-9);  // the board's centre
+  EXPECT_EQ(fit.frame.scale_source, map::ScaleSource::kBoard);
+  EXPECT_LT(fit.frame.scale_error, 1e-6);
+
+  map::Map map = s.map;
+  ApplyMetricFit(fit, &map);
+  EXPECT_TRUE(map.frame.metric());
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k)  // the camera heights, in metres
+    EXPECT_NEAR(map.keyframes[k].pose.Center().z(), 1.5, 1e-9);
+  // The record goes back to COLMAP's frame.
+  EXPECT_NEAR(map.frame.from_colmap.scale, fit.to_metric.scale, 1e-12);
+}
+
+TEST(MetricFrame, AWrongSightingIsDroppedAndAWrongSizeRefused) {
+  const Scene s = MakeScene();
+  std::vector<BoardSighting> sightings = Sightings(s);
+  for (Eigen::Vector2d& c : sightings[3].corners) c += Eigen::Vector2d(25, -10);  // another thing found
+  const TriangulatedBoard board = TriangulateBoard(s.map, sightings, {9, 6});
+  EXPECT_EQ(board.keyframes.size(), 7u);
+  EXPECT_EQ(board.sightings_dropped, 1);
+  EXPECT_NEAR(FitFromBoard(s.map, board, {{9, 6}, 0.05, true}).to_metric.scale * s.colmap_frame.scale, 1.0, 1e-6);
+
+  // The same corners read as a board with another grid do not fit it.
+  EXPECT_THROW(FitFromBoard(s.map, TriangulateBoard(s.map, Sightings(s), {6, 9}), {{6, 9}, 0.05, true}), map::MapError);
+}
+
+TEST(MetricFrame, TooFewOrTooSimilarSightingsAreRefusedWithWhatToTry) {
+  const Scene s = MakeScene();
+  const std::vector<BoardSighting> all = Sightings(s);
+  try {
+    TriangulateBoard(s.map, {all[0]}, {9, 6});
+    FAIL();
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("1 of 8 keyframes"), std::string::npos) << e.what();
+  }
+  Scene near = s;
+  near.map.keyframes[1].pose = near.map.keyframes[0].pose;  // the same view twice
+  try {
+    TriangulateBoard(near.map, {all[0], BoardSighting{1, all[0].corners}}, {9, 6});
+    FAIL();
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("nearly one direction"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MetricFrame, AKnownDistanceGivesMetresAndTheFloorGivesUp) {
+  const Scene s = MakeScene();
+  auto sightings_of = [&](const Eigen::Vector3d& metric) {
+    std::vector<PointSighting> sightings;
+    for (int k : {0, 2, 3}) {
+      sightings.push_back({std::to_string(k) + ".png",  // the file name alone finds the keyframe
+                           s.map.camera.Project(s.map.keyframes[k].pose.ToCamera(s.colmap_frame(metric)))});
+    }
+    return sightings;
+  };
+  const TriangulatedPoint a = TriangulatePoint(s.map, sightings_of({-0.2, 0.125, 0}));
+  const TriangulatedPoint b = TriangulatePoint(s.map, sightings_of({0.2, -0.125, 0}));
+  const double metres = std::hypot(0.4, 0.25);
+  const MetricFit fit = FitFromDistance(s.map, a, b, metres);
+  EXPECT_NEAR(fit.to_metric.scale * s.colmap_frame.scale, 1.0, 1e-9);
+  EXPECT_LT(UpErrorDeg(fit, s), 0.5);  // RANSAC's floor on exact points
+  EXPECT_GT(fit.frame.scale_error, 0);
+  EXPECT_LT(fit.frame.scale_error, 0.02);
+  EXPECT_EQ(fit.frame.scale_source, map::ScaleSource::kKnownDistance);
+
+  std::vector<PointSighting> unknown = sightings_of({0, 0, 0});
+  unknown[1].keyframe_name = "nowhere.png";
+  EXPECT_THROW(TriangulatePoint(s.map, unknown), map::MapError);
+  std::vector<PointSighting> apart = sightings_of({0, 0, 0});
+  apart[1].pixel += Eigen::Vector2d(30, 0);
+  EXPECT_THROW(TriangulatePoint(s.map, apart), map::MapError);
+}
+
+TEST(MetricFrame, TheCameraHeightEstimateIsStatedWithItsError) {
+  const Scene s = MakeScene(1.7);  // filmed higher than the typical 1.45 m
+  const MetricFit fit = FitFromCameraHeight(s.map);
+  EXPECT_NEAR(fit.to_metric.scale * s.colmap_frame.scale, kTypicalCameraHeight / 1.7, 1e-3);
+  EXPECT_LT(UpErrorDeg(fit, s), 0.5);
+  EXPECT_EQ(fit.frame.scale_source, map::ScaleSource::kCameraHeight);
+  EXPECT_EQ(fit.frame.scale_error, kCameraHeightRelativeError);
+  EXPECT_NE(fit.frame.how.find("estimate"), std::string::npos);
+  map::Map map = s.map;
+  ApplyMetricFit(fit, &map);
+  for (const map::Keyframe& k : map.keyframes) EXPECT_NEAR(k.pose.Center().z(), kTypicalCameraHeight, 2e-3);
+
+  map::Map no_floor = s.map;
+  no_floor.points.resize(2);
+  EXPECT_THROW(FitFromCameraHeight(no_floor), map::MapError);
+}
+
+}  // namespace
+}  // namespace arview::mapping
