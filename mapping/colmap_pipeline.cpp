@@ -19,6 +19,7 @@
 #include "base/process.h"
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
+#include "mapping/colmap_stages.h"
 #include "mapping/pair_matching.h"
 #include "recordings/trajectory.h"
 
@@ -35,13 +36,6 @@ MatchEngine ParseMatchEngine(const std::string& text) {
 }
 
 namespace {
-
-// The images COLMAP reads: a folder and names relative to it, with each name's frame.
-struct ImageSet {
-  fs::path root;
-  std::vector<std::string> names;
-  FrameLookup lookup;
-};
 
 // Stage inputs as text: a stage is skipped when the text saved after its last success matches.
 class StageRecord {
@@ -1049,6 +1043,48 @@ void WriteKeyframesTum(const map::Map& map, const fs::path& file) {
   } catch (const std::exception& e) {
     throw map::MapError(file.string() + ": cannot write keyframes (" + e.what() + ")");
   }
+}
+
+// The stages `arview map extend` shares with `arview map` (mapping/colmap_stages.h).
+
+ImageSet SelectImages(const recordings::Recording& recording, const fs::path& out_dir, const MapBuildOptions& options,
+                      const MapBuildCallbacks& cb, std::vector<int>* selected) {
+  CandidateFrames(recording, options);  // a bad --frames fails before anything is written
+  StageRecord stages(out_dir);
+  return recording.IsVideo() ? PrepareVideoImages(recording, out_dir, options, cb, stages, selected)
+                             : PrepareStillImages(recording, options, cb, selected);
+}
+
+void RunColmap(const MapBuildOptions& options, const fs::path& out_dir, const std::string& stage,
+               const std::vector<std::string>& args, int total, const MapBuildCallbacks& cb) {
+  ColmapRunner(options, out_dir, cb).Run(stage, args, total);
+}
+
+std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const MapBuildOptions& options,
+                                           const fs::path& database, const fs::path& image_root,
+                                           const fs::path& image_list) {
+  return ExtractArgs(camera, options, database, image_root, image_list);
+}
+
+std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const fs::path& database,
+                                          const fs::path& image_root, const fs::path& sparse) {
+  return MapperArgs(options, database, image_root, sparse);
+}
+
+bool ExhaustiveMatchingWanted(const MapBuildOptions& options, int frames) { return ExhaustivePairsWanted(options, frames); }
+
+void CopyColmapDatabase(const fs::path& database, const fs::path& copy) { CopyDatabase(database, copy); }
+
+void RemoveColmapDatabase(const fs::path& database) { RemoveDatabase(database); }
+
+fs::path LargestColmapModel(const fs::path& sparse_root) {
+  int models = 0;
+  return LargestModel(sparse_root, &models, {});
+}
+
+void WriteMapFiles(const MapBuildResult& result, const fs::path& out_dir, const MapBuildOptions& options,
+                   const MapBuildCallbacks& cb) {
+  WriteMapFolder(result, out_dir, options, cb);
 }
 
 }  // namespace arview::mapping

@@ -29,6 +29,7 @@
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_pipeline.h"
 #include "mapping/map_check.h"
+#include "mapping/test_temple_map.h"
 #include "recordings/accuracy.h"
 #include "recordings/importers.h"
 #include "recordings/trajectory.h"
@@ -44,29 +45,13 @@ class TempleMapTest : public ::testing::Test {
   static void SetUpTestSuite() {
     const fs::path source = testing::SharedData("templeRing");
     if (!fs::exists(source)) return;  // each test skips (or fails under ARVIEW_REQUIRE_DATA=1)
-    root_ = fs::temp_directory_path() / ("arview_temple_map_test_" + std::to_string(::getuid()));
+    root_ = testing::TempleMapRoot();
     scratch_ = root_ / ("scratch_" + std::to_string(::getpid()));
     fs::create_directories(scratch_);
-    const int lock = ::open((root_ / "lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
-    ASSERT_GE(lock, 0) << "cannot open " << (root_ / "lock");
-    ::flock(lock, LOCK_EX);
-    struct Unlock {
-      int fd;
-      ~Unlock() { ::close(fd); }  // closing releases the lock
-    } unlock{lock};
-    if (!fs::exists(root_ / "recording" / "frames.txt")) {
-      recordings::ImportOptions io;
-      io.overwrite = true;
-      recordings::ImportMiddlebury(source, root_ / "recording", io);
-    }
-    recording_ = std::make_unique<recordings::Recording>(recordings::LoadRecording(root_ / "recording"));
-    MapBuildOptions options;
-    options.frames_spec = "0-46:2";
-    // arview's matching on small frames (kAuto would take COLMAP's): the suite covers it whole.
-    options.match_engine = MatchEngine::kArview;
+    recording_ = std::make_unique<recordings::Recording>();
     MapBuildCallbacks cb;
     cb.progress = [](const std::string& stage, int done, int total) { progress_[stage] = {done, total}; };
-    result_ = std::make_unique<MapBuildResult>(BuildMap(*recording_, root_ / "map", options, cb));
+    result_ = std::make_unique<MapBuildResult>(testing::BuildSharedTempleMap(source, recording_.get(), cb));
   }
   static void TearDownTestSuite() {
     if (!scratch_.empty()) fs::remove_all(scratch_);

@@ -15,6 +15,7 @@
 #include "mapping/map_check.h"
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
+#include "tests/support/stub_map_folder.h"
 #include "tests/support/test_data.h"
 
 namespace arview {
@@ -456,6 +457,38 @@ TEST(Cli, MapInfoOnARefusedMapSaysWhy) {
   const auto empty = RunArview({"map", "info", dir.string()});
   EXPECT_NE(empty.err.find("map file missing"), std::string::npos) << empty.err;
   std::filesystem::remove_all(dir);
+}
+
+// Issue 40: `map extend` meets a map folder it cannot extend, or a recording of another camera,
+// with one line naming it and a non-zero exit, leaving the folder as it was.
+TEST(Cli, MapExtendBadInputsAreOneClearLine) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("arview_cli_extend_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::string recording = (dir / "rec").string();
+  testing::OneFrameRecording(recording, testing::CameraOfSize(640, 480));
+  testing::OneFrameRecording(dir / "small", testing::CameraOfSize(320, 240));
+  testing::WriteRandomMap(testing::CameraOfSize(640, 480), dir / "no-db");
+  testing::WriteStubMapFolder(testing::CameraOfSize(640, 480), dir / "map");
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  } cases[] = {
+      {{"map", "extend", (dir / "none").string(), recording}, "none: no such map folder"},
+      {{"map", "extend", (dir / "no-db").string(), recording}, "database.db: missing"},
+      {{"map", "extend", (dir / "map").string(), (dir / "small").string()},
+       "the recording's frames are 320x240, the map's camera 640x480"},
+      {{"map", "extend", (dir / "map").string(), (dir / "none").string()}, "none"},
+      {{"map", "extend", (dir / "map").string()}, "recording is required"},
+  };
+  for (const Case& c : cases) {
+    const auto r = RunArview(c.args);
+    EXPECT_NE(r.exit_code, 0) << c.message;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "map" / "extend.partial"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -24,6 +24,7 @@ void AddSynthCommand(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
 void AddCameraCommand(CLI::App& app);
 void AddMapCommand(CLI::App& app);
+void AddMapExtendCommand(CLI::App& map_command);  // `arview map extend`, under `arview map`
 void AddTrackCommand(CLI::App& app);
 void AddEvalCommand(CLI::App& app);
 void AddAnimCommand(CLI::App& app);
