@@ -333,10 +333,9 @@ std::map<std::uint32_t, const map::Keyframe*> ById(const std::vector<map::Keyfra
 
 // COLMAP 3.8's mapper normalises its model after each global bundle adjustment (centred, scaled
 // to a fixed extent; rotations untouched). The old keyframes' poses were held, so their centres
-// moved by exactly that shift and scale: fitted on them and undone with COLMAP's
-// model_transformer, the model is back in the map's own frame.
+// moved by exactly that shift and scale: fitted on them and undone (colmap_model.h's
+// WriteTransformedModel), the model is back in the map's own frame.
 void RestoreMapFrame(const fs::path& old_model, const fs::path& continued, const fs::path& restored,
-                     const fs::path& work, const MapExtendOptions& options, const MapBuildCallbacks& cb,
                      MapExtendResult* result) {
   const std::vector<map::Keyframe> before = ReadColmapCameraPath(old_model);
   const auto after = ById(ReadColmapCameraPath(continued));
@@ -350,16 +349,9 @@ void RestoreMapFrame(const fs::path& old_model, const fs::path& continued, const
   if (from.empty()) throw map::MapError(continued.string() + ": COLMAP's mapper kept none of the old keyframes");
   const Sim3 back = FitScaleAndShift(from, to);
   result->colmap_shift_scale = 1.0 / back.scale;
-  std::ostringstream matrix;
-  matrix.precision(17);
-  matrix << back.Matrix() << "\n";
-  const fs::path transform = work / "to_map_frame.txt";
-  WriteFileAtomically(transform, matrix.str());
-  fs::create_directories(restored);
-  RunColmap(options.build, work, "frame",
-            {"model_transformer", "--input_path", continued.string(), "--output_path", restored.string(),
-             "--transform_path", transform.string()},
-            0, cb);
+  // Written by arview (colmap_model.h): COLMAP's model_transformer ignores write errors and would
+  // leave a truncated model on a full disk.
+  WriteTransformedModel(continued, restored, back);
 }
 
 double RotationAngleDeg(const calib::Pose& a, const calib::Pose& b) {
@@ -607,7 +599,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     MatchPairs(PairsToMatch(old, session, work / "database.db", options), work / "database.db", work, options, cb);
     finish_stage("register");
     ContinueModel(old, session, work / "database.db", work, work / "continued", options, cb);
-    RestoreMapFrame(old.model_dir, work / "continued", work / "model", work, options, cb, &result);
+    RestoreMapFrame(old.model_dir, work / "continued", work / "model", &result);
     finish_stage("write");
     ReadExtendedMap(old, session, to_map_file, work, options.build.cancel, &result);
     if (result.registered == 0)

@@ -14,7 +14,8 @@
 //   MetricFit fit = FitFromBoard(map, TriangulateBoard(map, seen, {9, 6}), {{9, 6}, 0.025});
 //   ApplyMetricFit(fit, &map);   // the keyframes, the points and map.frame
 //
-// The COLMAP model on disk is transformed with `colmap model_transformer` (colmap_pipeline.h).
+// The COLMAP model on disk is moved with it (colmap_model.h's WriteTransformedModel, from
+// colmap_pipeline.cpp).
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
