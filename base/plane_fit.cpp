@@ -111,4 +111,19 @@ Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& centres, const
   return up.normalized();
 }
 
+Plane FitFloorUnderCameras(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& camera_centres,
+                           const std::vector<Eigen::Vector3d>& camera_up_axes, PlaneFitOptions options,
+                           Eigen::Vector3d* up) {
+  if (!options.up_prior) options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
+  Plane floor = FitDominantPlane(points, options);
+  double side = 0;
+  for (const auto& c : camera_centres) side += floor.Distance(c);
+  if (side < 0) {
+    floor.normal = -floor.normal;
+    floor.offset = -floor.offset;
+  }
+  if (up) *up = *options.up_prior;
+  return floor;
+}
+
 }  // namespace arview

@@ -43,4 +43,12 @@ Plane FitDominantPlane(const std::vector<Eigen::Vector3d>& points, const PlaneFi
 Eigen::Vector3d UpFromCameras(const std::vector<Eigen::Vector3d>& camera_centres,
                               const std::vector<Eigen::Vector3d>& camera_up_axes);
 
+// The floor under the cameras: the dominant plane of `points` among those within
+// options.max_tilt_deg of the cameras' up (options.up_prior, else UpFromCameras), its normal
+// turned towards the side the cameras are on. `up`, when given, receives the up used. Throws
+// arview::Error (no up, no plane).
+Plane FitFloorUnderCameras(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& camera_centres,
+                           const std::vector<Eigen::Vector3d>& camera_up_axes, PlaneFitOptions options,
+                           Eigen::Vector3d* up = nullptr);
+
 }  // namespace arview

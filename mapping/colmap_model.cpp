@@ -525,6 +525,12 @@ class BinaryPatch {
     Need(bytes);
     pos_ += static_cast<std::size_t>(bytes);
   }
+  // `count` records of `size` bytes: a count no file can hold fails as truncated, before the
+  // product could overflow.
+  void SkipRecords(std::uint64_t count, std::size_t size) {
+    if (count > (data_.size() - pos_) / size) Fail();
+    Skip(count * size);
+  }
   void SkipCString() {
     const auto end = std::find(data_.begin() + static_cast<std::ptrdiff_t>(pos_), data_.end(), '\0');
     if (end == data_.end()) Fail();
@@ -563,9 +569,7 @@ std::string TransformedImages(const fs::path& file, const Sim3& transform) {
     for (int k = 0; k < 7; ++k) f.WriteAt(pose_at + k * sizeof(double), out[k]);
     f.Read<std::uint32_t>();
     f.SkipCString();
-    const auto points = f.Read<std::uint64_t>();
-    if (points > (std::uint64_t{1} << 40)) f.Skip(points);  // an impossible count: fails as truncated
-    f.Skip(points * (2 * sizeof(double) + sizeof(std::int64_t)));
+    f.SkipRecords(f.Read<std::uint64_t>(), 2 * sizeof(double) + sizeof(std::int64_t));
   }
   return f.bytes();
 }
@@ -582,9 +586,7 @@ std::string TransformedPoints(const fs::path& file, const Sim3& transform) {
     const Eigen::Vector3d moved = transform(xyz);
     for (int k = 0; k < 3; ++k) f.WriteAt(xyz_at + k * sizeof(double), moved[k]);
     f.Skip(3 + sizeof(double));
-    const auto track = f.Read<std::uint64_t>();
-    if (track > (std::uint64_t{1} << 40)) f.Skip(track);
-    f.Skip(track * 2 * sizeof(std::uint32_t));
+    f.SkipRecords(f.Read<std::uint64_t>(), 2 * sizeof(std::uint32_t));
   }
   return f.bytes();
 }

@@ -182,22 +182,11 @@ Plane FindFloor(const map::Map& map) {
   std::vector<Eigen::Vector3d> points, up_axes;
   for (const map::MapPoint& p : map.points) points.push_back(p.xyz);
   for (const map::Keyframe& k : map.keyframes) up_axes.push_back(-(k.pose.q_cw.conjugate() * Eigen::Vector3d::UnitY()));
-  const std::vector<Eigen::Vector3d> centres = Centres(map);
-  PlaneFitOptions options;
-  Plane floor;
   try {
-    options.up_prior = UpFromCameras(centres, up_axes);
-    floor = FitDominantPlane(points, options);
+    return FitFloorUnderCameras(points, Centres(map), up_axes, {});
   } catch (const Error& e) {
     throw map::MapError(std::string("no floor found in the map's points: ") + e.what());
   }
-  double side = 0;
-  for (const auto& c : centres) side += floor.Distance(c);
-  if (side < 0) {
-    floor.normal = -floor.normal;
-    floor.offset = -floor.offset;
-  }
-  return floor;
 }
 
 // The frame standing on `floor`: z its normal, the origin below the cameras' mean centre, x the
@@ -348,12 +337,7 @@ MetricFit FitFromBoard(const map::Map& map, const TriangulatedBoard& board, cons
     to_board.t = half_turn * to_board.t;
   }
   double sum = 0;
-  std::vector<double> distances;
-  for (std::size_t k = 0; k < grid.size(); ++k) {
-    const Eigen::Vector3d fitted = to_board(board.corners[k]);
-    sum += (fitted - grid[k]).squaredNorm();
-    distances.push_back(fitted.norm());
-  }
+  for (std::size_t k = 0; k < grid.size(); ++k) sum += (to_board(board.corners[k]) - grid[k]).squaredNorm();
   MetricFit fit;
   fit.fit_rms_m = std::sqrt(sum / grid.size());
   if (fit.fit_rms_m > 0.2 * spec.square) {

@@ -182,10 +182,8 @@ void RunScale(const MapArgs& args) {
   const ScopedSignalCancellation signals;
   options.cancel = signals.token();
   ProgressBar bar;
-  mapping::MapBuildCallbacks callbacks;
-  callbacks.progress = [&](const std::string& stage, int done, int total) {
-    if (!signals.token().IsCancelled()) bar.Update(stage, done, total);
-  };
+  mapping::MapBuildCallbacks callbacks;  // progress only: the map's own check warnings are not news here
+  callbacks.progress = ConsoleCallbacks(bar, signals.token()).progress;
   try {
     std::optional<recordings::Recording> recording;
     if (!args.scale_recording.empty()) recording = recordings::LoadRecording(args.scale_recording);

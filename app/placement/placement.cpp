@@ -12,29 +12,15 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
                             const PlacementOptions& o) {
   if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
-  PlaneFitOptions plane_options = o.plane;
-  if (!plane_options.up_prior) {
+  Eigen::Vector3d camera_up;
+  const Plane plane = [&] {
     try {
-      plane_options.up_prior = UpFromCameras(camera_centres, camera_up_axes);
-    } catch (const Error& e) {
-      throw PlacementError(e.what());
-    }
-  }
-  Plane plane = [&] {
-    try {
-      return FitDominantPlane(points, plane_options);
+      return FitFloorUnderCameras(points, camera_centres, camera_up_axes, o.plane, &camera_up);
     } catch (const Error& e) {  // the map's points, said as a placement error (the caller names the map)
       throw PlacementError(e.what());
     }
   }();
 
-  // Up is the side of the plane the cameras are on.
-  double side = 0;
-  for (const auto& c : camera_centres) side += plane.Distance(c);
-  if (side < 0) {
-    plane.normal = -plane.normal;
-    plane.offset = -plane.offset;
-  }
   // Stand at the median of the plane's inliers near the middle, projected onto the plane.
   const Eigen::Vector3d middle = ComponentMedian(points);
   const double limit = o.plane.inlier_distance > 0 ? o.plane.inlier_distance : 0.01 * 2 * MedianDistance(points, middle);
@@ -48,7 +34,7 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
   // Face the first keyframe: its direction projected onto the plane (any perpendicular if above).
   // Stand upright in the viewers' world: up is the cameras' up (signed like the floor's normal);
   // the floor gives the footing. On a level floor the two agree within the RANSAC noise.
-  Eigen::Vector3d up = *plane_options.up_prior;
+  Eigen::Vector3d up = camera_up;
   if (up.dot(plane.normal) < 0) up = -up;
   Eigen::Vector3d forward = camera_centres.front() - position;
   forward -= forward.dot(up) * up;
