@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,33 @@ TEST_F(Camera, InfoListsTheEmulatedCamerasFormatsSizesRatesAndControls) {
     EXPECT_NE(out.find(line), std::string::npos) << line << "\n" << out;
   }
   EXPECT_EQ(out.find("Camera Controls"), std::string::npos) << "the class heading is not a control\n" << out;
+}
+
+// `camera list` reads /dev as on a user's machine: the emulated camera, given a driver's kind of
+// name (ARVIEW_FAKE_CAMERA_NODE), shows there with its name, driver and bus, after whatever
+// this machine has; `camera info` on the listed path describes it.
+TEST_F(Camera, ListShowsThePluggedInCameraAndInfoDescribesItAtThatPath) {
+  const std::string node = "/dev/video63";
+  if (fs::exists(node)) GTEST_SKIP() << node << " exists on this machine: the emulated node would hide it";
+  const CommandResult unplugged = RunWithCamera({"camera", "list"}, {});
+  ASSERT_EQ(unplugged.exit_code, 0) << unplugged.err;
+  EXPECT_EQ(unplugged.out.find(node), std::string::npos) << unplugged.out;
+
+  const CommandResult list = RunWithCamera({"camera", "list"}, {{"ARVIEW_FAKE_CAMERA_NODE", node}});
+  ASSERT_EQ(list.exit_code, 0) << list.err;
+  EXPECT_NE(list.out.find(node + ": arview emulated camera (uvcvideo, usb-arview-fake)\n"), std::string::npos)
+      << list.out;
+  EXPECT_EQ(list.out.find("no video devices"), std::string::npos) << list.out;
+  // Every line the machine's own nodes gave is still there: the node is added, nothing hidden.
+  if (unplugged.out.find("no video devices") == std::string::npos) {
+    std::istringstream lines(unplugged.out);
+    for (std::string line; std::getline(lines, line);) EXPECT_NE(list.out.find(line), std::string::npos) << line;
+  }
+
+  const CommandResult info = RunWithCamera({"camera", "info", node}, {{"ARVIEW_FAKE_CAMERA_NODE", node}});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find(node + ": arview emulated camera (driver uvcvideo"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("  MJPG (Motion-JPEG)"), std::string::npos) << info.out;
 }
 
 // Issue 35's figure: at 1280x720 USB 2 carries YUYV at 10 fps; asked for 30, auto takes MJPEG.

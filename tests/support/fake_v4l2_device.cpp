@@ -1,7 +1,8 @@
 // An emulated V4L2 camera for the `arview` binary, where no camera is attached: preloaded
 // (LD_PRELOAD), it answers the system calls V4l2Source makes (stat, open, ioctl, mmap, poll,
-// munmap, close) for the device /dev/video-arview-fake and passes every other call to the C
-// library. What `arview record`, `run` and `camera info` do with it is the real commands' doing
+// munmap, close) for the device /dev/video-arview-fake, lists it in /dev on request (opendir,
+// fdopendir, readdir, closedir) and passes every other call to the C library. What `arview
+// record`, `run`, `camera list` and `camera info` do with it is the real commands' doing
 // (tests/faults_test.cpp, tests/camera_test.cpp). In-process tests stand in a camera through
 // V4l2Io instead: recordings/v4l2_fake_camera_test.cpp.
 //
@@ -36,10 +37,15 @@
 //       half its length (a USB hiccup), a YUYV frame flagged V4L2_BUF_FLAG_ERROR.
 //   ARVIEW_FAKE_CAMERA_HALF_RATE_AFTER=<n>  after n frames the interval doubles (a camera whose
 //       automatic exposure lengthens in dim light).
+//   ARVIEW_FAKE_CAMERA_NODE=/dev/videoN     the camera also answers at this path, and a listing
+//       of its folder (opendir/readdir, as `arview camera list` reads /dev) shows it after the
+//       real entries, as a plugged-in webcam's node. /dev/video-arview-fake is not listed: it
+//       is not a name a driver gives (video<number>).
 // "Frames" counts every frame time since STREAMON, dropped ones included. A value that is not
 // a whole number, or a recording that cannot be read, makes open() fail with EINVAL after one
 // line on stderr: a test set up wrongly must not pass on grey frames.
 
+#include <dirent.h>
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <linux/videodev2.h>
@@ -62,8 +68,10 @@
 #include <cstring>
 #include <deque>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -87,6 +95,19 @@ constexpr size_t kCacheBytes = 256u << 20;
 template <class Function>
 Function Real(const char* name) {
   return reinterpret_cast<Function>(::dlsym(RTLD_NEXT, name));
+}
+
+// The listed node (ARVIEW_FAKE_CAMERA_NODE), "" when none.
+std::string ListedNode() {
+  const char* node = std::getenv("ARVIEW_FAKE_CAMERA_NODE");
+  return node != nullptr ? node : "";
+}
+
+bool IsFakePath(const char* path) {
+  if (path == nullptr) return false;
+  if (std::strcmp(path, kFakeDevice) == 0) return true;
+  const std::string node = ListedNode();
+  return !node.empty() && node == path;
 }
 
 // ---- Settings ----
@@ -695,12 +716,100 @@ std::unique_ptr<Camera> MakeCamera() {
   return std::make_unique<Camera>(std::move(settings), std::move(pictures), native);
 }
 
+// ---- The listed node in its folder's listing ----
+
+// A folder being read whose listing gains the node: its entry, given once after the real ones.
+struct Listing {
+  bool given = false;
+  dirent entry{};
+  dirent64 entry64{};
+};
+std::mutex g_listings_mutex;
+// Never destroyed: a folder may be read while the process exits.
+std::map<DIR*, Listing>& Listings() {
+  static auto* listings = new std::map<DIR*, Listing>;
+  return *listings;
+}
+
+std::string WithoutTrailingSlashes(std::string path) {
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  return path;
+}
+
+// Starts watching `dir` when `folder` is the listed node's folder.
+void WatchIfNodesFolder(DIR* dir, const std::string& folder) {
+  const std::string node = ListedNode();
+  if (dir == nullptr || node.empty()) return;
+  const size_t slash = node.rfind('/');
+  if (slash == std::string::npos || slash + 1 >= node.size() || node.size() - slash > sizeof(dirent::d_name)) return;
+  if (WithoutTrailingSlashes(folder) != WithoutTrailingSlashes(node.substr(0, std::max<size_t>(slash, 1)))) return;
+  Listing listing;
+  const std::string name = node.substr(slash + 1);
+  std::memcpy(listing.entry.d_name, name.c_str(), name.size() + 1);
+  std::memcpy(listing.entry64.d_name, name.c_str(), name.size() + 1);
+  listing.entry.d_type = listing.entry64.d_type = DT_CHR;
+  listing.entry.d_reclen = sizeof(dirent);
+  listing.entry64.d_reclen = sizeof(dirent64);
+  std::lock_guard<std::mutex> lock(g_listings_mutex);
+  Listings()[dir] = listing;
+}
+
+// The node's entry when `dir` is watched and its real entries are done (`real_entry` null).
+template <class Entry>
+Entry* NodeEntryAfter(DIR* dir, Entry* real_entry, Entry Listing::*entry) {
+  if (real_entry != nullptr) return real_entry;
+  std::lock_guard<std::mutex> lock(g_listings_mutex);
+  const auto it = Listings().find(dir);
+  if (it == Listings().end() || it->second.given) return nullptr;
+  it->second.given = true;
+  return &(it->second.*entry);
+}
+
 }  // namespace
 
 extern "C" {
 
+DIR* opendir(const char* name) {
+  static const auto real = Real<DIR* (*)(const char*)>("opendir");
+  DIR* dir = real(name);
+  WatchIfNodesFolder(dir, name);
+  return dir;
+}
+
+// libstdc++'s directory_iterator opens with openat and reads through fdopendir.
+DIR* fdopendir(int fd) {
+  static const auto real = Real<DIR* (*)(int)>("fdopendir");
+  DIR* dir = real(fd);
+  if (dir != nullptr && !ListedNode().empty()) {
+    char target[4096];
+    const std::string link = "/proc/self/fd/" + std::to_string(fd);
+    const ssize_t length = ::readlink(link.c_str(), target, sizeof(target) - 1);
+    if (length > 0) WatchIfNodesFolder(dir, std::string(target, static_cast<size_t>(length)));
+  }
+  return dir;
+}
+
+dirent* readdir(DIR* dir) {
+  static const auto real = Real<dirent* (*)(DIR*)>("readdir");
+  return NodeEntryAfter(dir, real(dir), &Listing::entry);
+}
+
+dirent64* readdir64(DIR* dir) {
+  static const auto real = Real<dirent64* (*)(DIR*)>("readdir64");
+  return NodeEntryAfter(dir, real(dir), &Listing::entry64);
+}
+
+int closedir(DIR* dir) {
+  {
+    std::lock_guard<std::mutex> lock(g_listings_mutex);
+    Listings().erase(dir);
+  }
+  static const auto real = Real<int (*)(DIR*)>("closedir");
+  return real(dir);
+}
+
 int stat(const char* path, struct stat* st) noexcept {
-  if (std::strcmp(path, kFakeDevice) == 0) {
+  if (IsFakePath(path)) {
     *st = {};
     st->st_mode = S_IFCHR | 0660;
     return 0;
@@ -718,7 +827,7 @@ int open(const char* path, int flags, ...) {
     va_end(args);
   }
   static const auto real = Real<int (*)(const char*, int, ...)>("open");
-  if (std::strcmp(path, kFakeDevice) != 0) return real(path, flags, mode);
+  if (!IsFakePath(path)) return real(path, flags, mode);
   std::lock_guard<std::mutex> lock(g_open);
   if (g_fd.load() >= 0) return Fail(EBUSY);
   std::unique_ptr<Camera> camera = MakeCamera();
