@@ -627,8 +627,12 @@ timeval MonotonicTime(std::chrono::steady_clock::time_point t) {
 }
 
 // The sensor: one frame per interval on CLOCK_MONOTONIC (steady_clock), into the next queued
-// buffer or dropped. Frame times missed (the process stopped, a slow encode) are caught up at
-// once, as a sensor that went on meanwhile: the free buffers are filled, the rest dropped. (The
+// buffer or dropped. Each frame's payload is made before its frame time, as a camera's encoder
+// works during the exposure and read-out: the emulation's own decoding and JPEG encoding (on
+// the reader's cores, where a real camera has its own chip) is not part of the frame's latency
+// from its capture timestamp. The USB transfer is not emulated: the buffer is filled at the
+// frame time. Frame times missed (the process stopped, a slow encode) are caught up at once, as
+// a sensor that went on meanwhile: the free buffers are filled, the rest dropped. (The
 // emulation lives in the reader's process, so a SIGSTOP stops it too.)
 void Camera::Produce() {
   using Clock = std::chrono::steady_clock;
@@ -639,6 +643,10 @@ void Camera::Produce() {
     const bool half = settings_.half_rate_after >= 0 && n >= settings_.half_rate_after;
     due += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
         (half ? 2.0 : 1.0) * interval_.numerator / std::max<uint32_t>(interval_.denominator, 1)));
+    // Made without the lock: the reader goes on dequeueing meanwhile.
+    lock.unlock();
+    const std::vector<uint8_t>& payload = Payload(n);
+    lock.lock();
     if (changed_.wait_until(lock, due, [&] { return stop_; })) return;
     if (settings_.unplug_after >= 0 && n >= settings_.unplug_after) {
       unplugged_ = true;
@@ -651,12 +659,6 @@ void Camera::Produce() {
     }
     ++sequence_;
     if (queued_.empty()) continue;  // no buffer: this frame is dropped, its number skipped
-    // Encoded without the lock: the reader goes on dequeueing meanwhile (only this thread
-    // takes from queued_, so the buffer waits).
-    lock.unlock();
-    const std::vector<uint8_t>& payload = Payload(n);
-    lock.lock();
-    if (stop_) return;
     const uint32_t index = queued_.front();
     queued_.pop_front();
     std::vector<uint8_t>& buffer = buffers_[index];
