@@ -631,7 +631,9 @@ timeval MonotonicTime(std::chrono::steady_clock::time_point t) {
 // works during the exposure and read-out: the emulation's own decoding and JPEG encoding (on
 // the reader's cores, where a real camera has its own chip) is not part of the frame's latency
 // from its capture timestamp. The USB transfer is not emulated: the buffer is filled at the
-// frame time. Frame times missed (the process stopped, a slow encode) are caught up at once, as
+// frame time. On a machine too busy to make a payload within a frame interval (a 1280x720 PNG
+// decoded and encoded while other jobs run) the emulated sensor runs late and every latency
+// includes that lag: `--stats`' `arrival` stage (capture to dequeue) shows it. Frame times missed (the process stopped, a slow encode) are caught up at once, as
 // a sensor that went on meanwhile: the free buffers are filled, the rest dropped. (The
 // emulation lives in the reader's process, so a SIGSTOP stops it too.)
 void Camera::Produce() {
