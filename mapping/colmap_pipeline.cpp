@@ -255,11 +255,6 @@ void ClearMatches(const fs::path& database) {
   }
 }
 
-void RemoveDatabase(const fs::path& database) {
-  std::error_code ec;
-  for (const char* suffix : {"", "-shm", "-wal", "-journal"}) fs::remove(database.string() + suffix, ec);
-}
-
 // The sparse model with the most registered images among <out>/sparse/<n>/.
 fs::path LargestModel(const fs::path& sparse_root, int* count, const MapBuildCallbacks& cb) {
   fs::path best;
@@ -439,28 +434,8 @@ bool FramesDoubled(const calib::Camera& camera, const MapBuildOptions& options) 
   return options.double_frames_below_px <= 0 || std::max(camera.width, camera.height) < options.double_frames_below_px;
 }
 
-// COLMAP's command lines for the three stages. Each stage's inputs include the previous
-// stage's, so that a change re-runs everything after it.
-std::vector<std::string> ExtractArgs(const calib::Camera& camera, const MapBuildOptions& options, const fs::path& database,
-                                     const fs::path& image_root, const fs::path& image_list) {
-  bool full_opencv = false;
-  const std::vector<double> params = ColmapCameraParams(camera, &full_opencv);
-  return {"feature_extractor", "--database_path", database.string(), "--image_path", image_root.string(),
-          "--image_list_path", image_list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
-          "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
-          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", std::to_string(options.threads),
-          "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
-          "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations),
-          "--SiftExtraction.first_octave", FramesDoubled(camera, options) ? "-1" : "0"};
-}
-
-bool ExhaustivePairsWanted(const MapBuildOptions& options, int frames) {
-  return options.matcher == MatcherKind::kExhaustive ||
-         (options.matcher == MatcherKind::kAuto && frames <= options.auto_exhaustive_limit);
-}
-
 std::vector<std::string> MatchArgs(const MapBuildOptions& options, const fs::path& database, int frames) {
-  const bool exhaustive = ExhaustivePairsWanted(options, frames);
+  const bool exhaustive = ExhaustiveMatchingWanted(options, frames);
   std::vector<std::string> args{exhaustive ? "exhaustive_matcher" : "sequential_matcher",
                                 "--database_path", database.string(),
                                 "--SiftMatching.use_gpu", "0",
@@ -486,7 +461,7 @@ bool NamesFitAMatchList(const std::vector<std::string>& names) {
 }
 
 std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, int frames) {
-  return ExhaustivePairsWanted(options, frames)
+  return ExhaustiveMatchingWanted(options, frames)
              ? ExhaustivePairs(frames)
              : SequentialPairs(frames, options.sequential_overlap, options.quadratic_overlap);
 }
@@ -501,29 +476,12 @@ std::string ArviewMatchInputs(const MapBuildOptions& options, int frames) {
   const PairMatchingOptions& m = options.pair_matching;
   std::ostringstream ss;
   ss << "arview pair matching\n"
-     << (ExhaustivePairsWanted(options, frames) ? "exhaustive" : "sequential " + std::to_string(options.sequential_overlap) +
-                                                                    (options.quadratic_overlap ? " quadratic" : ""))
+     << (ExhaustiveMatchingWanted(options, frames)
+             ? "exhaustive"
+             : "sequential " + std::to_string(options.sequential_overlap) + (options.quadratic_overlap ? " quadratic" : ""))
      << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
      << m.trees << " checks " << m.checks << " at least " << m.min_matches << "\nmatches_importer raw\n";
   return ss.str();
-}
-
-// A consistent copy of a COLMAP database (VACUUM INTO: whatever its journal holds is in the copy).
-void CopyDatabase(const fs::path& database, const fs::path& copy) {
-  RemoveDatabase(copy);
-  sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
-  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
-  sqlite3_stmt* st = nullptr;
-  const bool ok = rc == SQLITE_OK && sqlite3_prepare_v2(db, "VACUUM INTO ?", -1, &st, nullptr) == SQLITE_OK &&
-                  sqlite3_bind_text(st, 1, copy.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
-                  sqlite3_step(st) == SQLITE_DONE;
-  const std::string why = db ? sqlite3_errmsg(db) : "out of memory";
-  sqlite3_finalize(st);
-  if (!ok) {
-    RemoveDatabase(copy);
-    throw map::MapError(database.string() + ": cannot copy it to " + copy.string() + " for verification (" + why + ")");
-  }
 }
 
 // The candidate matches in `lists` verified by COLMAP (matches_importer --match_type raw), one
@@ -534,10 +492,10 @@ void VerifyMatches(ColmapRunner& colmap, const fs::path& database, const std::ve
   std::vector<fs::path> databases{database};
   for (size_t k = 1; k < lists.size(); ++k) {
     databases.push_back(database.string() + ".verify-" + std::to_string(k));
-    CopyDatabase(database, databases.back());
+    CopyColmapDatabase(database, databases.back());
   }
   const auto remove_copies = [&] {
-    for (size_t k = 1; k < databases.size(); ++k) RemoveDatabase(databases[k]);
+    for (size_t k = 1; k < databases.size(); ++k) RemoveColmapDatabase(databases[k]);
   };
   std::mutex mutex;
   int verified = 0;
@@ -627,25 +585,6 @@ void MatchWithArview(ColmapRunner& colmap, const fs::path& database, const fs::p
   }
   remove_lists();
   timings->push_back({"verify", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), false});
-}
-
-std::vector<std::string> MapperArgs(const MapBuildOptions& options, const fs::path& database, const fs::path& image_root,
-                                    const fs::path& sparse) {
-  const std::string refine = options.refine_intrinsics ? "1" : "0";
-  std::vector<std::string> args{"mapper", "--database_path", database.string(), "--image_path",
-                                image_root.string(), "--output_path", sparse.string(),
-                                "--Mapper.num_threads", std::to_string(options.threads),
-                                "--Mapper.ba_refine_focal_length", refine,
-                                "--Mapper.ba_refine_principal_point", refine,
-                                "--Mapper.ba_refine_extra_params", refine,
-                                "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
-                                "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
-                                "--Mapper.ba_global_max_num_iterations",
-                                std::to_string(options.ba_global_max_iterations),
-                                "--Mapper.ba_local_max_num_iterations",
-                                std::to_string(options.ba_local_max_iterations)};
-  args.insert(args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
-  return args;
 }
 
 // A COLMAP model that arview moved into a metric frame says so in <model>/arview_frame.txt: the
@@ -823,11 +762,78 @@ void MakeMetric(const KeyframeImages& images, const MapBuildOptions& options,
   ScaleCheckDistances(fit->to_metric.scale, &result->check);
 }
 
+}  // namespace
+
+// Stages `arview map extend` runs as well (declared in mapping/colmap_stages.h), used above too.
+
+void RemoveColmapDatabase(const fs::path& database) {
+  std::error_code ec;
+  for (const char* suffix : {"", "-shm", "-wal", "-journal"}) fs::remove(database.string() + suffix, ec);
+}
+
+// A consistent copy of a COLMAP database (VACUUM INTO: whatever its journal holds is in the copy).
+void CopyColmapDatabase(const fs::path& database, const fs::path& copy) {
+  RemoveColmapDatabase(copy);
+  sqlite3* db = nullptr;
+  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
+  sqlite3_stmt* st = nullptr;
+  const bool ok = rc == SQLITE_OK && sqlite3_prepare_v2(db, "VACUUM INTO ?", -1, &st, nullptr) == SQLITE_OK &&
+                  sqlite3_bind_text(st, 1, copy.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
+                  sqlite3_step(st) == SQLITE_DONE;
+  const std::string why = db ? sqlite3_errmsg(db) : "out of memory";
+  sqlite3_finalize(st);
+  if (!ok) {
+    RemoveColmapDatabase(copy);
+    throw map::MapError(database.string() + ": cannot copy it to " + copy.string() + " for verification (" + why + ")");
+  }
+}
+
+// COLMAP's command lines for the three stages. Each stage's inputs include the previous
+// stage's, so that a change re-runs everything after it.
+std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const MapBuildOptions& options,
+                                           const fs::path& database, const fs::path& image_root,
+                                           const fs::path& image_list) {
+  bool full_opencv = false;
+  const std::vector<double> params = ColmapCameraParams(camera, &full_opencv);
+  return {"feature_extractor", "--database_path", database.string(), "--image_path", image_root.string(),
+          "--image_list_path", image_list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
+          "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
+          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", std::to_string(options.threads),
+          "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
+          "--SiftExtraction.max_num_orientations", std::to_string(options.max_num_orientations),
+          "--SiftExtraction.first_octave", FramesDoubled(camera, options) ? "-1" : "0"};
+}
+
+std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const fs::path& database,
+                                          const fs::path& image_root, const fs::path& sparse) {
+  const std::string refine = options.refine_intrinsics ? "1" : "0";
+  std::vector<std::string> args{"mapper", "--database_path", database.string(), "--image_path",
+                                image_root.string(), "--output_path", sparse.string(),
+                                "--Mapper.num_threads", std::to_string(options.threads),
+                                "--Mapper.ba_refine_focal_length", refine,
+                                "--Mapper.ba_refine_principal_point", refine,
+                                "--Mapper.ba_refine_extra_params", refine,
+                                "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
+                                "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
+                                "--Mapper.ba_global_max_num_iterations",
+                                std::to_string(options.ba_global_max_iterations),
+                                "--Mapper.ba_local_max_num_iterations",
+                                std::to_string(options.ba_local_max_iterations)};
+  args.insert(args.end(), options.extra_mapper_args.begin(), options.extra_mapper_args.end());
+  return args;
+}
+
+bool ExhaustiveMatchingWanted(const MapBuildOptions& options, int frames) {
+  return options.matcher == MatcherKind::kExhaustive ||
+         (options.matcher == MatcherKind::kAuto && frames <= options.auto_exhaustive_limit);
+}
+
 // check.json, the keyframes, the top view, and the map file last: a disk that fills at an
 // earlier file fails the command without a new map.arvmap beside the error (each file is
 // written atomically; a previous map stays whole).
-void WriteMapFolder(const MapBuildResult& result, const fs::path& out_dir, const MapBuildOptions& options,
-                    const MapBuildCallbacks& cb) {
+void WriteMapFiles(const MapBuildResult& result, const fs::path& out_dir, const MapBuildOptions& options,
+                   const MapBuildCallbacks& cb) {
   WriteMapCheck(result.check, out_dir / kMapCheckFileName);
   if (cb.warning)
     for (const std::string& w : result.check.warnings) cb.warning(w);
@@ -837,8 +843,6 @@ void WriteMapFolder(const MapBuildResult& result, const fs::path& out_dir, const
   WriteTopView(result.map, out_dir / "map.png");
   map::SaveMap(result.map, out_dir / map::kMapFileName);
 }
-
-}  // namespace
 
 MapCheck RecheckMap(const fs::path& map_dir) {
   const map::Map built = map::LoadMap(map_dir);
@@ -900,7 +904,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   const fs::path sparse = out_dir / "sparse";
 
   // Each stage's inputs include the previous stage's, so that a change re-runs everything after it.
-  const std::vector<std::string> extract_args = ExtractArgs(recording.camera, options, database, images.root, list);
+  const std::vector<std::string> extract_args = ColmapExtractArgs(recording.camera, options, database, images.root, list);
   std::string inputs = Joined(extract_args);
   for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
 
@@ -936,7 +940,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     return [&colmap, name, args, n](std::vector<StageTiming>*) { colmap.Run(name, args, n); };
   };
 
-  const auto remove_database = [&] { RemoveDatabase(database); };
+  const auto remove_database = [&] { RemoveColmapDatabase(database); };
   stage("extract", inputs, remove_database, colmap_stage("extract", extract_args), fs::exists(database),
         remove_database);
 
@@ -956,7 +960,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   // Half-written matches stay until the next run clears them (clearing needs room to write).
   const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
 
-  const std::vector<std::string> mapper_args = MapperArgs(options, database, images.root, sparse);
+  const std::vector<std::string> mapper_args = ColmapMapperArgs(options, database, images.root, sparse);
   inputs += "--\n" + Joined(mapper_args);
   const std::string mapper_inputs = inputs;
   // `extra_args`: a retry's start (RetryFoldedMap), appended to the command and its inputs.
@@ -1008,7 +1012,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     return moved;
   };
   MakeMetric(KeyframeImagesIn(result.map, {images.root}), options, cb, read_moved_model, &result);
-  WriteMapFolder(result, out_dir, options, cb);
+  WriteMapFiles(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;
 }
@@ -1030,7 +1034,7 @@ map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* re
   ApplyMetricFit(fit, &result.map);
   TransformColmapModel(result.model_dir, fit.to_metric, RequestSignature(request), result.map.frame);
   ScaleCheckDistances(fit.to_metric.scale, &result.check);
-  WriteMapFolder(result, map_dir, options, cb);
+  WriteMapFiles(result, map_dir, options, cb);
   if (!check) RecheckMap(map_dir);  // a map from before the check: computed now, in metres
   return std::move(result.map);
 }
@@ -1060,31 +1064,9 @@ void RunColmap(const MapBuildOptions& options, const fs::path& out_dir, const st
   ColmapRunner(options, out_dir, cb).Run(stage, args, total);
 }
 
-std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const MapBuildOptions& options,
-                                           const fs::path& database, const fs::path& image_root,
-                                           const fs::path& image_list) {
-  return ExtractArgs(camera, options, database, image_root, image_list);
-}
-
-std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const fs::path& database,
-                                          const fs::path& image_root, const fs::path& sparse) {
-  return MapperArgs(options, database, image_root, sparse);
-}
-
-bool ExhaustiveMatchingWanted(const MapBuildOptions& options, int frames) { return ExhaustivePairsWanted(options, frames); }
-
-void CopyColmapDatabase(const fs::path& database, const fs::path& copy) { CopyDatabase(database, copy); }
-
-void RemoveColmapDatabase(const fs::path& database) { RemoveDatabase(database); }
-
 fs::path LargestColmapModel(const fs::path& sparse_root) {
   int models = 0;
   return LargestModel(sparse_root, &models, {});
-}
-
-void WriteMapFiles(const MapBuildResult& result, const fs::path& out_dir, const MapBuildOptions& options,
-                   const MapBuildCallbacks& cb) {
-  WriteMapFolder(result, out_dir, options, cb);
 }
 
 }  // namespace arview::mapping
