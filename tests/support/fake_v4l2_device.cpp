@@ -37,6 +37,11 @@
 //       half its length (a USB hiccup), a YUYV frame flagged V4L2_BUF_FLAG_ERROR.
 //   ARVIEW_FAKE_CAMERA_HALF_RATE_AFTER=<n>  after n frames the interval doubles (a camera whose
 //       automatic exposure lengthens in dim light).
+//   ARVIEW_FAKE_CAMERA_PRELOAD=1            STREAMON makes every picture's payload (on all cores,
+//       up to the cache's 256 MB) before the sensor starts: nothing is decoded or encoded while
+//       the camera streams, as with a real camera, whose encoder is its own chip. For latency
+//       measurements at sizes where the emulation's encoding would take a large share of the
+//       reader's cores (1280x720 and up); STREAMON then takes seconds.
 //   ARVIEW_FAKE_CAMERA_NODE=/dev/videoN     the camera also answers at this path, and a listing
 //       of its folder (opendir/readdir, as `arview camera list` reads /dev) shows it after the
 //       real entries, as a plugged-in webcam's node. /dev/video-arview-fake is not listed: it
@@ -115,6 +120,7 @@ bool IsFakePath(const char* path) {
 struct Settings {
   std::string recording;
   long unplug_after = -1, stall_after = -1, corrupt_every = 0, half_rate_after = -1;
+  long preload = 0;  // 1: every payload made at STREAMON
 };
 
 bool ReadCount(const char* name, long& value) {
@@ -136,7 +142,8 @@ bool ReadSettings(Settings& s) {
   return ReadCount("ARVIEW_FAKE_CAMERA_UNPLUG_AFTER", s.unplug_after) &&
          ReadCount("ARVIEW_FAKE_CAMERA_STALL_AFTER", s.stall_after) &&
          ReadCount("ARVIEW_FAKE_CAMERA_CORRUPT_EVERY", s.corrupt_every) &&
-         ReadCount("ARVIEW_FAKE_CAMERA_HALF_RATE_AFTER", s.half_rate_after);
+         ReadCount("ARVIEW_FAKE_CAMERA_HALF_RATE_AFTER", s.half_rate_after) &&
+         ReadCount("ARVIEW_FAKE_CAMERA_PRELOAD", s.preload);
 }
 
 // The image files a recording's frames.txt lists ("timestamp relative/path"; '#' comments).
@@ -283,6 +290,8 @@ class Camera {
   void StopProducer();
   void Produce();
   const std::vector<uint8_t>& Payload(long n);
+  std::vector<uint8_t> MakePayload(size_t index) const;
+  void Preload();
 
   Settings settings_;
   std::vector<std::string> pictures_;  // empty: grey frames
@@ -576,6 +585,7 @@ void Camera::StartProducer() {
   // The cache holds pictures for one format and size: streaming starts after S_FMT settled them.
   cache_.assign(pictures_.empty() ? 1 : pictures_.size(), {});
   cache_bytes_ = 0;
+  if (settings_.preload != 0) Preload();
   producer_ = std::thread([this] { Produce(); });
 }
 
@@ -588,10 +598,39 @@ void Camera::StopProducer() {
   if (producer_.joinable()) producer_.join();
 }
 
+// Every picture's payload into the cache, in playing order, 16 at a time on all cores, until
+// the cache is full.
+void Camera::Preload() {
+  constexpr size_t kBatch = 16;
+  for (size_t first = 0; first < cache_.size(); first += kBatch) {
+    std::vector<std::vector<uint8_t>> made(std::min(kBatch, cache_.size() - first));
+    cv::parallel_for_(cv::Range(0, static_cast<int>(made.size())),
+                      [&](const cv::Range& r) {
+                        for (int i = r.start; i < r.end; ++i) made[i] = MakePayload(first + i);
+                      });
+    for (size_t i = 0; i < made.size(); ++i) {
+      if (cache_bytes_ + made[i].size() > kCacheBytes) return;
+      cache_bytes_ += made[i].size();
+      cache_[first + i] = std::move(made[i]);
+    }
+  }
+}
+
 // The picture of frame n at the streamed format and size, encoded as the camera sends it.
 const std::vector<uint8_t>& Camera::Payload(long n) {
   const size_t index = pictures_.empty() ? 0 : static_cast<size_t>(n) % pictures_.size();
   if (!cache_[index].empty()) return cache_[index];
+  std::vector<uint8_t> out = MakePayload(index);
+  if (cache_bytes_ + out.size() <= kCacheBytes) {
+    cache_bytes_ += out.size();
+    cache_[index] = std::move(out);
+    return cache_[index];
+  }
+  scratch_ = std::move(out);
+  return scratch_;
+}
+
+std::vector<uint8_t> Camera::MakePayload(size_t index) const {
   cv::Mat bgr;
   if (pictures_.empty()) {
     bgr = cv::Mat(size_, CV_8UC3, cv::Scalar(128, 128, 128));
@@ -611,13 +650,7 @@ const std::vector<uint8_t>& Camera::Payload(long n) {
   } else {
     cv::imencode(".jpg", bgr, out, {cv::IMWRITE_JPEG_QUALITY, kJpegQuality});
   }
-  if (cache_bytes_ + out.size() <= kCacheBytes) {
-    cache_bytes_ += out.size();
-    cache_[index] = std::move(out);
-    return cache_[index];
-  }
-  scratch_ = std::move(out);
-  return scratch_;
+  return out;
 }
 
 // A time on steady_clock (CLOCK_MONOTONIC in libstdc++) as a buffer's timestamp.
