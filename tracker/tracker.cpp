@@ -470,6 +470,31 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   return true;
 }
 
+bool Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+                                    Track2D3D* inliers) const {
+  const TrackingOptions& opt = options_.tracking;
+  if (!*features) {
+    const auto extract_start = std::chrono::steady_clock::now();
+    features->emplace(relocalizer_->Extract(gray, *guided_extractor_));
+    result->keypoints = static_cast<int>((*features)->keypoints.size());
+    result->times.extract_ms += MillisecondsSince(extract_start);
+  }
+  const RelocalizationResult fresh = relocalizer_->Relocalize(**features);
+  result->matches = fresh.matches;
+  result->times.match_ms += fresh.match_ms;
+  result->times.ransac_ms += fresh.pose.stats.ransac_ms;
+  result->times.refine_ms += fresh.pose.stats.refine_ms;
+  if (!fresh.pose.ok || fresh.pose.stats.inliers < opt.min_inliers) return false;
+  const double turn_deg = fresh.pose.pose.q_cw.angularDistance(result->pose.q_cw) * 180.0 / M_PI;
+  if (turn_deg > opt.fresh_max_rotation_deg) return false;
+  result->pose = fresh.pose.pose;
+  result->inliers = fresh.pose.stats.inliers;
+  result->rms_px = fresh.pose.stats.rms_px;
+  result->fresh_inliers = fresh.pose.stats.inliers;
+  *inliers = fresh.inliers;
+  return true;
+}
+
 void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const {
   if (!resolution_.reduced() || !options_.refine_on_full_camera || inliers.pixels.empty()) return;
   const auto start = std::chrono::steady_clock::now();
@@ -672,6 +697,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   if (tracked) {
     result.status = TrackStatus::kTracking;
     result.reason.clear();
+    if (options_.tracking.pose_from_fresh_features) PoseFromFreshFeatures(gray, &result, &features, &inliers);
   } else {
     const RelocalizationResult reloc =
         features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);

@@ -119,6 +119,19 @@ struct TrackingOptions {
   double align_max_seconds = 0.5;
   double align_max_from_prediction_deg = 15;  // the most an aligned rotation may turn
   RotationAlignerOptions align;               // tracker/rotation_aligner.h
+  // Frames far apart (a sub-sampled clip, a set of photos tracked as a sequence): every tracked
+  // frame's SIFT (guided matching's, extracted when the flow did not need it) is matched against
+  // the whole map and posed as relocalization poses a frame (ratio test against every map point,
+  // RANSAC at relocalization's threshold, refinement on its inliers); that pose replaces the
+  // tracked one when it has at least min_inliers inliers and turns at most
+  // fresh_max_rotation_deg from it, and its inliers are what the flow follows next. Optical flow
+  // over motions of hundreds of pixels drifts from frame to frame and pulls the pose with it:
+  // phone-fox's odd frames (2-16 video frames apart) 0.0040-0.0050 -> 0.0018-0.0020 units median
+  // over three default maps (docs/tracker.md, "Fresh features on every tracked frame"). One SIFT
+  // extraction and one global matching a frame; off by default (a live camera's frames are close
+  // enough for the flow), and not applied with `background`.
+  bool pose_from_fresh_features = false;
+  double fresh_max_rotation_deg = 3;
 };
 // TrackingOptions::prefetch_below of a live session (TrackingOptions::background), where guided
 // matching's SIFT is only ever extracted ahead (docs/tracker.md, "The tracking worker").
@@ -170,6 +183,9 @@ struct FrameResult {
   int guided_matches = 0;  // added by guided matching
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
+  // > 0: the tracked pose was replaced by the pose of the frame's own SIFT matched globally, on
+  // this many inliers (TrackingOptions::pose_from_fresh_features).
+  int fresh_inliers = 0;
   // > 0: the pose's rotation came from image alignment (TrackingOptions::align_max_seconds), with
   // this correlation, its centre from the recent path; no correspondence supports it.
   double align_zncc = 0;
@@ -232,6 +248,10 @@ class Tracker {
   // After TrackWithPrior failed: the wide search around the prediction (wide_radius_fraction).
   bool TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                  std::optional<Features>* features, Track2D3D* inliers);
+  // A tracked frame posed again from its own SIFT matched globally (pose_from_fresh_features):
+  // replaces result->pose and *inliers when that pose agrees with the tracked one.
+  bool PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+                             Track2D3D* inliers) const;
   // After every feature-based step failed: the rotation from `reference_pyramid` (the last posed
   // frame's) to `gray` by image alignment, the centre predicted.
   bool TrackByAlignment(const std::vector<cv::Mat>& reference_pyramid, const cv::Mat& gray, double timestamp,

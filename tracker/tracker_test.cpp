@@ -193,6 +193,32 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   ExpectNear(r, far, 0.003, 0.2);
 }
 
+// pose_from_fresh_features: every tracked frame is posed again from its own SIFT matched against
+// the whole map, and that pose (close to the truth) is kept; without the option nothing is.
+TEST_F(PlanarTrackerTest, FreshFeaturesPoseEveryTrackedFrameFromGlobalMatches) {
+  TrackerOptions options;
+  options.tracking.pose_from_fresh_features = true;
+  Tracker tracker(*map_, options);
+  Tracker plain(*map_);
+  int fresh = 0;
+  for (int i = 0; i < 10; ++i) {
+    const calib::Pose truth = PathPose(3 * i);  // frames 12 mm apart
+    const cv::Mat frame = world_->Render(truth);
+    const FrameResult r = tracker.Track(frame, i / 10.0);
+    const FrameResult p = plain.Track(frame, i / 10.0);
+    ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
+    ExpectNear(r, truth, 0.003, 0.2);
+    EXPECT_EQ(p.fresh_inliers, 0);
+    if (r.status != TrackStatus::kTracking) continue;
+    EXPECT_GT(r.matches, 0) << "frame " << i;
+    if (r.fresh_inliers > 0) {
+      ++fresh;
+      EXPECT_EQ(r.inliers, r.fresh_inliers);
+    }
+  }
+  EXPECT_GE(fresh, 8);
+}
+
 // A relocalization without a prior pose extracts COLMAP's weaker keypoints (contrast 0.02);
 // flow would carry their localization error along, so the next frame starts from guided
 // matching around the relocalised pose. With relocalization at guided matching's threshold its

@@ -52,6 +52,7 @@ struct TrackArgs {
   double max_rms_px = 2.5;
   int tracking_min_inliers = 30;
   int replenish_below = 150;
+  bool fresh_features = false;
   int prefetch_below = tracker::TrackingOptions{}.prefetch_below;
   int prefetch_lag = tracker::TrackingOptions{}.prefetch_lag_frames;
   double guided_radius_px = 10;
@@ -89,6 +90,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.relocalization.pose.seed = a.seed;
   o.tracking.min_inliers = a.tracking_min_inliers;
   o.tracking.replenish_below = a.replenish_below;
+  o.tracking.pose_from_fresh_features = a.fresh_features;
   o.tracking.prefetch_below = a.prefetch_below;
   o.tracking.prefetch_lag_frames = a.prefetch_lag;
   o.tracking.guided_radius_px = a.guided_radius_px;
@@ -125,6 +127,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"guided_matches", r.guided_matches},
                               {"prefetched_matches", r.prefetched_matches},
                               {"wide_matches", r.wide_matches},
+                              {"fresh_inliers", r.fresh_inliers},
                               {"align_zncc", r.align_zncc},
                               {"keypoints", r.keypoints},
                               {"matches", r.matches},
@@ -335,6 +338,10 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(6, 100000));
   cmd->add_option("--replenish-below", a->replenish_below, "Run guided matching when fewer flow tracks survive")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_flag("--fresh-features", a->fresh_features,
+               "Pose every tracked frame again from its own SIFT matched against the whole map, as relocalization "
+               "does, kept when it agrees with the tracked pose: for frames far apart (a sub-sampled clip), where "
+               "the flow drifts; one SIFT extraction a frame more");
   cmd->add_option("--prefetch-below", a->prefetch_below,
                   "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
                   "(in the frame that needs it)")
