@@ -149,6 +149,35 @@ TEST(PlanarTrackerAtHd, AJumpOnAReducedFrameCostsOneRelocalizationExtraction) {
   EXPECT_LT(RotationErrorDeg(jump.pose, far), 0.2);
 }
 
+// pose_from_fresh_features on a reduced frame the flow posed alone: the fresh pose comes from
+// relocalization's own extraction (a smaller image), the keypoints a fresh tracker's
+// relocalization of the same frame finds, and it is as exact.
+TEST(PlanarTrackerAtHd, FreshFeaturesOfAFlowFrameAreRelocalizationsOwn) {
+  const HdPlane* hd = HdPlaneScene();
+  if (!hd) GTEST_SKIP() << "graf1.png missing (Debian package opencv-doc)";
+  const PlanarWorld& world = hd->world;
+  const map::Map& map = hd->map;
+  const calib::Pose start = LookAt({0.12, 0.06, -0.75}, {0.03, 0.01, 0});
+  const calib::Pose next = LookAt({0.125, 0.06, -0.75}, {0.03, 0.01, 0});  // 5 mm aside
+  const cv::Mat next_frame = world.Render(next);
+  Tracker own(map);
+  const FrameResult relocalised = own.Track(next_frame, 0.0);
+  ASSERT_EQ(relocalised.status, TrackStatus::kRelocalized) << relocalised.reason;
+
+  TrackerOptions options;
+  options.tracking.pose_from_fresh_features = true;
+  options.tracking.replenish_below = 0;  // the flow alone: no guided SIFT to reuse
+  Tracker tracker(map, options);
+  ASSERT_EQ(tracker.Track(world.Render(start), 0.0).status, TrackStatus::kRelocalized);
+  const FrameResult r = tracker.Track(next_frame, 1 / 30.0);
+  ASSERT_EQ(r.status, TrackStatus::kTracking) << r.reason;
+  EXPECT_EQ(r.guided_matches, 0);
+  EXPECT_GT(r.fresh_inliers, 0);
+  EXPECT_EQ(r.keypoints, relocalised.keypoints);
+  EXPECT_LT((r.pose.Center() - next.Center()).norm(), 0.003);
+  EXPECT_LT(RotationErrorDeg(r.pose, next), 0.2);
+}
+
 // Relocalization's own SIFT size: smaller only for frames that --sift-size reduces anyway.
 TEST(RelocSiftLongSide, ReducesOnlyFramesThatSiftReduces) {
   const calib::Camera vga = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
