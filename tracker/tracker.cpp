@@ -476,9 +476,10 @@ bool Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, st
   // A frame the flow posed alone has no SIFT yet: on a reduced frame relocalization's own, on a
   // smaller image still (phone-fox: 480 px, guided matching's threshold, so the flow may follow
   // its keypoints), is as exact and cheaper (median of three maps 0.00200 -> 0.00191 units);
-  // at the frame's own size guided matching's, as relocalization's there are weaker than the
-  // flow should follow (relocalization_keypoints_followed_).
-  if (!*features && !relocalizer_->OwnExtractionSmaller()) {
+  // at the frame's own size (or with relocalization's threshold below guided matching's)
+  // guided matching's, as relocalization's are then weaker than the flow should follow
+  // (relocalization_keypoints_followed_).
+  if (!*features && !(relocalizer_->OwnExtractionSmaller() && relocalization_keypoints_followed_)) {
     const auto extract_start = std::chrono::steady_clock::now();
     features->emplace(relocalizer_->Extract(gray, *guided_extractor_));
     result->keypoints = static_cast<int>((*features)->keypoints.size());
