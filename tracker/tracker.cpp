@@ -261,8 +261,17 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
       guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
     }
-    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c);
+    std::vector<double> motion_px;  // each surviving track's move from the last frame
+    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c,
+                    [&](std::size_t i, const Eigen::Vector2d& px) {
+                      motion_px.push_back((px - Eigen::Vector2d(last_inliers_.pixels[i].x, last_inliers_.pixels[i].y)).norm());
+                      return true;
+                    });
     for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
+    if (!motion_px.empty()) {
+      std::nth_element(motion_px.begin(), motion_px.begin() + motion_px.size() / 2, motion_px.end());
+      result->flow_motion_px = motion_px[motion_px.size() / 2];
+    }
   }
   result->flow_tracks = static_cast<int>(c.pixels.size());
   result->times.flow_ms = MillisecondsSince(flow_start);
@@ -696,6 +705,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   std::string tracking_reason;
   std::optional<Features> features;
   Track2D3D inliers;
+  const double after_last_pose_s = timestamp - last_timestamp_;
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     if (!tracked) {
@@ -707,7 +717,8 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   if (tracked) {
     result.status = TrackStatus::kTracking;
     result.reason.clear();
-    if (options_.tracking.pose_from_fresh_features) PoseFromFreshFeatures(gray, &result, &features, &inliers);
+    const double fresh_after_s = options_.tracking.fresh_features_after_s;
+    if (fresh_after_s >= 0 && after_last_pose_s > fresh_after_s) PoseFromFreshFeatures(gray, &result, &features, &inliers);
   } else {
     const RelocalizationResult reloc =
         features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);

@@ -149,7 +149,7 @@ TEST(PlanarTrackerAtHd, AJumpOnAReducedFrameCostsOneRelocalizationExtraction) {
   EXPECT_LT(RotationErrorDeg(jump.pose, far), 0.2);
 }
 
-// pose_from_fresh_features on a reduced frame the flow posed alone: the fresh pose comes from
+// Fresh features (fresh_features_after_s) on a reduced frame the flow posed alone: the fresh pose comes from
 // relocalization's own extraction (a smaller image), the keypoints a fresh tracker's
 // relocalization of the same frame finds, and it is as exact.
 TEST(PlanarTrackerAtHd, FreshFeaturesOfAFlowFrameAreRelocalizationsOwn) {
@@ -165,7 +165,7 @@ TEST(PlanarTrackerAtHd, FreshFeaturesOfAFlowFrameAreRelocalizationsOwn) {
   ASSERT_EQ(relocalised.status, TrackStatus::kRelocalized) << relocalised.reason;
 
   TrackerOptions options;
-  options.tracking.pose_from_fresh_features = true;
+  options.tracking.fresh_features_after_s = 0;  // every tracked frame
   options.tracking.replenish_below = 0;  // the flow alone: no guided SIFT to reuse
   Tracker tracker(map, options);
   ASSERT_EQ(tracker.Track(world.Render(start), 0.0).status, TrackStatus::kRelocalized);
@@ -222,30 +222,47 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   ExpectNear(r, far, 0.003, 0.2);
 }
 
-// pose_from_fresh_features: every tracked frame is posed again from its own SIFT matched against
-// the whole map, and that pose (close to the truth) is kept; without the option nothing is.
-TEST_F(PlanarTrackerTest, FreshFeaturesPoseEveryTrackedFrameFromGlobalMatches) {
-  TrackerOptions options;
-  options.tracking.pose_from_fresh_features = true;
-  Tracker tracker(*map_, options);
-  Tracker plain(*map_);
-  int fresh = 0;
-  for (int i = 0; i < 10; ++i) {
-    const calib::Pose truth = PathPose(3 * i);  // frames 12 mm apart
-    const cv::Mat frame = world_->Render(truth);
-    const FrameResult r = tracker.Track(frame, i / 10.0);
-    const FrameResult p = plain.Track(frame, i / 10.0);
-    ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
-    ExpectNear(r, truth, 0.003, 0.2);
-    EXPECT_EQ(p.fresh_inliers, 0);
-    if (r.status != TrackStatus::kTracking) continue;
-    EXPECT_GT(r.matches, 0) << "frame " << i;
-    if (r.fresh_inliers > 0) {
-      ++fresh;
-      EXPECT_EQ(r.inliers, r.fresh_inliers);
+// Fresh features: a tracked frame far from the last one in time (by default over 0.25 s: photos,
+// a sub-sampled clip) is posed again from its own SIFT matched against the whole map, and that
+// pose (close to the truth) is kept; frames at a video's rate are left to the flow, as with
+// fresh_features_after_s = -1 (never), unless it is 0 (every tracked frame).
+TEST_F(PlanarTrackerTest, FreshFeaturesPoseTrackedFramesFarApartFromGlobalMatches) {
+  struct Run {
+    const char* what;
+    double after_s;       // fresh_features_after_s
+    double frame_gap_s;   // between the frames' timestamps
+    bool fresh_expected;  // on the tracked frames
+  };
+  const double kDefault = TrackingOptions{}.fresh_features_after_s;
+  for (const Run run : {Run{"photos 1 s apart, the default", kDefault, 1.0, true},
+                        Run{"video at 10 fps, the default", kDefault, 0.1, false},
+                        Run{"video at 10 fps, every frame", 0.0, 0.1, true},
+                        Run{"photos 1 s apart, never", -1.0, 1.0, false}}) {
+    SCOPED_TRACE(run.what);
+    TrackerOptions options;
+    options.tracking.fresh_features_after_s = run.after_s;
+    Tracker tracker(*map_, options);
+    int tracked = 0, fresh = 0;
+    for (int i = 0; i < 10; ++i) {
+      const calib::Pose truth = PathPose(3 * i);  // frames 12 mm apart
+      const FrameResult r = tracker.Track(world_->Render(truth), i * run.frame_gap_s);
+      ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
+      ExpectNear(r, truth, 0.003, 0.2);
+      if (r.status != TrackStatus::kTracking) continue;
+      ++tracked;
+      if (r.fresh_inliers > 0) {
+        ++fresh;
+        EXPECT_EQ(r.inliers, r.fresh_inliers);
+        EXPECT_GT(r.matches, 0) << "frame " << i;
+      }
+    }
+    ASSERT_GE(tracked, 8);
+    if (run.fresh_expected) {
+      EXPECT_GE(fresh, tracked - 1);
+    } else {
+      EXPECT_EQ(fresh, 0);
     }
   }
-  EXPECT_GE(fresh, 8);
 }
 
 // A relocalization without a prior pose extracts COLMAP's weaker keypoints (contrast 0.02);
