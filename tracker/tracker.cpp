@@ -261,8 +261,17 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
       guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
     }
-    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c);
+    std::vector<double> motion_px;  // each surviving track's move from the last frame
+    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c,
+                    [&](std::size_t i, const Eigen::Vector2d& px) {
+                      motion_px.push_back((px - Eigen::Vector2d(last_inliers_.pixels[i].x, last_inliers_.pixels[i].y)).norm());
+                      return true;
+                    });
     for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
+    if (!motion_px.empty()) {
+      std::nth_element(motion_px.begin(), motion_px.begin() + motion_px.size() / 2, motion_px.end());
+      result->flow_motion_px = motion_px[motion_px.size() / 2];
+    }
   }
   result->flow_tracks = static_cast<int>(c.pixels.size());
   result->times.flow_ms = MillisecondsSince(flow_start);
@@ -470,6 +479,41 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   return true;
 }
 
+bool Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+                                    Track2D3D* inliers) const {
+  const TrackingOptions& opt = options_.tracking;
+  // A frame the flow posed alone has no SIFT yet: on a reduced frame relocalization's own, on a
+  // smaller image still (phone-fox: 480 px, guided matching's threshold, so the flow may follow
+  // its keypoints), is as exact and cheaper (median of three maps 0.00200 -> 0.00191 units);
+  // at the frame's own size (or with relocalization's threshold below guided matching's)
+  // guided matching's, as relocalization's are then weaker than the flow should follow
+  // (relocalization_keypoints_followed_).
+  if (!*features && !(relocalizer_->OwnExtractionSmaller() && relocalization_keypoints_followed_)) {
+    const auto extract_start = std::chrono::steady_clock::now();
+    features->emplace(relocalizer_->Extract(gray, *guided_extractor_));
+    result->keypoints = static_cast<int>((*features)->keypoints.size());
+    result->times.extract_ms += MillisecondsSince(extract_start);
+  }
+  const RelocalizationResult fresh = *features ? relocalizer_->Relocalize(**features) : relocalizer_->Relocalize(gray);
+  if (!*features) {
+    result->keypoints = fresh.keypoints;
+    result->times.extract_ms += fresh.extract_ms;
+  }
+  result->matches = fresh.matches;
+  result->times.match_ms += fresh.match_ms;
+  result->times.ransac_ms += fresh.pose.stats.ransac_ms;
+  result->times.refine_ms += fresh.pose.stats.refine_ms;
+  if (!fresh.pose.ok || fresh.pose.stats.inliers < opt.min_inliers) return false;
+  const double turn_deg = fresh.pose.pose.q_cw.angularDistance(result->pose.q_cw) * 180.0 / M_PI;
+  if (turn_deg > opt.fresh_max_rotation_deg) return false;
+  result->pose = fresh.pose.pose;
+  result->inliers = fresh.pose.stats.inliers;
+  result->rms_px = fresh.pose.stats.rms_px;
+  result->fresh_inliers = fresh.pose.stats.inliers;
+  *inliers = fresh.inliers;
+  return true;
+}
+
 void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const {
   if (!resolution_.reduced() || !options_.refine_on_full_camera || inliers.pixels.empty()) return;
   const auto start = std::chrono::steady_clock::now();
@@ -661,6 +705,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   std::string tracking_reason;
   std::optional<Features> features;
   Track2D3D inliers;
+  const double after_last_pose_s = timestamp - last_timestamp_;
   if (has_pose_) {
     tracked = TrackWithPrior(gray, timestamp, &result, &features, &inliers);
     if (!tracked) {
@@ -672,6 +717,8 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   if (tracked) {
     result.status = TrackStatus::kTracking;
     result.reason.clear();
+    const double fresh_after_s = options_.tracking.fresh_features_after_s;
+    if (fresh_after_s >= 0 && after_last_pose_s > fresh_after_s) PoseFromFreshFeatures(gray, &result, &features, &inliers);
   } else {
     const RelocalizationResult reloc =
         features ? relocalizer_->Relocalize(*features) : relocalizer_->Relocalize(gray);

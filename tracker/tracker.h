@@ -119,6 +119,22 @@ struct TrackingOptions {
   double align_max_seconds = 0.5;
   double align_max_from_prediction_deg = 15;  // the most an aligned rotation may turn
   RotationAlignerOptions align;               // tracker/rotation_aligner.h
+  // Frames far apart (a sub-sampled clip, a set of photos tracked as a sequence): a tracked frame
+  // that comes more than fresh_features_after_s after the last posed one has its SIFT (guided
+  // matching's, extracted when the flow did not need it) matched against the whole map and posed
+  // as relocalization poses a frame (ratio test against every map point, RANSAC at
+  // relocalization's threshold, refinement on its inliers); that pose replaces the tracked one
+  // when it has at least min_inliers inliers and turns at most fresh_max_rotation_deg from it,
+  // and its inliers are what the flow follows next. Optical flow is made for a camera's frame
+  // rate: over motions of hundreds of pixels it drifts from frame to frame and pulls the pose
+  // with it (phone-fox's odd frames, 2-16 video frames apart: 0.0040-0.0050 -> 0.0018-0.0020
+  // units median over three default maps; docs/tracker.md, "Fresh features on frames far
+  // apart"). One SIFT extraction and one global matching a frame. The default, 0.25 s (under 4
+  // frames a second), leaves a camera's video to the flow alone: the room's lap at 30 fps is
+  // tracked exactly as without it. 0: every tracked frame; negative: never. Not applied with
+  // `background` (a live session).
+  double fresh_features_after_s = 0.25;
+  double fresh_max_rotation_deg = 3;
 };
 // TrackingOptions::prefetch_below of a live session (TrackingOptions::background), where guided
 // matching's SIFT is only ever extracted ahead (docs/tracker.md, "The tracking worker").
@@ -167,9 +183,13 @@ struct FrameResult {
   double rms_px = 0;       // inlier RMS, working pixels
   double rms_gate_px = 0;  // the largest RMS a tracked pose could have had (tracking only)
   int flow_tracks = 0;     // LK tracks that survived into this frame
+  double flow_motion_px = 0;  // their median move from the last frame, pixels of the working frame
   int guided_matches = 0;  // added by guided matching
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
+  // > 0: the tracked pose was replaced by the pose of the frame's own SIFT matched globally, on
+  // this many inliers (TrackingOptions::fresh_features_after_s).
+  int fresh_inliers = 0;
   // > 0: the pose's rotation came from image alignment (TrackingOptions::align_max_seconds), with
   // this correlation, its centre from the recent path; no correspondence supports it.
   double align_zncc = 0;
@@ -232,6 +252,10 @@ class Tracker {
   // After TrackWithPrior failed: the wide search around the prediction (wide_radius_fraction).
   bool TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                  std::optional<Features>* features, Track2D3D* inliers);
+  // A tracked frame posed again from its own SIFT matched globally (fresh_features_after_s):
+  // replaces result->pose and *inliers when that pose agrees with the tracked one.
+  bool PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+                             Track2D3D* inliers) const;
   // After every feature-based step failed: the rotation from `reference_pyramid` (the last posed
   // frame's) to `gray` by image alignment, the centre predicted.
   bool TrackByAlignment(const std::vector<cv::Mat>& reference_pyramid, const cv::Mat& gray, double timestamp,

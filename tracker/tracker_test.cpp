@@ -149,6 +149,35 @@ TEST(PlanarTrackerAtHd, AJumpOnAReducedFrameCostsOneRelocalizationExtraction) {
   EXPECT_LT(RotationErrorDeg(jump.pose, far), 0.2);
 }
 
+// Fresh features (fresh_features_after_s) on a reduced frame the flow posed alone: the fresh pose comes from
+// relocalization's own extraction (a smaller image), the keypoints a fresh tracker's
+// relocalization of the same frame finds, and it is as exact.
+TEST(PlanarTrackerAtHd, FreshFeaturesOfAFlowFrameAreRelocalizationsOwn) {
+  const HdPlane* hd = HdPlaneScene();
+  if (!hd) GTEST_SKIP() << "graf1.png missing (Debian package opencv-doc)";
+  const PlanarWorld& world = hd->world;
+  const map::Map& map = hd->map;
+  const calib::Pose start = LookAt({0.12, 0.06, -0.75}, {0.03, 0.01, 0});
+  const calib::Pose next = LookAt({0.125, 0.06, -0.75}, {0.03, 0.01, 0});  // 5 mm aside
+  const cv::Mat next_frame = world.Render(next);
+  Tracker own(map);
+  const FrameResult relocalised = own.Track(next_frame, 0.0);
+  ASSERT_EQ(relocalised.status, TrackStatus::kRelocalized) << relocalised.reason;
+
+  TrackerOptions options;
+  options.tracking.fresh_features_after_s = 0;  // every tracked frame
+  options.tracking.replenish_below = 0;  // the flow alone: no guided SIFT to reuse
+  Tracker tracker(map, options);
+  ASSERT_EQ(tracker.Track(world.Render(start), 0.0).status, TrackStatus::kRelocalized);
+  const FrameResult r = tracker.Track(next_frame, 1 / 30.0);
+  ASSERT_EQ(r.status, TrackStatus::kTracking) << r.reason;
+  EXPECT_EQ(r.guided_matches, 0);
+  EXPECT_GT(r.fresh_inliers, 0);
+  EXPECT_EQ(r.keypoints, relocalised.keypoints);
+  EXPECT_LT((r.pose.Center() - next.Center()).norm(), 0.003);
+  EXPECT_LT(RotationErrorDeg(r.pose, next), 0.2);
+}
+
 // Relocalization's own SIFT size: smaller only for frames that --sift-size reduces anyway.
 TEST(RelocSiftLongSide, ReducesOnlyFramesThatSiftReduces) {
   const calib::Camera vga = calib::Camera::Pinhole(640, 480, 500, 500, 319.5, 239.5);
@@ -191,6 +220,49 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
       << r.reason << " flow " << r.flow_tracks << " guided " << r.guided_matches << " inliers "
       << r.inliers << " err " << (r.pose.Center() - far.Center()).norm();
   ExpectNear(r, far, 0.003, 0.2);
+}
+
+// Fresh features: a tracked frame far from the last one in time (by default over 0.25 s: photos,
+// a sub-sampled clip) is posed again from its own SIFT matched against the whole map, and that
+// pose (close to the truth) is kept; frames at a video's rate are left to the flow, as with
+// fresh_features_after_s = -1 (never), unless it is 0 (every tracked frame).
+TEST_F(PlanarTrackerTest, FreshFeaturesPoseTrackedFramesFarApartFromGlobalMatches) {
+  struct Run {
+    const char* what;
+    double after_s;       // fresh_features_after_s
+    double frame_gap_s;   // between the frames' timestamps
+    bool fresh_expected;  // on the tracked frames
+  };
+  const double kDefault = TrackingOptions{}.fresh_features_after_s;
+  for (const Run run : {Run{"photos 1 s apart, the default", kDefault, 1.0, true},
+                        Run{"video at 10 fps, the default", kDefault, 0.1, false},
+                        Run{"video at 10 fps, every frame", 0.0, 0.1, true},
+                        Run{"photos 1 s apart, never", -1.0, 1.0, false}}) {
+    SCOPED_TRACE(run.what);
+    TrackerOptions options;
+    options.tracking.fresh_features_after_s = run.after_s;
+    Tracker tracker(*map_, options);
+    int tracked = 0, fresh = 0;
+    for (int i = 0; i < 10; ++i) {
+      const calib::Pose truth = PathPose(3 * i);  // frames 12 mm apart
+      const FrameResult r = tracker.Track(world_->Render(truth), i * run.frame_gap_s);
+      ASSERT_NE(r.status, TrackStatus::kLost) << "frame " << i << ": " << r.reason;
+      ExpectNear(r, truth, 0.003, 0.2);
+      if (r.status != TrackStatus::kTracking) continue;
+      ++tracked;
+      if (r.fresh_inliers > 0) {
+        ++fresh;
+        EXPECT_EQ(r.inliers, r.fresh_inliers);
+        EXPECT_GT(r.matches, 0) << "frame " << i;
+      }
+    }
+    ASSERT_GE(tracked, 8);
+    if (run.fresh_expected) {
+      EXPECT_GE(fresh, tracked - 1);
+    } else {
+      EXPECT_EQ(fresh, 0);
+    }
+  }
 }
 
 // A relocalization without a prior pose extracts COLMAP's weaker keypoints (contrast 0.02);

@@ -52,6 +52,7 @@ struct TrackArgs {
   double max_rms_px = 2.5;
   int tracking_min_inliers = 30;
   int replenish_below = 150;
+  double fresh_features_after = tracker::TrackingOptions{}.fresh_features_after_s;
   int prefetch_below = tracker::TrackingOptions{}.prefetch_below;
   int prefetch_lag = tracker::TrackingOptions{}.prefetch_lag_frames;
   double guided_radius_px = 10;
@@ -89,6 +90,7 @@ tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
   o.relocalization.pose.seed = a.seed;
   o.tracking.min_inliers = a.tracking_min_inliers;
   o.tracking.replenish_below = a.replenish_below;
+  o.tracking.fresh_features_after_s = a.fresh_features_after;
   o.tracking.prefetch_below = a.prefetch_below;
   o.tracking.prefetch_lag_frames = a.prefetch_lag;
   o.tracking.guided_radius_px = a.guided_radius_px;
@@ -125,6 +127,8 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"guided_matches", r.guided_matches},
                               {"prefetched_matches", r.prefetched_matches},
                               {"wide_matches", r.wide_matches},
+                              {"fresh_inliers", r.fresh_inliers},
+                              {"flow_motion_px", r.flow_motion_px},
                               {"align_zncc", r.align_zncc},
                               {"keypoints", r.keypoints},
                               {"matches", r.matches},
@@ -335,6 +339,12 @@ void AddTrackCommand(CLI::App& app) {
       ->capture_default_str()->check(CLI::Range(6, 100000));
   cmd->add_option("--replenish-below", a->replenish_below, "Run guided matching when fewer flow tracks survive")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+  cmd->add_option("--fresh-features-after", a->fresh_features_after,
+                  "A tracked frame that comes more than this many seconds after the last posed one is posed again "
+                  "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
+                  "the tracked pose: frames far apart (a sub-sampled clip, photos), where optical flow drifts; one SIFT "
+                  "extraction a frame more. 0: every tracked frame; -1: never")
+      ->capture_default_str()->check(CLI::Range(-1.0, 1e9));
   cmd->add_option("--prefetch-below", a->prefetch_below,
                   "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
                   "(in the frame that needs it)")
