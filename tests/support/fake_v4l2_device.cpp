@@ -76,7 +76,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -291,6 +290,7 @@ class Camera {
   void Produce();
   const std::vector<uint8_t>& Payload(long n);
   std::vector<uint8_t> MakePayload(size_t index) const;
+  bool Cache(size_t index, std::vector<uint8_t>& payload);
   void Preload();
 
   Settings settings_;
@@ -609,11 +609,17 @@ void Camera::Preload() {
                         for (int i = r.start; i < r.end; ++i) made[i] = MakePayload(first + i);
                       });
     for (size_t i = 0; i < made.size(); ++i) {
-      if (cache_bytes_ + made[i].size() > kCacheBytes) return;
-      cache_bytes_ += made[i].size();
-      cache_[first + i] = std::move(made[i]);
+      if (!Cache(first + i, made[i])) return;
     }
   }
+}
+
+// Keeps picture `index`'s payload (moved from) for the next lap when the cache has room for it.
+bool Camera::Cache(size_t index, std::vector<uint8_t>& payload) {
+  if (cache_bytes_ + payload.size() > kCacheBytes) return false;
+  cache_bytes_ += payload.size();
+  cache_[index] = std::move(payload);
+  return true;
 }
 
 // The picture of frame n at the streamed format and size, encoded as the camera sends it.
@@ -621,11 +627,7 @@ const std::vector<uint8_t>& Camera::Payload(long n) {
   const size_t index = pictures_.empty() ? 0 : static_cast<size_t>(n) % pictures_.size();
   if (!cache_[index].empty()) return cache_[index];
   std::vector<uint8_t> out = MakePayload(index);
-  if (cache_bytes_ + out.size() <= kCacheBytes) {
-    cache_bytes_ += out.size();
-    cache_[index] = std::move(out);
-    return cache_[index];
-  }
+  if (Cache(index, out)) return cache_[index];
   scratch_ = std::move(out);
   return scratch_;
 }
@@ -666,9 +668,10 @@ timeval MonotonicTime(std::chrono::steady_clock::time_point t) {
 // from its capture timestamp. The USB transfer is not emulated: the buffer is filled at the
 // frame time. On a machine too busy to make a payload within a frame interval (a 1280x720 PNG
 // decoded and encoded while other jobs run) the emulated sensor runs late and every latency
-// includes that lag: `--stats`' `arrival` stage (capture to dequeue) shows it. Frame times missed (the process stopped, a slow encode) are caught up at once, as
-// a sensor that went on meanwhile: the free buffers are filled, the rest dropped. (The
-// emulation lives in the reader's process, so a SIGSTOP stops it too.)
+// includes that lag: `--stats`' `arrival` stage (capture to dequeue) shows it. Frame times
+// missed (the process stopped, a slow encode) are caught up at once, as a sensor that went on
+// meanwhile: the free buffers are filled, the rest dropped. (The emulation lives in the
+// reader's process, so a SIGSTOP stops it too.)
 void Camera::Produce() {
   using Clock = std::chrono::steady_clock;
   std::unique_lock<std::mutex> lock(m_);
