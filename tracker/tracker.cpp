@@ -479,7 +479,7 @@ bool Tracker::TrackWide(const cv::Mat& gray, double timestamp, FrameResult* resu
   return true;
 }
 
-bool Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+void Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
                                     Track2D3D* inliers) const {
   const TrackingOptions& opt = options_.tracking;
   // A frame the flow posed alone has no SIFT yet: on a reduced frame relocalization's own, on a
@@ -503,15 +503,14 @@ bool Tracker::PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, st
   result->times.match_ms += fresh.match_ms;
   result->times.ransac_ms += fresh.pose.stats.ransac_ms;
   result->times.refine_ms += fresh.pose.stats.refine_ms;
-  if (!fresh.pose.ok || fresh.pose.stats.inliers < opt.min_inliers) return false;
+  if (!fresh.pose.ok || fresh.pose.stats.inliers < opt.min_inliers) return;
   const double turn_deg = fresh.pose.pose.q_cw.angularDistance(result->pose.q_cw) * 180.0 / M_PI;
-  if (turn_deg > opt.fresh_max_rotation_deg) return false;
+  if (turn_deg > opt.fresh_max_rotation_deg) return;
   result->pose = fresh.pose.pose;
   result->inliers = fresh.pose.stats.inliers;
   result->rms_px = fresh.pose.stats.rms_px;
   result->fresh_inliers = fresh.pose.stats.inliers;
   *inliers = fresh.inliers;
-  return true;
 }
 
 void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) const {

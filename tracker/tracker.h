@@ -253,8 +253,9 @@ class Tracker {
   bool TrackWide(const cv::Mat& gray, double timestamp, FrameResult* result,
                  std::optional<Features>* features, Track2D3D* inliers);
   // A tracked frame posed again from its own SIFT matched globally (fresh_features_after_s):
-  // replaces result->pose and *inliers when that pose agrees with the tracked one.
-  bool PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
+  // replaces result->pose and *inliers when that pose agrees with the tracked one (then
+  // result->fresh_inliers > 0).
+  void PoseFromFreshFeatures(const cv::Mat& gray, FrameResult* result, std::optional<Features>* features,
                              Track2D3D* inliers) const;
   // After every feature-based step failed: the rotation from `reference_pyramid` (the last posed
   // frame's) to `gray` by image alignment, the centre predicted.
