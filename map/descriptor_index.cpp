@@ -6,7 +6,13 @@
 // shuffles with cv::theRNG(), which is seeded here.
 #include <opencv2/flann.hpp>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
+#include <cstdint>
+#include <type_traits>
 #include <cstdlib>
 
 #include <cmath>
@@ -24,7 +30,71 @@ namespace arview::map {
 namespace {
 
 constexpr int kDescriptorSize = 128;
-using FlannIndex = cvflann::Index<cvflann::L2<unsigned char>>;
+// cvflann's L2 for bytes: the same squared distance as cvflann::L2<unsigned char>, bit for bit
+// (every partial sum is an integer below 2^24, exact in a float), computed 16 bytes at a time.
+// cvflann's own converts each byte to float and tests for an early exit every 4 bytes, which
+// the compiler cannot vectorise: the distance was most of the time of matching two frames. An
+// early exit only ever rejected a candidate whose full distance is larger still, so every
+// search returns what it returned with cvflann's.
+struct L2Bytes {
+  typedef cvflann::True is_kdtree_distance;
+  typedef cvflann::True is_vector_space_distance;
+  typedef unsigned char ElementType;
+  typedef float ResultType;
+  typedef ResultType CentersType;
+
+  template <typename Iterator1, typename Iterator2>
+  ResultType operator()(Iterator1 a, Iterator2 b, size_t size, ResultType /*worst_dist*/ = -1) const {
+    if constexpr (IsBytes<Iterator1>() && IsBytes<Iterator2>()) {
+      return static_cast<ResultType>(SquaredDistance(a, b, size));
+    } else {  // a k-means centre (floats), or cvflann's zero iterator, against bytes
+      ResultType result = 0;
+      for (size_t i = 0; i < size; ++i) {
+        const ResultType d = static_cast<ResultType>(a[i]) - static_cast<ResultType>(b[i]);
+        result += d * d;
+      }
+      return result;
+    }
+  }
+
+  template <typename Iterator>
+  static constexpr bool IsBytes() {
+    return std::is_pointer_v<Iterator> &&
+           std::is_same_v<std::remove_cv_t<std::remove_pointer_t<Iterator>>, unsigned char>;
+  }
+
+  template <typename U, typename V>
+  ResultType accum_dist(const U& a, const V& b, int) const {
+    return static_cast<ResultType>((a - b) * (a - b));
+  }
+
+  static std::int32_t SquaredDistance(const unsigned char* a, const unsigned char* b, size_t size) {
+    size_t i = 0;
+    std::int32_t sum = 0;
+#if defined(__SSE2__)
+    const __m128i zero = _mm_setzero_si128();
+    __m128i acc = zero;
+    for (; i + 16 <= size; i += 16) {
+      const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + i));
+      const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i));
+      const __m128i low = _mm_sub_epi16(_mm_unpacklo_epi8(va, zero), _mm_unpacklo_epi8(vb, zero));
+      const __m128i high = _mm_sub_epi16(_mm_unpackhi_epi8(va, zero), _mm_unpackhi_epi8(vb, zero));
+      acc = _mm_add_epi32(acc, _mm_madd_epi16(low, low));
+      acc = _mm_add_epi32(acc, _mm_madd_epi16(high, high));
+    }
+    alignas(16) std::int32_t lanes[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), acc);
+    sum = lanes[0] + lanes[1] + lanes[2] + lanes[3];
+#endif
+    for (; i < size; ++i) {
+      const std::int32_t d = static_cast<std::int32_t>(a[i]) - static_cast<std::int32_t>(b[i]);
+      sum += d * d;
+    }
+    return sum;
+  }
+};
+
+using FlannIndex = cvflann::Index<L2Bytes>;
 
 void CheckDescriptorMatrix(const cv::Mat& m, const char* what) {
   if (m.type() != CV_8UC1 || m.cols != kDescriptorSize) {

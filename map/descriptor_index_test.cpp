@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <opencv2/core.hpp>
+#include <opencv2/flann.hpp>
 
 #include <cmath>
 #include <random>
@@ -66,6 +67,42 @@ TEST(DescriptorIndex, SameSeedSameNeighbours) {
       ASSERT_EQ(first[q].size(), second[q].size()) << "kind " << static_cast<int>(kind) << " query " << q;
       for (size_t j = 0; j < first[q].size(); ++j)
         ASSERT_EQ(first[q][j].row, second[q][j].row) << "kind " << static_cast<int>(kind) << " query " << q;
+    }
+  }
+}
+
+// arview's byte distance answers exactly what cvflann's own L2<unsigned char> answers: the same
+// trees (same seed), the same neighbours, the same distances, for kd-trees and k-means alike.
+TEST(DescriptorIndex, TheByteDistanceAnswersAsCvflannsOwn) {
+  const cv::Mat data = RandomDescriptors(3000, 11);
+  const cv::Mat queries = RandomDescriptors(300, 12);
+  for (IndexKind kind : {IndexKind::kKdTree, IndexKind::kKMeans, IndexKind::kLinear}) {
+    const IndexParams params{.kind = kind, .checks = 32, .seed = 3};
+    const auto ours = DescriptorIndex(data, params).Knn(queries, 2);
+    const cv::RNG caller_rng = cv::theRNG();
+    cvflann::seed_random(params.seed);
+    std::srand(params.seed);
+    const cvflann::IndexParams flann_params =
+        kind == IndexKind::kKdTree   ? cvflann::IndexParams(cvflann::KDTreeIndexParams(params.trees))
+        : kind == IndexKind::kKMeans ? cvflann::IndexParams(cvflann::KMeansIndexParams(params.branching, params.iterations))
+                                     : cvflann::IndexParams(cvflann::LinearIndexParams());
+    const cvflann::Matrix<unsigned char> view(data.data, static_cast<size_t>(data.rows), 128);
+    cvflann::Index<cvflann::L2<unsigned char>> theirs(view, flann_params);
+    theirs.buildIndex();
+    cv::theRNG() = caller_rng;
+    std::vector<int> rows(static_cast<size_t>(queries.rows) * 2);
+    std::vector<float> squared(rows.size());
+    cvflann::Matrix<int> row_view(rows.data(), static_cast<size_t>(queries.rows), 2);
+    cvflann::Matrix<float> squared_view(squared.data(), static_cast<size_t>(queries.rows), 2);
+    theirs.knnSearch(cvflann::Matrix<unsigned char>(queries.data, static_cast<size_t>(queries.rows), 128), row_view,
+                     squared_view, 2,
+                     cvflann::SearchParams(kind == IndexKind::kLinear ? cvflann::FLANN_CHECKS_UNLIMITED : params.checks));
+    for (size_t q = 0; q < ours.size(); ++q) {
+      ASSERT_EQ(ours[q].size(), 2u);
+      for (size_t j = 0; j < 2; ++j) {
+        EXPECT_EQ(static_cast<int>(ours[q][j].row), rows[q * 2 + j]) << "kind " << static_cast<int>(kind) << " query " << q;
+        EXPECT_EQ(ours[q][j].distance, std::sqrt(squared[q * 2 + j])) << "kind " << static_cast<int>(kind) << " query " << q;
+      }
     }
   }
 }

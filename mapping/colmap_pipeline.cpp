@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <fstream>
 #include <cstdio>
@@ -692,16 +693,18 @@ KeyframeImages KeyframeImagesIn(const map::Map& map, const std::vector<fs::path>
 }
 
 // The requested fit. Throws MapError when it cannot be made.
+// `board_search`: the board's search already under way, or null to search the keyframes now.
 MetricFit FitRequested(const map::Map& map, const ScaleRequest& request, const KeyframeImages& images,
-                       const MapBuildOptions& options, const MapBuildCallbacks& cb) {
+                       const MapBuildOptions& options, const MapBuildCallbacks& cb,
+                       BoardSearchInBackground* board_search = nullptr) {
   switch (request.from) {
     case ScaleFrom::kBoard: {
-      const std::vector<BoardSighting> seen = FindBoard(
-          map, images, request.board.inner_corners,
-          [&](int done, int total) {
-            if (cb.progress) cb.progress("board", done, total);
-          },
-          options.cancel);
+      const auto progress = [&](int done, int total) {
+        if (cb.progress) cb.progress("board", done, total);
+      };
+      const std::vector<BoardSighting> seen =
+          board_search ? board_search->Sightings(map, progress, options.cancel)
+                       : FindBoard(map, images, request.board.inner_corners, progress, options.cancel);
       return FitFromBoard(map, TriangulateBoard(map, seen, request.board.inner_corners), request.board);
     }
     case ScaleFrom::kKnownDistance:
@@ -719,7 +722,7 @@ MetricFit FitRequested(const map::Map& map, const ScaleRequest& request, const K
 // result->scale_failure says why), the COLMAP model with it.
 // `read_model` reads the moved model back: the map is then exactly what a re-run reads (COLMAP
 // rounds the transformed poses its own way), so that the same command again writes the same bytes.
-void MakeMetric(const KeyframeImages& images, const MapBuildOptions& options,
+void MakeMetric(const KeyframeImages& images, BoardSearchInBackground* board_search, const MapBuildOptions& options,
                 const MapBuildCallbacks& cb, const std::function<map::Map()>& read_model, MapBuildResult* result) {
   // The model read may be one an earlier run moved already: its frame comes with it.
   const std::optional<ModelFrame> earlier = ReadModelFrame(result->model_dir);
@@ -736,7 +739,7 @@ void MakeMetric(const KeyframeImages& images, const MapBuildOptions& options,
   if (options.scale.from == ScaleFrom::kNone) return;
   std::optional<MetricFit> fit;
   try {
-    fit = FitRequested(result->map, options.scale, images, options, cb);
+    fit = FitRequested(result->map, options.scale, images, options, cb, board_search);
   } catch (const map::MapError& e) {
     if (options.scale.from == ScaleFrom::kCameraHeight) {
       if (cb.note) cb.note(std::string("the map stays in COLMAP's units and orientation: ") + e.what());
@@ -811,6 +814,11 @@ std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const 
   std::vector<std::string> args{"mapper", "--database_path", database.string(), "--image_path",
                                 image_root.string(), "--output_path", sparse.string(),
                                 "--Mapper.num_threads", std::to_string(options.threads),
+                                // COLMAP runs a bundle adjustment of fewer residuals on one thread;
+                                // its default bar (50,000) keeps every local adjustment of a
+                                // 96-frame room (20,000-45,000) there: 27 s of its 66 s mapper.
+                                // The demo room's mapper at 5,000: 46 s, the same map.
+                                "--Mapper.ba_min_num_residuals_for_multi_threading", "5000",
                                 "--Mapper.ba_refine_focal_length", refine,
                                 "--Mapper.ba_refine_principal_point", refine,
                                 "--Mapper.ba_refine_extra_params", refine,
@@ -992,6 +1000,22 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
   };
   match();
+  // The board is looked for while COLMAP maps, on the CPU time its mapper leaves (a third of two
+  // cores); not when the mapper's stage will be skipped, as its model is then likely made metric.
+  std::optional<BoardSearchInBackground> board_search;
+  if (options.scale.from == ScaleFrom::kBoard && !(fs::is_directory(sparse) && stages.Matches("map", mapper_inputs))) {
+    board_search.emplace(
+        images.names,
+        [root = images.root](const std::string& name) {
+          try {
+            return ReadImageFile(root / name, cv::IMREAD_GRAYSCALE);
+          } catch (const Error&) {
+            return cv::Mat();
+          }
+        },
+        options.scale.board.inner_corners,
+        options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  }
   mapper({});
   t0 = std::chrono::steady_clock::now();
   read_model();
@@ -1011,7 +1035,8 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     moved.camera.focus = recording.camera.focus;
     return moved;
   };
-  MakeMetric(KeyframeImagesIn(result.map, {images.root}), options, cb, read_moved_model, &result);
+  MakeMetric(KeyframeImagesIn(result.map, {images.root}), board_search ? &*board_search : nullptr, options, cb,
+             read_moved_model, &result);
   WriteMapFiles(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;

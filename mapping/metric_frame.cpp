@@ -3,13 +3,22 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include <pthread.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <mutex>
 #include <optional>
+#include <thread>
+#include <unordered_map>
 
 #include "base/plane_fit.h"
 #include "base/stats.h"
@@ -232,6 +241,18 @@ Sim3 Compose(const Sim3& a, const Sim3& b) {
   return c;
 }
 
+namespace {
+
+// The board's corners in one grey image, or none.
+std::vector<Eigen::Vector2d> BoardCornersIn(const cv::Mat& gray, cv::Size inner) {
+  std::vector<Eigen::Vector2d> corners;
+  if (gray.empty()) return corners;
+  for (const cv::Point2f& p : calib::FindChessboardCorners(gray, inner)) corners.emplace_back(p.x, p.y);
+  return corners;
+}
+
+}  // namespace
+
 std::vector<BoardSighting> FindBoard(const map::Map& map, const KeyframeImages& images, cv::Size inner,
                                      const std::function<void(int, int)>& progress, const CancellationToken& cancel) {
   // Keyframes in parallel (a detector that misses takes ~0.3 s on a 640x480 frame), in order.
@@ -242,15 +263,8 @@ std::vector<BoardSighting> FindBoard(const map::Map& map, const KeyframeImages& 
   cv::parallel_for_(cv::Range(0, total), [&](const cv::Range& range) {
     for (int k = range.start; k < range.end; ++k) {
       if (cancel.IsCancelled()) return;
-      const cv::Mat gray = images(static_cast<std::size_t>(k));
-      if (!gray.empty()) {
-        const std::vector<cv::Point2f> corners = calib::FindChessboardCorners(gray, inner);
-        if (!corners.empty()) {
-          BoardSighting s{static_cast<std::size_t>(k), {}};
-          for (const cv::Point2f& p : corners) s.corners.emplace_back(p.x, p.y);
-          found[k] = std::move(s);
-        }
-      }
+      std::vector<Eigen::Vector2d> corners = BoardCornersIn(images(static_cast<std::size_t>(k)), inner);
+      if (!corners.empty()) found[k] = BoardSighting{static_cast<std::size_t>(k), std::move(corners)};
       const std::lock_guard<std::mutex> lock(progress_mutex);
       ++done;
       if (progress) progress(done, total);
@@ -260,6 +274,140 @@ std::vector<BoardSighting> FindBoard(const map::Map& map, const KeyframeImages& 
   std::vector<BoardSighting> sightings;
   for (auto& s : found)
     if (s) sightings.push_back(std::move(*s));
+  return sightings;
+}
+
+struct BoardSearchInBackground::State {
+  enum class Image : char { kNotStarted, kStarted, kDone };
+  std::vector<std::string> names;
+  ReadImage read;
+  cv::Size inner;
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::vector<Image> images;                        // under mutex
+  std::vector<std::vector<Eigen::Vector2d>> corners;  // under mutex; an image's, once kDone
+  std::exception_ptr failure;                       // under mutex: the first image that threw
+  bool stopping = false;                            // under mutex
+  std::vector<std::thread> threads;
+
+  // Searches image i and records it (the first of two searches of one image to finish counts).
+  void Search(std::size_t i) {
+    std::vector<Eigen::Vector2d> found;
+    std::exception_ptr thrown;
+    try {
+      found = BoardCornersIn(read(names[i]), inner);
+    } catch (...) {
+      thrown = std::current_exception();
+    }
+    const std::lock_guard lock(mutex);
+    if (thrown && !failure) failure = thrown;
+    if (images[i] != Image::kDone) {
+      images[i] = Image::kDone;
+      corners[i] = std::move(found);
+    }
+    changed.notify_all();
+  }
+
+  // The first image of `wanted` in `state` (under mutex), marked started; nullopt when none.
+  std::optional<std::size_t> Take(const std::vector<std::size_t>& wanted, Image state) {
+    for (std::size_t i : wanted) {
+      if (images[i] != state) continue;
+      images[i] = Image::kStarted;
+      return i;
+    }
+    return std::nullopt;
+  }
+};
+
+namespace {
+
+void SearchInTheBackground(BoardSearchInBackground::State& state) {
+  pthread_setname_np(pthread_self(), "arview-board");  // shown by top -H
+  // The lowest nice value rather than SCHED_IDLE: a nice-19 thread still gets a little time on a
+  // machine that other work keeps busy, so that the join in the destructor cannot wait forever.
+  // Failing to lower it costs only the priority.
+  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
+  (void)setpriority(PRIO_PROCESS, tid, 19);
+  std::vector<std::size_t> all(state.names.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  for (;;) {
+    std::optional<std::size_t> image;
+    {
+      const std::lock_guard lock(state.mutex);
+      if (state.stopping) return;
+      image = state.Take(all, BoardSearchInBackground::State::Image::kNotStarted);
+    }
+    if (!image) return;
+    state.Search(*image);
+  }
+}
+
+}  // namespace
+
+BoardSearchInBackground::BoardSearchInBackground(std::vector<std::string> names, ReadImage read,
+                                                 cv::Size inner_corners, int threads)
+    : state_(std::make_shared<State>()) {
+  state_->names = std::move(names);
+  state_->read = std::move(read);
+  state_->inner = inner_corners;
+  state_->images.assign(state_->names.size(), State::Image::kNotStarted);
+  state_->corners.resize(state_->names.size());
+  for (int t = 0; t < std::max(1, threads); ++t) state_->threads.emplace_back(SearchInTheBackground, std::ref(*state_));
+}
+
+BoardSearchInBackground::~BoardSearchInBackground() {
+  {
+    const std::lock_guard lock(state_->mutex);
+    state_->stopping = true;
+  }
+  for (std::thread& t : state_->threads) t.join();
+}
+
+std::vector<BoardSighting> BoardSearchInBackground::Sightings(const map::Map& map,
+                                                              const std::function<void(int, int)>& progress,
+                                                              const CancellationToken& cancel) {
+  State& s = *state_;
+  std::unordered_map<std::string, std::size_t> by_name;
+  for (std::size_t i = 0; i < s.names.size(); ++i) by_name.emplace(s.names[i], i);
+  std::vector<std::size_t> wanted;  // the keyframes' images, in keyframe order
+  std::vector<std::optional<BoardSighting>> found(map.keyframes.size());
+  const int total = static_cast<int>(map.keyframes.size());
+  int searched_here = 0;
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    const auto it = by_name.find(map.keyframes[k].name);
+    if (it != by_name.end()) {
+      wanted.push_back(it->second);
+      continue;
+    }
+    cancel.ThrowIfCancelled("stopped looking for the board; the map was not changed");
+    std::vector<Eigen::Vector2d> corners = BoardCornersIn(s.read(map.keyframes[k].name), s.inner);
+    if (!corners.empty()) found[k] = BoardSighting{k, std::move(corners)};
+    ++searched_here;
+  }
+  for (;;) {
+    std::optional<std::size_t> image;
+    {
+      const std::lock_guard lock(s.mutex);
+      if (s.failure) std::rethrow_exception(s.failure);
+      const auto done = std::count_if(wanted.begin(), wanted.end(), [&](std::size_t i) { return s.images[i] == State::Image::kDone; });
+      if (progress) progress(searched_here + static_cast<int>(done), total);
+      if (static_cast<std::size_t>(done) == wanted.size()) break;
+      // Not all done: one is not started, or a background thread holds it.
+      image = s.Take(wanted, State::Image::kNotStarted);
+      if (!image) image = s.Take(wanted, State::Image::kStarted);
+    }
+    cancel.ThrowIfCancelled("stopped looking for the board; the map was not changed");
+    s.Search(*image);
+  }
+  const std::lock_guard lock(s.mutex);
+  for (std::size_t k = 0, w = 0; k < map.keyframes.size(); ++k) {
+    if (!by_name.count(map.keyframes[k].name)) continue;
+    const std::size_t i = wanted[w++];
+    if (!s.corners[i].empty()) found[k] = BoardSighting{k, s.corners[i]};
+  }
+  std::vector<BoardSighting> sightings;
+  for (auto& f : found)
+    if (f) sightings.push_back(std::move(*f));
   return sightings;
 }
 

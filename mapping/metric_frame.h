@@ -22,6 +22,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,37 @@ using KeyframeImages = std::function<cv::Mat(std::size_t keyframe)>;
 std::vector<BoardSighting> FindBoard(const map::Map& map, const KeyframeImages& images, cv::Size inner_corners,
                                      const std::function<void(int, int)>& progress = {},
                                      const CancellationToken& cancel = {});
+
+// The board looked for in a set of images while the caller does other work (arview map: while
+// COLMAP extracts, matches and maps): on `threads` threads that get only the CPU time nothing
+// else wants (Linux's SCHED_IDLE), so that the stages beside it are not slowed. The map's
+// keyframes are not known before COLMAP has mapped, so every image given is searched.
+//
+//   BoardSearchInBackground search(names, read, {9, 6}, 2);
+//   ... COLMAP's stages ...
+//   std::vector<BoardSighting> seen = search.Sightings(map, progress, cancel);
+//
+// Stopped and joined when destroyed.
+class BoardSearchInBackground {
+ public:
+  using ReadImage = std::function<cv::Mat(const std::string& name)>;  // grey; empty when unreadable
+  BoardSearchInBackground(std::vector<std::string> names, ReadImage read, cv::Size inner_corners, int threads);
+  ~BoardSearchInBackground();
+  BoardSearchInBackground(const BoardSearchInBackground&) = delete;
+  BoardSearchInBackground& operator=(const BoardSearchInBackground&) = delete;
+
+  // The sightings in the map's keyframes (by Keyframe::name), as FindBoard gives them. The
+  // calling thread searches too while it waits, at its own priority: the images not yet
+  // started, then those an idle thread still holds, so that a busy machine cannot starve the
+  // result. A keyframe whose name was not given is searched here. `progress(done, total)`.
+  std::vector<BoardSighting> Sightings(const map::Map& map, const std::function<void(int, int)>& progress = {},
+                                       const CancellationToken& cancel = {});
+
+  struct State;  // shared with the threads
+
+ private:
+  std::shared_ptr<State> state_;
+};
 
 // The corners triangulated from the keyframes' poses: each sighting put in the first one's corner
 // order (a chessboard is found starting from any of its corners), then every corner triangulated

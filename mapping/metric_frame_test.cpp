@@ -4,8 +4,13 @@
 
 #include <Eigen/Geometry>
 
+#include <opencv2/imgproc.hpp>
+
+#include <atomic>
+#include <map>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 namespace arview::mapping {
 namespace {
@@ -177,6 +182,84 @@ TEST(MetricFrame, TheCameraHeightEstimateIsStatedWithItsError) {
   map::Map no_floor = s.map;
   no_floor.points.resize(2);
   EXPECT_THROW(FitFromCameraHeight(no_floor), map::MapError);
+}
+
+// A grey 640x480 image: a board of 10x7 squares of `square` px at `origin` on a noisy
+// background, or the background alone when square is 0.
+cv::Mat BoardImage(int square, cv::Point origin, int seed) {
+  cv::Mat image(480, 640, CV_8UC1);
+  cv::theRNG().state = static_cast<std::uint64_t>(seed);
+  cv::randu(image, 100, 156);
+  cv::GaussianBlur(image, image, {5, 5}, 2);
+  if (square == 0) return image;
+  cv::rectangle(image, cv::Rect(origin.x - square, origin.y - square, 12 * square, 9 * square), 255, cv::FILLED);
+  for (int row = 0; row < 7; ++row)
+    for (int column = 0; column < 10; ++column)
+      if ((row + column) % 2 == 0)
+        cv::rectangle(image, cv::Rect(origin.x + column * square, origin.y + row * square, square, square), 0, cv::FILLED);
+  return image;
+}
+
+TEST(BoardSearchInBackground, FindsWhatFindBoardFindsInTheMapsKeyframes) {
+  // Six images the search is given (two without the board, one unreadable), a keyframe whose
+  // image it was not given, and one image that is not a keyframe.
+  std::map<std::string, cv::Mat> images{{"a.png", BoardImage(30, {100, 80}, 1)}, {"b.png", BoardImage(0, {}, 2)},
+                                        {"c.png", BoardImage(24, {250, 200}, 3)}, {"d.png", cv::Mat()},
+                                        {"e.png", BoardImage(0, {}, 4)},           {"f.png", BoardImage(36, {40, 60}, 5)},
+                                        {"late.png", BoardImage(28, {200, 150}, 6)}};
+  std::atomic<int> reads{0};
+  const auto read = [&](const std::string& name) {
+    ++reads;
+    return images.at(name).clone();
+  };
+  map::Map map;
+  for (const char* name : {"f.png", "a.png", "b.png", "late.png", "c.png", "d.png"}) {
+    map::Keyframe k;
+    k.name = name;
+    map.keyframes.push_back(k);
+  }
+  const std::vector<BoardSighting> expected = FindBoard(
+      map, [&](std::size_t k) { return images.at(map.keyframes[k].name); }, {9, 6});
+  ASSERT_EQ(expected.size(), 4u);  // f, a, late, c
+
+  BoardSearchInBackground search({"a.png", "b.png", "c.png", "d.png", "e.png", "f.png"}, read, {9, 6}, 2);
+  std::vector<std::pair<int, int>> progress;
+  const std::vector<BoardSighting> found =
+      search.Sightings(map, [&](int done, int total) { progress.emplace_back(done, total); });
+  ASSERT_EQ(found.size(), expected.size());
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    EXPECT_EQ(found[i].keyframe, expected[i].keyframe);
+    ASSERT_EQ(found[i].corners.size(), 54u);
+    for (std::size_t c = 0; c < 54; ++c) EXPECT_LT((found[i].corners[c] - expected[i].corners[c]).norm(), 1e-9);
+  }
+  ASSERT_FALSE(progress.empty());
+  EXPECT_EQ(progress.back(), std::make_pair(6, 6));
+  EXPECT_GE(reads.load(), 6);  // every keyframe's image, e.png perhaps not yet
+}
+
+TEST(BoardSearchInBackground, AReadThatThrowsReachesTheCallerAndDestructionStopsTheThreads) {
+  const auto throwing = [](const std::string& name) -> cv::Mat {
+    if (name == "bad.png") throw std::runtime_error("bad.png: cannot read");
+    return BoardImage(0, {}, 7);
+  };
+  map::Map map;
+  for (const char* name : {"ok.png", "bad.png"}) {
+    map::Keyframe k;
+    k.name = name;
+    map.keyframes.push_back(k);
+  }
+  {
+    BoardSearchInBackground search({"ok.png", "bad.png"}, throwing, {9, 6}, 2);
+    EXPECT_THROW(search.Sightings(map), std::runtime_error);
+  }
+  // Destroyed while many images are still to be searched: returns once each thread's image is done.
+  std::vector<std::string> many(200, "ok.png");
+  { BoardSearchInBackground search(many, throwing, {9, 6}, 2); }
+  // A cancelled token stops the caller's part.
+  BoardSearchInBackground search(many, throwing, {9, 6}, 1);
+  CancellationToken cancel;
+  cancel.Cancel();
+  EXPECT_THROW(search.Sightings(map, {}, cancel), CancelledError);
 }
 
 }  // namespace
