@@ -323,7 +323,7 @@ namespace {
 
 void SearchInTheBackground(BoardSearchInBackground::State& state) {
   pthread_setname_np(pthread_self(), "arview-board");  // shown by top -H
-  // The lowest nice value rather than SCHED_IDLE: a nice-19 thread still gets a little time on a
+  // Nice 19, the lowest priority, rather than SCHED_IDLE: a nice-19 thread still gets a little time on a
   // machine that other work keeps busy, so that the join in the destructor cannot wait forever.
   // Failing to lower it costs only the priority.
   const auto tid = static_cast<id_t>(syscall(SYS_gettid));
@@ -386,20 +386,23 @@ std::vector<BoardSighting> BoardSearchInBackground::Sightings(const map::Map& ma
   }
   for (;;) {
     std::optional<std::size_t> image;
+    std::size_t done = 0;
     {
       const std::lock_guard lock(s.mutex);
       if (s.failure) std::rethrow_exception(s.failure);
-      const auto done = std::count_if(wanted.begin(), wanted.end(), [&](std::size_t i) { return s.images[i] == State::Image::kDone; });
-      if (progress) progress(searched_here + static_cast<int>(done), total);
-      if (static_cast<std::size_t>(done) == wanted.size()) break;
+      done = static_cast<std::size_t>(
+          std::count_if(wanted.begin(), wanted.end(), [&](std::size_t i) { return s.images[i] == State::Image::kDone; }));
       // Not all done: one is not started, or a background thread holds it.
-      image = s.Take(wanted, State::Image::kNotStarted);
-      if (!image) image = s.Take(wanted, State::Image::kStarted);
+      if (done < wanted.size()) image = s.Take(wanted, State::Image::kNotStarted);
+      if (done < wanted.size() && !image) image = s.Take(wanted, State::Image::kStarted);
     }
+    if (progress) progress(searched_here + static_cast<int>(done), total);
+    if (!image) break;
     cancel.ThrowIfCancelled("stopped looking for the board; the map was not changed");
     s.Search(*image);
   }
   const std::lock_guard lock(s.mutex);
+  s.stopping = true;  // the images no keyframe was made from are not needed
   for (std::size_t k = 0, w = 0; k < map.keyframes.size(); ++k) {
     if (!by_name.count(map.keyframes[k].name)) continue;
     const std::size_t i = wanted[w++];

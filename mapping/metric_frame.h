@@ -64,9 +64,9 @@ std::vector<BoardSighting> FindBoard(const map::Map& map, const KeyframeImages& 
                                      const CancellationToken& cancel = {});
 
 // The board looked for in a set of images while the caller does other work (arview map: while
-// COLMAP extracts, matches and maps): on `threads` threads that get only the CPU time nothing
-// else wants (Linux's SCHED_IDLE), so that the stages beside it are not slowed. The map's
-// keyframes are not known before COLMAP has mapped, so every image given is searched.
+// COLMAP maps, which leaves a third of two cores unused): on `threads` threads at the lowest
+// priority (nice 19), so that they take mostly CPU time nothing else wants. The map's keyframes
+// are not known before COLMAP has mapped, so every image given is searched.
 //
 //   BoardSearchInBackground search(names, read, {9, 6}, 2);
 //   ... COLMAP's stages ...
@@ -85,6 +85,7 @@ class BoardSearchInBackground {
   // calling thread searches too while it waits, at its own priority: the images not yet
   // started, then those an idle thread still holds, so that a busy machine cannot starve the
   // result. A keyframe whose name was not given is searched here. `progress(done, total)`.
+  // Once: the background threads stop when it returns.
   std::vector<BoardSighting> Sightings(const map::Map& map, const std::function<void(int, int)>& progress = {},
                                        const CancellationToken& cancel = {});
 
