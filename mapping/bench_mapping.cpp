@@ -11,6 +11,7 @@
 // Read the CPU column: on a shared machine the wall time includes waiting for a core.
 
 #include <benchmark/benchmark.h>
+#include <opencv2/flann.hpp>
 
 #include <cstdlib>
 #include <iostream>
@@ -110,6 +111,36 @@ void BM_Knn(benchmark::State& state) {
   state.counters["queries"] = d.queries.rows;  // time per query = CPU time / queries
 }
 
+// The same kd-tree search through cvflann's own L2<unsigned char> (what DescriptorIndex used
+// before its byte distance, map/descriptor_index.cpp): the same trees (same seed) and answers,
+// side by side in one run.
+void BM_KnnCvflannL2(benchmark::State& state) {
+  const BenchData& d = Data();
+  const map::IndexParams p = Params(state);
+  const cv::RNG caller_rng = cv::theRNG();
+  cvflann::seed_random(p.seed);
+  std::srand(p.seed);
+  cvflann::Index<cvflann::L2<unsigned char>> index(
+      cvflann::Matrix<unsigned char>(d.map.descriptors.data, static_cast<size_t>(d.map.descriptors.rows), 128),
+      cvflann::KDTreeIndexParams(p.trees));
+  index.buildIndex();
+  cv::theRNG() = caller_rng;
+  const size_t queries = static_cast<size_t>(d.queries.rows);
+  std::vector<int> rows(queries * 2);
+  std::vector<float> squared(queries * 2);
+  cvflann::Matrix<int> row_view(rows.data(), queries, 2);
+  cvflann::Matrix<float> squared_view(squared.data(), queries, 2);
+  for (auto _ : state) {
+    index.knnSearch(cvflann::Matrix<unsigned char>(d.queries.data, queries, 128), row_view, squared_view, 2,
+                    cvflann::SearchParams(p.checks));
+    benchmark::DoNotOptimize(rows.data());
+  }
+  int hits = 0;
+  for (size_t q = 0; q < queries; ++q) hits += rows[q * 2] == static_cast<int>(d.truth[q]);
+  state.counters["recall"] = static_cast<double>(hits) / static_cast<double>(queries);
+  state.counters["queries"] = d.queries.rows;
+}
+
 // Args: kind (0 linear, 1 kd-tree, 2 k-means), trees or branching, checks.
 void IndexGrid(benchmark::internal::Benchmark* b) {
   b->Args({0, 1, 0});
@@ -121,6 +152,7 @@ void IndexGrid(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_BuildIndex)->Args({1, 4, 64})->Args({1, 8, 64})->Args({2, 32, 64})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Knn)->Apply(IndexGrid)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_KnnCvflannL2)->Args({1, 4, 32})->Args({1, 4, 64})->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
