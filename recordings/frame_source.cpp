@@ -3,6 +3,8 @@
 #include "base/image_file.h"
 #include "base/stats.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <numeric>
 #include <thread>
@@ -44,6 +46,54 @@ RecordingSource::RecordingSource(Recording recording, ReplayOptions options)
       throw SourceError(file + ": cannot be opened as a video (OpenCV FFmpeg backend)");
     }
   }
+  if (options_.paced && options_.read_ahead > 0) ahead_thread_ = std::thread(&RecordingSource::ReadAhead, this);
+}
+
+RecordingSource::~RecordingSource() {
+  if (!ahead_thread_.joinable()) return;
+  {
+    const std::lock_guard lock(ahead_mutex_);
+    stopping_ = true;
+  }
+  ahead_changed_.notify_all();
+  ahead_thread_.join();
+}
+
+void RecordingSource::ReadAhead() {
+  pthread_setname_np(pthread_self(), "arview-readahd");  // shown by top -H
+  for (;;) {
+    {
+      std::unique_lock lock(ahead_mutex_);
+      ahead_changed_.wait(lock, [&] { return stopping_ || static_cast<int>(ahead_.size()) < options_.read_ahead; });
+      if (stopping_) return;
+    }
+    std::optional<Read> read;
+    std::exception_ptr error;
+    try {
+      read = ReadNext();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    {
+      const std::lock_guard lock(ahead_mutex_);
+      if (read) ahead_.push_back(std::move(*read));
+      else ahead_ended_ = true;
+      ahead_error_ = error;
+    }
+    ahead_changed_.notify_all();
+    if (!read) return;
+  }
+}
+
+std::optional<RecordingSource::Read> RecordingSource::ReadNext() {
+  if (cursor_ == order_.size()) {
+    if (!options_.loop || (options_.passes > 0 && pass_ >= options_.passes)) return std::nullopt;
+    cursor_ = 0;
+    ++pass_;
+    loop_offset_ += pass_length_;
+  }
+  const int index = order_[cursor_++];
+  return Read{ReadFrame(index), index, recording_.frames[index].timestamp + loop_offset_};
 }
 
 cv::Mat RecordingSource::ReadVideoFrame(int index) {
@@ -99,16 +149,25 @@ std::chrono::steady_clock::time_point RecordingSource::WaitUntilDue(double times
 }
 
 bool RecordingSource::Next(Frame& frame) {
-  if (cursor_ == order_.size()) {
-    if (!options_.loop || (options_.passes > 0 && pass_ >= options_.passes)) return false;
-    cursor_ = 0;
-    ++pass_;
-    loop_offset_ += pass_length_;
+  std::optional<Read> read;
+  if (ahead_thread_.joinable()) {
+    std::unique_lock lock(ahead_mutex_);
+    ahead_changed_.wait(lock, [&] { return !ahead_.empty() || ahead_ended_; });
+    if (ahead_.empty()) {
+      if (ahead_error_) std::rethrow_exception(ahead_error_);
+      return false;
+    }
+    read = std::move(ahead_.front());
+    ahead_.pop_front();
+    lock.unlock();
+    ahead_changed_.notify_all();
+  } else {
+    read = ReadNext();
+    if (!read) return false;
   }
-  const int index = order_[cursor_++];
-  frame.image = ReadFrame(index);
-  frame.index = index;
-  frame.timestamp = recording_.frames[index].timestamp + loop_offset_;
+  frame.image = std::move(read->image);
+  frame.index = read->index;
+  frame.timestamp = read->timestamp;
   // Paced, the frame is "captured" when it is due, as a camera's would be: a slow read shows as
   // latency. Unpaced, it is captured when it is read.
   frame.capture_time = options_.paced ? WaitUntilDue(frame.timestamp) : std::chrono::steady_clock::now();

@@ -3,10 +3,16 @@
 // the real-time pipeline read every source through this one interface.
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <exception>
 #include <filesystem>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -61,6 +67,12 @@ struct ReplayOptions {
   long passes = 0;
   // 0-based indices into frames.txt to deliver, in this order (ParseFrameSpec); empty = all.
   std::vector<int> frames;
+  // With paced: frames read and decoded up to this many ahead of their time, on a thread of the
+  // source's own, from its construction on, as a camera's driver holds the frames its sensor has
+  // made: a frame is then due with its pixels ready, and a moment when the decoding falls behind
+  // (the session's busy start) is made up before the frame is due. 0: each frame is read
+  // when the one before it has been taken.
+  int read_ahead = 8;
 };
 
 // Replays a recording folder: one image per frame, or one video file decoded with OpenCV's
@@ -68,11 +80,22 @@ struct ReplayOptions {
 class RecordingSource : public FrameSource {
  public:
   explicit RecordingSource(Recording recording, ReplayOptions options = {});
+  ~RecordingSource() override;
+  RecordingSource(const RecordingSource&) = delete;
+  RecordingSource& operator=(const RecordingSource&) = delete;
   bool Next(Frame& frame) override;
   std::string Name() const override { return recording_.root.string(); }
   const Recording& recording() const { return recording_; }
 
  private:
+  struct Read {
+    cv::Mat image;
+    int index = 0;
+    double timestamp = 0;
+  };
+  // The next frame of the order (across the loop's passes), read and decoded; none at the end.
+  std::optional<Read> ReadNext();
+  void ReadAhead();  // the read-ahead thread
   cv::Mat ReadFrame(int index);
   cv::Mat ReadVideoFrame(int index);
   // Sleeps until the frame at `timestamp` is due and returns when that is.
@@ -90,6 +113,16 @@ class RecordingSource : public FrameSource {
   bool started_ = false;
   std::chrono::steady_clock::time_point wall_start_;
   double first_timestamp_ = 0;
+
+  // Read-ahead (options_.paced with read_ahead > 0): the thread owns everything above but the
+  // pacing; these are shared with Next, under ahead_mutex_.
+  std::mutex ahead_mutex_;
+  std::condition_variable ahead_changed_;
+  std::deque<Read> ahead_;
+  bool ahead_ended_ = false;        // the thread has read its last frame, or failed
+  std::exception_ptr ahead_error_;  // why it failed, given to Next after the frames before it
+  bool stopping_ = false;
+  std::thread ahead_thread_;        // last: started when everything it uses is made
 };
 
 }  // namespace arview::recordings

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <memory>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -92,6 +94,72 @@ TEST(RecordingSource, PacedReplayWaitsForTheRecordedTimes) {
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(n, 6);
   EXPECT_GE(elapsed, 0.1 - 1e-3);  // frame 5 is due 5 × 0.02 s after frame 0: a lower bound only
+}
+
+// Paced, frames are read ahead on the source's own thread: the same frames, in order, at their times.
+TEST(RecordingSource, PacedReadAheadDeliversEveryFrameInOrderAtItsTime) {
+  TempDir dir("replay_ahead");
+  const Recording rec = MakeStillRecording(dir.path() / "rec", 6);
+  for (const int read_ahead : {0, 1, 3}) {
+    ReplayOptions options;
+    options.paced = true;
+    options.read_ahead = read_ahead;
+    RecordingSource source(rec, options);
+    Frame f;
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < 6; ++i) {
+      ASSERT_TRUE(source.Next(f)) << read_ahead;
+      EXPECT_EQ(f.index, i);
+      EXPECT_NEAR(f.timestamp, 10.0 + 0.02 * i, 1e-9);
+      EXPECT_EQ(cv::norm(f.image, test::MakeImage(64, 48, i), cv::NORM_INF), 0);
+      // Its capture time is its due time, whenever it was read.
+      EXPECT_NEAR(std::chrono::duration<double>(f.capture_time - start).count(), 0.02 * i, 0.015) << read_ahead;
+    }
+    EXPECT_FALSE(source.Next(f));
+    EXPECT_FALSE(source.Next(f));
+  }
+}
+
+// The frames are read from the source's construction on: frames already read are delivered
+// though their files are gone, and a frame that cannot be read stops the replay, naming its
+// file, after every frame before it.
+TEST(RecordingSource, ReadAheadReadsBeforeTheFramesAreDueAndReportsAFailureInItsPlace) {
+  TempDir dir("replay_ahead_read");
+  const Recording rec = MakeStillRecording(dir.path() / "rec", 7);
+  ReplayOptions options;
+  options.paced = true;
+  options.read_ahead = 4;
+  RecordingSource source(rec, options);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // 4 frames of 64x48 read long since
+  for (int i = 0; i < 4; ++i) fs::remove(rec.FramePath(i));
+  fs::remove(rec.FramePath(5));
+  Frame f;
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(source.Next(f));
+    EXPECT_EQ(f.index, i);
+  }
+  try {
+    source.Next(f);
+    ADD_FAILURE() << "the missing frame 5 was not reported";
+  } catch (const SourceError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(rec.FramePath(5).string() + ": ", 0), 0u) << e.what();
+  }
+}
+
+// A looping replay stopped partway: the read-ahead thread is stopped and joined.
+TEST(RecordingSource, ReadAheadStopsWithTheSource) {
+  TempDir dir("replay_ahead_stop");
+  const Recording rec = MakeStillRecording(dir.path() / "rec", 3);
+  ReplayOptions options;
+  options.paced = true;
+  options.loop = true;
+  options.speed = 10;
+  auto source = std::make_unique<RecordingSource>(rec, options);
+  Frame f;
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(source->Next(f));
+  const auto start = std::chrono::steady_clock::now();
+  source.reset();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
 }
 
 TEST(RecordingSource, ReplaysAVideoRecording) {

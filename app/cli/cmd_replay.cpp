@@ -23,6 +23,7 @@ struct ReplayArgs {
   std::string recording, map_dir, out, frames;
   bool paced = false;
   long loop = 1;
+  int read_ahead = recordings::ReplayOptions{}.read_ahead;
   SessionFlags session;
 };
 
@@ -41,12 +42,18 @@ void AddReplayCommand(CLI::App& app) {
                   "--loop 100 --out null)")
       ->capture_default_str()
       ->check(CLI::Range(1L, 100000000L));
+  cmd->add_option("--read-ahead", a->read_ahead,
+                  "With --paced: frames read and decoded this many ahead of their time, as a camera's driver holds "
+                  "frames (0: each frame read when the one before it is taken)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
     const ScopedSignalCancellation signals;
     const recordings::Recording recording = recordings::LoadRecording(a->recording);
     recordings::ReplayOptions replay;
     replay.paced = a->paced;
+    replay.read_ahead = a->read_ahead;
     replay.loop = a->loop > 1;
     replay.passes = a->loop;
     if (!a->frames.empty()) replay.frames = recordings::ParseFrameSpec(a->frames, static_cast<int>(recording.frames.size()));
