@@ -325,11 +325,13 @@ void ContinueModel(const OldMap& old, const ImageSet& session, const fs::path& d
             static_cast<int>(old.map.keyframes.size() + session.names.size()), cb);
 }
 
+// Pointers into `keyframes`, which must outlive the result (a temporary is refused below).
 std::map<std::uint32_t, const map::Keyframe*> ById(const std::vector<map::Keyframe>& keyframes) {
   std::map<std::uint32_t, const map::Keyframe*> by_id;
   for (const map::Keyframe& k : keyframes) by_id[k.colmap_image_id] = &k;
   return by_id;
 }
+std::map<std::uint32_t, const map::Keyframe*> ById(std::vector<map::Keyframe>&&) = delete;
 
 // COLMAP 3.8's mapper normalises its model after each global bundle adjustment (centred, scaled
 // to a fixed extent; rotations untouched). The old keyframes' poses were held, so their centres
@@ -338,7 +340,9 @@ std::map<std::uint32_t, const map::Keyframe*> ById(const std::vector<map::Keyfra
 void RestoreMapFrame(const fs::path& old_model, const fs::path& continued, const fs::path& restored,
                      MapExtendResult* result) {
   const std::vector<map::Keyframe> before = ReadColmapCameraPath(old_model);
-  const auto after = ById(ReadColmapCameraPath(continued));
+  // Kept in a variable: ById's pointers into a temporary dangled (found by AddressSanitizer).
+  const std::vector<map::Keyframe> continued_path = ReadColmapCameraPath(continued);
+  const auto after = ById(continued_path);
   std::vector<Eigen::Vector3d> from, to;
   for (const map::Keyframe& k : before) {
     if (const auto it = after.find(k.colmap_image_id); it != after.end()) {
