@@ -85,14 +85,14 @@ PairMatches MatchPair(const std::vector<cv::Mat>& descriptors, const std::vector
   const auto a = static_cast<size_t>(pair.first), b = static_cast<size_t>(pair.second);
   const std::vector<int> forward = BestMatchesOneWay(descriptors[a], indices[b], o);
   PairMatches out{pair, {}};
-  const std::vector<int> chosen = ChosenRows(forward);
-  // The cross-check can only remove matches: a pair already short of min_matches is done.
-  if (static_cast<int>(chosen.size()) < o.min_matches) return out;
   // The cross-check asks only about the rows of b that the forward search chose: each query's
   // answer does not depend on the others, so this is the full backward search's result for them
   // at a third to a half of its cost.
   std::vector<int> backward;
   if (o.cross_check) {
+    const std::vector<int> chosen = ChosenRows(forward);
+    // It keeps at most one match per chosen row: a pair already short of min_matches is done.
+    if (static_cast<int>(chosen.size()) < o.min_matches) return out;
     cv::Mat asked(static_cast<int>(chosen.size()), descriptors[b].cols, descriptors[b].type());
     for (size_t i = 0; i < chosen.size(); ++i) descriptors[b].row(chosen[i]).copyTo(asked.row(static_cast<int>(i)));
     const std::vector<int> answers = BestMatchesOneWay(asked, indices[a], o);
