@@ -675,18 +675,23 @@ void ScaleCheckDistances(double scale, MapCheck* check) {
   check->scene_depth *= scale;
 }
 
+// A frame's grey image, or an empty one when the file cannot be read (the board is then not
+// seen in it).
+cv::Mat GreyImageOrNone(const fs::path& file) {
+  try {
+    return ReadImageFile(file, cv::IMREAD_GRAYSCALE);
+  } catch (const Error&) {
+    return cv::Mat();
+  }
+}
+
 // A keyframe's grey image from the folder the map's frames were given to COLMAP from.
 KeyframeImages KeyframeImagesIn(const map::Map& map, const std::vector<fs::path>& roots) {
   return [&map, roots](std::size_t k) {
     for (const fs::path& root : roots) {
       const fs::path file = root / map.keyframes[k].name;
       std::error_code ec;
-      if (!fs::is_regular_file(file, ec)) continue;
-      try {
-        return ReadImageFile(file, cv::IMREAD_GRAYSCALE);
-      } catch (const Error&) {
-        return cv::Mat();
-      }
+      if (fs::is_regular_file(file, ec)) return GreyImageOrNone(file);
     }
     return cv::Mat();
   };
@@ -1006,13 +1011,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   if (options.scale.from == ScaleFrom::kBoard && !(fs::is_directory(sparse) && stages.Matches("map", mapper_inputs))) {
     board_search.emplace(
         images.names,
-        [root = images.root](const std::string& name) {
-          try {
-            return ReadImageFile(root / name, cv::IMREAD_GRAYSCALE);
-          } catch (const Error&) {
-            return cv::Mat();
-          }
-        },
+        [root = images.root](const std::string& name) { return GreyImageOrNone(root / name); },
         options.scale.board.inner_corners,
         options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
   }
