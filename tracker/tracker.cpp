@@ -44,8 +44,11 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
   guided_extractor_ = std::make_unique<SiftExtractor>(guided_features);
   relocalization_keypoints_followed_ = ActiveFeatures(resolution_.work(), options.relocalization).contrast_threshold >=
                                        options.tracking.guided_contrast_threshold;
-  prefetch_extractor_ = std::make_unique<SiftExtractor>(guided_features);
-  if (options.tracking.background || options.tracking.prefetch_below > 0) worker_ = std::make_unique<Worker>();
+  if (options.tracking.background || options.tracking.prefetch_below > 0) {
+    worker_ = std::make_unique<TrackingWorker>(map_, resolution_.work(), index_, options.relocalization, guided_features,
+                                               TrackingWorker::FlowSettings{options.tracking.lk_window_px,
+                                                                            options.tracking.lk_pyramid_levels});
+  }
   point_stamp_.assign(map.points.size(), 0);
   point_keyframes_.resize(map.points.size());
   for (size_t k = 0; k < map.keyframes.size(); ++k)
@@ -79,9 +82,7 @@ void Tracker::ForgetPrior() {
 
 std::vector<cv::Mat> Tracker::FlowPyramid(const cv::Mat& gray) const {
   const TrackingOptions& opt = options_.tracking;
-  std::vector<cv::Mat> pyramid;
-  cv::buildOpticalFlowPyramid(gray, pyramid, cv::Size(opt.lk_window_px, opt.lk_window_px), opt.lk_pyramid_levels);
-  return pyramid;
+  return tracker::FlowPyramid(gray, opt.lk_window_px, opt.lk_pyramid_levels);
 }
 
 std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_pyramid,
@@ -136,11 +137,7 @@ Tracker::PriorPose Tracker::PoseFromPrior(const Correspondences& c, AbsolutePose
 // A frame's guided features being extracted on a worker thread, with what matching them and
 // following them into a later frame needs of it.
 struct Tracker::Prefetch {
-  struct Extracted {
-    Features features;
-    double cpu_ms = 0;  // the worker's CPU time
-  };
-  std::future<Extracted> extracted;  // run by worker_
+  std::future<TrackingWorker::Extracted> extracted;  // run by worker_
   std::int64_t frame = 0;  // frames_tracked_ of the frame
   calib::Pose pose;        // its pose (working camera)
   std::vector<cv::Mat> pyramid;
@@ -149,12 +146,7 @@ struct Tracker::Prefetch {
 
 // A relocalization running on the worker (TrackingOptions::background), and the frame it works on.
 struct Tracker::Recovery {
-  struct Outcome {
-    RelocalizationResult relocalization;
-    std::vector<cv::Mat> pyramid;  // the frame's, for following the inliers into a later frame
-    double cpu_ms = 0;             // the worker's CPU time
-  };
-  std::future<Outcome> outcome;  // run by worker_
+  std::future<TrackingWorker::Relocalized> outcome;  // run by worker_
   std::int64_t frame = 0;        // frames_tracked_ of the frame
 };
 
@@ -181,14 +173,7 @@ void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
   prefetch->pose = result.pose;
   prefetch->pyramid = last_pyramid_;  // shares the images: the next frame builds its own
   prefetch->tracked_points = last_inliers_.points;
-  // The caller may reuse the frame's buffer once Track() returns.
-  prefetch->extracted = worker_->Submit<Prefetch::Extracted>([this, image = gray.clone()] {
-    const double cpu_start = ThreadCpuMilliseconds();
-    Prefetch::Extracted out;
-    out.features = relocalizer_->Extract(image, *prefetch_extractor_);
-    out.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
-    return out;
-  });
+  prefetch->extracted = worker_->ExtractAhead(gray);
   prefetch_ = std::move(prefetch);
 }
 
@@ -197,7 +182,7 @@ int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose&
   const TrackingOptions& opt = options_.tracking;
   const calib::Camera& camera = resolution_.work();
   const std::unique_ptr<Prefetch> prefetch = std::move(prefetch_);
-  const Prefetch::Extracted extracted = prefetch->extracted.get();
+  const TrackingWorker::Extracted extracted = prefetch->extracted.get();
   result->keypoints = static_cast<int>(extracted.features.keypoints.size());
   result->times.extract_ms += extracted.cpu_ms;
   result->times.cpu_ms += extracted.cpu_ms;  // Track() adds its own thread's
@@ -612,21 +597,13 @@ void Tracker::StartRecovery(const cv::Mat& gray) {
   prefetch_.reset();  // its features would come after the relocalization's
   auto recovery = std::make_unique<Recovery>();
   recovery->frame = frames_tracked_;
-  // The caller may reuse the frame's buffer once Track() returns.
-  recovery->outcome = worker_->Submit<Recovery::Outcome>([this, image = gray.clone()] {
-    const double cpu_start = ThreadCpuMilliseconds();
-    Recovery::Outcome out;
-    out.relocalization = relocalizer_->Relocalize(image);
-    if (out.relocalization.pose.ok) out.pyramid = FlowPyramid(image);
-    out.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
-    return out;
-  });
+  recovery->outcome = worker_->Relocalize(gray);
   recovery_ = std::move(recovery);
 }
 
 bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D* inliers) {
   const std::unique_ptr<Recovery> recovery = std::move(recovery_);
-  const Recovery::Outcome outcome = recovery->outcome.get();
+  const TrackingWorker::Relocalized outcome = recovery->outcome.get();
   const RelocalizationResult& reloc = outcome.relocalization;
   result->keypoints = reloc.keypoints;
   result->matches = reloc.matches;

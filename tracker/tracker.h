@@ -24,7 +24,7 @@
 #include "tracker/relocalizer.h"
 #include "tracker/residual_gate.h"
 #include "tracker/rotation_aligner.h"
-#include "tracker/worker.h"
+#include "tracker/tracking_worker.h"
 #include "tracker/working_resolution.h"
 
 namespace arview::tracker {
@@ -206,6 +206,10 @@ struct FrameResult {
   StageTimes times;
 };
 
+// Threads: every method is called from one thread at a time (the pipeline's `arview-track`, the
+// main thread of `arview track`). With TrackingOptions::background or prefetch_below a
+// TrackingWorker's thread works beside it, on its own copies, relocalizer and SIFT; the two share
+// only the map and its index, which both only read (tracker/tracking_worker.h).
 class Tracker {
  public:
   // Validates the map and builds its descriptor index. `map` must outlive the tracker.
@@ -335,7 +339,6 @@ class Tracker {
   // as it lives; a weak keypoint (COLMAP's contrast threshold) is placed less exactly. Otherwise
   // the next frame starts from guided matching around the relocalised pose.
   bool relocalization_keypoints_followed_ = true;
-  std::unique_ptr<SiftExtractor> prefetch_extractor_;  // the worker's own, the same settings
   std::unique_ptr<Prefetch> prefetch_;                 // an extraction ahead, pending or done
   std::unique_ptr<Recovery> recovery_;                 // a relocalization on the worker, pending or done
   std::int64_t frames_tracked_ = 0;                    // Track() calls, for the prefetch's lag
@@ -355,7 +358,10 @@ class Tracker {
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
-  // Last: destroyed first, so that a running job finishes while the members it uses still exist.
-  std::unique_ptr<Worker> worker_;
+  // Background work (TrackingOptions::background, prefetch_below): its own relocalizer and SIFT,
+  // so that no object here but the map and the index is touched by two threads
+  // (tracker/tracking_worker.h). Last: destroyed first, so that a running job finishes while
+  // the map and the index it reads still exist.
+  std::unique_ptr<TrackingWorker> worker_;
 };
 }  // namespace arview::tracker

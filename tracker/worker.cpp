@@ -7,17 +7,13 @@
 
 namespace arview::tracker {
 
-Worker::Worker(int nice_increment) : thread_([this, nice_increment] { Run(nice_increment); }) {}
+Worker::Worker(int nice_increment)
+    : thread_([this, nice_increment](std::stop_token stop) { Run(stop, nice_increment); }) {}
 
 Worker::~Worker() {
-  {
-    std::lock_guard lock(mutex_);
-    stopping_ = true;
-    waiting_ = nullptr;  // destroys its packaged_task: the future sees a broken promise
-  }
-  wake_.notify_all();
-  thread_.join();
-}
+  std::lock_guard lock(mutex_);
+  waiting_ = nullptr;  // destroys its packaged_task: the future sees a broken promise
+}  // then thread_'s destructor asks the thread to stop and joins it
 
 void Worker::Post(std::function<void()> job) {
   std::function<void()> dropped;  // destroyed outside the lock
@@ -34,16 +30,15 @@ bool Worker::Busy() const {
   return running_ || waiting_;
 }
 
-void Worker::Run(int nice_increment) {
+void Worker::Run(std::stop_token stop, int nice_increment) {
   pthread_setname_np(pthread_self(), "arview-trackwk");  // shown by top -H
   // On Linux a thread's nice value is its own (setpriority on its thread id). Failing to lower
   // it costs only the priority, so the result is not checked.
   const auto tid = static_cast<id_t>(syscall(SYS_gettid));
   (void)setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + nice_increment);
   std::unique_lock lock(mutex_);
-  for (;;) {
-    wake_.wait(lock, [this] { return stopping_ || waiting_; });
-    if (stopping_) return;
+  // Returns false, nothing waiting, once a stop is asked.
+  while (wake_.wait(lock, stop, [this] { return waiting_ != nullptr; })) {
     std::function<void()> job = std::move(waiting_);
     waiting_ = nullptr;
     running_ = true;

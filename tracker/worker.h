@@ -8,10 +8,14 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <stop_token>
 #include <thread>
 
 namespace arview::tracker {
 
+// Which thread may touch what: Submit and Busy from the owner's thread (or any: they lock);
+// a job runs on the worker thread alone, and what it touches besides its own copies is its
+// submitter's rule to state (tracker/tracking_worker.h).
 class Worker {
  public:
   // nice_increment: added to the thread's nice value (Linux schedules threads one by one), so
@@ -37,14 +41,15 @@ class Worker {
 
  private:
   void Post(std::function<void()> job);
-  void Run(int nice_increment);
+  void Run(std::stop_token stop, int nice_increment);
 
   mutable std::mutex mutex_;
-  std::condition_variable wake_;
+  std::condition_variable_any wake_;  // waits on the stop token too
   std::function<void()> waiting_;  // empty: none
   bool running_ = false;
-  bool stopping_ = false;
-  std::thread thread_;  // last: started once the members above exist
+  // Last: started once the members above exist; its destructor asks it to stop and joins it
+  // before they go.
+  std::jthread thread_;
 };
 
 }  // namespace arview::tracker
