@@ -146,10 +146,14 @@ struct PipelineReport {
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
 
-// Runs until the source ends (or `stop()` returns true, or the sink asks to stop: checked by
-// every stage between frames, and by the sink's thread at least every 50 ms; a stopped run
-// drains nothing). `on_frame` runs on the sink's thread after each frame. Rethrows on the
-// caller's thread the first error any stage raised, after every thread has stopped.
+// Runs until the source ends (or `stop()` returns true, or the sink asks to stop: checked by the
+// sink's thread after each frame and at least every 50 ms, which then asks every stage to stop
+// between frames; a stopped run drains nothing). The stages and which thread may touch what:
+// pipeline_stages.h. `on_frame` runs on the sink's thread after each frame, with no lock held,
+// given the sink stage's own report: its counts, first outputs, recent rate and latency and
+// summaries so far (frames_read, source_fault, trajectory and stages are filled in once every
+// stage has ended). Rethrows on the caller's thread the first error any stage raised, after
+// every thread has stopped.
 PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
                            FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,
                            const std::function<void(const PipelineReport&)>& on_frame = {},

@@ -17,7 +17,8 @@ namespace arview::app {
 // Milliseconds, summarised by base/stats.h (median, p95, mean, max, count, ...).
 using TimingSummary = Summary;
 
-// Thread-safe: stages running on different threads record into one object.
+// Each pipeline stage owns one and records into it on its own thread; the owner reads the
+// summaries after joining it. Thread-safe all the same (a lock no other thread contends).
 class StageStats {
  public:
   void Record(const std::string& stage, double ms);
@@ -28,6 +29,8 @@ class StageStats {
   std::map<std::string, StreamingSummary> summaries_;
 };
 
+// Times one stage's work on one frame: records the milliseconds from its construction to the end
+// of its scope under `stage`.
 class ScopedStageTimer {
  public:
   ScopedStageTimer(StageStats& stats, std::string stage)

@@ -104,7 +104,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::optional<tracker::LossDiagnoser> diagnoser;
   std::exception_ptr tracker_error;
   double tracker_seconds = 0;
-  std::thread tracker_start([&] {
+  // Joined below, or by its destructor however this thread leaves (a bad scene, a renderer that
+  // fails).
+  std::jthread tracker_start([&] {
     try {
       const Clock::time_point t0 = Clock::now();
       tracker.emplace(map, o.tracker);
@@ -116,13 +118,6 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
       tracker_error = std::current_exception();
     }
   });
-  // Joins the tracker's thread however this one leaves (a bad scene, a renderer that fails).
-  struct JoinTrackerStart {
-    std::thread& thread;
-    ~JoinTrackerStart() {
-      if (thread.joinable()) thread.join();
-    }
-  } join_tracker_start{tracker_start};
 
   std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
