@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "app/cli/commands.h"
+#include "app/cli/numeric_flags.h"
+#include "app/cli/output_flags.h"
 #include "base/progress.h"
 #include "app/cli/session_flags.h"
 #include "app/pipeline/stage_stats.h"
@@ -180,6 +182,7 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
 }
 
 void RunTrack(const TrackArgs& args) {
+  RequireDistinctOutputs({{"--out", args.out}, {"--stats", args.stats}});
   if (args.working_size != 0 && args.working_size < 64)
     throw CommandError("--working-size must be 0 (full resolution) or at least 64 (got " +
                        std::to_string(args.working_size) + ")", 2);
@@ -295,9 +298,9 @@ void AddTrackCommand(CLI::App& app) {
   auto a = std::make_shared<TrackArgs>();
   cmd->add_option("recording", a->recording, "Recording folder")->required();
   cmd->add_option("--map", a->map, "Map directory (or its map.arvmap)")->required();
-  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required();
+  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required()->check(OutputFileCheck());
   cmd->add_option("--frames", a->frames, "Frames to track, e.g. 1-46:2 (default: all)");
-  cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON");
+  cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON")->check(OutputFileCheck());
   cmd->add_option("--solver", a->solver, "Minimal solver in RANSAC: kneip | gao | epnp")
       ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
   cmd->add_option("--max-features", a->max_features,
@@ -344,7 +347,7 @@ void AddTrackCommand(CLI::App& app) {
                   "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
                   "the tracked pose: frames far apart (a sub-sampled clip, photos), where optical flow drifts; one SIFT "
                   "extraction a frame more. 0: every tracked frame; -1: never")
-      ->capture_default_str()->check(CLI::Range(-1.0, 1e9));
+      ->capture_default_str()->check(CLI::Range(-1.0, 1e9))->check(NeverOrNotNegative());
   cmd->add_option("--prefetch-below", a->prefetch_below,
                   "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
                   "(in the frame that needs it)")
