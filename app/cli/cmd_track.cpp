@@ -196,20 +196,12 @@ void RunTrack(const TrackArgs& args) {
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
   recordings::ReplayOptions replay;
-  try {
-    rec = recordings::LoadRecording(args.recording);
-    if (!args.frames.empty())
-      replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  }
+  rec = recordings::LoadRecording(args.recording);
+  if (!args.frames.empty())
+    replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
   const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
   map::Map map;
-  try {
-    map = map::LoadMap(args.map);
-  } catch (const map::MapError& e) {
-    throw CommandError(e.what());
-  }
+  map = map::LoadMap(args.map);
   if (map.camera.Size() != rec.camera.Size()) {
     std::ostringstream msg;
     msg << args.recording << " has " << rec.camera.width << "x" << rec.camera.height << " frames but the map "
@@ -234,23 +226,19 @@ void RunTrack(const TrackArgs& args) {
   recordings::Trajectory trajectory;
   Progress progress("track");
   recordings::Frame frame;
-  try {
-    while (!signals.token().IsCancelled() && source.Next(frame)) {
-      // A frame after a gap in --frames has no valid motion prior.
-      if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
-      FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp), {}};
-      if (record.result.status != tracker::TrackStatus::kLost) {
-        trajectory.push_back({record.timestamp, record.result.pose});
-      } else {
-        record.loss = diagnoser.Diagnose(frame.image, record.result);
-        losses.Add(*record.loss);
-      }
-      frames.push_back(std::move(record));
-      if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
-                      ToString(frames.back().result.status));
+  while (!signals.token().IsCancelled() && source.Next(frame)) {
+    // A frame after a gap in --frames has no valid motion prior.
+    if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
+    FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp), {}};
+    if (record.result.status != tracker::TrackStatus::kLost) {
+      trajectory.push_back({record.timestamp, record.result.pose});
+    } else {
+      record.loss = diagnoser.Diagnose(frame.image, record.result);
+      losses.Add(*record.loss);
     }
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
+    frames.push_back(std::move(record));
+    if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
+                    ToString(frames.back().result.status));
   }
   progress.Finish();
   // Interrupted: neither the trajectory nor the statistics are written (a partial trajectory
@@ -259,11 +247,7 @@ void RunTrack(const TrackArgs& args) {
                                    std::to_string(frame_count) + " frames; not written: " + args.out +
                                    (args.stats.empty() ? "" : ", " + args.stats));
 
-  try {
-    recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  }
+  recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);
   const StatusSummaries summaries = SummarizeByStatus(frames);
   if (!args.stats.empty()) WriteStatsJson(args.stats, args, frames, summaries);
 

@@ -203,12 +203,8 @@ void AddViewCommand(CLI::App& app) {
   AddGlFlags(cmd, a->gl);
   cmd->callback([a] {
     if (a->orbit.empty() != a->out.empty()) throw CommandError("--orbit and --out go together: --orbit <spec> --out orbit.mp4");
-    try {
-      if (!a->orbit.empty()) RunOrbit(*a);
-      else RunWindow(*a);
-    } catch (const anim::Error& e) {
-      throw CommandError(e.what());
-    }
+    if (!a->orbit.empty()) RunOrbit(*a);
+    else RunWindow(*a);
   });
 }
 
