@@ -546,6 +546,8 @@ TEST_F(Round4BadInputs, OutputFlagsThatNameNoFileOrOneFileTwiceAreRefusedBeforeT
   EXPECT_FALSE(std::filesystem::exists(At("t.txt")));
   ExpectRefused({"track", At("rec"), "--map", At("map"), "--out", At("rec")}, "--out: '" + At("rec") + "' is a folder",
                 kFlagCheck);
+  ExpectRefused({"view", "--scene", At("none.yaml"), "--stats", At("sd2/")},
+                "--stats: '" + At("sd2/") + "' names a folder (it ends in '/')", kFlagCheck);
 }
 
 TEST_F(Round4BadInputs, FlagsThatWereTakenAndIgnoredAreRefused) {
