@@ -2,7 +2,10 @@
 
 #include <Eigen/Dense>
 
+#include <charconv>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -180,6 +183,15 @@ const std::set<std::string>& InformationalKeys() {
   return keys;
 }
 
+// A plain decimal integer that fits 32 bits, as V4L2 control values do.
+bool IsInt32Text(const std::string& text) {
+  const std::string number = text.substr(0, text.find_last_not_of(" \t", text.find(" #")) + 1);  // a comment after it
+  std::int64_t value = 0;
+  const char* end = number.data() + number.size();
+  const auto [stop, error] = std::from_chars(number.data(), end, value);
+  return !number.empty() && error == std::errc() && stop == end && value >= INT32_MIN && value <= INT32_MAX;
+}
+
 // What is checked on the text before OpenCV's FileStorage parses it, because FileStorage
 // itself crashes on it: a matrix header whose rows/cols are not small plain numbers makes it
 // allocate tens of GB, deep nesting overflows its recursive parser's stack, and a key given
@@ -187,18 +199,30 @@ const std::set<std::string>& InformationalKeys() {
 void PrecheckCameraText(const std::string& text, const std::string& source) {
   std::istringstream lines(text);
   std::string line;
+  std::string field;  // the top-level key the line belongs to
   for (int number = 1; std::getline(lines, line); ++number) {
     const size_t key_start = line.find_first_not_of(' ');
     if (key_start == std::string::npos) continue;
     const size_t colon = line.find(':', key_start);
     if (colon == std::string::npos) continue;
     const std::string key = line.substr(key_start, colon - key_start);
+    if (key_start == 0) field = key;
     std::string value = line.substr(colon + 1);
     value.erase(0, value.find_first_not_of(" \t"));
     value.erase(value.find_last_not_of(" \t\r") + 1);
     auto fail = [&](const std::string& problem) {
       throw CameraError(source + ": line " + std::to_string(number) + ": " + problem);
     };
+    // OpenCV's reader takes an empty key and fails later with a bare "basic_string::_M_create".
+    if (key.empty()) {
+      fail(key_start == 0 ? std::string("a key is empty (before ':')")
+                          : "a key of " + field + " is empty (before ': " + value + "'; a matrix holds rows, cols, dt, data)");
+    }
+    // OpenCV's reader wraps integers beyond 32 bits (2147483648 read as -2147483648).
+    if (key_start == 0 && key == "focus_absolute" && !IsInt32Text(value)) {
+      fail("focus_absolute '" + value + "' must be a whole number from " + std::to_string(INT32_MIN) + " to " +
+           std::to_string(INT32_MAX) + " (a 32-bit V4L2 control value)");
+    }
     if (key == "rows" || key == "cols") {
       const bool small_number = !value.empty() && value.size() <= 2 &&
                                 value.find_first_not_of("0123456789") == std::string::npos && std::stoi(value) > 0 &&

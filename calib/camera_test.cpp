@@ -111,7 +111,7 @@ const char* kGood =
     "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n";
 
 TEST(Camera, LoadRejectsBadFilesNamingTheField) {
-  EXPECT_NE(LoadError(std::string(kGood) + "focus_absolute: 2.5\n").find("field focus_absolute must be an integer"),
+  EXPECT_NE(LoadError(std::string(kGood) + "focus_absolute: 2.5\n").find("line 10: focus_absolute '2.5' must be a whole number"),
             std::string::npos);
   EXPECT_EQ(LoadError(kGood), "");
 
@@ -204,6 +204,39 @@ TEST(Camera, AMatrixWithoutOneOfItsKeysIsRefusedNamingTheFileAndTheKey) {
         << key << ": " << m;
     EXPECT_EQ(m.find("basic_string"), std::string::npos) << m;
   }
+}
+
+// Issue 57: OpenCV's reader wrapped a focus position beyond 32 bits (2147483648 read as
+// -2147483648, 1e20 as -1), a wrong focus taken silently; the map file's reader refuses them.
+TEST(Camera, AFocusPositionBeyond32BitsIsRefusedNotWrapped) {
+  for (const std::string value : {"2147483648", "-2147483649", "1e20", "99999999999999999999"}) {
+    const std::string m = LoadError(std::string(kGood) + "focus_absolute: " + value + "\n");
+    EXPECT_NE(m.find("arview_camera_bad.yaml: line 10: focus_absolute '" + value +
+                     "' must be a whole number from -2147483648 to 2147483647"),
+              std::string::npos)
+        << value << ": " << m;
+  }
+  for (const std::int64_t held : {std::int64_t{2147483647}, std::int64_t{-2147483648}, std::int64_t{0}}) {
+    const auto path = ProcessTempDir() / "arview_camera_focus.yaml";
+    WriteFile(path, std::string(kGood) + "focus_absolute: " + std::to_string(held) + "  # the lens\n");
+    EXPECT_EQ(LoadCamera(path).focus, std::optional<std::int64_t>(held));
+    std::filesystem::remove(path);
+  }
+}
+
+// Issue 57: the distortion matrix's `dt` line damaged to an empty key ("   : d") reached the user
+// as "cam.yaml: basic_string::_M_create"; the line and the field are named.
+TEST(Camera, AnEmptyKeyIsRefusedNamingItsLineAndField) {
+  std::string damaged = std::string(kGood) +
+                        "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   : d\n"
+                        "   data: [ 0.1, -0.2, 0., 0., 0. ]\n";
+  std::string m = LoadError(damaged);
+  EXPECT_NE(m.find("arview_camera_bad.yaml: line 13: a key of distortion_coefficients is empty (before ': d'"),
+            std::string::npos)
+      << m;
+  EXPECT_EQ(m.find("basic_string"), std::string::npos) << m;
+  m = LoadError(std::string(kGood) + ": 3\n");
+  EXPECT_NE(m.find("line 10: a key is empty"), std::string::npos) << m;
 }
 
 TEST(Camera, DevicesFifosAndDirectoriesAreNotReadAsCameraFiles) {

@@ -496,6 +496,7 @@ std::vector<map::Keyframe> ReadColmapCameraPath(const fs::path& sparse_dir, cons
   return keyframes;
 }
 
+
 namespace {
 
 // A COLMAP binary file read whole, walked value by value, with values written over where they lie.
@@ -647,20 +648,38 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
 
 namespace {
 
-map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
-                  const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
-                  bool check_values) {
+// A model's three files read and checked each on its own and against each other's camera.
+struct ModelFiles {
+  std::vector<ColmapImage> images;
+  std::vector<ColmapPoint> points;
+  calib::Camera camera;
+};
+
+ModelFiles ReadModelFiles(const fs::path& sparse_dir, const CancellationToken& cancel) {
   const fs::path cameras_file = sparse_dir / "cameras.bin";
   const fs::path images_file = sparse_dir / "images.bin";
   const fs::path points_file = sparse_dir / "points3D.bin";
   const auto cameras = ReadCameras(cameras_file, cancel);
-  auto images = ReadImages(images_file, cancel);
-  const auto points = ReadPoints(points_file, cancel);
-  if (images.empty()) throw map::MapError(images_file.string() + ": the model has no registered images");
-  if (points.empty()) throw map::MapError(points_file.string() + ": the model has no 3D points");
+  ModelFiles model;
+  model.images = ReadImages(images_file, cancel);
+  model.points = ReadPoints(points_file, cancel);
+  if (model.images.empty()) throw map::MapError(images_file.string() + ": the model has no registered images");
+  if (model.points.empty()) throw map::MapError(points_file.string() + ": the model has no 3D points");
+  model.camera = TheOneCamera(cameras, model.images, cameras_file, images_file);
+  return model;
+}
+
+map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+                  const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,
+                  bool check_values) {
+  const fs::path images_file = sparse_dir / "images.bin";
+  const fs::path points_file = sparse_dir / "points3D.bin";
+  ModelFiles files = ReadModelFiles(sparse_dir, cancel);
+  auto& images = files.images;
+  const auto& points = files.points;
 
   map::Map map;
-  map.camera = TheOneCamera(cameras, images, cameras_file, images_file);
+  map.camera = files.camera;
 
   SortByFrame(images, frames, images_file);
 
@@ -753,6 +772,10 @@ map::Map ReadColmapMap(const fs::path& sparse_dir, const fs::path& database, con
   return NamingInput<map::MapError>(sparse_dir.string(), [&] {
     return ReadColmapModel(sparse_dir, database, frames, cancel, keypoints, check_values);
   });
+}
+
+void RequireReadableModel(const fs::path& sparse_dir, const CancellationToken& cancel) {
+  NamingInput<map::MapError>(sparse_dir.string(), [&] { return ReadModelFiles(sparse_dir, cancel).images.size(); });
 }
 
 void RequireModelValuesInRange(const map::Map& map, const fs::path& sparse_dir) {

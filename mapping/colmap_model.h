@@ -48,6 +48,11 @@ map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::files
 // is gone. Throws MapError as ReadColmapMap does.
 std::vector<map::Keyframe> ReadColmapCameraPath(const std::filesystem::path& sparse_dir, const FrameLookup& frames = {});
 
+// Reads cameras.bin, images.bin and points3D.bin of a sparse model as ReadColmapMap does, without
+// the database: a damaged model is a MapError naming its file before anything runs on it
+// (`arview map extend`, whose COLMAP stages would otherwise end in COLMAP's stack trace).
+void RequireReadableModel(const std::filesystem::path& sparse_dir, const CancellationToken& cancel = {});
+
 // The SIFT descriptors COLMAP extracted for the named images (one rows x 128 CV_8U matrix each,
 // in the order of `names`). Throws MapError naming the database and the image that is missing
 // or malformed.

@@ -21,6 +21,7 @@
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
+#include "mapping/map_extend.h"
 #include "mapping/pair_matching.h"
 #include "recordings/trajectory.h"
 
@@ -712,9 +713,12 @@ MetricFit FitRequested(const map::Map& map, const ScaleRequest& request, const K
                        : FindBoard(map, images, request.board.inner_corners, progress, options.cancel);
       return FitFromBoard(map, TriangulateBoard(map, seen, request.board.inner_corners), request.board);
     }
-    case ScaleFrom::kKnownDistance:
-      return FitFromDistance(map, TriangulatePoint(map, request.point_a), TriangulatePoint(map, request.point_b),
-                             request.distance_m);
+    case ScaleFrom::kKnownDistance: {
+      // One end, then the other: an error is about the first end given wrongly.
+      const TriangulatedPoint a = TriangulatePoint(map, request.point_a);
+      const TriangulatedPoint b = TriangulatePoint(map, request.point_b);
+      return FitFromDistance(map, a, b, request.distance_m);
+    }
     case ScaleFrom::kCameraHeight:
       return FitFromCameraHeight(map);
     case ScaleFrom::kNone:
@@ -1049,6 +1053,9 @@ map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* re
   result.model_dir = LargestModel(map_dir / "sparse", &models, {});
   if (result.model_dir.empty())
     throw map::MapError((map_dir / "sparse").string() + ": no COLMAP model (the folder arview map wrote keeps it)");
+  // The model moves with the map: it must be the map's own (another map's would be rescaled), and
+  // a map file moved after COLMAP takes its model along through that move.
+  const std::optional<Sim3> to_map_file = RequireOwnModel(result.model_dir, result.map, map_dir);
   const std::optional<MapCheck> check = ReadMapCheck(map_dir / kMapCheckFileName);
   if (check) result.check = *check;
   std::vector<fs::path> roots{map_dir / "images", map_dir};
@@ -1056,7 +1063,8 @@ map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* re
   const MetricFit fit = FitRequested(result.map, request, KeyframeImagesIn(result.map, roots), options, cb);
   options.cancel.ThrowIfCancelled("the map was not changed");
   ApplyMetricFit(fit, &result.map);
-  TransformColmapModel(result.model_dir, fit.to_metric, RequestSignature(request), result.map.frame);
+  TransformColmapModel(result.model_dir, to_map_file ? Compose(fit.to_metric, *to_map_file) : fit.to_metric,
+                       RequestSignature(request), result.map.frame);
   ScaleCheckDistances(fit.to_metric.scale, &result.check);
   WriteMapFiles(result, map_dir, options, cb);
   if (!check) RecheckMap(map_dir);  // a map from before the check: computed now, in metres

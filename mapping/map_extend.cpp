@@ -11,11 +11,13 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include "base/atomic_file.h"
 #include "base/cancellation.h"
+#include "base/input_guard.h"
 #include "base/process.h"
 #include "map/descriptor_index.h"
 #include "map/map_file.h"
@@ -78,13 +80,20 @@ OldMap RequireExtendableMap(const fs::path& map_dir) {
   old.map = map::LoadMap(map_dir);  // names map.arvmap when it is missing or damaged
   if (old.map.keyframes.empty()) throw map::MapError((map_dir / map::kMapFileName).string() + ": the map has no keyframes");
   old.database = map_dir / "database.db";
-  if (!fs::is_regular_file(old.database, ec))
-    throw map::MapError(old.database.string() +
-                        ": missing: a map is extended in COLMAP's database, which the folder arview map wrote keeps");
+  const char* why_needed = "a map is extended in COLMAP's database, which the folder arview map wrote keeps";
+  if (!fs::exists(old.database, ec)) throw map::MapError(old.database.string() + ": missing: " + why_needed);
+  try {
+    RequireRegularFile(old.database);
+  } catch (const InputError& e) {
+    throw map::MapError(std::string(e.what()) + " (" + why_needed + ")");
+  }
   old.model_dir = LargestColmapModel(map_dir / "sparse");
   if (old.model_dir.empty())
     throw map::MapError((map_dir / "sparse").string() +
                         ": no COLMAP model to extend (the folder arview map wrote keeps it in sparse/<n>/)");
+  // Before any COLMAP stage: COLMAP reads the model only when the mapper starts, and a damaged
+  // file ends it in its own stack trace.
+  RequireReadableModel(old.model_dir);
   return old;
 }
 
@@ -233,6 +242,73 @@ ImageSet CopyIntoSession(const ImageSet& selected, const fs::path& images_root, 
     set.lookup[prefixed] = selected.lookup.at(name);
   }
   return set;
+}
+
+// A file's bytes, or nothing when it cannot be read.
+std::optional<std::string> BytesOf(const fs::path& file) {
+  try {
+    return ReadFileUpTo(file, kMaxImageFileBytes);
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
+// The selected frames whose image is, byte for byte, a keyframe's image kept in the map folder
+// (images/, where `arview map` writes a video's frames and each extension copies its own): the same
+// frames given to an extension again. Frame name → the keyframe's name. Only the keyframe images of
+// a size some selected frame has are read.
+std::map<std::string, std::string> FramesAlreadyInMap(const ImageSet& selected, const map::Map& map,
+                                                      const fs::path& map_dir) {
+  std::map<std::uintmax_t, std::vector<std::string>> by_size;
+  std::error_code ec;
+  for (const std::string& name : selected.names) {
+    const std::uintmax_t size = fs::file_size(selected.root / name, ec);
+    if (!ec) by_size[size].push_back(name);
+  }
+  std::map<std::string, std::string> found;
+  for (const map::Keyframe& k : map.keyframes) {
+    for (const fs::path& root : {map_dir / "images", map_dir}) {
+      const fs::path file = root / k.name;
+      const std::uintmax_t size = fs::file_size(file, ec);
+      if (ec) continue;
+      const auto same_size = by_size.find(size);
+      if (same_size == by_size.end()) break;
+      const std::optional<std::string> keyframe_bytes = BytesOf(file);
+      for (const std::string& name : same_size->second)
+        if (keyframe_bytes && !found.count(name) && BytesOf(selected.root / name) == keyframe_bytes) found[name] = k.name;
+      break;
+    }
+  }
+  return found;
+}
+
+// `selected` without the frames the map holds already (a note names them; all of them: a MapError,
+// before anything is extracted), and `selected_frames` with it.
+ImageSet WithoutFramesInMap(const ImageSet& selected, const map::Map& map, const fs::path& map_dir,
+                            const recordings::Recording& recording, const MapBuildCallbacks& cb,
+                            std::vector<int>* selected_frames) {
+  const std::map<std::string, std::string> in_map = FramesAlreadyInMap(selected, map, map_dir);
+  if (in_map.empty()) return selected;
+  const auto& [first_frame, first_keyframe] = *in_map.begin();
+  const std::string example = "'" + first_frame + "' is keyframe '" + first_keyframe + "'";
+  if (in_map.size() == selected.names.size()) {
+    throw map::MapError("every frame selected from " + recording.root.string() + " is in the map already (" + example +
+                        "): nothing to add; the map in " + map_dir.string() + " is as it was");
+  }
+  if (cb.note) {
+    cb.note(std::to_string(in_map.size()) + " of the " + std::to_string(selected.names.size()) + " frames selected from " +
+            recording.root.string() + " are in the map already (" + example + "): skipped");
+  }
+  ImageSet fresh;
+  fresh.root = selected.root;
+  selected_frames->clear();
+  for (const std::string& name : selected.names) {
+    if (in_map.count(name)) continue;
+    fresh.names.push_back(name);
+    fresh.lookup[name] = selected.lookup.at(name);
+    selected_frames->push_back(fresh.lookup[name].frame_index);
+  }
+  return fresh;
 }
 
 // For each new frame, the old keyframes (indices into old.keyframes) that own the nearest
@@ -567,6 +643,29 @@ std::optional<Sim3> MapFileFrameOfModel(const std::vector<map::Keyframe>& model_
   return s;
 }
 
+std::optional<Sim3> RequireOwnModel(const fs::path& model_dir, const map::Map& map_file, const fs::path& map_dir) {
+  const std::vector<map::Keyframe> model = ReadColmapCameraPath(model_dir);
+  const auto in_model = ById(model);
+  const std::string whose =
+      model_dir.string() + ": not the COLMAP model of " + (map_dir / map::kMapFileName).string() + " (";
+  for (const map::Keyframe& k : map_file.keyframes) {
+    const auto it = in_model.find(k.colmap_image_id);
+    if (it == in_model.end()) {
+      throw map::MapError(whose + "its keyframe '" + k.name + "', COLMAP's image " + std::to_string(k.colmap_image_id) +
+                          ", is not in the model): another map's model in this folder?");
+    }
+    if (it->second->name != k.name) {
+      throw map::MapError(whose + "COLMAP's image " + std::to_string(k.colmap_image_id) + " is '" + it->second->name +
+                          "' there and '" + k.name + "' in the map): another map's model in this folder?");
+    }
+  }
+  try {
+    return MapFileFrameOfModel(model, map_file);
+  } catch (const map::MapError& e) {
+    throw map::MapError(whose + e.what() + "): another map's model in this folder?");
+  }
+}
+
 MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recording& recording,
                           const MapExtendOptions& options_arg, const MapBuildCallbacks& cb) {
   const fs::path map_dir = fs::absolute(map_dir_arg).lexically_normal();
@@ -576,7 +675,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     throw map::MapError("COLMAP not found: '" + options_arg.build.colmap + "' cannot be run (install COLMAP: apt-get install colmap)");
   MapExtendOptions options = options_arg;
   if (!options.max_features_set) TakeMapsSiftSettings(map_dir, &options.build);
-  const std::optional<Sim3> to_map_file = MapFileFrameOfModel(ReadColmapCameraPath(old.model_dir), old.map);
+  const std::optional<Sim3> to_map_file = RequireOwnModel(old.model_dir, old.map, map_dir);
   const auto names = SqliteFile(old.database, SQLITE_OPEN_READONLY).ImageNames();
   const std::int64_t camera_id = MapCameraId(old, names);
 
@@ -594,7 +693,9 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
     t0 = std::chrono::steady_clock::now();
   };
   try {
-    const ImageSet selected = SelectImages(recording, work / "select", options.build, cb, &result.selected_frames);
+    const ImageSet selected = WithoutFramesInMap(
+        SelectImages(recording, work / "select", options.build, cb, &result.selected_frames), old.map, map_dir,
+        recording, cb, &result.selected_frames);
     if (selected.names.empty()) throw map::MapError("no frames of " + recording.root.string() + " to add");
     const ImageSet session = CopyIntoSession(selected, work / "images", result.session, options.build.cancel);
     finish_stage("extract");

@@ -95,6 +95,14 @@ map::Map CarryFrameRecord(const map::Map& old_map, map::Map model);
 // other (within 1e-6 of the path's extent).
 std::optional<Sim3> MapFileFrameOfModel(const std::vector<map::Keyframe>& model_path, const map::Map& map_file);
 
+// MapFileFrameOfModel for the model in `model_dir` (its sparse/<n>/) and the map file of
+// `map_dir`, once the model is known to be the map's own: every keyframe of the map file is one of
+// its images, by id and name. Throws map::MapError naming the model's folder and the map file
+// otherwise (another map's model copied in), before anything is written: `map extend` and
+// `map scale` refuse such a folder alike.
+std::optional<Sim3> RequireOwnModel(const std::filesystem::path& model_dir, const map::Map& map_file,
+                                    const std::filesystem::path& map_dir);
+
 // The scale s and shift c that best map `from` onto `to` (to ≈ s·from + c, least squares, no
 // rotation): what COLMAP's normalisation did to the old keyframes' centres, inverted.
 Sim3 FitScaleAndShift(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to);

@@ -3,9 +3,12 @@
 // an extension refuses before it writes anything.
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
 
 #include <csignal>
 #include <fstream>
@@ -14,6 +17,7 @@
 #include <sstream>
 
 #include "base/cancellation.h"
+#include "base/process.h"
 #include "calib/camera.h"
 #include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
@@ -23,6 +27,7 @@
 #include "recordings/recording.h"
 #include "recordings/trajectory.h"
 #include "tests/support/random_map.h"
+#include "tests/support/folder_bytes.h"
 #include "tests/support/stub_map_folder.h"
 #include "tests/support/test_data.h"
 
@@ -136,7 +141,7 @@ TEST(ExtendMap, RefusesWhatItCannotExtendNamingIt) {
   EXPECT_NE(ExtendError(dir / "no-model", recording).find("sparse: no COLMAP model to extend"), std::string::npos);
 
   // A map with its database and model, and a recording of another camera size.
-  testing::WriteStubMapFolder(CameraOfSize(640, 480), dir / "map");
+  testing::WriteStubMapFolder(dir / "map");
   const recordings::Recording small = OneFrameRecording(dir / "small", CameraOfSize(320, 240));
   const std::string size_error = ExtendError(dir / "map", small);
   EXPECT_NE(size_error.find("camera.yaml: the recording's frames are 320x240, the map's camera 640x480"),
@@ -148,17 +153,93 @@ TEST(ExtendMap, RefusesWhatItCannotExtendNamingIt) {
   fs::remove_all(dir);
 }
 
-// Every file of a folder, with its bytes.
-std::map<std::string, std::string> Snapshot(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (!e.is_regular_file()) continue;
-    std::ifstream in(e.path(), std::ios::binary);
-    std::stringstream bytes;
-    bytes << in.rdbuf();
-    files[fs::relative(e.path(), dir).string()] = bytes.str();
+// Issue 57: what `map extend` found only in COLMAP's stages (a damaged cameras.bin: two stages
+// run, then 15 lines of COLMAP's stack trace), or called by the wrong name (a FIFO as "missing"),
+// or took (another map's model beside the map file), each named before anything is written.
+TEST(ExtendMap, ADamagedModelAFifoDatabaseAndAnotherMapsModelAreNamedBeforeAnyStage) {
+  const fs::path dir = ScratchDir("round4");
+  const recordings::Recording recording = OneFrameRecording(dir / "rec", CameraOfSize(640, 480));
+
+  testing::WriteStubMapFolder(dir / "cameras");
+  const fs::path cameras = dir / "cameras" / "sparse" / "0" / "cameras.bin";
+  fs::resize_file(cameras, fs::file_size(cameras) - 9);  // cut inside the camera's parameters
+  const auto cut = testing::FolderBytes(dir / "cameras");
+  const std::string damaged = ExtendError(dir / "cameras", recording);
+  EXPECT_EQ(damaged.rfind(cameras.string() + ": ", 0), 0u) << damaged;
+  EXPECT_TRUE(cut == testing::FolderBytes(dir / "cameras")) << "the map folder changed";
+
+  testing::WriteStubMapFolder(dir / "fifo");
+  fs::remove(dir / "fifo" / "database.db");
+  ASSERT_EQ(::mkfifo((dir / "fifo" / "database.db").c_str(), 0644), 0);
+  const std::string fifo = ExtendError(dir / "fifo", recording);
+  EXPECT_NE(fifo.find("database.db: is a FIFO"), std::string::npos) << fifo;
+  EXPECT_EQ(fifo.find("missing"), std::string::npos) << fifo;
+
+  testing::WriteStubMapFolder(dir / "other");
+  map::Map other = map::LoadMap(dir / "other");
+  other.keyframes[1].name = "frames/000009.png";  // the map file of another map, the model of this one
+  map::SaveMap(other, dir / "other" / map::kMapFileName);
+  const auto before = testing::FolderBytes(dir / "other");
+  const std::string model = ExtendError(dir / "other", recording);
+  EXPECT_NE(model.find((dir / "other" / "sparse" / "0").string() + ": not the COLMAP model of " +
+                       (dir / "other" / "map.arvmap").string() +
+                       " (COLMAP's image 2 is 'frames/000002.png' there and 'frames/000009.png' in the map)"),
+            std::string::npos)
+      << model;
+  EXPECT_TRUE(before == testing::FolderBytes(dir / "other")) << "the map folder changed";
+  fs::remove_all(dir);
+}
+
+// The stub folder's database.db made one COLMAP could be asked about: its images table names the
+// map's two keyframes, with camera 1.
+void WriteStubDatabase(const fs::path& map_dir) {
+  fs::remove(map_dir / "database.db");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((map_dir / "database.db").c_str(), &db), SQLITE_OK);
+  const char* sql =
+      "CREATE TABLE images(image_id INTEGER PRIMARY KEY, name TEXT, camera_id INTEGER);"
+      "INSERT INTO images VALUES(1, 'frames/000001.png', 1);INSERT INTO images VALUES(2, 'frames/000002.png', 1);";
+  EXPECT_EQ(sqlite3_exec(db, sql, nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(db);
+}
+
+// Issue 57: `map extend` twice with the same frames registered them twice (duplicate keyframes).
+// Frames whose image is a keyframe's, byte for byte, are skipped with a note; when every frame is,
+// the extension is refused before anything runs.
+TEST(ExtendMap, FramesTheMapHoldsAlreadyAreSkippedAndAllOfThemRefused) {
+  if (FindExecutable("colmap").empty()) GTEST_SKIP() << "needs COLMAP (apt-get install colmap)";
+  const fs::path dir = ScratchDir("again");
+  const recordings::Recording one = OneFrameRecording(dir / "rec", CameraOfSize(640, 480));
+  testing::WriteStubMapFolder(dir / "map");
+  WriteStubDatabase(dir / "map");
+  // The recording's frame kept as keyframe 2's image, as an extension keeps the frames it adds.
+  fs::create_directories(dir / "map" / "images" / "frames");
+  fs::copy_file(dir / "rec" / "frames" / "000000.png", dir / "map" / "images" / "frames" / "000002.png");
+  const auto before = testing::FolderBytes(dir / "map");
+  const std::string all = ExtendError(dir / "map", one);
+  EXPECT_NE(all.find("every frame selected from " + (dir / "rec").string() + " is in the map already "
+                     "('frames/000000.png' is keyframe 'frames/000002.png'): nothing to add; the map in " +
+                     (dir / "map").string() + " is as it was"),
+            std::string::npos)
+      << all;
+  EXPECT_TRUE(before == testing::FolderBytes(dir / "map")) << "the map folder changed";
+  EXPECT_FALSE(fs::exists(dir / "map" / kExtendPartialName));
+
+  // A second, new frame: the one in the map is skipped, said in a note; the other goes on to
+  // COLMAP (whose extraction fails on the stub's database: not this test's concern).
+  cv::imwrite((dir / "rec" / "frames" / "000001.png").string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar(30, 60, 90)));
+  recordings::WriteFramesTxt(dir / "rec", {{0.0, "frames/000000.png"}, {0.1, "frames/000001.png"}});
+  std::vector<std::string> notes;
+  MapBuildCallbacks cb;
+  cb.note = [&notes](const std::string& note) { notes.push_back(note); };
+  try {
+    ExtendMap(dir / "map", recordings::LoadRecording(dir / "rec"), {}, cb);
+  } catch (const std::exception&) {
   }
-  return files;
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0], "1 of the 2 frames selected from " + (dir / "rec").string() +
+                          " are in the map already ('frames/000000.png' is keyframe 'frames/000002.png'): skipped");
+  fs::remove_all(dir);
 }
 
 // A copy of the shared map folder while TempleMapTest's processes may be rewriting its files
@@ -277,7 +358,7 @@ TEST_F(ExtendTempleMapTest, RegistersTheNewFramesAndKeepsTheOldKeyframesAndTheFr
 
 TEST_F(ExtendTempleMapTest, ACancelledExtensionLeavesTheMapAsItWas) {
   const fs::path dir = CopyOfTheMap("cancelled");
-  const auto before = Snapshot(dir);
+  const auto before = testing::FolderBytes(dir);
   MapExtendOptions options = OddFrames();
   MapBuildCallbacks cb;
   // Stopped while COLMAP's mapper is registering the new frames, the longest stage's child.
@@ -292,7 +373,7 @@ TEST_F(ExtendTempleMapTest, ACancelledExtensionLeavesTheMapAsItWas) {
         << e.what();
   }
   EXPECT_FALSE(fs::exists(dir / kExtendPartialName));
-  EXPECT_TRUE(before == Snapshot(dir)) << "the map folder changed";
+  EXPECT_TRUE(before == testing::FolderBytes(dir)) << "the map folder changed";
 }
 
 // Frames of another place (OpenCV's chessboard photos, 640x480 as templeRing) register nowhere:
@@ -301,7 +382,7 @@ TEST_F(ExtendTempleMapTest, FramesOfAnotherPlaceAreRefusedAndTheMapStaysAsItWas)
   const fs::path photos = "/usr/share/doc/opencv-doc/examples/data";
   if (!fs::exists(photos / "left01.jpg")) GTEST_SKIP() << "needs Debian's opencv-doc (" << photos << ")";
   const fs::path dir = CopyOfTheMap("elsewhere");
-  const auto before = Snapshot(dir);
+  const auto before = testing::FolderBytes(dir);
   const fs::path root = scratch_ / "chessboard";
   recordings::PrepareRecordingFolder(root, true);
   calib::SaveCamera(recording_->camera, root / "camera.yaml");
@@ -321,14 +402,14 @@ TEST_F(ExtendTempleMapTest, FramesOfAnotherPlaceAreRefusedAndTheMapStaysAsItWas)
     EXPECT_NE(std::string(e.what()).find("registered none of the 4 new frames"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir / kExtendPartialName));
-  EXPECT_TRUE(before == Snapshot(dir)) << "the map folder changed";
+  EXPECT_TRUE(before == testing::FolderBytes(dir)) << "the map folder changed";
 }
 
 // A COLMAP stage that fails: its output's last lines and the map's own colmap.log named (the work
 // folder's log is moved there), every other file as it was.
 TEST_F(ExtendTempleMapTest, AFailingColmapStageNamesTheMapsLogAndLeavesTheMap) {
   const fs::path dir = CopyOfTheMap("failing");
-  auto before = Snapshot(dir);
+  auto before = testing::FolderBytes(dir);
   const fs::path fake = scratch_ / "colmap_failing_to_match.sh";
   std::ofstream(fake) << "#!/bin/sh\nif [ \"$1\" = matches_importer ]; then echo 'E: the matcher broke'; exit 3; fi\n"
                          "exec colmap \"$@\"\n";
@@ -346,7 +427,7 @@ TEST_F(ExtendTempleMapTest, AFailingColmapStageNamesTheMapsLogAndLeavesTheMap) {
     ASSERT_FALSE(e.log_tail.empty());
     EXPECT_EQ(e.log_tail.back(), "E: the matcher broke");
   }
-  auto after = Snapshot(dir);
+  auto after = testing::FolderBytes(dir);
   EXPECT_NE(after["colmap.log"].find("E: the matcher broke"), std::string::npos);
   before.erase("colmap.log");
   after.erase("colmap.log");

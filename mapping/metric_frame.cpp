@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 #include <unordered_map>
 
@@ -157,20 +158,30 @@ std::vector<BoardSighting> InOneOrder(const map::Map& map, const std::vector<Boa
   return ordered;
 }
 
+// The widest angle between two rays (each in its keyframe's camera frame, `poses` the keyframes'),
+// from the pixels alone: triangulating from views too close is what it guards against.
+double WidestRayAngleDeg(const std::vector<calib::Pose>& poses, const std::vector<Eigen::Vector3d>& rays) {
+  double widest = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Eigen::Vector3d a = poses[i].q_cw.conjugate() * rays[i];
+    for (std::size_t j = i + 1; j < rays.size(); ++j) {
+      const Eigen::Vector3d b = poses[j].q_cw.conjugate() * rays[j];
+      widest = std::max(widest, std::acos(std::clamp(a.dot(b), -1.0, 1.0)) / kDeg);
+    }
+  }
+  return widest;
+}
+
 // The widest angle between two sightings' rays to the board's middle corner (the angle between
-// the two views at the board), from the pixels alone: triangulating from views too close is what
-// it guards against.
+// the two views at the board).
 double WidestAngleDeg(const map::Map& map, const std::vector<const BoardSighting*>& sightings) {
+  std::vector<calib::Pose> poses;
   std::vector<Eigen::Vector3d> rays;
   for (const BoardSighting* s : sightings) {
-    const Eigen::Vector2d& middle = s->corners[s->corners.size() / 2];
-    rays.push_back(map.keyframes[s->keyframe].pose.q_cw.conjugate() * Ray(map.camera, middle));
+    poses.push_back(map.keyframes[s->keyframe].pose);
+    rays.push_back(Ray(map.camera, s->corners[s->corners.size() / 2]));
   }
-  double widest = 0;
-  for (std::size_t i = 0; i < rays.size(); ++i)
-    for (std::size_t j = i + 1; j < rays.size(); ++j)
-      widest = std::max(widest, std::acos(std::clamp(rays[i].dot(rays[j]), -1.0, 1.0)) / kDeg);
-  return widest;
+  return WidestRayAngleDeg(poses, rays);
 }
 
 Eigen::Vector3d Mean(const std::vector<Eigen::Vector3d>& points) {
@@ -520,14 +531,25 @@ TriangulatedPoint TriangulatePoint(const map::Map& map, const std::vector<PointS
   std::vector<calib::Pose> poses;
   std::vector<Eigen::Vector3d> rays;
   std::vector<Eigen::Vector2d> pixels;
+  std::set<const map::Keyframe*> used;
   for (const PointSighting& s : sightings) {
     const auto k = std::find_if(map.keyframes.begin(), map.keyframes.end(), [&](const map::Keyframe& kf) {
       return kf.name == s.keyframe_name || std::filesystem::path(kf.name).filename() == s.keyframe_name;
     });
     if (k == map.keyframes.end()) throw map::MapError("no keyframe named '" + s.keyframe_name + "' in the map (keyframes.txt lists them)");
+    // One keyframe twice gives one ray twice: the rays meet anywhere along it.
+    if (!used.insert(&*k).second) {
+      throw map::MapError("keyframe '" + k->name + "' is given twice for one point: its pixel is needed in two "
+                          "different keyframes, whose rays cross at the point");
+    }
     poses.push_back(k->pose);
     rays.push_back(Ray(map.camera, s.pixel));
     pixels.push_back(s.pixel);
+  }
+  if (const double widest = WidestRayAngleDeg(poses, rays); widest < kMinWidestAngleDeg) {
+    throw map::MapError(Format("the keyframes given for a point see it from nearly one direction (their rays %.1f "
+                               "degrees apart at most, 3 needed): give its pixel in keyframes further apart",
+                               widest));
   }
   TriangulatedPoint point;
   point.xyz = TriangulateRays(poses, rays);

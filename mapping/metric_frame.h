@@ -125,8 +125,9 @@ struct TriangulatedPoint {
   double uncertainty = 0;  // map units: the position's error for a one-pixel error in the pixels
 };
 
-// Throws map::MapError naming an unknown keyframe, fewer than two sightings, or rays that do not
-// meet (more than 4 px apart when reprojected).
+// Throws map::MapError naming an unknown keyframe, fewer than two sightings, a keyframe given
+// twice, rays less than 3 degrees apart (nearly one ray: the point could be anywhere along it),
+// or rays that do not meet (more than 4 px apart when reprojected).
 TriangulatedPoint TriangulatePoint(const map::Map& map, const std::vector<PointSighting>& sightings);
 
 // Scale from the distance between two triangulated points; up and origin from the floor.

@@ -167,6 +167,35 @@ TEST(MetricFrame, AKnownDistanceGivesMetresAndTheFloorGivesUp) {
   EXPECT_THROW(TriangulatePoint(s.map, apart), map::MapError);
 }
 
+// Issue 57: one end given as the same keyframe twice is one ray, and was taken with a "likely
+// scale error 249%"; keyframes whose rays hardly part are the same ray in all but name.
+TEST(MetricFrame, APointSeenAlongOneRayIsRefusedNamingTheKeyframe) {
+  const Scene s = MakeScene();
+  const Eigen::Vector3d corner = s.colmap_frame(Eigen::Vector3d(-0.2, 0.125, 0));
+  const auto sighting = [&](int k) {
+    return PointSighting{std::to_string(k) + ".png", s.map.camera.Project(s.map.keyframes[k].pose.ToCamera(corner))};
+  };
+  try {
+    TriangulatePoint(s.map, {sighting(2), sighting(2)});
+    FAIL() << "the same keyframe twice was taken";
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("keyframe '" + s.map.keyframes[2].name + "' is given twice for one point"),
+              std::string::npos)
+        << e.what();
+  }
+  Scene near = s;
+  near.map.keyframes[1].pose = near.map.keyframes[0].pose;  // another name, the same view
+  try {
+    TriangulatePoint(near.map, {sighting(0), PointSighting{"1.png", sighting(0).pixel}});
+    FAIL() << "two keyframes of one view were taken";
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("see it from nearly one direction (their rays 0.0 degrees apart"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(TriangulatePoint(s.map, {sighting(0), sighting(2)}));
+}
+
 TEST(MetricFrame, TheCameraHeightEstimateIsStatedWithItsError) {
   const Scene s = MakeScene(1.7);  // filmed higher than the typical 1.45 m
   const MetricFit fit = FitFromCameraHeight(s.map);

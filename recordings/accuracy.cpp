@@ -185,6 +185,10 @@ nlohmann::ordered_json StatsJson(const ErrorStats& s) {
   return {{"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median}, {"max", s.max}, {"count", s.count}};
 }
 
+std::string RpeNotComputed(const AccuracyReport& r) {
+  return "fewer than " + std::to_string(r.rpe_delta + 1) + " associated poses";
+}
+
 }  // namespace
 
 std::string ReportToJson(const AccuracyReport& r) {
@@ -205,8 +209,15 @@ std::string ReportToJson(const AccuracyReport& r) {
   j["ate"] = StatsJson(r.ate);
   j["rotation_deg"] = StatsJson(r.rotation_deg);
   j["rpe_delta"] = r.rpe_delta;
-  j["rpe_translation"] = StatsJson(r.rpe_translation);
-  j["rpe_rotation_deg"] = StatsJson(r.rpe_rotation_deg);
+  // No pairs: null and the reason, as the text says "not computed" (summaries of nothing read 0).
+  if (r.rpe_translation.count > 0) {
+    j["rpe_translation"] = StatsJson(r.rpe_translation);
+    j["rpe_rotation_deg"] = StatsJson(r.rpe_rotation_deg);
+  } else {
+    j["rpe_translation"] = nullptr;
+    j["rpe_rotation_deg"] = nullptr;
+    j["rpe_not_computed"] = RpeNotComputed(r);
+  }
   return j.dump(2) + "\n";
 }
 
@@ -235,8 +246,7 @@ std::string ReportToText(const AccuracyReport& r) {
                   r.rpe_delta, r.rpe_translation.rmse, r.rpe_translation.median, r.rpe_rotation_deg.rmse,
                   r.rpe_rotation_deg.median);
   } else {
-    std::snprintf(buf, sizeof(buf), "RPE (%d)     not computed: fewer than %d associated poses\n", r.rpe_delta,
-                  r.rpe_delta + 1);
+    std::snprintf(buf, sizeof(buf), "RPE (%d)     not computed: %s\n", r.rpe_delta, RpeNotComputed(r).c_str());
   }
   o << buf;
   return o.str();

@@ -201,6 +201,21 @@ TEST(ReportToJson, HoldsTheHeadlineNumbers) {
   EXPECT_NE(ReportToText(r).find("ATE"), std::string::npos);
 }
 
+// Issue 57: with too few associated poses for one RPE pair, the JSON said rmse 0.0 from zero
+// pairs where the text said "not computed".
+TEST(ReportToJson, AnRpeOfNoPairsIsNullWithTheReason) {
+  const Trajectory gt = Orbit(12);
+  AccuracyOptions options;
+  options.rpe_delta = 20;  // more than the 12 associated poses
+  const std::string json = ReportToJson(EvaluateTrajectory(gt, gt, options));
+  EXPECT_NE(json.find("\"rpe_translation\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"rpe_rotation_deg\": null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"rpe_not_computed\": \"fewer than 21 associated poses\""), std::string::npos) << json;
+  EXPECT_NE(ReportToText(EvaluateTrajectory(gt, gt, options)).find("not computed: fewer than 21 associated poses"),
+            std::string::npos);
+  EXPECT_EQ(ReportToJson(EvaluateTrajectory(gt, gt)).find("rpe_not_computed"), std::string::npos);
+}
+
 TEST(PlotTrajectories, DrawsBothViewsWithErrorColours) {
   const Trajectory gt = Orbit(50);
   Trajectory est = gt;
@@ -269,6 +284,22 @@ TEST(Tum, MalformedLinesAreNamedWithFileAndLine) {
                 .find(":2: the position (8.71e+306, -0.99, 0.6) lies beyond 1e+100 of the origin"),
             std::string::npos);
   EXPECT_EQ(error_for("1 1e99 0 0 0 0 0 1\n"), "");
+  fs::remove(file);
+}
+
+// Issue 57: two different poses at one time were read, and the association dropped one unsaid.
+TEST(Tum, TwoPosesAtOneTimeAreRefusedNamingBothLines) {
+  const fs::path file = fs::temp_directory_path() / ("arview_tum_twice_" + std::to_string(::getpid()) + ".txt");
+  std::ofstream(file) << "1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n# again\n1 0.5 0 0 0 0 0 1\n";
+  try {
+    ReadTum(file);
+    FAIL() << "two poses at 1 s read";
+  } catch (const RecordingError& e) {
+    EXPECT_EQ(std::string(e.what()), file.string() + ":4: a second pose at the time 1 s, another than line 1's: one "
+                                                      "time, one pose");
+  }
+  std::ofstream(file) << "1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n";  // the same pose again
+  EXPECT_EQ(ReadTum(file).size(), 2u);
   fs::remove(file);
 }
 

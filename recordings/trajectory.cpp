@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <sstream>
 
 namespace arview::recordings {
@@ -26,6 +27,7 @@ namespace {
 Trajectory ReadTumFile(const std::filesystem::path& path) {
   std::istringstream in(ReadRecordingText(path));
   Trajectory out;
+  std::map<double, std::pair<int, std::size_t>> first_at;  // timestamp → its first line, its pose
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
@@ -58,6 +60,18 @@ Trajectory ReadTumFile(const std::filesystem::path& path) {
       throw RecordingError(message.str());
     }
     out.push_back({v[0], calib::Pose::FromCameraToWorld(q_wc, {v[1], v[2], v[3]})});
+    // Two poses at one time: the association would keep one of them and drop the other unsaid.
+    const auto [earlier_at, inserted] = first_at.emplace(v[0], std::make_pair(line_no, out.size() - 1));
+    if (!inserted) {
+      const calib::Pose& earlier = out[earlier_at->second.second].pose;
+      if (earlier.q_cw.coeffs() != out.back().pose.q_cw.coeffs() || earlier.t_cw != out.back().pose.t_cw) {
+        std::ostringstream message;
+        message << path.string() << ":" << line_no << ": a second pose at the time " << std::setprecision(17) << v[0]
+                << " s, another than line " << earlier_at->second.first << "'s: one time, one pose";
+        throw RecordingError(message.str());
+      }
+      out.pop_back();  // the same pose again: kept once
+    }
   }
   return out;
 }

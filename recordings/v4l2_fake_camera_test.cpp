@@ -781,6 +781,30 @@ TEST(V4l2FakeCamera, AValueOutsideAControlsRangeIsOneErrorNamingDeviceControlAnd
   EXPECT_TRUE(camera.writes().empty());
 }
 
+// Issue 57: a focus off the control's step (7 on a step of 5) was taken silently, and the driver
+// held the lens at another position than the one asked for.
+TEST(V4l2FakeCamera, AFocusBetweenTheControlsStepsIsRefusedNamingTheNearestPositions) {
+  V4l2Options o;
+  o.focus = "7";
+  FakeCamera camera(Usb2Webcam());
+  try {
+    V4l2Source("/dev/video7", o, camera);
+    FAIL() << "focus 7 was taken";
+  } catch (const SourceError& e) {
+    EXPECT_TRUE(Contains(e.what(), "/dev/video7: focus 7 is between the steps of control 'Focus, Absolute' (0..250, "
+                                   "step 5): the camera holds 5 or 10"))
+        << e.what();
+  }
+  EXPECT_TRUE(camera.writes().empty());  // refused before anything was changed
+  o.focus = "249";
+  EXPECT_TRUE(Contains(OpenError(Usb2Webcam(), o), "focus 249 is between the steps of control 'Focus, Absolute' "
+                                                   "(0..250, step 5): the camera holds 245 or 250"));
+  o.focus = "245";
+  FakeCamera on_step(Usb2Webcam());
+  V4l2Source source("/dev/video7", o, on_step);
+  EXPECT_EQ(on_step.control(V4L2_CID_FOCUS_ABSOLUTE), 245);
+}
+
 TEST(V4l2FakeCamera, ACameraWithoutTheControlsSaysSoInOneNoteEach) {
   FakeConfig c = Usb2Webcam();
   c.controls.clear();

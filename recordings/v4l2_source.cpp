@@ -581,10 +581,18 @@ bool V4l2Source::TryWriteControl(const CameraControl& control, int64_t value) {
 }
 
 void V4l2Source::CheckRange(const CameraControl& control, int64_t value, const std::string& what) const {
-  if (value < control.minimum || value > control.maximum) {
-    Fail(what + " " + std::to_string(value) + " is outside the range of control '" + control.name + "' (" +
-         std::to_string(control.minimum) + ".." + std::to_string(control.maximum) + ", step " +
-         std::to_string(control.step) + ")");
+  const std::string range = " (" + std::to_string(control.minimum) + ".." + std::to_string(control.maximum) +
+                            ", step " + std::to_string(control.step) + ")";
+  if (value < control.minimum || value > control.maximum)
+    Fail(what + " " + std::to_string(value) + " is outside the range of control '" + control.name + "'" + range);
+  // The driver would round a value between steps to one of them without a word (a focus of 7 held
+  // at 5 or 10: another focal length than the one asked for).
+  if (control.step > 1 && (value - control.minimum) % control.step != 0) {
+    const int64_t below = value - (value - control.minimum) % control.step;
+    std::string nearest = std::to_string(below);
+    if (below + control.step <= control.maximum) nearest += " or " + std::to_string(below + control.step);
+    Fail(what + " " + std::to_string(value) + " is between the steps of control '" + control.name + "'" + range +
+         ": the camera holds " + nearest);
   }
 }
 

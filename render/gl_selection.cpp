@@ -56,14 +56,15 @@ void AppendDevices(const std::vector<EglDeviceInfo>& devices, std::optional<int>
 }  // namespace
 
 std::vector<GlCandidate> PlanGlCandidates(GlBackend backend, const std::vector<EglDeviceInfo>& devices,
-                                          std::optional<int> requested) {
+                                          std::optional<int> requested, const std::string& requested_by) {
   if (backend == GlBackend::kOsMesa) return {{GlCandidateKind::kOsMesa}};
   if (backend == GlBackend::kEgl) return {{GlCandidateKind::kEglSurfaceless}};
   if (requested) {
     bool listed = false;
     for (const EglDeviceInfo& d : devices) listed = listed || d.index == *requested;
     if (!listed) {
-      throw RenderError("GL device " + std::to_string(*requested) + " does not exist: EGL lists " +
+      throw RenderError("GL device " + std::to_string(*requested) +
+                        (requested_by.empty() ? std::string() : " (" + requested_by + ")") + " does not exist: EGL lists " +
                         (devices.empty()       ? std::string("no device")
                          : devices.size() == 1 ? std::string("1 (index 0)")
                                                : std::to_string(devices.size()) + " (0-" + std::to_string(devices.size() - 1) + ")") +

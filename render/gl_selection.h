@@ -69,9 +69,10 @@ std::optional<int> RequestedGlDevice(std::optional<int> flag, const char* enviro
 // The order in which to try: for kAuto the requested device, the other hardware devices, Mesa's
 // surfaceless platform, the software devices, OSMesa; for kEglDevice the devices alone, in the
 // same order; for kEgl and kOsMesa that one backend. Throws RenderError when `requested` names a
-// device the list does not have (saying how many there are).
+// device the list does not have (saying how many there are, and naming `requested_by`, the flag or
+// variable that asked for it, e.g. "ARVIEW_GL_DEVICE=5": a variable set long ago is easily forgotten).
 std::vector<GlCandidate> PlanGlCandidates(GlBackend backend, const std::vector<EglDeviceInfo>& devices,
-                                          std::optional<int> requested);
+                                          std::optional<int> requested, const std::string& requested_by = "");
 
 struct GlAttempt {
   GlCandidate candidate;

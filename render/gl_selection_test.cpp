@@ -61,6 +61,14 @@ TEST(GlSelection, ARequestedDeviceComesFirstEvenASoftwareOne) {
     EXPECT_STREQ(e.what(), "GL device 3 does not exist: EGL lists 3 (0-2); 'arview info gl' lists them");
   }
   EXPECT_THROW(PlanGlCandidates(GlBackend::kEglDevice, {}, 0), RenderError);
+  // Issue 57: a device asked for by the environment was reported without naming the variable.
+  try {
+    PlanGlCandidates(GlBackend::kAuto, two_gpus, 5, "ARVIEW_GL_DEVICE=5");
+    FAIL() << "device 5 of 3 accepted";
+  } catch (const RenderError& e) {
+    EXPECT_STREQ(e.what(), "GL device 5 (ARVIEW_GL_DEVICE=5) does not exist: EGL lists 3 (0-2); 'arview info gl' "
+                           "lists them");
+  }
 }
 
 TEST(GlSelection, EglDeviceTriesDevicesOnlyAndTheOtherBackendsThemselvesOnly) {

@@ -362,11 +362,14 @@ OffscreenContext::OffscreenContext(GlBackend backend, int device, int threads) {
 
 std::unique_ptr<OffscreenContext> OffscreenContext::Create(const OffscreenOptions& options) {
   const bool uses_devices = options.backend == GlBackend::kAuto || options.backend == GlBackend::kEglDevice;
-  const std::optional<int> requested =
-      uses_devices ? RequestedGlDevice(options.device, std::getenv("ARVIEW_GL_DEVICE")) : std::nullopt;
+  const char* environment = std::getenv("ARVIEW_GL_DEVICE");
+  const std::optional<int> requested = uses_devices ? RequestedGlDevice(options.device, environment) : std::nullopt;
+  const std::string requested_by = options.device ? "--gl-device " + std::to_string(*options.device)
+                                   : environment  ? "ARVIEW_GL_DEVICE=" + std::string(environment)
+                                                  : "";
   const EglDevices* devices = uses_devices ? &ListEglDevices() : nullptr;
-  const std::vector<GlCandidate> plan =
-      PlanGlCandidates(options.backend, devices ? devices->info : std::vector<EglDeviceInfo>{}, requested);
+  const std::vector<GlCandidate> plan = PlanGlCandidates(
+      options.backend, devices ? devices->info : std::vector<EglDeviceInfo>{}, requested, requested_by);
   std::unique_ptr<OffscreenContext> context;
   std::vector<GlAttempt> attempts;
   try {

@@ -99,7 +99,26 @@ TEST_F(GlCliTest, ADeviceThatDoesNotExistIsOneLineNamingIt) {
   const auto flag = Render("auto", "a.png", {"--gl-device", "63"});
   EXPECT_EQ(flag.exit_code, 1);
   EXPECT_EQ(LineCount(flag.err), 1) << flag.err;
-  EXPECT_NE(flag.err.find("GL device 63 does not exist"), std::string::npos) << flag.err;
+  EXPECT_NE(flag.err.find("GL device 63 (--gl-device 63) does not exist"), std::string::npos) << flag.err;
+  EXPECT_FALSE(fs::exists(dir_ / "a.png"));
+  {
+    // Issue 57: a device the variable asks for was not said to come from it.
+    const ScopedGlDeviceVariable absent("63");
+    const auto from_variable = Render("auto", "a.png");
+    EXPECT_EQ(from_variable.exit_code, 1);
+    EXPECT_EQ(LineCount(from_variable.err), 1) << from_variable.err;
+    EXPECT_NE(from_variable.err.find("GL device 63 (ARVIEW_GL_DEVICE=63) does not exist"), std::string::npos)
+        << from_variable.err;
+    EXPECT_FALSE(fs::exists(dir_ / "a.png"));
+  }
+  // Issue 57: --gl-device with a backend that takes no device was accepted and ignored.
+  const auto ignored = Render("osmesa", "a.png", {"--gl-device", "5"});
+  EXPECT_EQ(ignored.exit_code, 2);
+  EXPECT_EQ(LineCount(ignored.err), 1) << ignored.err;
+  EXPECT_NE(ignored.err.find("--gl-device 5 picks an EGL device: it needs --gl auto or egl-device (--gl osmesa "
+                             "renders without one)"),
+            std::string::npos)
+      << ignored.err;
   EXPECT_FALSE(fs::exists(dir_ / "a.png"));
 
   const ScopedGlDeviceVariable bad("first");

@@ -10,7 +10,7 @@ extern "C" {
 
 #include <cmath>
 
-#include "render/offscreen.h"
+#include "video/video_error.h"
 
 namespace arview::video {
 
@@ -48,7 +48,7 @@ struct H264Writer::State {
   }
 
   [[noreturn]] void Fail(const std::string& what, int error) const {
-    throw render::RenderError(name + ": " + what + " (" + AvErrorText(error) + ")");
+    throw VideoError(name + ": " + what + " (" + AvErrorText(error) + ")");
   }
 
   // Sends `input` (nullptr: flush) and writes every packet the encoder has ready.
@@ -72,7 +72,7 @@ H264Writer::H264Writer(std::unique_ptr<State> state) : state_(std::move(state)) 
 H264Writer::~H264Writer() {
   try {
     Close();
-  } catch (const render::RenderError&) {
+  } catch (const VideoError&) {
     // Destruction must not throw; Close() reports the error to a caller that asks.
   }
 }
@@ -131,8 +131,8 @@ std::unique_ptr<H264Writer> H264Writer::Open(const std::filesystem::path& path, 
 
 void H264Writer::Write(const cv::Mat& bgr) {
   State& s = *state_;
-  if (s.closed) throw render::RenderError(s.name + ": the video is already closed");
-  if (bgr.size() != s.size || bgr.type() != CV_8UC3) throw render::RenderError(s.name + ": frame is not 8-bit BGR at the opened size");
+  if (s.closed) throw VideoError(s.name + ": the video is already closed");
+  if (bgr.size() != s.size || bgr.type() != CV_8UC3) throw VideoError(s.name + ": frame is not 8-bit BGR at the opened size");
   int error = av_frame_make_writable(s.frame);  // the encoder may still hold the last one
   if (error < 0) s.Fail("out of memory for a frame", error);
   const uint8_t* source[1] = {bgr.data};

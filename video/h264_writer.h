@@ -23,7 +23,7 @@ struct H264Options {
 class H264Writer {
  public:
   // Nothing when this FFmpeg has no libx264 encoder or the size is odd (the caller then falls
-  // back to OpenCV's writer); throws RenderError naming the file when the file cannot be opened or written.
+  // back to OpenCV's writer); throws VideoError naming the file when the file cannot be opened or written.
   static std::unique_ptr<H264Writer> Open(const std::filesystem::path& path, cv::Size size, double fps,
                                           const H264Options& options = {});
   ~H264Writer();

@@ -11,7 +11,7 @@
 #include <filesystem>
 
 #include "video/h264_writer.h"
-#include "render/offscreen.h"
+#include "video/video_error.h"
 #include "video/window.h"
 
 namespace arview::video {
@@ -23,7 +23,7 @@ std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::t
 
 void CheckFrame(const cv::Mat& frame, cv::Size size, const std::string& target) {
   if (frame.size() != size || frame.type() != CV_8UC3) {
-    throw render::RenderError(target + ": frame is " + SizeText(frame.size()) + " type " + std::to_string(frame.type()) +
+    throw VideoError(target + ": frame is " + SizeText(frame.size()) + " type " + std::to_string(frame.type()) +
                       ", the sink was opened for " + SizeText(size) + " BGR");
   }
 }
@@ -32,14 +32,10 @@ class WindowSink final : public FrameSink {
  public:
   WindowSink(std::string title, cv::Size size, const WindowPlacement& placement) : title_(std::move(title)), size_(size) {
     if (!HasDisplay()) {
-      throw render::RenderError("window output needs a display, and DISPLAY is not set; "
+      throw VideoError("window output needs a display, and DISPLAY is not set; "
                                 "write to a file instead (e.g. --out out.mp4)");
     }
-    try {
-      window_ = DisplayWindow::Open(title_, size, "write to a file instead (e.g. --out out.mp4)", placement);
-    } catch (const Error& e) {
-      throw render::RenderError(e.what());
-    }
+    window_ = DisplayWindow::Open(title_, size, "write to a file instead (e.g. --out out.mp4)", placement);
     // Kept for after Close: the session describes its output once the window is gone.
     const std::string placed = window_->PlacementText();
     description_ = "window \"" + title_ + "\" (" + window_->PresentMethod() + (placed.empty() ? "" : ", " + placed) + ")";
@@ -79,9 +75,9 @@ class WindowSink final : public FrameSink {
 class VideoSink final : public FrameSink {
  public:
   VideoSink(const fs::path& path, cv::Size size, double fps) : path_(path), size_(size) {
-    if (!(fps > 0 && fps <= 1000)) throw render::RenderError(path.string() + ": frame rate must be in (0, 1000]");
+    if (!(fps > 0 && fps <= 1000)) throw VideoError(path.string() + ": frame rate must be in (0, 1000]");
     if (path.has_parent_path() && !fs::is_directory(path.parent_path())) {
-      throw render::RenderError(path.string() + ": folder " + path.parent_path().string() + " does not exist");
+      throw VideoError(path.string() + ": folder " + path.parent_path().string() + " does not exist");
     }
     // H.264 through libx264 at a fast preset (video/h264_writer.h says why not OpenCV's writer);
     // without libx264, OpenCV's writer: H.264 if its FFmpeg has another encoder for it, else
@@ -99,7 +95,7 @@ class VideoSink final : public FrameSink {
         break;
       }
     }
-    if (!writer_.isOpened()) throw render::RenderError(path.string() + ": OpenCV's FFmpeg writer cannot open this file");
+    if (!writer_.isOpened()) throw VideoError(path.string() + ": OpenCV's FFmpeg writer cannot open this file");
   }
   ~VideoSink() override {
     h264_.reset();
@@ -116,7 +112,7 @@ class VideoSink final : public FrameSink {
     std::error_code ec;
     if (!closed_ && (!fs::exists(path_, ec) || fs::file_size(path_, ec) == 0)) {
       closed_ = true;
-      throw render::RenderError(path_.string() + ": the video file was not written");
+      throw VideoError(path_.string() + ": the video file was not written");
     }
     closed_ = true;
   }
@@ -136,7 +132,7 @@ class PngSequenceSink final : public FrameSink {
   PngSequenceSink(const fs::path& folder, cv::Size size) : folder_(folder), size_(size) {
     std::error_code ec;
     fs::create_directories(folder, ec);
-    if (ec || !fs::is_directory(folder)) throw render::RenderError(folder.string() + ": cannot create the PNG folder");
+    if (ec || !fs::is_directory(folder)) throw VideoError(folder.string() + ": cannot create the PNG folder");
   }
   void Write(const cv::Mat& bgr) override {
     CheckFrame(bgr, size_, folder_.string());
@@ -181,12 +177,12 @@ bool HasDisplay() {
 
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
                                     const WindowPlacement& window) {
-  if (frame_size.width <= 0 || frame_size.height <= 0) throw render::RenderError("sink: frame size must be positive");
+  if (frame_size.width <= 0 || frame_size.height <= 0) throw VideoError("sink: frame size must be positive");
   if (IsWindowTarget(target)) {
     return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size, window);
   }
   if (target == "null") return std::make_unique<NullSink>(frame_size);
-  if (target.empty()) throw render::RenderError("sink: no output given");
+  if (target.empty()) throw VideoError("sink: no output given");
   const fs::path path(target);
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -194,7 +190,7 @@ std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_si
   if (target.back() == '/' || ext.empty() || fs::is_directory(path)) {
     return std::make_unique<PngSequenceSink>(path, frame_size);
   }
-  throw render::RenderError(target + ": unknown output (expected window, null, a .mp4/.avi/.mkv file, or a folder for PNGs)");
+  throw VideoError(target + ": unknown output (expected window, null, a .mp4/.avi/.mkv file, or a folder for PNGs)");
 }
 
 }  // namespace arview::video

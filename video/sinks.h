@@ -1,7 +1,7 @@
 #pragma once
 // Where augmented frames go: a window (video/window.h), an MP4 file (libx264, else OpenCV's
 // FFmpeg writer), or a folder of PNGs. OpenSink picks by the target's form:
-//   "window" or "window:<title>"  → an X11 window (no display → RenderError saying so)
+//   "window" or "window:<title>"  → an X11 window (no display → VideoError saying so)
 //   "null"                         → frames counted and discarded (soak runs, timing)
 //   "<file>.mp4" | ".avi" | ".mkv" → a video file at the given frame rate
 //   "<folder>/" or an existing folder or a name without extension → <folder>/000000.png, ...
@@ -19,7 +19,7 @@ namespace arview::video {
 class FrameSink {
  public:
   virtual ~FrameSink() = default;
-  // Throws RenderError naming the target when the frame cannot be written (or, for a window,
+  // Throws VideoError naming the target when the frame cannot be written (or, for a window,
   // shown). Every frame must have the size given at opening.
   virtual void Write(const cv::Mat& bgr) = 0;
   // Flushes and closes; safe to call twice. Destruction closes too, without throwing.

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <iterator>
 
-#include "render/offscreen.h"
+#include "video/video_error.h"
 #include "video/sinks.h"
 
 namespace arview::video {
@@ -87,7 +87,7 @@ TEST(Sinks, PngFolderNumbersFrames) {
   sink->Write(Frame(1));
   EXPECT_TRUE(fs::exists(folder / "000000.png"));
   EXPECT_TRUE(fs::exists(folder / "000001.png"));
-  EXPECT_THROW(sink->Write(cv::Mat(10, 10, CV_8UC3)), render::RenderError);
+  EXPECT_THROW(sink->Write(cv::Mat(10, 10, CV_8UC3)), VideoError);
   fs::remove_all(folder.parent_path());
 }
 
@@ -95,16 +95,16 @@ TEST(Sinks, WindowWithoutDisplaySaysSo) {
   if (HasDisplay()) GTEST_SKIP() << "a display is present";
   try {
     OpenSink("window", {160, 120}, 30);
-    FAIL() << "expected render::RenderError";
-  } catch (const render::RenderError& e) {
+    FAIL() << "expected VideoError";
+  } catch (const VideoError& e) {
     EXPECT_NE(std::string(e.what()).find("DISPLAY"), std::string::npos) << e.what();
   }
 }
 
 TEST(Sinks, RejectsUnknownTargets) {
-  EXPECT_THROW(OpenSink("out.gif", {160, 120}, 30), render::RenderError);
-  EXPECT_THROW(OpenSink("/nonexistent-folder/x.mp4", {160, 120}, 30), render::RenderError);
-  EXPECT_THROW(OpenSink("", {160, 120}, 30), render::RenderError);
+  EXPECT_THROW(OpenSink("out.gif", {160, 120}, 30), VideoError);
+  EXPECT_THROW(OpenSink("/nonexistent-folder/x.mp4", {160, 120}, 30), VideoError);
+  EXPECT_THROW(OpenSink("", {160, 120}, 30), VideoError);
 }
 
 }  // namespace

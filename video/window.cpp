@@ -14,7 +14,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "base/error.h"
+#include "video/video_error.h"
 
 namespace arview::video {
 
@@ -61,16 +61,16 @@ class X11Window final : public DisplayWindow {
       : size_(size) {
     const char* name = std::getenv("DISPLAY");
     if (name == nullptr || *name == '\0') {
-      throw Error("window: no display (DISPLAY is not set); " + without_display);
+      throw VideoError("window: no display (DISPLAY is not set); " + without_display);
     }
     display_ = XOpenDisplay(name);
-    if (!display_) throw Error(std::string("window: cannot open display '") + name + "'; " + without_display);
+    if (!display_) throw VideoError(std::string("window: cannot open display '") + name + "'; " + without_display);
     const int screen = DefaultScreen(display_);
     Visual* visual = DefaultVisual(display_, screen);
     const int depth = DefaultDepth(display_, screen);
     if (depth != 24 || visual->red_mask != 0xff0000 || visual->green_mask != 0xff00 || visual->blue_mask != 0xff) {
       XCloseDisplay(display_);
-      throw Error(std::string("window: display '") + name + "' has a " + std::to_string(depth) +
+      throw VideoError(std::string("window: display '") + name + "' has a " + std::to_string(depth) +
                   "-bit visual; a 24-bit true-colour display is needed");
     }
     cv::Point origin(0, 0);
@@ -122,7 +122,7 @@ class X11Window final : public DisplayWindow {
   }
 
   void Show(const cv::Mat& bgr) override {
-    if (bgr.size() != size_ || bgr.type() != CV_8UC3) throw Error("window: frame does not fit the window");
+    if (bgr.size() != size_ || bgr.type() != CV_8UC3) throw VideoError("window: frame does not fit the window");
     cv::Mat pixels(size_, CV_8UC4, image_->data, image_->bytes_per_line);
     cv::cvtColor(bgr, pixels, cv::COLOR_BGR2BGRA);
     shown_ = true;
@@ -161,7 +161,7 @@ class X11Window final : public DisplayWindow {
       list += (list.empty() ? "" : ", ") + o.name + " " + AreaText(o.area);
     }
     XCloseDisplay(display_);
-    throw Error(std::string("window: display '") + display_name + "' has no connected output '" + output + "' (" +
+    throw VideoError(std::string("window: display '") + display_name + "' has no connected output '" + output + "' (" +
                 (list.empty() ? std::string("it reports none through RandR") : "connected: " + list) + ")");
   }
 
@@ -204,9 +204,9 @@ class X11Window final : public DisplayWindow {
     if (!image_) {
       char* pixels = static_cast<char*>(std::malloc(static_cast<size_t>(size_.width) * size_.height * 4));
       image_ = XCreateImage(display_, visual, depth, ZPixmap, 0, pixels, size_.width, size_.height, 32, 0);
-      if (!image_) throw Error("window: cannot create the window's image");
+      if (!image_) throw VideoError("window: cannot create the window's image");
     }
-    if (image_->bits_per_pixel != 32) throw Error("window: the display does not store 32-bit pixels");
+    if (image_->bits_per_pixel != 32) throw VideoError("window: the display does not store 32-bit pixels");
   }
 
   void Translate(const XEvent& e, std::vector<InputEvent>& out) {
@@ -270,7 +270,7 @@ class X11Window final : public DisplayWindow {
 
 std::unique_ptr<DisplayWindow> DisplayWindow::Open(const std::string& title, cv::Size size, const std::string& without_display,
                                                    const WindowPlacement& placement) {
-  if (size.width <= 0 || size.height <= 0) throw Error("window: size must be positive");
+  if (size.width <= 0 || size.height <= 0) throw VideoError("window: size must be positive");
   return std::make_unique<X11Window>(title, size, without_display, placement);
 }
 

@@ -44,10 +44,10 @@ struct DisplayOutput {
 
 class DisplayWindow {
  public:
-  // Opens a window of `size` on $DISPLAY. Throws arview::Error with one line when there is no
+  // Opens a window of `size` on $DISPLAY. Throws VideoError with one line when there is no
   // display (DISPLAY unset, or the server refuses) or its visual is not 24-bit true colour;
   // `without_display` ends that line (what to do instead, e.g. "write to a file with --out").
-  // An unknown `placement.output` is an Error listing the connected ones.
+  // An unknown `placement.output` is a VideoError listing the connected ones.
   static std::unique_ptr<DisplayWindow> Open(const std::string& title, cv::Size size, const std::string& without_display,
                                              const WindowPlacement& placement = {});
   virtual ~DisplayWindow() = default;

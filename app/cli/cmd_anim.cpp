@@ -2,7 +2,6 @@
 // arview anim weights --scene <scene.yaml> --viewpoint x,y,z [--character <name>] [--time s] [--json]
 
 #include <cmath>
-#include <functional>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -220,13 +219,6 @@ void RunWeights(const AnimArgs& args) {
   if (spec->idle.balance.given) std::cout << "balance: " << balance_text << "\n";
 }
 
-void Guard(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const anim::Error& e) {
-    throw CommandError(e.what());
-  }
-}
 
 }  // namespace
 
@@ -238,7 +230,7 @@ void AddAnimCommand(CLI::App& app) {
   auto* info = cmd->add_subcommand("info", "Skeleton, clips, meshes and bones per mesh of a character asset");
   info->add_option("asset", args->asset, "Character file (glTF .glb/.gltf, FBX, Collada .dae, DirectX .X, BVH)")->required();
   info->add_flag("--json", args->json, "Print JSON instead of text");
-  info->callback([args] { Guard([&] { RunInfo(*args); }); });
+  info->callback([args] { RunInfo(*args); });
 
   auto* weights = cmd->add_subcommand(
       "weights", "Key weights (and the blended head's and gesturing arm's directions) for one viewpoint; what the idle section learns");
@@ -248,7 +240,7 @@ void AddAnimCommand(CLI::App& app) {
   weights->add_option("--character", args->character, "Character name in the scene (default: the first)");
   weights->add_option("--time", args->time, "Animation time in seconds (default 0)");
   weights->add_flag("--json", args->json, "Print JSON instead of text");
-  weights->callback([args] { Guard([&] { RunWeights(*args); }); });
+  weights->callback([args] { RunWeights(*args); });
 }
 
 }  // namespace arview::app

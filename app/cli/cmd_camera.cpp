@@ -117,11 +117,7 @@ void AddCameraCommand(CLI::App& app) {
   info->add_option("device", args->device, "V4L2 device, e.g. /dev/video0");
   info->add_option("--device", args->device_flag, "The same, as run and record name it");
   info->callback([args] {
-    try {
-      RunInfo(*args);
-    } catch (const recordings::SourceError& e) {
-      throw CommandError(e.what());
-    }
+    RunInfo(*args);
   });
 }
 

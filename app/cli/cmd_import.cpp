@@ -22,21 +22,13 @@ void RunImport(const ImportArgs& args) {
   recordings::ImportOptions options;
   options.overwrite = args.force;
   if (!args.camera.empty()) {
-    try {
-      options.camera = calib::LoadCamera(args.camera);
-    } catch (const calib::CameraError& e) {
-      throw CommandError(e.what());
-    }
+    options.camera = calib::LoadCamera(args.camera);
   }
-  try {
-    const recordings::ImportResult r = recordings::Import(args.kind, args.source, args.out, options);
-    for (const std::string& note : r.notes) std::cout << "note: " << note << "\n";
-    std::cout << "imported " << r.frame_count << " frames (" << r.camera.width << "x" << r.camera.height
-              << ", fx " << r.camera.fx << ", fy " << r.camera.fy << ")"
-              << (r.has_groundtruth ? " with ground truth" : ", no ground truth") << " into " << args.out << "\n";
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  }
+  const recordings::ImportResult r = recordings::Import(args.kind, args.source, args.out, options);
+  for (const std::string& note : r.notes) std::cout << "note: " << note << "\n";
+  std::cout << "imported " << r.frame_count << " frames (" << r.camera.width << "x" << r.camera.height
+            << ", fx " << r.camera.fx << ", fy " << r.camera.fy << ")"
+            << (r.has_groundtruth ? " with ground truth" : ", no ground truth") << " into " << args.out << "\n";
 }
 
 }  // namespace

@@ -142,22 +142,14 @@ void RunMap(const MapArgs& args) {
                          ". Its scale is " + (result.map.frame.metric() ? "the camera-height estimate" : "COLMAP's") +
                          "; 'arview map scale " + args.out + " ...' sets it once the board is usable");
     }
-  } catch (const CommandError&) {
-    throw;
   } catch (const mapping::ColmapStageError& e) {
     bar.Finish();
     std::cerr << "last lines of COLMAP's output (" << e.log.string() << "):\n";
     for (const auto& line : e.log_tail) std::cerr << "  | " << line << "\n";
-    throw CommandError(e.what());
+    throw;  // main() says its line
   } catch (const CancelledError&) {
     bar.Finish();
     throw;  // its message says which stage stopped and what was kept
-  } catch (const ProcessError& e) {
-    throw CommandError(e.what());
-  } catch (const map::MapError& e) {
-    throw CommandError(e.what());
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
   }
 }
 
@@ -192,14 +184,10 @@ void RunScale(const MapArgs& args) {
     std::cout << "frame: " << DescribeFrame(map.frame) << "\n"
               << "rewrote " << args.scale_dir << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
               << ", keyframes.txt, map.png} and the COLMAP model in metres\n";
-  } catch (const mapping::ColmapStageError& e) {
-    throw CommandError(e.what());
-  } catch (const ProcessError& e) {
-    throw CommandError(e.what());
+  } catch (const mapping::ColmapStageError&) {
+    throw;  // a MapError whose own line main() says, without the map's name before it
   } catch (const map::MapError& e) {
     throw CommandError(args.scale_dir + ": " + e.what() + " (the map was not changed)");
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
   }
 }
 
@@ -215,50 +203,46 @@ void RequireMapNotRefused(const std::string& dir) {
 }
 
 void RunInfo(const std::string& dir, bool recheck) {
-  try {
-    RequireMapNotRefused(dir);
-    // Before anything is printed, so that a folder without COLMAP's model fails with one line.
-    std::error_code ec;  // a name too long or a folder that cannot be searched: LoadMap says so, naming it
-    if (recheck) mapping::RecheckMap(fs::is_regular_file(dir, ec) ? fs::path(dir).parent_path() : fs::path(dir));
-    const auto start = std::chrono::steady_clock::now();
-    const map::Map map = map::LoadMap(dir);
-    const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    const auto s = map::ComputeStats(map);
-    int first = -1, last = -1;
-    for (const auto& k : map.keyframes) {
-      if (first < 0 || k.frame_index < first) first = k.frame_index;
-      last = std::max(last, k.frame_index);
-    }
-    const auto& c = map.camera;
-    std::cout << "map:                 " << dir << "\n"
-              << "camera:              " << c.width << "x" << c.height << ", fx " << c.fx << ", fy " << c.fy << ", cx "
-              << c.cx << ", cy " << c.cy << "\n"
-              << "keyframes:           " << s.keyframes << " (frames " << first << " to " << last << ")\n"
-              << "points:              " << s.points << "\n"
-              << "mean track length:   " << Fixed(s.mean_track_length, 2) << "\n"
-              << "observations:        " << s.observations << "\n"
-              << "reprojection error:  mean " << Fixed(s.mean_reprojection_error, 3) << " px, median "
-              << Fixed(s.median_reprojection_error, 3) << " px (COLMAP's mean point error "
-              << Fixed(s.mean_colmap_point_error, 3) << " px)\n"
-              << "descriptors:         " << s.descriptors << " (128 x uint8, "
-              << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
-              << "load time:           " << Fixed(load_ms, 1) << " ms\n";
-    std::cout << "frame:               " << DescribeFrame(map.frame) << "\n";
-    const fs::path folder = fs::is_directory(dir, ec) ? fs::path(dir) : fs::path(dir).parent_path();
-    if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
-      std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
-      for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
-      if (!check->flagged()) std::cout << "                     (nothing flagged)\n";
-    } else {
-      std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
-                << " is written by arview map since issue 17)\n";
-    }
-    if (const auto why = map::DegeneratePoints(map)) {
-      std::cout << "warning:             the map's points cannot hold a floor ('arview place' refuses the map): " << *why
-                << "\n";
-    }
-  } catch (const map::MapError& e) {
-    throw CommandError(e.what());
+  RequireMapNotRefused(dir);
+  // Before anything is printed, so that a folder without COLMAP's model fails with one line.
+  std::error_code ec;  // a name too long or a folder that cannot be searched: LoadMap says so, naming it
+  if (recheck) mapping::RecheckMap(fs::is_regular_file(dir, ec) ? fs::path(dir).parent_path() : fs::path(dir));
+  const auto start = std::chrono::steady_clock::now();
+  const map::Map map = map::LoadMap(dir);
+  const double load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const auto s = map::ComputeStats(map);
+  int first = -1, last = -1;
+  for (const auto& k : map.keyframes) {
+    if (first < 0 || k.frame_index < first) first = k.frame_index;
+    last = std::max(last, k.frame_index);
+  }
+  const auto& c = map.camera;
+  std::cout << "map:                 " << dir << "\n"
+            << "camera:              " << c.width << "x" << c.height << ", fx " << c.fx << ", fy " << c.fy << ", cx "
+            << c.cx << ", cy " << c.cy << "\n"
+            << "keyframes:           " << s.keyframes << " (frames " << first << " to " << last << ")\n"
+            << "points:              " << s.points << "\n"
+            << "mean track length:   " << Fixed(s.mean_track_length, 2) << "\n"
+            << "observations:        " << s.observations << "\n"
+            << "reprojection error:  mean " << Fixed(s.mean_reprojection_error, 3) << " px, median "
+            << Fixed(s.median_reprojection_error, 3) << " px (COLMAP's mean point error "
+            << Fixed(s.mean_colmap_point_error, 3) << " px)\n"
+            << "descriptors:         " << s.descriptors << " (128 x uint8, "
+            << Fixed(static_cast<double>(s.descriptors) * 128 / (1 << 20), 1) << " MiB)\n"
+            << "load time:           " << Fixed(load_ms, 1) << " ms\n";
+  std::cout << "frame:               " << DescribeFrame(map.frame) << "\n";
+  const fs::path folder = fs::is_directory(dir, ec) ? fs::path(dir) : fs::path(dir).parent_path();
+  if (const auto check = mapping::ReadMapCheck(folder / mapping::kMapCheckFileName)) {
+    std::cout << "check:               " << mapping::DescribeMapCheck(*check) << "\n";
+    for (const auto& warning : check->warnings) std::cout << "warning:             the map " << warning << "\n";
+    if (!check->flagged()) std::cout << "                     (nothing flagged)\n";
+  } else {
+    std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
+              << " is written by arview map since issue 17)\n";
+  }
+  if (const auto why = map::DegeneratePoints(map)) {
+    std::cout << "warning:             the map's points cannot hold a floor ('arview place' refuses the map): " << *why
+              << "\n";
   }
 }
 

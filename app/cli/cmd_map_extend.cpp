@@ -93,11 +93,7 @@ void RunExtend(const ExtendArgs& args) {
       std::cerr << "last lines of COLMAP's output (" << stage->log.string() << "):\n";
       for (const auto& line : stage->log_tail) std::cerr << "  | " << line << "\n";
     }
-    throw CommandError(e.what());
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  } catch (const ProcessError& e) {
-    throw CommandError(e.what());
+    throw;  // main() says its line
   }
 }
 

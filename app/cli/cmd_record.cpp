@@ -51,11 +51,7 @@ void RunRecord(const RecordArgs& args) {
   const cv::Size size = *ParseFrameSize(size_text);  // checked by --size's validator
   std::optional<calib::Camera> camera;
   if (!args.camera.empty()) {
-    try {
-      camera = calib::LoadCamera(args.camera);
-    } catch (const calib::CameraError& e) {
-      throw CommandError(e.what());
-    }
+    camera = calib::LoadCamera(args.camera);
   }
   // Ctrl-C (or SIGTERM) is how a recording without --seconds ends: the frames written so far
   // are a valid recording. With --seconds, an early stop says so and exits non-zero.
@@ -69,71 +65,67 @@ void RunRecord(const RecordArgs& args) {
   // session would leave holes whenever a PNG takes longer to write than a frame period.
   options.newest_only = false;
   options.cancel = signals.token();
+  recordings::V4l2Source source(args.device, options);
+  std::cerr << source.GrantedLine() << "\n";
+  for (const std::string& note : source.notes()) std::cerr << "note: " << note << "\n";
+  if (source.size() != size) {
+    std::cerr << "note: " << args.device << " gives " << source.size().width << "x" << source.size().height
+              << " instead of " << size_text << "\n";
+  }
+  if (camera && camera->Size() != source.size()) {
+    throw CommandError(args.camera + ": camera is " + std::to_string(camera->width) + "x" +
+                       std::to_string(camera->height) + " but " + args.device + " delivers " +
+                       std::to_string(source.size().width) + "x" + std::to_string(source.size().height));
+  }
+  if (camera) {
+    if (const std::string mismatch = FocusMismatch(source, *camera, args.camera); !mismatch.empty())
+      std::cerr << "warning: " << mismatch << "\n";
+    // The recording says at which focus its frames were taken, so that a map built from it
+    // and the sessions run on that map hold the camera there too.
+    if (!camera->focus && source.focus_held() && source.focus_position()) {
+      camera->focus = source.focus_position();
+      std::cerr << "note: " << args.camera << " does not say at which focus it was calibrated; the recording's "
+                << "camera.yaml says the focus it was made at, " << *camera->focus << "\n";
+    }
+  }
+  recordings::RecordingWriter writer(args.out, camera, args.force);
+  std::cerr << "recording into " << args.out << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
+  bool progress_shown = false;  // the progress line is redrawn in place: ended before any other line
+  auto progress = [&](const recordings::RecordStats& s) {
+    const recordings::SourceCounts c = source.Counts();
+    std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps  %5lld lost", s.seconds, s.frames, s.fps,
+                 static_cast<long long>(c.driver_dropped + c.corrupt_skipped + c.stale_skipped + s.skipped));
+    std::fflush(stderr);
+    progress_shown = true;
+  };
+  recordings::RecordStats stats;
   try {
-    recordings::V4l2Source source(args.device, options);
-    std::cerr << source.GrantedLine() << "\n";
-    for (const std::string& note : source.notes()) std::cerr << "note: " << note << "\n";
-    if (source.size() != size) {
-      std::cerr << "note: " << args.device << " gives " << source.size().width << "x" << source.size().height
-                << " instead of " << size_text << "\n";
-    }
-    if (camera && camera->Size() != source.size()) {
-      throw CommandError(args.camera + ": camera is " + std::to_string(camera->width) + "x" +
-                         std::to_string(camera->height) + " but " + args.device + " delivers " +
-                         std::to_string(source.size().width) + "x" + std::to_string(source.size().height));
-    }
-    if (camera) {
-      if (const std::string mismatch = FocusMismatch(source, *camera, args.camera); !mismatch.empty())
-        std::cerr << "warning: " << mismatch << "\n";
-      // The recording says at which focus its frames were taken, so that a map built from it
-      // and the sessions run on that map hold the camera there too.
-      if (!camera->focus && source.focus_held() && source.focus_position()) {
-        camera->focus = source.focus_position();
-        std::cerr << "note: " << args.camera << " does not say at which focus it was calibrated; the recording's "
-                  << "camera.yaml says the focus it was made at, " << *camera->focus << "\n";
-      }
-    }
-    recordings::RecordingWriter writer(args.out, camera, args.force);
-    std::cerr << "recording into " << args.out << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
-    bool progress_shown = false;  // the progress line is redrawn in place: ended before any other line
-    auto progress = [&](const recordings::RecordStats& s) {
-      const recordings::SourceCounts c = source.Counts();
-      std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps  %5lld lost", s.seconds, s.frames, s.fps,
-                   static_cast<long long>(c.driver_dropped + c.corrupt_skipped + c.stale_skipped + s.skipped));
-      std::fflush(stderr);
-      progress_shown = true;
-    };
-    recordings::RecordStats stats;
-    try {
-      stats = recordings::RecordFrames(source, writer, args.seconds, signals.token(), progress);
-    } catch (const recordings::RecordingError& e) {
-      // The camera failing (SourceError) or the disk (a frame or frames.txt that cannot be
-      // written): either way the frames before stay a valid recording, or none is left.
-      if (progress_shown) std::fprintf(stderr, "\n");
-      if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
-      throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
-                         " frames recorded before stay a valid recording in " + args.out +
-                         LostText(source.Counts(), 0));
-    }
+    stats = recordings::RecordFrames(source, writer, args.seconds, signals.token(), progress);
+  } catch (const recordings::RecordingError& e) {
+    // The camera failing (SourceError) or the disk (a frame or frames.txt that cannot be
+    // written): either way the frames before stay a valid recording, or none is left.
     if (progress_shown) std::fprintf(stderr, "\n");
-    if (writer.RemoveIfEmpty()) {
-      signals.token().ThrowIfCancelled("stopped before the first frame; nothing was recorded");
-      throw CommandError("stopped before the first frame; nothing was recorded");
-    }
-    if (args.seconds > 0 && signals.token().IsCancelled()) {
-      std::ostringstream what;
-      what << "stopped after " << stats.seconds << " of " << args.seconds << " s; the " << stats.frames
-           << " frames recorded stay a valid recording in " << args.out;
-      signals.token().ThrowIfCancelled(what.str());
-    }
-    std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out
-              << LostText(source.Counts(), stats.skipped) << "\n";
-    if (!camera) {
-      std::cout << "note: no --camera given: put a camera.yaml (arview calibrate) into " << args.out
-                << " before mapping or tracking\n";
-    }
-  } catch (const recordings::RecordingError& e) {  // SourceError included
-    throw CommandError(e.what());
+    if (writer.RemoveIfEmpty()) throw CommandError(std::string(e.what()) + "; nothing was recorded");
+    throw CommandError(std::string(e.what()) + "; the " + std::to_string(writer.frame_count()) +
+                       " frames recorded before stay a valid recording in " + args.out +
+                       LostText(source.Counts(), 0));
+  }
+  if (progress_shown) std::fprintf(stderr, "\n");
+  if (writer.RemoveIfEmpty()) {
+    signals.token().ThrowIfCancelled("stopped before the first frame; nothing was recorded");
+    throw CommandError("stopped before the first frame; nothing was recorded");
+  }
+  if (args.seconds > 0 && signals.token().IsCancelled()) {
+    std::ostringstream what;
+    what << "stopped after " << stats.seconds << " of " << args.seconds << " s; the " << stats.frames
+         << " frames recorded stay a valid recording in " << args.out;
+    signals.token().ThrowIfCancelled(what.str());
+  }
+  std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out
+            << LostText(source.Counts(), stats.skipped) << "\n";
+  if (!camera) {
+    std::cout << "note: no --camera given: put a camera.yaml (arview calibrate) into " << args.out
+              << " before mapping or tracking\n";
   }
 }
 

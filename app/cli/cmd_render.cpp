@@ -76,61 +76,47 @@ std::string Fixed3(double x) {
 void RunRender(const RenderArgs& args) {
   const calib::Pose pose = ParsePose(args.pose);
   calib::Camera camera;
-  try {
-    camera = calib::LoadCamera(args.camera);
-  } catch (const calib::CameraError& e) {
-    throw CommandError(e.what());
-  }
+  camera = calib::LoadCamera(args.camera);
   cv::Mat background;
   if (!args.background.empty()) {
-    try {
-      background = ReadImageFile(args.background, cv::IMREAD_COLOR);
-    } catch (const Error& e) {
-      throw CommandError(e.what());
-    }
+    background = ReadImageFile(args.background, cv::IMREAD_COLOR);
   }
   const std::string ext = std::filesystem::path(args.out).extension().string();
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") throw CommandError(args.out + ": --out must end in .png or .jpg");
-  try {
-    const authoring::Scene scene = authoring::LoadScene(args.scene);
-    if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
-    const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
-    std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
-    for (const authoring::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
+  const authoring::Scene scene = authoring::LoadScene(args.scene);
+  if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
+  const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
+  std::vector<std::unique_ptr<authoring::AnimatedCharacter>> characters;
+  for (const authoring::CharacterSpec& spec : scene.characters) characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
 
-    auto context = render::OffscreenContext::Create(ToOffscreenOptions(args.gl));
-    render::ArOptions options;
-    options.antialiasing = render::ParseAntialiasing(args.antialiasing);
-    options.shadow = !args.no_shadow;
-    options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
-    options.lighting = lighting.mode;
-    options.prt_cache_folder = render::DefaultPrtCacheFolder();
-    options.cast_shadow = !args.no_cast_shadow;
-    options.occlusion = !args.no_occlusion;
-    options.exposure_smoothing = 1.0;  // one frame: its own exposure
-    render::ArRenderer renderer(*context, camera, options);
-    if (lighting.light) renderer.SetRoomLight(*lighting.light);
-    std::vector<const anim::AnimatorFrame*> frames;
-    for (auto& c : characters) {
-      renderer.AddCharacter(c->character(), c->spec().placement());
-      frames.push_back(&c->Update(c->spec().placement().ViewpointFromCamera(pose.Center()), args.time));
-    }
-    const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
-                                   : renderer.Render(background, pose, frames);
-    WriteImageAtomically(args.out, image);
-    std::cout << "wrote " << args.out << " (" << image.cols << "x" << image.rows << ", "
-              << characters.size() << " character" << (characters.size() == 1 ? "" : "s")
-              << (camera.HasDistortion() ? ", undistorted view" : "")
-              << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ", lighting "
-              << render::LightingModeName(lighting.mode)
-              << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s" + (renderer.prt_from_cache() > 0 ? ", from its cache" : "") + ")" : "")
-              << ") ["
-              << context->Description() << "]\n";
-  } catch (const anim::Error& e) {
-    throw CommandError(e.what());
-  } catch (const render::RenderError& e) {
-    throw CommandError(e.what());
+  auto context = render::OffscreenContext::Create(ToOffscreenOptions(args.gl));
+  render::ArOptions options;
+  options.antialiasing = render::ParseAntialiasing(args.antialiasing);
+  options.shadow = !args.no_shadow;
+  options.skinning = args.skinning == "lbs" ? anim::SkinningMethod::kLinear : anim::SkinningMethod::kDualQuaternion;
+  options.lighting = lighting.mode;
+  options.prt_cache_folder = render::DefaultPrtCacheFolder();
+  options.cast_shadow = !args.no_cast_shadow;
+  options.occlusion = !args.no_occlusion;
+  options.exposure_smoothing = 1.0;  // one frame: its own exposure
+  render::ArRenderer renderer(*context, camera, options);
+  if (lighting.light) renderer.SetRoomLight(*lighting.light);
+  std::vector<const anim::AnimatorFrame*> frames;
+  for (auto& c : characters) {
+    renderer.AddCharacter(c->character(), c->spec().placement());
+    frames.push_back(&c->Update(c->spec().placement().ViewpointFromCamera(pose.Center()), args.time));
   }
+  const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
+                                 : renderer.Render(background, pose, frames);
+  WriteImageAtomically(args.out, image);
+  std::cout << "wrote " << args.out << " (" << image.cols << "x" << image.rows << ", "
+            << characters.size() << " character" << (characters.size() == 1 ? "" : "s")
+            << (camera.HasDistortion() ? ", undistorted view" : "")
+            << (renderer.used_linear_fallback() ? ", linear skinning (joints scale)" : "") << ", lighting "
+            << render::LightingModeName(lighting.mode)
+            << (lighting.mode == render::LightingMode::kShShadowed ? " (PRT " + Fixed3(renderer.prt_seconds()) + " s" + (renderer.prt_from_cache() > 0 ? ", from its cache" : "") + ")" : "")
+            << ") ["
+            << context->Description() << "]\n";
 }
 
 }  // namespace

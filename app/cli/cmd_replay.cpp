@@ -6,6 +6,7 @@
 
 #include "app/session/ar_session.h"
 #include "app/cli/commands.h"
+#include "app/cli/output_flags.h"
 #include "base/atomic_file.h"
 #include "app/cli/session_flags.h"
 #include "base/cancellation.h"
@@ -42,13 +43,19 @@ void AddReplayCommand(CLI::App& app) {
                   "--loop 100 --out null)")
       ->capture_default_str()
       ->check(CLI::Range(1L, 100000000L));
-  cmd->add_option("--read-ahead", a->read_ahead,
+  CLI::Option* read_ahead = cmd->add_option("--read-ahead", a->read_ahead,
                   "With --paced: frames read and decoded this many ahead of their time, as a camera's driver holds "
                   "frames (0: each frame read when the one before it is taken)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
   AddSessionFlags(cmd, a->session);
-  cmd->callback([a] {
+  cmd->callback([a, read_ahead] {
+    // An unpaced replay reads each frame when the tracker takes it: there is no ahead.
+    if (read_ahead->count() > 0 && !a->paced)
+      throw CommandError("--read-ahead needs --paced: an unpaced replay reads each frame when the tracker takes it", 2);
+    const bool to_file = !video::IsWindowTarget(a->out) && a->out != "null";
+    RequireDistinctOutputs(
+        {{"--out", to_file ? a->out : ""}, {"--trajectory", a->session.trajectory}, {"--stats", a->session.stats}});
     const ScopedSignalCancellation signals;
     const recordings::Recording recording = recordings::LoadRecording(a->recording);
     recordings::ReplayOptions replay;
@@ -79,7 +86,6 @@ void AddReplayCommand(CLI::App& app) {
     o.cancel_ends_normally = to_window || a->out == "null";
 
     // A video or a PNG folder is written under a temporary name and renamed when complete.
-    const bool to_file = !to_window && a->out != "null";
     std::unique_ptr<PendingOutput> pending;
     if (to_file) {
       pending = std::make_unique<PendingOutput>(a->out);

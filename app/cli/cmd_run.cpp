@@ -5,6 +5,7 @@
 #include "app/session/ar_session.h"
 #include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
+#include "app/cli/output_flags.h"
 #include "app/pipeline/pipeline_report.h"
 #include "app/cli/numeric_flags.h"
 #include "app/cli/session_flags.h"
@@ -47,6 +48,9 @@ void AddRunCommand(CLI::App& app) {
   AddCameraFlags(cmd, a->camera, "default: the map's camera size; another of the same aspect scales the map's camera exactly");
   AddSessionFlags(cmd, a->session);
   cmd->callback([a] {
+    const bool to_file = !video::IsWindowTarget(a->out) && a->out != "null";
+    RequireDistinctOutputs(
+        {{"--out", to_file ? a->out : ""}, {"--trajectory", a->session.trajectory}, {"--stats", a->session.stats}});
     SessionOptions o;
     o.command_start = Clock::now();
     ApplySessionFlags(a->session, /*live_source=*/true, o);

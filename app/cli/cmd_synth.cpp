@@ -50,18 +50,14 @@ void RunSynthRoom(SynthArgs& args) {
   o.height = size.height;
   SetUpBoard(args);
   const auto start = std::chrono::steady_clock::now();
-  try {
-    o.gl = ToOffscreenOptions(args.gl);
-    const synth::SynthRoomReport report = synth::SynthesizeRoom(o, [&](int done, int total) {
-      if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
-    });
-    if (!args.quiet) std::cerr << "\n";
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "wrote " << report.frames << " frames (" << o.width << "x" << o.height << ", " << o.fps << " fps, seed " << o.seed
-              << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
-  } catch (const std::exception& e) {
-    throw CommandError(e.what());
-  }
+  o.gl = ToOffscreenOptions(args.gl);
+  const synth::SynthRoomReport report = synth::SynthesizeRoom(o, [&](int done, int total) {
+    if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
+  });
+  if (!args.quiet) std::cerr << "\n";
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "wrote " << report.frames << " frames (" << o.width << "x" << o.height << ", " << o.fps << " fps, seed " << o.seed
+            << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
 }
 
 }  // namespace

@@ -14,6 +14,8 @@
 #include <sstream>
 
 #include "app/cli/commands.h"
+#include "app/cli/numeric_flags.h"
+#include "app/cli/output_flags.h"
 #include "base/progress.h"
 #include "app/cli/session_flags.h"
 #include "app/pipeline/stage_stats.h"
@@ -180,6 +182,7 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
 }
 
 void RunTrack(const TrackArgs& args) {
+  RequireDistinctOutputs({{"--out", args.out}, {"--stats", args.stats}});
   if (args.working_size != 0 && args.working_size < 64)
     throw CommandError("--working-size must be 0 (full resolution) or at least 64 (got " +
                        std::to_string(args.working_size) + ")", 2);
@@ -193,20 +196,12 @@ void RunTrack(const TrackArgs& args) {
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
   recordings::ReplayOptions replay;
-  try {
-    rec = recordings::LoadRecording(args.recording);
-    if (!args.frames.empty())
-      replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  }
+  rec = recordings::LoadRecording(args.recording);
+  if (!args.frames.empty())
+    replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
   const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
   map::Map map;
-  try {
-    map = map::LoadMap(args.map);
-  } catch (const map::MapError& e) {
-    throw CommandError(e.what());
-  }
+  map = map::LoadMap(args.map);
   if (map.camera.Size() != rec.camera.Size()) {
     std::ostringstream msg;
     msg << args.recording << " has " << rec.camera.width << "x" << rec.camera.height << " frames but the map "
@@ -231,23 +226,19 @@ void RunTrack(const TrackArgs& args) {
   recordings::Trajectory trajectory;
   Progress progress("track");
   recordings::Frame frame;
-  try {
-    while (!signals.token().IsCancelled() && source.Next(frame)) {
-      // A frame after a gap in --frames has no valid motion prior.
-      if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
-      FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp), {}};
-      if (record.result.status != tracker::TrackStatus::kLost) {
-        trajectory.push_back({record.timestamp, record.result.pose});
-      } else {
-        record.loss = diagnoser.Diagnose(frame.image, record.result);
-        losses.Add(*record.loss);
-      }
-      frames.push_back(std::move(record));
-      if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
-                      ToString(frames.back().result.status));
+  while (!signals.token().IsCancelled() && source.Next(frame)) {
+    // A frame after a gap in --frames has no valid motion prior.
+    if (!frames.empty() && frame.index != frames.back().index + 1) tracker->Reset();
+    FrameRecord record{static_cast<int>(frame.index), frame.timestamp, tracker->Track(frame.image, frame.timestamp), {}};
+    if (record.result.status != tracker::TrackStatus::kLost) {
+      trajectory.push_back({record.timestamp, record.result.pose});
+    } else {
+      record.loss = diagnoser.Diagnose(frame.image, record.result);
+      losses.Add(*record.loss);
     }
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
+    frames.push_back(std::move(record));
+    if (!signals.token().IsCancelled()) progress.Update(static_cast<long>(frames.size()), static_cast<long>(frame_count),
+                    ToString(frames.back().result.status));
   }
   progress.Finish();
   // Interrupted: neither the trajectory nor the statistics are written (a partial trajectory
@@ -256,11 +247,7 @@ void RunTrack(const TrackArgs& args) {
                                    std::to_string(frame_count) + " frames; not written: " + args.out +
                                    (args.stats.empty() ? "" : ", " + args.stats));
 
-  try {
-    recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);
-  } catch (const recordings::RecordingError& e) {
-    throw CommandError(e.what());
-  }
+  recordings::WriteTum(trajectory, args.out, "arview track " + args.recording + " --map " + args.map);
   const StatusSummaries summaries = SummarizeByStatus(frames);
   if (!args.stats.empty()) WriteStatsJson(args.stats, args, frames, summaries);
 
@@ -295,9 +282,9 @@ void AddTrackCommand(CLI::App& app) {
   auto a = std::make_shared<TrackArgs>();
   cmd->add_option("recording", a->recording, "Recording folder")->required();
   cmd->add_option("--map", a->map, "Map directory (or its map.arvmap)")->required();
-  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required();
+  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required()->check(OutputFileCheck());
   cmd->add_option("--frames", a->frames, "Frames to track, e.g. 1-46:2 (default: all)");
-  cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON");
+  cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON")->check(OutputFileCheck());
   cmd->add_option("--solver", a->solver, "Minimal solver in RANSAC: kneip | gao | epnp")
       ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
   cmd->add_option("--max-features", a->max_features,
@@ -344,7 +331,7 @@ void AddTrackCommand(CLI::App& app) {
                   "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
                   "the tracked pose: frames far apart (a sub-sampled clip, photos), where optical flow drifts; one SIFT "
                   "extraction a frame more. 0: every tracked frame; -1: never")
-      ->capture_default_str()->check(CLI::Range(-1.0, 1e9));
+      ->capture_default_str()->check(CLI::Range(-1.0, 1e9))->check(NeverOrNotNegative());
   cmd->add_option("--prefetch-below", a->prefetch_below,
                   "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
                   "(in the frame that needs it)")

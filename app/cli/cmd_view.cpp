@@ -14,6 +14,7 @@
 #include "app/cli/commands.h"
 #include "app/cli/gl_flags.h"
 #include "app/cli/numeric_flags.h"
+#include "app/cli/output_flags.h"
 #include "base/atomic_file.h"
 #include "app/pipeline/pipeline_report.h"
 #include "app/pipeline/stage_stats.h"
@@ -197,18 +198,15 @@ void AddViewCommand(CLI::App& app) {
   cmd->add_option("--seconds", a->seconds, "Window: close after this many seconds (0: when asked)")->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("--no-hud", a->no_hud, "Start with the overlay hidden (h toggles it)");
   cmd->add_flag("--no-help", a->no_help, "Start with the key help hidden (? toggles it)");
-  cmd->add_option("--stats", a->stats, "Write frame rate and per-stage timings as JSON");
+  cmd->add_option("--stats", a->stats, "Write frame rate and per-stage timings as JSON")->check(OutputFileCheck());
   cmd->add_flag("--json", a->json, "Window: print the final state (camera, viewpoint, weights, keys, timings) as JSON");
   cmd->add_option("--aa", a->aa, "Antialiasing: msaa (4x) or none")->capture_default_str();
   AddGlFlags(cmd, a->gl);
   cmd->callback([a] {
     if (a->orbit.empty() != a->out.empty()) throw CommandError("--orbit and --out go together: --orbit <spec> --out orbit.mp4");
-    try {
-      if (!a->orbit.empty()) RunOrbit(*a);
-      else RunWindow(*a);
-    } catch (const anim::Error& e) {
-      throw CommandError(e.what());
-    }
+    RequireDistinctOutputs({{"--out", a->out}, {"--stats", a->stats}});
+    if (!a->orbit.empty()) RunOrbit(*a);
+    else RunWindow(*a);
   });
 }
 

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "app/cli/commands.h"
+
 namespace arview::app {
 
 void AddGlFlags(CLI::App* cmd, GlFlags& f) {
@@ -22,6 +24,12 @@ void AddGlFlags(CLI::App* cmd, GlFlags& f) {
 render::OffscreenOptions ToOffscreenOptions(const GlFlags& f) {
   render::OffscreenOptions o;
   o.backend = render::ParseGlBackend(f.backend);
+  // Only auto and egl-device choose among EGL's devices: taken with another, it would be ignored.
+  if (f.device >= 0 && o.backend != render::GlBackend::kAuto && o.backend != render::GlBackend::kEglDevice) {
+    throw CommandError("--gl-device " + std::to_string(f.device) + " picks an EGL device: it needs --gl auto or "
+                       "egl-device (--gl " + f.backend + " renders without one)",
+                       2);
+  }
   o.threads = f.threads;
   if (f.device >= 0) o.device = f.device;
   o.verbose = f.verbose;

@@ -20,7 +20,8 @@ struct GlFlags {
 };
 
 void AddGlFlags(CLI::App* cmd, GlFlags& flags);
-// Throws render::RenderError on a bad --gl value.
+// Throws render::RenderError on a bad --gl value, CommandError on --gl-device with --gl osmesa or
+// egl (which use no EGL device).
 render::OffscreenOptions ToOffscreenOptions(const GlFlags& flags);
 
 }  // namespace arview::app

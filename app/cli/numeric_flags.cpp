@@ -99,6 +99,16 @@ CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest) {
   return CLI::Validator(check, "WIDTHxHEIGHT");
 }
 
+CLI::Validator NeverOrNotNegative() {
+  const auto check = [](const std::string& text) -> std::string {
+    double value = 0;
+    if (!CLI::detail::lexical_cast(text, value)) return "";  // not a number: the option's own check says so
+    if (value == -1 || value >= 0) return "";
+    return "'" + text + "' must be -1 (never) or 0 and up";
+  };
+  return CLI::Validator(check, "");
+}
+
 CLI::Validator BoardSizeCheck() {
   auto check = [](std::string& text) -> std::string {
     const std::optional<cv::Size> size = ParseFrameSize(text);

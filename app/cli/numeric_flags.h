@@ -25,6 +25,9 @@ std::optional<cv::Size> ParseFrameSize(const std::string& text);
 // CLI11 reports its message as "--size: ..." with the usage exit status.
 CLI::Validator FrameSizeCheck(cv::Size smallest, cv::Size largest);
 
+// A number of seconds where -1 means never: -1 or at least 0 (-0.5 read as never, undocumented).
+CLI::Validator NeverOrNotNegative();
+
 // A chessboard's inner corners written COLUMNSxROWS (as --size), each 2..99: --board's check on
 // `synth room` and `map`.
 CLI::Validator BoardSizeCheck();

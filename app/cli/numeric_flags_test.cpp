@@ -65,3 +65,18 @@ TEST(GuardNumericOptions, LeadingZerosAreDecimalNotOctal) {
 
 }  // namespace
 }  // namespace arview::app
+
+namespace arview::app {
+namespace {
+
+// Issue 57: --fresh-features-after -0.5 meant "never", though only -1 is documented.
+TEST(NeverOrNotNegative, TakesMinusOneAndZeroUpAndNothingBetween) {
+  const CLI::Validator check = NeverOrNotNegative();
+  for (std::string ok : {"-1", "-1.0", "0", "0.25", "30"}) EXPECT_EQ(check(ok), "") << ok;
+  for (std::string bad : {"-0.5", "-0.0001", "-2", "-1.5"}) {
+    EXPECT_EQ(check(bad), "'" + bad + "' must be -1 (never) or 0 and up") << bad;
+  }
+}
+
+}  // namespace
+}  // namespace arview::app

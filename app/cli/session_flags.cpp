@@ -1,5 +1,6 @@
 #include "app/cli/session_flags.h"
 
+#include "app/cli/output_flags.h"
 #include "app/placement/scene_lighting.h"
 #include "base/cache_folder.h"
 #include "render/hmd.h"
@@ -18,8 +19,10 @@ void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
-  cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)");
-  cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON");
+  cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)")
+      ->check(OutputFileCheck());
+  cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON")
+      ->check(OutputFileCheck());
   cmd->add_flag("--hmd", f.hmd,
                 "Head-mounted display: one half per eye, the same video in both (one camera), the character "
                 "rendered once (biocular; see --stereo-character)");
