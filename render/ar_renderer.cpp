@@ -291,6 +291,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
     draw.model_to_map = placed.placement.ModelToMap();
     draw.skinning_matrices = out.skinning_matrices;
     draw.skinning_dual_quats = out.skinning_dual_quats;
+    draw.morph_weights = out.morph_weights;
     draw.method = options_.skinning;
     draw.cull_back_faces = options_.cull_back_faces;
     // Key light from above and in front of the character, so that its face is lit and the
