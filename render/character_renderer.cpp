@@ -236,16 +236,6 @@ cv::Mat DecodeTexture(const anim::Texture& t, const std::string& source) {
 // filtering is costly (measured with bench_render).
 constexpr float kCharacterAnisotropy = 1.f;
 
-// Per vertex, how far its morph targets can move it (Σ |position delta|): with weights in
-// [−1, 1] a morphed vertex stays that close to where it rests.
-std::vector<float> MorphReach(const anim::Mesh& mesh) {
-  std::vector<float> reach(mesh.positions.size(), 0.f);
-  for (const anim::MeshMorph& m : mesh.morphs)
-    for (size_t i = 0; i < m.vertices.size() && i < m.position_deltas.size(); ++i)
-      if (m.vertices[i] < reach.size()) reach[m.vertices[i]] += m.position_deltas[i].norm();
-  return reach;
-}
-
 int MaxJoints(const GlApi& gl) {
   // skin (16 floats) + two vec4 per joint, with room for the other uniforms.
   GLint components = 0;
@@ -281,7 +271,6 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
         (!mesh.uvs.empty() && mesh.uvs.size() != n)) {
       throw RenderError(character.source + ": mesh '" + mesh.name + "' has inconsistent vertex arrays");
     }
-    const std::vector<float> reach = MorphReach(mesh);
     std::vector<CharacterVertex> vertices(n);
     for (size_t i = 0; i < n; ++i) {
       CharacterVertex& v = vertices[i];
@@ -300,7 +289,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
         v.weights[k] = mesh.weights[i][k];
         if (v.weights[k] > 0) {
           const int j = v.joints[k];
-          const float d = (inverse_bind[j] * mesh.positions[i].homogeneous()).head<3>().norm() + reach[i];
+          const float d = (inverse_bind[j] * mesh.positions[i].homogeneous()).head<3>().norm();
           joint_radii_[j] = std::max(joint_radii_[j], d);
         }
       }
@@ -326,6 +315,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     attribute(4, 4, offsetof(CharacterVertex, weights));
     gl.BindVertexArray(0);
     UploadMorphs(mesh, character.source, gpu);
+    AddMorphReach(mesh, inverse_bind);
     gpu.index_count = static_cast<GLsizei>(mesh.indices.size());
     gpu.vertex_count = static_cast<int>(n);
     triangles_ += gpu.index_count / 3;
@@ -371,6 +361,35 @@ void CharacterRenderer::UploadMorphs(const anim::Mesh& mesh, const std::string& 
   gpu.morph_buffer = MakeBuffer(gl, GL_TEXTURE_BUFFER, texels.data(), texels.size() * sizeof(float));
   gl.BindBuffer(GL_TEXTURE_BUFFER, 0);
   gpu.morph_texture = MakeBufferTexture(gl, gpu.morph_buffer.get(), GL_RGB32F);
+}
+
+void CharacterRenderer::AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind) {
+  if (mesh.morphs.empty()) return;
+  morph_reach_.resize(static_cast<size_t>(morph_targets_) * joints_, 0.f);
+  frame_radii_.resize(joints_);
+  for (const anim::MeshMorph& m : mesh.morphs) {
+    for (size_t i = 0; i < m.vertices.size(); ++i) {
+      const size_t v = m.vertices[i];
+      for (int k = 0; k < 4; ++k) {
+        if (mesh.weights[v][k] <= 0) continue;
+        const int j = mesh.joints[v][k];
+        float& reach = morph_reach_[static_cast<size_t>(m.target) * joints_ + j];
+        reach = std::max(reach, (inverse_bind[j].topLeftCorner<3, 3>() * m.position_deltas[i]).norm());
+      }
+    }
+  }
+}
+
+std::span<const float> CharacterRenderer::JointRadii(std::span<const float> morph_weights) {
+  if (morph_reach_.empty() || morph_weights.size() != static_cast<size_t>(morph_targets_)) return joint_radii_;
+  std::copy(joint_radii_.begin(), joint_radii_.end(), frame_radii_.begin());
+  for (int t = 0; t < morph_targets_; ++t) {
+    const float w = std::abs(morph_weights[t]);
+    if (w == 0.f || !std::isfinite(w)) continue;
+    const float* reach = &morph_reach_[static_cast<size_t>(t) * joints_];
+    for (int j = 0; j < joints_; ++j) frame_radii_[j] += w * reach[j];
+  }
+  return frame_radii_;
 }
 
 int CharacterRenderer::ActiveMorphs(const GpuMesh& mesh, std::span<const float> weights) {

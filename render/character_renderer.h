@@ -68,6 +68,9 @@ class CharacterRenderer {
   // every skinned vertex stays within these spheres around the posed joints (for rigid joints),
   // which bounds the character on screen.
   const std::vector<float>& joint_radii() const { return joint_radii_; }
+  // The same with a frame's morph targets: each radius grows by Σ_k |w_k| · (the farthest target
+  // k moves a vertex the joint influences). Valid until the next call; no allocation.
+  std::span<const float> JointRadii(std::span<const float> morph_weights);
   // Uploads per-vertex PRT transfer (ComputeShadowedTransfer of the same character); needed by
   // LightingMode::kShShadowed. Throws RenderError when the vertex counts differ.
   void SetTransfer(const CharacterTransfer& transfer);
@@ -94,6 +97,7 @@ class CharacterRenderer {
   // This draw's targets for one mesh, in active_base_/active_weight_; returns their count.
   int ActiveMorphs(const GpuMesh& mesh, std::span<const float> weights);
   void UploadMorphs(const anim::Mesh& mesh, const std::string& source, GpuMesh& gpu);
+  void AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind);
   const GlApi* gl_;
   int joints_ = 0;
   int triangles_ = 0;
@@ -129,6 +133,8 @@ class CharacterRenderer {
   std::vector<float> joint_radii_;
   std::vector<float> dq_upload_;
   int morph_targets_ = 0;
+  std::vector<float> morph_reach_;  // [target · joints + joint]: the farthest the target moves a vertex of the joint
+  std::vector<float> frame_radii_;  // JointRadii's
   int morph_applied_ = 0, morph_dropped_ = 0;
   std::vector<std::pair<float, int>> morph_candidates_;  // (|weight|, target); reserved at upload
   std::array<GLint, kMaxActiveMorphTargets> active_base_{};

@@ -151,6 +151,48 @@ TEST_F(MorphCube, WeightedTargetsChangeThePicture) {
   EXPECT_GT(cv::countNonZero(diff > 10), 1000) << "the first target moves the cube's top";
 }
 
+// The drawn rectangle grows with the weighted targets: weights that push the cube beyond its rest
+// size (negative, and over 1) give the full-frame picture.
+TEST_F(MorphCube, TheBoundedRenderHoldsTheMorphedCube) {
+  for (const std::vector<float>& w : {std::vector<float>{-1.5f, 0}, std::vector<float>{0, 2.5f}, std::vector<float>{-1, -1}}) {
+    cv::Mat pictures[2];
+    for (const bool full : {false, true}) {
+      ArOptions options;
+      options.shadow = false;
+      options.full_frame = full;
+      ArRenderer renderer(testing::SharedContext(), TestCamera(), options);
+      renderer.AddCharacter(cube_, CubePlacement());
+      anim::AnimatorFrame frame = frame_;
+      frame.morph_weights = w;
+      const anim::AnimatorFrame* frames[] = {&frame};
+      pictures[full] = renderer.Render({}, LookingAtCube(), frames);
+    }
+    cv::Mat diff;
+    cv::absdiff(pictures[0], pictures[1], diff);
+    cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::countNonZero(diff > 1), 0) << w[0] << ", " << w[1];
+  }
+}
+
+// The warm-up also draws the morphing programs (every target barely weighted) and leaves no trace.
+TEST_F(MorphCube, TheWarmUpDrawsTheMorphingProgramAndLeavesNoTrace) {
+  const std::vector<float> w{0.4f, 0.6f};
+  anim::AnimatorFrame frame = frame_;
+  frame.morph_weights = w;
+  const anim::AnimatorFrame* frames[] = {&frame};
+  cv::Mat pictures[2];
+  for (const bool warm : {false, true}) {
+    ArRenderer renderer(testing::SharedContext(), TestCamera(), {});
+    renderer.AddCharacter(cube_, CubePlacement());
+    const anim::AnimatorFrame* rest[] = {&frame_};
+    if (warm) renderer.WarmUp(LookingAtCube(), rest);
+    pictures[warm] = renderer.Render({}, LookingAtCube(), frames);
+  }
+  cv::Mat diff;
+  cv::absdiff(pictures[0], pictures[1], diff);
+  EXPECT_EQ(cv::countNonZero(diff.reshape(1)), 0);
+}
+
 TEST_F(MorphCube, AWrongNumberOfWeightsIsRefused) {
   ArRenderer renderer(testing::SharedContext(), TestCamera(), {});
   renderer.AddCharacter(cube_, CubePlacement());
