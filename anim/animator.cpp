@@ -31,6 +31,7 @@ void FrameBuffers::Finish(const Skeleton& skeleton, AnimatorFrame& frame, const 
   frame.skinning_dual_quats = skin_dq;
   frame.model = model;
   frame.local = local;
+  frame.morph_weights = local[0].morph;
 }
 
 Animator::Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Schedule> schedule, AnimatorOptions options,
@@ -104,6 +105,13 @@ void Animator::Distance(double time, double distance) {
       armed_[i] = true;
     }
   }
+}
+
+bool Animator::SetMorphWeight(int target, float weight) {
+  std::vector<float>& weights = buffers_.local[0].morph;
+  if (target < 0 || target >= static_cast<int>(weights.size()) || !std::isfinite(weight)) return false;
+  weights[target] = weight;
+  return true;
 }
 
 const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {

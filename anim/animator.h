@@ -61,6 +61,9 @@ struct AnimatorFrame {
   bool converged = true;                      // DIB converged on every joint
   int max_iterations = 0;                     // DIB, the worst joint (PlacedCharacter::Update)
   int triggered = 0;                          // distance triggers fired this frame
+  // One weight per morph target (Skeleton::morph_targets; empty without targets): the playing
+  // clips' weight tracks blended, then whatever a face layer set (Animator::SetMorphWeight).
+  std::span<const float> morph_weights;
 
   // The weight of the layers below the view-adaptive action (the idle): 0 while the viewer is
   // tracked, 1 once the view-adaptive action has faded out (or where there is none).
@@ -93,6 +96,11 @@ class Animator {
 
   // `time` in seconds, monotonic (a jump backwards restarts the tracking-loss state).
   const AnimatorFrame& Update(double time, const FrameInputs& inputs);
+
+  // A face layer's write, after Update and before the frame is drawn: target `target`'s weight
+  // in the frame Update returned (the next Update starts again from the clips). False, and
+  // nothing written, for a target out of range or a non-finite weight. Never allocates.
+  bool SetMorphWeight(int target, float weight);
 
   Schedule& schedule() { return *schedule_; }
   const Skeleton& skeleton() const { return *skeleton_; }

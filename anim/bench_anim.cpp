@@ -9,6 +9,9 @@
 //   BM_FourActionSchedule3600    BM_ScheduleUpdateGesture/dib:0, exactly 3600 updates (callgrind)
 //   BM_IdleLayerSample/<balance> the idle layer alone, without (0) or with (1) the balance shifts
 //                                under its variations, on the constructed 13-joint standing person
+//   BM_MorphWeights/<targets>    Animator::Update of tests/support/face_schedule.h: three clips
+//                                keying <targets> morph target weights (0: none), sampled and
+//                                blended, and a face layer's write
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
@@ -16,6 +19,7 @@
 #include "anim/pose.h"
 #include "anim/animator.h"
 #include "anim_authoring/scene.h"
+#include "tests/support/face_schedule.h"
 #include "tests/support/four_action_schedule.h"
 #include "tests/support/standing_recording.h"
 #include "tests/support/test_data.h"
@@ -251,6 +255,12 @@ void BM_IdleLayerSample(benchmark::State& state) {
   state.SetLabel(state.range(0) ? "balance shifts + idle variations, 13 joints" : "idle variations, 13 joints");
 }
 BENCHMARK(BM_IdleLayerSample)->Arg(0)->Arg(1)->ArgName("balance");
+
+void BM_MorphWeights(benchmark::State& state) {
+  testing::FaceSchedule face(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(face.Step(1.0 / 60).morph_weights.data());
+}
+BENCHMARK(BM_MorphWeights)->Arg(0)->Arg(16)->Arg(52)->Arg(128)->ArgName("targets");
 
 }  // namespace
 }  // namespace arview::anim

@@ -148,7 +148,7 @@ Mirror::Mirror(BlendablePtr inner, std::shared_ptr<const Skeleton> skeleton, con
   n_ = (rp.transpose() * lateral).normalized();
   partner_ = MirrorPartners(*skeleton_);
   const int n = skeleton_->size();
-  source_.Resize(n);
+  source_.Resize(n, skeleton_->morph_target_count());
   model_rot_.assign(n, Eigen::Quaterniond::Identity());
   mirrored_rot_ = model_rot_;
   model_pos_.assign(n, Eigen::Vector3d::Zero());
@@ -184,6 +184,9 @@ bool Mirror::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
     out.rigid[j] = DualQuatd::FromRotationTranslation(local, translation);
     out.scale[j] = source_.scale[partner_[j]];
   }
+  // The face as the inner object keyed it (a target is not exchanged with its mirror image).
+  out.morph_keyed = source_.morph_keyed && out.morph.size() == source_.morph.size();
+  if (out.morph_keyed) std::copy(source_.morph.begin(), source_.morph.end(), out.morph.begin());
   return true;
 }
 

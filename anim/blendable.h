@@ -118,7 +118,7 @@ class Window : public Blendable {
 // Left↔Right, _L↔_R, ...), reflected across the character's sagittal plane (normal
 // `lateral` = up × forward in model space). Done in model space against the rest pose so that
 // it holds for rigs whose left and right joint frames are not mirror images: at rest the mirror
-// returns the rest pose.
+// returns the rest pose. Morph target weights pass through as the inner object keyed them.
 class Mirror : public Blendable {
  public:
   Mirror(BlendablePtr inner, std::shared_ptr<const Skeleton> skeleton, const Eigen::Vector3d& lateral = Eigen::Vector3d::UnitX());

@@ -30,6 +30,12 @@ int Skeleton::Find(const std::string& name) const {
   return -1;
 }
 
+int Skeleton::FindMorphTarget(const std::string& name) const {
+  for (int k = 0; k < morph_target_count(); ++k)
+    if (morph_targets[k] == name) return k;
+  return -1;
+}
+
 const Clip* Character::FindClip(const std::string& name) const {
   for (const Clip& c : clips)
     if (c.name == name) return &c;

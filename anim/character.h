@@ -10,6 +10,8 @@
 //   c.materials[c.meshes[i].material].base_color and .texture (index into c.textures, or −1)
 //   c.textures[k]: .path (a file), or .encoded bytes (png/jpg, decode them), or raw .rgba
 //   c.clips[n].name, .duration (seconds)
+//   c.skeleton.morph_targets[k]: a morph target's name; c.meshes[i].morphs: its deltas on mesh i;
+//   c.clips[n].weight_tracks: its weight over time (anim/morph.h builds and checks them)
 //
 // Skinning (see pose.h for the jobs that compute it every frame):
 //   skin_j = model_j · inverse_bind_j, where model_j is joint j's model-space transform;
@@ -64,9 +66,16 @@ struct Skeleton {
   // model_root = root_parent · local_root.
   Eigen::Matrix4d root_parent = Eigen::Matrix4d::Identity();
 
+  // The morph targets (blend shapes) the clips and the face key, by name; a pose carries one
+  // weight per target (LocalPose::morph), as a skeleton names its joints. The deltas are the
+  // meshes' (Mesh::morphs). Empty for a character without targets.
+  std::vector<std::string> morph_targets;
+
   int size() const { return static_cast<int>(names.size()); }
+  int morph_target_count() const { return static_cast<int>(morph_targets.size()); }
   // −1 when absent. Exact name match.
   int Find(const std::string& name) const;
+  int FindMorphTarget(const std::string& name) const;
 };
 
 template <class V>
@@ -82,11 +91,19 @@ struct JointTrack {
   std::vector<Key<Eigen::Vector3d>> scale;
 };
 
+// One morph target's weight over time, interpolated linearly between keys (as glTF's LINEAR
+// weights). A target without a track weighs 0 while the clip plays.
+struct WeightTrack {
+  int target = 0;  // index into Skeleton::morph_targets
+  std::vector<Key<double>> weights;  // times increasing
+};
+
 struct Clip {
   std::string name;
   double duration = 0;           // seconds
   double ticks_per_second = 0;   // from the file (e.g. 120 for CMU BVH); 0 if it gave none
   std::vector<JointTrack> tracks;  // one per skeleton joint
+  std::vector<WeightTrack> weight_tracks;  // at most one per morph target; empty: no face keys
 };
 
 struct Texture {
@@ -103,6 +120,15 @@ struct Material {
   int texture = -1;  // base-colour texture: index into Character::textures, −1 if none
 };
 
+// One morph target's deltas on one mesh, sparse: only the vertices it moves. A weighted target
+// moves vertex v to positions[v] + w·position_deltas[i] (normals likewise) before skinning.
+struct MeshMorph {
+  int target = 0;                                // index into Skeleton::morph_targets
+  std::vector<std::uint32_t> vertices;           // increasing, below the mesh's vertex count
+  std::vector<Eigen::Vector3f> position_deltas;  // one per listed vertex, model units
+  std::vector<Eigen::Vector3f> normal_deltas;    // one per listed vertex (zero where none given)
+};
+
 struct Mesh {
   std::string name;
   std::vector<Eigen::Vector3f> positions;  // model space, rest pose
@@ -112,6 +138,7 @@ struct Mesh {
   std::vector<std::array<std::uint16_t, 4>> joints;  // skeleton joint indices per vertex
   std::vector<Eigen::Vector4f> weights;    // matching weights, sum 1 (unused slots 0)
   int material = -1;                       // index into Character::materials
+  std::vector<MeshMorph> morphs;           // at most one per morph target
   int vertex_count() const { return static_cast<int>(positions.size()); }
 };
 

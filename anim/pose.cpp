@@ -1,5 +1,7 @@
 #include "anim/pose.h"
 
+#include "anim/morph.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -52,13 +54,15 @@ Eigen::Matrix4d AffineProduct(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b
 
 }  // namespace
 
-void LocalPose::Resize(int joints) {
+void LocalPose::Resize(int joints, int morph_targets) {
   rigid.assign(joints, DualQuatd());
   scale.assign(joints, Eigen::Vector3d::Ones());
+  morph.assign(morph_targets, 0.f);
+  morph_keyed = false;
 }
 
 LocalPose LocalPose::Rest(const Skeleton& skeleton) {
-  LocalPose p(skeleton.size());
+  LocalPose p(skeleton.size(), skeleton.morph_target_count());
   for (int j = 0; j < skeleton.size(); ++j) {
     p.rigid[j] = skeleton.rest[j].Rigid();
     p.scale[j] = skeleton.rest[j].scale;
@@ -68,7 +72,8 @@ LocalPose LocalPose::Rest(const Skeleton& skeleton) {
 
 bool SamplingJob::Validate() const {
   return skeleton && clip && output && std::isfinite(time) && output->size() == skeleton->size() &&
-         static_cast<int>(clip->tracks.size()) == skeleton->size();
+         static_cast<int>(clip->tracks.size()) == skeleton->size() &&
+         WeightTracksFit(clip->weight_tracks, skeleton->morph_target_count(), output->morph.size());
 }
 
 bool SamplingJob::Run() const {
@@ -86,6 +91,7 @@ bool SamplingJob::Run() const {
                                                           SampleVec(tr.translation, t, rest.translation));
     output->scale[j] = SampleVec(tr.scale, t, rest.scale);
   }
+  SampleWeightTracks(clip->weight_tracks, t, *output);
   return true;
 }
 

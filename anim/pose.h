@@ -28,10 +28,16 @@ namespace arview::anim {
 struct LocalPose {
   std::vector<DualQuatd> rigid;
   std::vector<Eigen::Vector3d> scale;
+  // One weight per morph target (Skeleton::morph_targets), or empty: a pose sized for joints
+  // alone, which samplers fill without the face. `morph_keyed` says whether the object that
+  // wrote the pose set the weights (a clip with weight tracks, a schedule playing one); the
+  // frame blender blends the weights of those that did, and leaves the others out.
+  std::vector<float> morph;
+  bool morph_keyed = false;
 
   LocalPose() = default;
-  explicit LocalPose(int joints) { Resize(joints); }
-  void Resize(int joints);
+  explicit LocalPose(int joints, int morph_targets = 0) { Resize(joints, morph_targets); }
+  void Resize(int joints, int morph_targets = 0);
   int size() const { return static_cast<int>(rigid.size()); }
   // The skeleton's rest pose.
   static LocalPose Rest(const Skeleton& skeleton);

@@ -1,5 +1,6 @@
 #include "anim/prepared_clip.h"
 
+#include "anim/morph.h"
 #include "anim/taylor_trig.h"
 
 #include <algorithm>
@@ -37,10 +38,16 @@ DualQuatd Rigid(const Eigen::Quaterniond& r, const Eigen::Vector3d& t) {
 }  // namespace
 
 PreparedClip::PreparedClip(const Skeleton& skeleton, const Clip& clip, bool nlerp, std::span<const int> joints)
-    : duration_(clip.duration), joint_count_(skeleton.size()) {
+    : duration_(clip.duration),
+      joint_count_(skeleton.size()),
+      morph_target_count_(skeleton.morph_target_count()),
+      weight_tracks_(clip.weight_tracks) {
   if (static_cast<int>(clip.tracks.size()) != skeleton.size())
     throw Error("clip '" + clip.name + "' has " + std::to_string(clip.tracks.size()) + " tracks for " +
                 std::to_string(skeleton.size()) + " joints");
+  if (!WeightTracksFit(weight_tracks_, morph_target_count_, 0))
+    throw Error("clip '" + clip.name + "' has a weight track for a morph target the skeleton lacks (" +
+                std::to_string(morph_target_count_) + " targets)");
   if (joints.empty())
     for (int j = 0; j < skeleton.size(); ++j) joints_.push_back(j);
   else
@@ -114,7 +121,8 @@ PreparedClip::PreparedClip(const Skeleton& skeleton, const Clip& clip, bool nler
 }
 
 bool PreparedSamplingJob::Validate() const {
-  return clip && output && std::isfinite(time) && output->size() == clip->joint_count();
+  return clip && output && std::isfinite(time) && output->size() == clip->joint_count() &&
+         WeightTracksFit(clip->weight_tracks_, clip->morph_target_count_, output->morph.size());
 }
 
 bool PreparedSamplingJob::Run() const {
@@ -163,6 +171,7 @@ bool PreparedSamplingJob::Run() const {
     output->rigid[p.joint] = p.rigid >= 0 ? c.rigids_[p.rigid] : Rigid(rotation(p.rotation), vector(p.translation));
     output->scale[p.joint] = vector(p.scale);
   }
+  SampleWeightTracks(c.weight_tracks_, t, *output);
   return true;
 }
 

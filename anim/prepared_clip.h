@@ -15,6 +15,8 @@
 //     come from their Taylor series (taylor_trig.h; θ ≤ π/2 on the short way) instead of libm;
 //   - channels with one key or none (the rest value) are constants, and a joint whose rotation
 //     and translation are both constant has its dual quaternion stored.
+// The clip's morph target weight tracks are kept as they are and sampled as SamplingJob does
+// (morph.h), into the output's weights when it has them.
 
 #include "anim/pose.h"
 
@@ -70,6 +72,8 @@ class PreparedClip {
   std::vector<RotationPair> pairs_;            // parallel to rotations_ (the pair starting at that key)
   std::vector<Eigen::Vector3d> vectors_;       // translation and scale keys and constants
   std::vector<DualQuatd> rigids_;
+  int morph_target_count_ = 0;
+  std::vector<WeightTrack> weight_tracks_;
 };
 
 struct PreparedSamplingJob {

@@ -33,7 +33,7 @@ Schedule::Schedule(std::shared_ptr<const Skeleton> skeleton, const FrameBlenderO
   if (!(options_.rest_threshold >= 0)) throw Error("schedule: rest_threshold must be non-negative");
   slots_.resize(capacity);
   for (Slot& s : slots_) {
-    s.pose.Resize(skeleton_->size());
+    s.pose.Resize(skeleton_->size(), skeleton_->morph_target_count());
     s.mask_rotation.assign(skeleton_->size(), 1.0);
     s.mask_translation.assign(skeleton_->size(), 1.0);
   }
@@ -135,6 +135,7 @@ double Schedule::Duration() const {
 
 bool Schedule::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
   if (out.size() != skeleton_->size() || !std::isfinite(t)) return false;
+  if (!out.morph.empty() && static_cast<int>(out.morph.size()) != skeleton_->morph_target_count()) return false;
   active_.clear();
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     Slot& s = slots_[i];
@@ -149,6 +150,7 @@ bool Schedule::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
       continue;
     }
     s.scaling = s.action.params.Scaling(at, s.length);
+    s.pose.morph_keyed = false;  // set by an object that keys the face
     if (!s.action.object->Sample(at, inputs, s.pose)) return false;
     active_.push_back(static_cast<int>(i));
   }
@@ -157,6 +159,7 @@ bool Schedule::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
     for (std::size_t k = i; k > 0 && slots_[active_[k - 1]].action.layer > slots_[active_[k]].action.layer; --k)
       std::swap(active_[k - 1], active_[k]);
   Blend(out);
+  BlendMorph(out);
   return true;
 }
 
@@ -281,6 +284,33 @@ void Schedule::Blend(LocalPose& out) {
     }
     out.rigid[j] = below;
     out.scale[j] = below_scale;
+  }
+}
+
+void Schedule::BlendMorph(LocalPose& out) const {
+  out.morph_keyed = false;
+  if (out.morph.empty()) return;
+  std::fill(out.morph.begin(), out.morph.end(), 0.f);  // the rest: no target weighted
+  const int active_count = static_cast<int>(active_.size());
+  for (int a = 0; a < active_count;) {
+    const int first = a;
+    const int layer = slots_[active_[a]].action.layer;
+    double total = 0;
+    for (; a < active_count && slots_[active_[a]].action.layer == layer; ++a)
+      if (slots_[active_[a]].pose.morph_keyed) total += slots_[active_[a]].weight;
+    if (total <= 0) continue;  // nothing on this layer keys the face: what is below stays
+    // As the joints: what is below fills the layer up to the threshold on layer 0, to 1 above.
+    const double fill = first == 0 ? options_.rest_threshold : 1.0;
+    const double norm = std::max(total, fill);
+    const auto below = static_cast<float>(std::max(0.0, fill - total) / norm);
+    for (float& w : out.morph) w *= below;
+    for (int k = first; k < a; ++k) {
+      const Slot& s = slots_[active_[k]];
+      if (!s.pose.morph_keyed) continue;
+      const auto f = static_cast<float>(s.weight / norm);
+      for (std::size_t i = 0; i < out.morph.size(); ++i) out.morph[i] += f * s.pose.morph[i];
+    }
+    out.morph_keyed = true;
   }
 }
 

@@ -23,6 +23,10 @@
 // quaternions are blended with DLB or DIB; where they differ, rotation (sign-aligned normalised
 // sum) and translation (weighted mean) are blended apart. A joint with exactly one contributor
 // takes its transform unchanged (a masked layer leaves the others exactly as they were).
+// Morph target weights (the face, morph.h) blend the same way, as scalars, over the actions whose
+// object keyed them (LocalPose::morph_keyed: a clip with weight tracks) with their time weights
+// (joint masks do not apply): normalised within a layer, the rest (every weight 0) filling layer 0
+// up to the threshold, each higher layer over what is below in proportion to its total weight.
 //
 // A schedule is blendable, so schedules nest (an action's object may be a schedule). Its
 // duration is the end of its last bounded action, or unbounded when an action keeps rendering
@@ -107,6 +111,7 @@ class Schedule : public Blendable {
   };
   int free_count() const;
   void Blend(LocalPose& out);
+  void BlendMorph(LocalPose& out) const;
 
   std::shared_ptr<const Skeleton> skeleton_;
   FrameBlenderOptions options_;

@@ -513,8 +513,10 @@ class GltfChecker {
         if (s >= samplers.size()) Fail(w + ".sampler = " + std::to_string(s) + " is outside " + where + ".samplers");
         if (!ch.contains("target") || !ch["target"].is_object()) Fail(w + ".target is missing");
         const json& target = ch["target"];
-        Index(target, "node", "nodes", w + ".target");
-        CheckChannelOutput(samplers[s], String(target, "path", w + ".target"), w);
+        const auto node = Index(target, "node", "nodes", w + ".target");
+        const std::string path = String(target, "path", w + ".target");
+        CheckChannelOutput(samplers[s], path, w);
+        if (path == "weights") CheckWeightsOutput(samplers[s], node, w);
       }
     }
   }
@@ -533,6 +535,35 @@ class GltfChecker {
     if (output.count < input.count * per_time)
       Fail(where + ": " + std::to_string(output.count) + " output values for " + std::to_string(input.count) +
            " key times" + (per_time == 3 ? " (CUBICSPLINE needs three each)" : ""));
+  }
+
+  // A weights channel keys every morph target of its node's mesh at each time (glTF 2.0 §3.11):
+  // Assimp takes the targets per time from the output's length, so a short or long output would
+  // pair weights with the wrong targets and times.
+  void CheckWeightsOutput(const json& sampler, const std::optional<std::uint64_t>& node, const std::string& where) const {
+    if (!node) Fail(where + ": a weights channel without a target node");
+    const json& n = doc_.at("nodes").at(*node);
+    if (!n.is_object() || !n.contains("mesh") || !n["mesh"].is_number_unsigned() ||
+        n["mesh"].get<std::uint64_t>() >= Count("meshes"))
+      Fail(where + ": animates the morph target weights of node " + std::to_string(*node) + ", which has no mesh");
+    const std::size_t mesh_index = n["mesh"].get<std::size_t>();
+    const json& mesh = doc_.at("meshes").at(mesh_index);
+    std::uint64_t targets = 0;
+    if (mesh.is_object() && mesh.contains("primitives") && mesh["primitives"].is_array() && !mesh["primitives"].empty() &&
+        mesh["primitives"][0].is_object() && mesh["primitives"][0].contains("targets") &&
+        mesh["primitives"][0]["targets"].is_array())
+      targets = mesh["primitives"][0]["targets"].size();
+    const bool named = mesh.is_object() && mesh.contains("name") && mesh["name"].is_string();
+    const std::string mesh_name = named ? mesh["name"].get<std::string>() : "meshes[" + std::to_string(mesh_index) + "]";
+    if (targets == 0)
+      Fail(where + ": animates the morph target weights of mesh '" + mesh_name + "', which has no morph targets");
+    const Accessor& input = accessors_[sampler["input"].get<std::size_t>()];
+    const Accessor& output = accessors_[sampler["output"].get<std::size_t>()];
+    const std::uint64_t per_time = (sampler.value("interpolation", std::string("LINEAR")) == "CUBICSPLINE" ? 3 : 1) * targets;
+    if (output.count != input.count * per_time)
+      Fail(where + ": " + std::to_string(output.count) + " weights for " + std::to_string(input.count) +
+           " key times and the " + std::to_string(targets) + " morph targets of mesh '" + mesh_name + "' (" +
+           std::to_string(input.count * per_time) + " expected)");
   }
 
   void CheckScenes() const {

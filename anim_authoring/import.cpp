@@ -6,6 +6,7 @@
 
 #include "base/library_errors.h"
 
+#include "anim/morph.h"
 #include "anim_authoring/gltf_check.h"
 
 #include <assimp/Importer.hpp>
@@ -18,6 +19,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <span>
 #include <unordered_map>
 
 namespace arview::authoring {
@@ -93,14 +95,17 @@ struct Influence {
   float weight;
 };
 
-// Applies `m` to a mesh's positions and its inverse transpose to its normals.
-void BakeTransform(anim::Mesh& mesh, const Eigen::Matrix4d& m) {
+// Applies `m` to a mesh's positions and its inverse transpose to its normals (either alone when
+// the other flag is off).
+void BakeTransform(anim::Mesh& mesh, const Eigen::Matrix4d& m, bool positions = true, bool normals = true) {
   if (m.isIdentity(1e-12)) return;
   const Eigen::Matrix3f a = m.block<3, 3>(0, 0).cast<float>();
   const Eigen::Vector3f t = m.block<3, 1>(0, 3).cast<float>();
   const Eigen::Matrix3f n = a.inverse().transpose();
-  for (auto& p : mesh.positions) p = a * p + t;
-  for (auto& v : mesh.normals) v = (n * v).normalized();
+  if (positions)
+    for (auto& p : mesh.positions) p = a * p + t;
+  if (normals)
+    for (auto& v : mesh.normals) v = (n * v).normalized();
 }
 
 void FinishInfluences(anim::Mesh& mesh, std::vector<std::vector<Influence>>& inf, int fallback_joint) {
@@ -166,6 +171,7 @@ class Importer {
     ImportMeshes(c);
     ImportMaterials(c);
     ImportClips(c);
+    anim::CheckMorphTargets(c);
     return c;
   }
 
@@ -179,11 +185,66 @@ class Importer {
       for (unsigned a = 0; a < scene_->mNumAnimations; ++a)
         for (unsigned ch = 0; ch < scene_->mAnimations[a]->mNumChannels; ++ch)
           names.insert(scene_->mAnimations[a]->mChannels[ch]->mNodeName.C_Str());
+    // A mesh animated by its morph targets alone (AnimatedMorphCube): its node is the skeleton.
+    if (names.empty()) names = MorphMeshNodes();
     if (names.empty()) throw anim::Error(file_ + ": no skeleton (no skinned mesh and no animated node)");
     const NodeSelection sel = SelectSkeletonNodes(scene_, names, file_);
     if (sel.top->mParent) sk.root_parent = GlobalTransform(sel.top->mParent);
     AddJoints(sel.top, -1, sel, sk, index_);
     if (sk.size() > 65535) throw anim::Error(file_ + ": more than 65535 joints");
+  }
+
+  // The nodes that hold a mesh with morph targets.
+  std::set<std::string> MorphMeshNodes() const {
+    std::set<std::string> names;
+    std::vector<std::pair<const aiNode*, unsigned>> instances;
+    CollectInstances(scene_->mRootNode, instances);
+    for (const auto& [node, mi] : instances)
+      if (scene_->mMeshes[mi]->mNumAnimMeshes > 0) names.insert(node->mName.C_Str());
+    return names;
+  }
+
+  // The mesh's morph targets (aiMesh::mAnimMeshes hold absolute positions and normals) as deltas
+  // from the base, in model space: the target's vertices go through the same `bakes` as the
+  // mesh's before the base is subtracted. A target named as one of another mesh (glTF primitives
+  // of one mesh share their targets) is the same target; unnamed ones are "<mesh>#<i>".
+  void ImportMorphs(const aiMesh* m, std::span<const Eigen::Matrix4d> bakes, anim::Character& c, std::size_t mesh_index) {
+    std::vector<int>& targets = mesh_targets_[m];
+    targets.clear();  // a mesh instanced twice: the targets of its last copy
+    const anim::Mesh& mesh = c.meshes[mesh_index];
+    for (unsigned a = 0; a < m->mNumAnimMeshes; ++a) {
+      const aiAnimMesh* am = m->mAnimMeshes[a];
+      std::string name = am->mName.length ? am->mName.C_Str() : mesh.name + "#" + std::to_string(a);
+      const std::string where = file_ + ": morph target '" + name + "' of mesh '" + mesh.name + "'";
+      if (am->mNumVertices != m->mNumVertices)
+        throw anim::Error(where + " has " + std::to_string(am->mNumVertices) + " vertices, the mesh " +
+                          std::to_string(m->mNumVertices));
+      anim::Mesh shape;
+      shape.positions = mesh.positions;
+      shape.normals = mesh.normals;
+      if (am->mVertices) {
+        shape.positions.clear();
+        for (unsigned v = 0; v < am->mNumVertices; ++v)
+          shape.positions.emplace_back(am->mVertices[v].x, am->mVertices[v].y, am->mVertices[v].z);
+        for (const Eigen::Matrix4d& b : bakes) BakeTransform(shape, b, /*positions=*/true, /*normals=*/false);
+      }
+      if (am->mNormals) {
+        shape.normals.clear();
+        for (unsigned v = 0; v < am->mNumVertices; ++v) {
+          const Eigen::Vector3f n(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+          shape.normals.push_back(n.norm() > 0 ? n.normalized() : n);
+        }
+        for (const Eigen::Matrix4d& b : bakes) BakeTransform(shape, b, /*positions=*/false, /*normals=*/true);
+      }
+      std::vector<Eigen::Vector3f> dp(mesh.positions.size()), dn(mesh.positions.size());
+      for (std::size_t v = 0; v < dp.size(); ++v) {
+        dp[v] = shape.positions[v] - mesh.positions[v];
+        dn[v] = shape.normals[v] - mesh.normals[v];
+        if (!dp[v].allFinite() || !dn[v].allFinite())
+          throw anim::Error(where + " has a non-finite position or normal at vertex " + std::to_string(v));
+      }
+      targets.push_back(anim::AddMorphTarget(c, name, static_cast<int>(mesh_index), dp, dn));
+    }
   }
 
   void ImportMeshes(anim::Character& c) {
@@ -225,6 +286,9 @@ class Importer {
       if (bake) BakeTransform(mesh, *bake);
       FinishInfluences(mesh, inf, JointOf(m->mBones[0]->mName.C_Str()));
       c.meshes.push_back(std::move(mesh));
+      std::vector<Eigen::Matrix4d> bakes{place};
+      if (bake) bakes.push_back(*bake);
+      ImportMorphs(m, bakes, c, c.meshes.size() - 1);
     }
     // Joints that no skin references: bind them where they rest.
     for (int j = 0; j < sk.size(); ++j)
@@ -235,10 +299,12 @@ class Importer {
       const int j = NearestJoint(node);
       anim::Mesh mesh = CopyGeometry(m);
       // At rest: model_j · IB_j · v' = G_node · v.
-      BakeTransform(mesh, sk.inverse_bind[j].inverse() * rest_model_[j].inverse() * GlobalTransform(node));
+      const Eigen::Matrix4d place = sk.inverse_bind[j].inverse() * rest_model_[j].inverse() * GlobalTransform(node);
+      BakeTransform(mesh, place);
       std::vector<std::vector<Influence>> inf(m->mNumVertices, {{j, 1.0f}});
       FinishInfluences(mesh, inf, j);
       c.meshes.push_back(std::move(mesh));
+      ImportMorphs(m, std::span<const Eigen::Matrix4d>(&place, 1), c, c.meshes.size() - 1);
     }
   }
 
@@ -265,7 +331,7 @@ class Importer {
     return p[best];
   }
 
-  void CollectInstances(const aiNode* node, std::vector<std::pair<const aiNode*, unsigned>>& out) {
+  void CollectInstances(const aiNode* node, std::vector<std::pair<const aiNode*, unsigned>>& out) const {
     for (unsigned i = 0; i < node->mNumMeshes; ++i) out.emplace_back(node, node->mMeshes[i]);
     for (unsigned c = 0; c < node->mNumChildren; ++c) CollectInstances(node->mChildren[c], out);
   }
@@ -368,9 +434,45 @@ class Importer {
         for (const auto& k : tr.rotation)
           if (!k.value.coeffs().allFinite()) throw anim::Error(file_ + ": clip '" + clip.name + "' has a non-finite key");
       }
+      for (unsigned ch = 0; ch < anim->mNumMorphMeshChannels; ++ch)
+        ImportWeightChannel(c, clip, anim->mMorphMeshChannels[ch], tps);
       if (!(clip.duration >= 0) || !std::isfinite(clip.duration))
         throw anim::Error(file_ + ": clip '" + clip.name + "' has an invalid duration");
       c.clips.push_back(std::move(clip));
+    }
+  }
+
+  // A morph channel animates the weights of a node's meshes (glTF: the node's one mesh, its
+  // primitives sharing the targets); each key lists (target of the mesh, weight) pairs. One weight
+  // track per target; a key for a target the mesh lacks is an error naming it.
+  void ImportWeightChannel(const anim::Character& c, anim::Clip& clip, const aiMeshMorphAnim* channel, double tps) {
+    const std::string node_name = channel->mName.C_Str();
+    const std::string where = file_ + ": clip '" + clip.name + "'";
+    const aiNode* node = scene_->mRootNode->FindNode(channel->mName);
+    const std::vector<int>* targets = nullptr;
+    for (unsigned i = 0; node && i < node->mNumMeshes && !targets; ++i)
+      if (auto it = mesh_targets_.find(scene_->mMeshes[node->mMeshes[i]]); it != mesh_targets_.end() && !it->second.empty())
+        targets = &it->second;
+    if (!targets) throw anim::Error(where + " keys morph target weights of '" + node_name + "', which has no morph targets");
+    std::map<int, std::vector<anim::Key<double>>> tracks;
+    for (unsigned k = 0; k < channel->mNumKeys; ++k) {
+      const aiMeshMorphKey& key = channel->mKeys[k];
+      for (unsigned i = 0; i < key.mNumValuesAndWeights; ++i) {
+        const unsigned value = key.mValues[i];
+        if (value >= targets->size())
+          throw anim::Error(where + ": a weight track for morph target " + std::to_string(value) + " of '" + node_name +
+                            "', which has " + std::to_string(targets->size()) + " targets");
+        const int target = (*targets)[value];
+        if (!std::isfinite(key.mWeights[i]) || !std::isfinite(key.mTime))
+          throw anim::Error(where + ": a non-finite weight key for morph target '" + c.skeleton.morph_targets[target] + "'");
+        tracks[target].push_back({key.mTime / tps, key.mWeights[i]});
+      }
+    }
+    for (auto& [target, keys] : tracks) {
+      for (const anim::WeightTrack& t : clip.weight_tracks)
+        if (t.target == target)
+          throw anim::Error(where + " keys morph target '" + c.skeleton.morph_targets[target] + "' twice");
+      clip.weight_tracks.push_back({target, std::move(keys)});
     }
   }
 
@@ -379,6 +481,7 @@ class Importer {
   std::string file_;
   std::unordered_map<const aiNode*, int> index_;
   std::vector<Eigen::Matrix4d> rest_model_;
+  std::map<const aiMesh*, std::vector<int>> mesh_targets_;  // a mesh's anim meshes → the character's targets
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 // std::vector. Sanitizer builds bring their own allocator; there the test is skipped.
 
 #include "anim/balance_shift.h"
+#include "tests/support/face_schedule.h"
 #include "tests/support/four_action_schedule.h"
 #include "tests/support/standing_recording.h"
 #include "tests/support/test_data.h"
@@ -91,6 +92,26 @@ TEST(NoAllocation, FourActionScheduleWithPointGesture) {
 TEST(NoAllocation, FourActionScheduleWithMirroredGesture) {
   ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(testing::kBcnEpileptic), "Debian package assimp-testmodels");
   ExpectUpdatesAllocateNothing(testing::FourActionSchedule::Gesture::kMirroredClip, false);
+}
+
+// The face channel: 52 morph targets keyed by three clips (one mirrored, one on a layer above),
+// their weights sampled and blended every frame, and a face layer's write after each update.
+TEST(NoAllocation, MorphTargetWeightsSampledBlendedAndSet) {
+#ifndef ARVIEW_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "allocations are not counted in sanitizer builds (they replace malloc)";
+#else
+  testing::FaceSchedule face(52);
+  face.Step(1.0 / 60);
+  const long before = g_allocations.load();
+  float sum = 0;
+  for (int frame = 0; frame < 1200; ++frame) {
+    const anim::AnimatorFrame& f = face.Step(1.0 / 60);
+    for (float w : f.morph_weights) sum += w;
+  }
+  const long allocations = g_allocations.load() - before;
+  EXPECT_GT(sum, 0) << "the clips key the weights";
+  EXPECT_EQ(allocations, 0) << "allocations in 1200 Animator::Update calls with morph targets";
+#endif
 }
 
 // The balance-shift layer with the idle synthesizer's variations on top, learned from the

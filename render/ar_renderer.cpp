@@ -210,7 +210,7 @@ cv::Rect ArRenderer::ScreenBounds(const calib::Pose& eye, std::span<const anim::
     const Placed& placed = characters_[i];
     const anim::AnimatorFrame& frame = *frames[i];
     const Eigen::Matrix4d model_to_map = placed.placement.ModelToMap();
-    const std::vector<float>& radii = placed.renderer->joint_radii();
+    const std::span<const float> radii = placed.renderer->JointRadii(frame.morph_weights);
     for (size_t j = 0; j < frame.model.size() && j < radii.size(); ++j) {
       if (radii[j] <= 0) continue;
       // The joint's sphere of influence, enlarged 10% (DQS need not stay inside the linear
@@ -291,6 +291,7 @@ void ArRenderer::DrawLayer(const cv::Rect& rect, const calib::Pose& eye, std::sp
     draw.model_to_map = placed.placement.ModelToMap();
     draw.skinning_matrices = out.skinning_matrices;
     draw.skinning_dual_quats = out.skinning_dual_quats;
+    draw.morph_weights = out.morph_weights;
     draw.method = options_.skinning;
     draw.cull_back_faces = options_.cull_back_faces;
     // Key light from above and in front of the character, so that its face is lit and the
@@ -333,6 +334,19 @@ void ArRenderer::WarmUp(const calib::Pose& pose, std::span<const anim::AnimatorF
   UpdateCastShadows(frames);
   cv::Mat frame = PrepareBackground(cv::Mat());
   Compose(frame, pose, frames);
+  // Once more with every morph target barely weighted, for the meshes' morphing programs.
+  std::vector<std::vector<float>> weights(frames.size());
+  std::vector<anim::AnimatorFrame> morphed(frames.size());
+  std::vector<const anim::AnimatorFrame*> morphed_ptrs(frames.size());
+  bool any = false;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    morphed[i] = *frames[i];
+    weights[i].assign(frames[i]->morph_weights.size(), 1e-4f);
+    if (!weights[i].empty()) morphed[i].morph_weights = weights[i];
+    any = any || !weights[i].empty();
+    morphed_ptrs[i] = &morphed[i];
+  }
+  if (any) Compose(frame, pose, morphed_ptrs);
 }
 
 cv::Mat ArRenderer::RenderSideBySide(const cv::Mat& background, const calib::Pose& pose,

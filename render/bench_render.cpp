@@ -15,6 +15,11 @@
 //                                lens distortion in the AR path)
 //   BM_SynthRoomFrame            one frame of `arview synth room` (render + read-back, no PNG),
 //                                at poses spread over the default 10 s path
+//   BM_ArFrameMorph/weighted:<n> BM_ArFrame of the 25k-triangle tube with 52 morph targets that
+//                                each move every vertex, <n> of them weighted (0: the program
+//                                without morphing)
+//   BM_ArFrameFace/weighted:<n>  the same tube with a 4000-triangle head mesh on top that the 52
+//                                targets move alone (a face of its own)
 // llvmpipe's thread count is fixed per process: run once per count,
 //   bench_render --gl_threads=1    and    bench_render --gl_threads=2
 // (also --gl=auto|egl-device|egl|osmesa, and --gl_device=N; ARVIEW_GL_DEVICE is honoured). Characters come from ../shared/data; missing ones are skipped.
@@ -28,6 +33,7 @@
 #include <cstring>
 #include <map>
 
+#include "anim/morph.h"
 #include "anim_authoring/character_builder.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
@@ -123,6 +129,33 @@ std::shared_ptr<const anim::Character> MakeTube(int triangles) {
   return std::make_shared<const anim::Character>(std::move(c));
 }
 
+// The tube with 52 morph targets on mesh `morphed`, each moving every vertex of it (the most a
+// target can cost): along its normal, by up to 2 cm, in a pattern of its own. With a head, the
+// targets move a second mesh alone: a 4000-triangle tube 0.24 m tall on top, bound to the top
+// joint (a face of its own, as a character's head mesh).
+std::shared_ptr<const anim::Character> MakeMorphTube(bool head) {
+  anim::Character c = *MakeTube(25000);
+  if (head) {
+    anim::Mesh face = MakeTube(4000)->meshes[0];
+    for (Eigen::Vector3f& p : face.positions) p = 0.15f * p + Eigen::Vector3f(0, 1.6f, 0);
+    for (auto& j : face.joints) j = {9, 0, 0, 0};
+    for (auto& w : face.weights) w = Eigen::Vector4f(1, 0, 0, 0);
+    c.meshes.push_back(face);
+  }
+  const int morphed = head ? 1 : 0;
+  const anim::Mesh& mesh = c.meshes[morphed];
+  for (int k = 0; k < 52; ++k) {
+    std::vector<Eigen::Vector3f> positions(mesh.positions.size()), normals(mesh.positions.size());
+    for (size_t v = 0; v < positions.size(); ++v) {
+      const float s = 0.02f * static_cast<float>(std::sin(0.37 * k + 0.013 * static_cast<double>(v)));
+      positions[v] = s * mesh.normals[v];
+      normals[v] = Eigen::Vector3f(0, 0.1f * s, 0);
+    }
+    anim::AddMorphTarget(c, "target" + std::to_string(k), morphed, positions, normals);
+  }
+  return std::make_shared<const anim::Character>(std::move(c));
+}
+
 struct Subject {
   std::shared_ptr<const anim::Character> character;
   authoring::CharacterSpec spec;
@@ -157,6 +190,8 @@ Subject* GetSubject(const std::string& name) {
   std::unique_ptr<Subject> subject;
   if (name == "tube25k") {
     subject = MakeSubject(MakeTube(25000), 1.0);
+  } else if (name == "tube25k_morph52" || name == "tube25k_face52") {
+    subject = MakeSubject(MakeMorphTube(name == "tube25k_face52"), 1.0);
   } else {
     const auto path = name == "Fox" ? arview::testing::SharedData("characters/Fox/glTF-Binary/Fox.glb")
                                     : arview::testing::SharedData("characters/CesiumMan.glb");
@@ -206,7 +241,7 @@ RoomLight BenchRoomLight(const cv::Mat& background, const calib::Pose& camera_po
 enum class LitPart { kNothing, kCastShadow, kOcclusion, kPrt, kExposure };
 
 void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing antialiasing, bool lit = false,
-                LitPart without = LitPart::kNothing, cv::Size size = {640, 480}) {
+                LitPart without = LitPart::kNothing, cv::Size size = {640, 480}, int weighted_targets = 0) {
   Subject* subject = GetSubject(name);
   if (subject == nullptr) {
     state.SkipWithError(("no " + name + " in ../shared/data/characters").c_str());
@@ -230,14 +265,24 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
   const Eigen::Vector3d viewpoint = subject->spec.placement().ViewpointFromCamera(subject->camera_pose.Center());
   double time = 0;
   cv::Mat frame;
+  // The first `weighted_targets` morph targets at weights between 0.3 and 0.9, the others 0.
+  std::vector<float> weights(subject->character->skeleton.morph_target_count(), 0.f);
+  for (int k = 0; k < std::min(weighted_targets, static_cast<int>(weights.size())); ++k) weights[k] = 0.3f + 0.6f * (k % 7) / 6;
+  auto animate = [&] {
+    anim::AnimatorFrame f = subject->animated->Update(viewpoint, time);
+    if (!weights.empty()) f.morph_weights = weights;
+    return f;
+  };
   // Warm-up outside the timing: llvmpipe compiles each new pipeline state at its first draw.
   for (int i = 0; i < 3; ++i) {
-    const anim::AnimatorFrame* out = &subject->animated->Update(viewpoint, time);
+    const anim::AnimatorFrame f = animate();
+    const anim::AnimatorFrame* out = &f;
     frame = renderer.Render(background, subject->camera_pose, {&out, 1});
   }
   const double cpu_start = ProcessCpuSeconds();
   for (auto _ : state) {
-    const anim::AnimatorFrame* out = &subject->animated->Update(viewpoint, time);
+    const anim::AnimatorFrame f = animate();
+    const anim::AnimatorFrame* out = &f;
     frame = renderer.Render(background, subject->camera_pose, {&out, 1});
     benchmark::DoNotOptimize(frame.data);
     time += 1.0 / 30;
@@ -256,6 +301,12 @@ void RunArFrame(benchmark::State& state, const std::string& name, Antialiasing a
 }
 
 void BM_ArFrame(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa); }
+void BM_ArFrameMorph(benchmark::State& state) {
+  RunArFrame(state, "tube25k_morph52", Antialiasing::kMsaa, false, LitPart::kNothing, {640, 480}, static_cast<int>(state.range(0)));
+}
+void BM_ArFrameFace(benchmark::State& state) {
+  RunArFrame(state, "tube25k_face52", Antialiasing::kMsaa, false, LitPart::kNothing, {640, 480}, static_cast<int>(state.range(0)));
+}
 void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone); }
 // The room's light (issue 14): SH through self-shadowed PRT, the exposure follower, the cast
 // shadow from the dominant light and a depth-only occluder proxy, on top of BM_ArFrame.
@@ -355,6 +406,8 @@ BENCHMARK_CAPTURE(BM_Readback1080p, direct, false)->Unit(benchmark::kMillisecond
 BENCHMARK_CAPTURE(BM_Readback1080p, pixel_buffer, true)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_UndistortBackground)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthRoomFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ArFrameMorph)->Arg(0)->Arg(4)->Arg(16)->Arg(32)->ArgName("weighted")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ArFrameFace)->Arg(0)->Arg(8)->Arg(32)->ArgName("weighted")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace arview::render

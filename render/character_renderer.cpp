@@ -3,6 +3,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -26,8 +28,9 @@ struct ProgramVariant {
   bool dual_quaternion = true;
   LightingMode lighting = LightingMode::kFixed;
   bool textured = true;  // false: the material's colour alone, no texture fetch
-  size_t Index() const {  // 0..11
-    return 4 * static_cast<size_t>(lighting) + (dual_quaternion ? 2 : 0) + (textured ? 1 : 0);
+  bool morphed = false;  // adds the weighted morph target deltas before skinning
+  size_t Index() const {  // 0..23
+    return 12 * (morphed ? 1 : 0) + 4 * static_cast<size_t>(lighting) + (dual_quaternion ? 2 : 0) + (textured ? 1 : 0);
   }
 };
 
@@ -37,7 +40,8 @@ struct ProgramVariant {
 std::string VariantDefines(const ProgramVariant& v) {
   return "#version 450 core\n#define DUAL_QUATERNION " + std::to_string(v.dual_quaternion ? 1 : 0) +
          "\n#define LIGHTING " + std::to_string(static_cast<int>(v.lighting)) + "\n#define TEXTURED " +
-         std::to_string(v.textured ? 1 : 0) + "\n";
+         std::to_string(v.textured ? 1 : 0) + "\n#define MORPH " + std::to_string(v.morphed ? 1 : 0) +
+         "\n#define MAX_MORPHS " + std::to_string(CharacterRenderer::kMaxActiveMorphTargets) + "\n";
 }
 
 std::string VertexShader(int joints, const ProgramVariant& variant) {
@@ -60,6 +64,15 @@ uniform vec4 dq_dual[JOINTS];
 // linear blend skinning.
 uniform mat3 model_rotation; // model_to_map's rotation, without its scale
 uniform vec3 sh[9];          // incident radiance (map frame), RGB
+#if MORPH
+// The mesh's deltas (per target: the positions of every vertex, then the normals), and this
+// draw's targets with a non-zero weight: their first texel and weight.
+uniform samplerBuffer morph_deltas;
+uniform int morph_count;
+uniform int morph_base[MAX_MORPHS];
+uniform float morph_weight[MAX_MORPHS];
+uniform int morph_vertices;
+#endif
 out vec3 v_normal;
 out vec2 v_uv;
 out vec3 v_prt;              // lighting 2: radiance / albedo at the vertex
@@ -91,6 +104,16 @@ void main() {
   vec3 p;
   vec3 n;
   mat3 skin_rotation;
+  // Morph targets first, in the bind pose (glTF's order: morph, then skin).
+  vec3 bind_position = position;
+  vec3 bind_normal = normal;
+#if MORPH
+  for (int i = 0; i < morph_count; ++i) {
+    int texel = morph_base[i] + gl_VertexID;
+    bind_position += morph_weight[i] * texelFetch(morph_deltas, texel).xyz;
+    bind_normal += morph_weight[i] * texelFetch(morph_deltas, texel + morph_vertices).xyz;
+  }
+#endif
 #if DUAL_QUATERNION
   // Kavan et al. 2007: blend in the hemisphere of the first joint, normalise, apply.
   vec4 r0 = dq_real[joints.x];
@@ -108,16 +131,16 @@ void main() {
   dual /= len;
   // translation = 2 · dual · conj(real)
   vec3 t = 2.0 * (real.w * dual.xyz - dual.w * real.xyz + cross(real.xyz, dual.xyz));
-  p = rotate(real, position) + t;
-  n = rotate(real, normal);
+  p = rotate(real, bind_position) + t;
+  n = rotate(real, bind_normal);
 #if LIGHTING == 2
   skin_rotation = quat_matrix(real);
 #endif
 #else
   mat4 m = weights.x * skin[joints.x] + weights.y * skin[joints.y] + weights.z * skin[joints.z] +
            weights.w * skin[joints.w];
-  p = (m * vec4(position, 1.0)).xyz;
-  n = mat3(m) * normal;
+  p = (m * vec4(bind_position, 1.0)).xyz;
+  n = mat3(m) * bind_normal;
 #if LIGHTING == 2
   // The rotation of the blended matrix (Gram-Schmidt): SH rotation needs an orthogonal one.
   vec3 x = normalize(m[0].xyz);
@@ -240,6 +263,8 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   for (int j = 0; j < std::min(joints_, static_cast<int>(character.skeleton.inverse_bind.size())); ++j) {
     inverse_bind[j] = character.skeleton.inverse_bind[j].cast<float>();
   }
+  morph_targets_ = character.skeleton.morph_target_count();
+  morph_candidates_.reserve(morph_targets_);
   for (const anim::Mesh& mesh : character.meshes) {
     const size_t n = mesh.positions.size();
     if (mesh.normals.size() != n || mesh.joints.size() != n || mesh.weights.size() != n ||
@@ -289,6 +314,8 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
     attribute(4, 4, offsetof(CharacterVertex, weights));
     gl.BindVertexArray(0);
+    UploadMorphs(mesh, character.source, gpu);
+    AddMorphReach(mesh, inverse_bind);
     gpu.index_count = static_cast<GLsizei>(mesh.indices.size());
     gpu.vertex_count = static_cast<int>(n);
     triangles_ += gpu.index_count / 3;
@@ -303,8 +330,95 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
   CheckGl(gl, "character upload (" + character.source + ")");
 }
 
-const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured) {
-  const ProgramVariant variant{dual_quaternion, lighting, textured};
+void CharacterRenderer::UploadMorphs(const anim::Mesh& mesh, const std::string& source, GpuMesh& gpu) {
+  if (mesh.morphs.empty()) return;
+  const GlApi& gl = *gl_;
+  const size_t n = mesh.positions.size();
+  const std::string where = source + ": mesh '" + mesh.name + "'";
+  gpu.morph_base.assign(morph_targets_, -1);
+  std::vector<float> texels(mesh.morphs.size() * 2 * n * 3, 0.f);
+  for (size_t i = 0; i < mesh.morphs.size(); ++i) {
+    const anim::MeshMorph& m = mesh.morphs[i];
+    if (m.target < 0 || m.target >= morph_targets_ || gpu.morph_base[m.target] >= 0 ||
+        m.position_deltas.size() != m.vertices.size() || m.normal_deltas.size() != m.vertices.size()) {
+      throw RenderError(where + " has morph deltas that do not fit the character's targets");
+    }
+    const size_t base = i * 2 * n;
+    gpu.morph_base[m.target] = static_cast<int>(base);
+    for (size_t k = 0; k < m.vertices.size(); ++k) {
+      const size_t v = m.vertices[k];
+      if (v >= n) throw RenderError(where + " has a morph delta for vertex " + std::to_string(v) + " of " + std::to_string(n));
+      std::copy_n(m.position_deltas[k].data(), 3, &texels[(base + v) * 3]);
+      std::copy_n(m.normal_deltas[k].data(), 3, &texels[(base + n + v) * 3]);
+    }
+  }
+  GLint max_texels = 0;
+  gl.GetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+  if (texels.size() / 3 > static_cast<size_t>(max_texels)) {
+    throw RenderError(where + ": " + std::to_string(mesh.morphs.size()) + " morph targets of " + std::to_string(n) +
+                      " vertices exceed the buffer texture's " + std::to_string(max_texels) + " texels");
+  }
+  gpu.morph_buffer = MakeBuffer(gl, GL_TEXTURE_BUFFER, texels.data(), texels.size() * sizeof(float));
+  gl.BindBuffer(GL_TEXTURE_BUFFER, 0);
+  gpu.morph_texture = MakeBufferTexture(gl, gpu.morph_buffer.get(), GL_RGB32F);
+}
+
+void CharacterRenderer::AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind) {
+  if (mesh.morphs.empty()) return;
+  morph_reach_.resize(static_cast<size_t>(morph_targets_) * joints_, 0.f);
+  frame_radii_.resize(joints_);
+  for (const anim::MeshMorph& m : mesh.morphs) {
+    for (size_t i = 0; i < m.vertices.size(); ++i) {
+      const size_t v = m.vertices[i];
+      for (int k = 0; k < 4; ++k) {
+        if (mesh.weights[v][k] <= 0) continue;
+        const int j = mesh.joints[v][k];
+        float& reach = morph_reach_[static_cast<size_t>(m.target) * joints_ + j];
+        reach = std::max(reach, (inverse_bind[j].topLeftCorner<3, 3>() * m.position_deltas[i]).norm());
+      }
+    }
+  }
+}
+
+std::span<const float> CharacterRenderer::JointRadii(std::span<const float> morph_weights) {
+  if (morph_reach_.empty() || morph_weights.size() != static_cast<size_t>(morph_targets_)) return joint_radii_;
+  std::copy(joint_radii_.begin(), joint_radii_.end(), frame_radii_.begin());
+  for (int t = 0; t < morph_targets_; ++t) {
+    const float w = std::abs(morph_weights[t]);
+    if (w == 0.f || !std::isfinite(w)) continue;
+    const float* reach = &morph_reach_[static_cast<size_t>(t) * joints_];
+    for (int j = 0; j < joints_; ++j) frame_radii_[j] += w * reach[j];
+  }
+  return frame_radii_;
+}
+
+int CharacterRenderer::ActiveMorphs(const GpuMesh& mesh, std::span<const float> weights) {
+  if (mesh.morph_base.empty() || weights.empty()) return 0;
+  morph_candidates_.clear();  // reserved for every target: no allocation
+  for (size_t k = 0; k < weights.size() && k < mesh.morph_base.size(); ++k) {
+    if (weights[k] != 0.f && std::isfinite(weights[k]) && mesh.morph_base[k] >= 0) {
+      morph_candidates_.emplace_back(std::abs(weights[k]), static_cast<int>(k));
+    }
+  }
+  int count = static_cast<int>(morph_candidates_.size());
+  if (count > kMaxActiveMorphTargets) {
+    std::nth_element(morph_candidates_.begin(), morph_candidates_.begin() + kMaxActiveMorphTargets, morph_candidates_.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    morph_dropped_ += count - kMaxActiveMorphTargets;
+    count = kMaxActiveMorphTargets;
+  }
+  for (int i = 0; i < count; ++i) {
+    const int target = morph_candidates_[i].second;
+    active_base_[i] = mesh.morph_base[target];
+    active_weight_[i] = weights[target];
+  }
+  morph_applied_ += count;
+  return count;
+}
+
+const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured,
+                                                                bool morphed) {
+  const ProgramVariant variant{dual_quaternion, lighting, textured, morphed};
   std::unique_ptr<Program>& slot = programs_.at(variant.Index());
   if (slot) return *slot;
   const GlApi& gl = *gl_;
@@ -315,7 +429,8 @@ const CharacterRenderer::Program& CharacterRenderer::ProgramFor(bool dual_quater
                   Uniform(gl, p, "skin"),       Uniform(gl, p, "dq_real"), Uniform(gl, p, "dq_dual"),
                   Uniform(gl, p, "light"),      Uniform(gl, p, "key"),     Uniform(gl, p, "ambient"),
                   Uniform(gl, p, "base_color"), Uniform(gl, p, "albedo"),  Uniform(gl, p, "model_rotation"),
-                  Uniform(gl, p, "sh")};
+                  Uniform(gl, p, "sh"),         Uniform(gl, p, "morph_deltas"), Uniform(gl, p, "morph_count"),
+                  Uniform(gl, p, "morph_base"), Uniform(gl, p, "morph_weight"), Uniform(gl, p, "morph_vertices")};
   slot = std::move(program);
   return *slot;
 }
@@ -352,6 +467,11 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
       (d.method == anim::SkinningMethod::kDualQuaternion && static_cast<int>(d.skinning_dual_quats.size()) != joints_)) {
     throw RenderError("character draw: " + std::to_string(joints_) + " skinning transforms expected");
   }
+  if (!d.morph_weights.empty() && static_cast<int>(d.morph_weights.size()) != morph_targets_) {
+    throw RenderError("character draw: " + std::to_string(d.morph_weights.size()) + " morph weights for " +
+                      std::to_string(morph_targets_) + " targets");
+  }
+  morph_applied_ = morph_dropped_ = 0;
   // DQ skinning drops scale; with scaled joints linear blend is the correct one.
   const bool dual = d.method == anim::SkinningMethod::kDualQuaternion && anim::RigidSkinning(d.skinning_matrices);
   used_linear_fallback_ = d.method == anim::SkinningMethod::kDualQuaternion && !dual;
@@ -394,8 +514,19 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
     const Program* bound = nullptr;
     for (const GpuMesh& mesh : meshes_) {
       if ((mesh.texture >= 0) != textured) continue;
-      if (bound == nullptr) bound = &UseProgram(ProgramFor(dual, u.lighting, textured), u, d);
+      const int morphs = ActiveMorphs(mesh, d.morph_weights);
+      const Program& program = ProgramFor(dual, u.lighting, textured, morphs > 0);
+      if (bound != &program) bound = &UseProgram(program, u, d);
       if (textured) gl.BindTexture(GL_TEXTURE_2D, textures_[mesh.texture].get());
+      if (morphs > 0) {
+        gl.ActiveTexture(GL_TEXTURE1);
+        gl.BindTexture(GL_TEXTURE_BUFFER, mesh.morph_texture.get());
+        gl.ActiveTexture(GL_TEXTURE0);
+        gl.Uniform1i(bound->loc.morph_count, morphs);
+        gl.Uniform1iv(bound->loc.morph_base, morphs, active_base_.data());
+        gl.Uniform1fv(bound->loc.morph_weight, morphs, active_weight_.data());
+        gl.Uniform1i(bound->loc.morph_vertices, mesh.vertex_count);
+      }
       gl.Uniform4f(bound->loc.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
       gl.BindVertexArray(mesh.vao.get());
       gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
@@ -426,6 +557,7 @@ const CharacterRenderer::Program& CharacterRenderer::UseProgram(const Program& p
   gl.Uniform1f(loc.key, d.key);
   gl.Uniform1f(loc.ambient, d.ambient);
   gl.Uniform1i(loc.albedo, 0);
+  if (loc.morph_deltas >= 0) gl.Uniform1i(loc.morph_deltas, 1);  // texture unit 1
   return program;
 }
 

@@ -2,6 +2,10 @@
 // Draws an anim::Character skinned in the vertex shader, with dual quaternions (Kavan et al.
 // 2007; the default) or linear blend skinning, base-colour textures and factors, normals, and a
 // key + ambient light; and the soft contact shadow that keeps it on its ground plane.
+// Morph targets (anim/morph.h) are added in the vertex shader before skinning: each mesh's deltas
+// live in a buffer texture, and a draw passes the targets with a non-zero weight (at most
+// kMaxActiveMorphTargets a mesh) as uniforms; a mesh with none weighted uses the program without
+// morphing (docs/render.md, "Morph targets").
 
 #include <Eigen/Core>
 
@@ -9,6 +13,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "anim/character.h"
@@ -40,10 +45,16 @@ struct CharacterDraw {
   bool cull_back_faces = true;
   LightingMode lighting = LightingMode::kFixed;
   room::ShRgb sh{};  // the room's incident radiance (map frame, RGB) for the SH modes
+  // One weight per morph target of the character (AnimatorFrame::morph_weights), or empty: none.
+  std::span<const float> morph_weights;
 };
 
 class CharacterRenderer {
  public:
+  // The most targets one mesh applies in a draw: the largest weights (by magnitude) are applied,
+  // the others dropped and counted (morph_targets_dropped()).
+  static constexpr int kMaxActiveMorphTargets = 32;
+
   // Uploads meshes and textures; throws RenderError when the character has more joints than
   // the vertex shader can take, or a texture cannot be decoded.
   CharacterRenderer(const GlApi& gl, const anim::Character& character);
@@ -57,10 +68,18 @@ class CharacterRenderer {
   // every skinned vertex stays within these spheres around the posed joints (for rigid joints),
   // which bounds the character on screen.
   const std::vector<float>& joint_radii() const { return joint_radii_; }
+  // The same with a frame's morph targets: each radius grows by Σ_k |w_k| · (the farthest target
+  // k moves a vertex the joint influences). Valid until the next call; no allocation.
+  std::span<const float> JointRadii(std::span<const float> morph_weights);
   // Uploads per-vertex PRT transfer (ComputeShadowedTransfer of the same character); needed by
   // LightingMode::kShShadowed. Throws RenderError when the vertex counts differ.
   void SetTransfer(const CharacterTransfer& transfer);
   bool has_transfer() const { return has_transfer_; }
+  int morph_target_count() const { return morph_targets_; }
+  // Of the last draw, summed over the meshes: the targets applied, and those dropped beyond
+  // kMaxActiveMorphTargets.
+  int morph_targets_applied() const { return morph_applied_; }
+  int morph_targets_dropped() const { return morph_dropped_; }
 
  private:
   struct GpuMesh {
@@ -69,21 +88,32 @@ class CharacterRenderer {
     int vertex_count = 0;
     Eigen::Vector4f base_color = Eigen::Vector4f::Ones();
     int texture = -1;  // index into textures_, −1: none (the untextured program)
+    // Morph deltas: per target that moves this mesh, vertex_count position texels then
+    // vertex_count normal texels (RGB32F) in one buffer texture; morph_base[target] is the
+    // first texel of a target's, −1 where it does not move this mesh.
+    GlName morph_buffer, morph_texture;
+    std::vector<int> morph_base;
   };
+  // This draw's targets for one mesh, in active_base_/active_weight_; returns their count.
+  int ActiveMorphs(const GpuMesh& mesh, std::span<const float> weights);
+  void UploadMorphs(const anim::Mesh& mesh, const std::string& source, GpuMesh& gpu);
+  void AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind);
   const GlApi* gl_;
   int joints_ = 0;
   int triangles_ = 0;
   struct Locations {
     GLint mvp, model, normal_matrix, skin, dq_real, dq_dual, light, key, ambient, base_color, albedo;
     GLint model_rotation, sh;
+    GLint morph_deltas, morph_count, morph_base, morph_weight, morph_vertices;
   };
   struct Program {
     GlName program;
     Locations loc{};
   };
-  // One program per variant (skinning method x lighting mode x textured or not), compiled on
-  // first use: llvmpipe pays for every branch of a shader that branches on uniforms.
-  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured);
+  // One program per variant (skinning method x lighting mode x textured or not x morphed or
+  // not), compiled on first use: llvmpipe pays for every branch of a shader that branches on
+  // uniforms.
+  const Program& ProgramFor(bool dual_quaternion, LightingMode lighting, bool textured, bool morphed = false);
   // What a draw sets in each program it uses (all but the mesh's colour), computed once a draw.
   struct DrawUniforms {
     bool dual = true;
@@ -95,13 +125,20 @@ class CharacterRenderer {
   };
   // Binds `program` and sets the draw's uniforms in it; returns it.
   const Program& UseProgram(const Program& program, const DrawUniforms& u, const CharacterDraw& d);
-  std::array<std::unique_ptr<Program>, 12> programs_;
+  std::array<std::unique_ptr<Program>, 24> programs_;
   std::vector<GlName> textures_;
   std::vector<GpuMesh> meshes_;
   bool used_linear_fallback_ = false;
   bool has_transfer_ = false;
   std::vector<float> joint_radii_;
   std::vector<float> dq_upload_;
+  int morph_targets_ = 0;
+  std::vector<float> morph_reach_;  // [target · joints + joint]: the farthest the target moves a vertex of the joint
+  std::vector<float> frame_radii_;  // JointRadii's
+  int morph_applied_ = 0, morph_dropped_ = 0;
+  std::vector<std::pair<float, int>> morph_candidates_;  // (|weight|, target); reserved at upload
+  std::array<GLint, kMaxActiveMorphTargets> active_base_{};
+  std::array<GLfloat, kMaxActiveMorphTargets> active_weight_{};
 };
 
 // A soft elliptical shadow on a ground plane, drawn before the character into the transparent

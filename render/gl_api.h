@@ -84,6 +84,9 @@ namespace arview::render {
   X(GLint, GetUniformLocation, (GLuint, const GLchar*))                                               \
   X(void, Uniform1i, (GLint, GLint))                                                                  \
   X(void, Uniform1f, (GLint, GLfloat))                                                                \
+  X(void, Uniform1iv, (GLint, GLsizei, const GLint*))                                                 \
+  X(void, Uniform1fv, (GLint, GLsizei, const GLfloat*))                                               \
+  X(void, TexBuffer, (GLenum, GLenum, GLuint))                                                        \
   X(void, Uniform2f, (GLint, GLfloat, GLfloat))                                                       \
   X(void, Uniform3f, (GLint, GLfloat, GLfloat, GLfloat))                                              \
   X(void, Uniform4f, (GLint, GLfloat, GLfloat, GLfloat, GLfloat))                                     \

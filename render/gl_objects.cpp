@@ -116,6 +116,16 @@ GlName MakeBuffer(const GlApi& gl, GLenum target, const void* data, size_t bytes
   return buffer;
 }
 
+GlName MakeBufferTexture(const GlApi& gl, GLuint buffer, GLenum format) {
+  GLuint name = 0;
+  gl.GenTextures(1, &name);
+  GlName texture(&gl, name, [](const GlApi& g, GLuint n) { g.DeleteTextures(1, &n); });
+  gl.BindTexture(GL_TEXTURE_BUFFER, name);
+  gl.TexBuffer(GL_TEXTURE_BUFFER, format, buffer);
+  gl.BindTexture(GL_TEXTURE_BUFFER, 0);
+  return texture;
+}
+
 GlName MakeVertexArray(const GlApi& gl) {
   GLuint name = 0;
   gl.GenVertexArrays(1, &name);

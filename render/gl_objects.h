@@ -63,6 +63,8 @@ void UpdateTexture(const GlApi& gl, GLuint texture, const cv::Mat& image);
 
 GlName MakeBuffer(const GlApi& gl, GLenum target, const void* data, size_t bytes, GLenum usage = GL_STATIC_DRAW);
 GlName MakeVertexArray(const GlApi& gl);
+// A buffer texture (GL_TEXTURE_BUFFER) reading `buffer` as texels of `format` (e.g. GL_RGB32F).
+GlName MakeBufferTexture(const GlApi& gl, GLuint buffer, GLenum format);
 
 // A read-back through a pixel-buffer object: Start asks the GL to copy a rectangle into the
 // buffer and sets a fence, and returns at once on a GPU (the copy runs while the CPU does other

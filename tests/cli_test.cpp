@@ -174,6 +174,22 @@ TEST(Cli, AnimWeightsSaysWhatTheIdleAndBalanceLayersLearned) {
   std::filesystem::remove(scene);
 }
 
+// `anim info` lists a character's morph targets (name, vertices moved) and the targets each clip's
+// weight tracks key (issue 52); a character without targets says it has none.
+TEST(Cli, AnimInfoListsMorphTargetsAndWeightTracks) {
+  const std::string cube = "/usr/share/assimp/models/glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf";
+  ARVIEW_REQUIRE_DATA_PATH(std::filesystem::path(cube), "Debian package assimp-testmodels");
+  const auto r = RunArview({"anim", "info", cube});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("  Square  4.200 s  (1000.0 ticks/s)  weight tracks: Cube#0 Cube#1\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("morph targets: 2\n  [0] Cube#0: 12 vertices\n  [1] Cube#1: 8 vertices\n"), std::string::npos) << r.out;
+  const auto json = RunArview({"anim", "info", cube, "--json"});
+  EXPECT_NE(json.out.find("\"weight_tracks\": [\n        \"Cube#0\",\n        \"Cube#1\"\n      ]"), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("\"name\": \"Cube#1\",\n      \"vertices\": 8"), std::string::npos) << json.out;
+  const auto bcn = RunArview({"anim", "info", "/usr/share/assimp/models/X/BCN_Epileptic.X"});
+  EXPECT_NE(bcn.out.find("\nmorph targets: 0\n"), std::string::npos) << bcn.out;
+}
+
 }  // namespace
 }  // namespace arview
 

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -51,6 +53,22 @@ int BonesUsed(const anim::Mesh& mesh, int joints) {
   return n;
 }
 
+// How many vertices a morph target moves, over every mesh.
+std::size_t VerticesMoved(const anim::Character& c, int target) {
+  std::size_t n = 0;
+  for (const anim::Mesh& m : c.meshes)
+    for (const anim::MeshMorph& morph : m.morphs)
+      if (morph.target == target) n += morph.vertices.size();
+  return n;
+}
+
+// The names of the targets a clip's weight tracks key.
+std::vector<std::string> WeightTrackNames(const anim::Character& c, const anim::Clip& clip) {
+  std::vector<std::string> names;
+  for (const anim::WeightTrack& t : clip.weight_tracks) names.push_back(c.skeleton.morph_targets[t.target]);
+  return names;
+}
+
 std::string TextureText(const anim::Character& c, int texture) {
   if (texture < 0) return "none";
   const anim::Texture& t = c.textures[texture];
@@ -69,7 +87,13 @@ void RunInfo(const AnimArgs& args) {
     for (int i = 0; i < sk.size(); ++i) joints.push_back({{"index", i}, {"name", sk.names[i]}, {"parent", sk.parents[i]}});
     nlohmann::ordered_json& clips = j["clips"] = nlohmann::ordered_json::array();
     for (const anim::Clip& clip : c.clips)
-      clips.push_back({{"name", clip.name}, {"duration_s", clip.duration}, {"ticks_per_second", clip.ticks_per_second}});
+      clips.push_back({{"name", clip.name},
+                       {"duration_s", clip.duration},
+                       {"ticks_per_second", clip.ticks_per_second},
+                       {"weight_tracks", WeightTrackNames(c, clip)}});
+    nlohmann::ordered_json& targets = j["morph_targets"] = nlohmann::ordered_json::array();
+    for (int k = 0; k < sk.morph_target_count(); ++k)
+      targets.push_back({{"index", k}, {"name", sk.morph_targets[k]}, {"vertices", VerticesMoved(c, k)}});
     nlohmann::ordered_json& meshes = j["meshes"] = nlohmann::ordered_json::array();
     for (const anim::Mesh& m : c.meshes) {
       nlohmann::ordered_json mesh = {{"name", m.name},
@@ -97,8 +121,14 @@ void RunInfo(const AnimArgs& args) {
   for (const anim::Clip& clip : c.clips) {
     std::cout << "  " << clip.name << "  " << Fixed(clip.duration) << " s";
     if (clip.ticks_per_second > 0) std::cout << "  (" << Fixed(clip.ticks_per_second, 1) << " ticks/s)";
+    const std::vector<std::string> weights = WeightTrackNames(c, clip);
+    if (!weights.empty()) std::cout << "  weight tracks:";
+    for (const std::string& name : weights) std::cout << " " << name;
     std::cout << "\n";
   }
+  std::cout << "morph targets: " << sk.morph_target_count() << "\n";
+  for (int k = 0; k < sk.morph_target_count(); ++k)
+    std::cout << "  [" << k << "] " << sk.morph_targets[k] << ": " << VerticesMoved(c, k) << " vertices\n";
   std::cout << "meshes: " << c.meshes.size() << "\n";
   for (const anim::Mesh& m : c.meshes) {
     std::cout << "  " << (m.name.empty() ? "(unnamed)" : m.name) << ": " << m.positions.size() << " vertices, "
@@ -227,7 +257,8 @@ void AddAnimCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("anim", "Inspect characters and view-adaptive blend weights ('anim info', 'anim weights')");
   cmd->require_subcommand(1);
 
-  auto* info = cmd->add_subcommand("info", "Skeleton, clips, meshes and bones per mesh of a character asset");
+  auto* info = cmd->add_subcommand(
+      "info", "Skeleton, clips (with their morph target weight tracks), morph targets, meshes and bones per mesh of a character asset");
   info->add_option("asset", args->asset, "Character file (glTF .glb/.gltf, FBX, Collada .dae, DirectX .X, BVH)")->required();
   info->add_flag("--json", args->json, "Print JSON instead of text");
   info->callback([args] { RunInfo(*args); });

@@ -20,14 +20,16 @@ inline std::string FoxSceneYaml() {
          "        clip: Walk\n";
 }
 
-// Looking at the anchor from 2 m, 0.8 m up, z up.
-inline calib::Pose LookingAtFox() {
-  const Eigen::Vector3d eye(0.9, -1.8, 0.8), target(0.2, 0.1, 0.35);
+// A camera at `eye` looking at `target`, z up (image rows down the map's z).
+inline calib::Pose LookingAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
   const Eigen::Vector3d forward = (target - eye).normalized();
   const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
   Eigen::Matrix3d r_wc;
   r_wc << right, forward.cross(right), forward;
   return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r_wc), eye);
 }
+
+// Looking at the anchor from 2 m, 0.8 m up, z up.
+inline calib::Pose LookingAtFox() { return LookingAt({0.9, -1.8, 0.8}, {0.2, 0.1, 0.35}); }
 
 }  // namespace arview::testing
