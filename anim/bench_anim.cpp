@@ -305,7 +305,7 @@ void BM_FigureUpdate(benchmark::State& state) {
     const AnimatorFrame& f = animator->Update(t, ViewerInFront(t));
     benchmark::DoNotOptimize(f.skinning_matrices.data());
   }
-  state.SetLabel(std::string("builtin:figure, 42 joints, 8 look-at keys, DLB") + (state.range(0) ? ", gaze" : ""));
+  state.SetLabel(std::string("builtin:figure, 38 joints, 8 look-at keys, DLB") + (state.range(0) ? ", gaze" : ""));
 }
 BENCHMARK(BM_FigureUpdate)->Arg(0)->Arg(1)->ArgName("gaze");
 

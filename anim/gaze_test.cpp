@@ -169,6 +169,7 @@ TEST(GazeBehaviour, RestBlinksSeventeenTimesAMinute) {
   GazeBehaviour behaviour(options);
   behaviour.set_log(&log);
   behaviour.Advance(kSeconds);
+  std::printf("[gaze] rest, 10 min, seed 1: %zu blinks = %.1f/min (mode 17)\n", log.blinks.size(), log.blinks.size() / kMinutes);
   EXPECT_NEAR(log.blinks.size() / kMinutes, 17.0, 1.7);
   EXPECT_EQ(behaviour.blinks_started(), static_cast<long>(log.blinks.size()));
 }

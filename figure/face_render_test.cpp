@@ -123,7 +123,9 @@ TEST(FigureFaceRender, IrisesTurnTowardTheCameraAndLidsCloseOnABlink) {
   behaviour.set_log(&log);
   behaviour.Advance(60);
   ASSERT_FALSE(log.blinks.empty());
-  const Shot shut = Render("{mode: listening, seed: 1}", log.blinks.front().start + 0.05);
+  const double shut_at = log.blinks.front().start + 0.05;
+  std::printf("[face] the first blink of seed 1 is shut at t = %.4f s\n", shut_at);
+  const Shot shut = Render("{mode: listening, seed: 1}", shut_at);
   Save(shut, "face_blink.png");
   for (int eye = 0; eye < 2; ++eye) {
     const EyeLook open = Look(looking, eye), closed = Look(shut, eye);
