@@ -101,5 +101,32 @@ TEST(FigureFace, EyesMeetTheCameraAndTheHeadStaysWhereTheLookAtChainPutsIt) {
   EXPECT_EQ(worst_head, 0.0);
 }
 
+// The jaw opens the mouth: turned 15° down it carries the lower lip and the chin down and leaves
+// the upper lip where it is.
+TEST(FigureFace, TheJawOpensTheLips) {
+  const anim::Character c = MakeHumanoid();
+  const int jaw = c.skeleton.Find("Jaw");
+  anim::LocalPose pose = anim::LocalPose::Rest(c.skeleton);
+  pose.rigid[jaw] = anim::DualQuatd::FromRotationTranslation(Eigen::Quaterniond(Eigen::AngleAxisd(15 * M_PI / 180, Eigen::Vector3d::UnitX())),
+                                                            c.skeleton.rest[jaw].translation);
+  std::vector<Eigen::Matrix4d> model(c.skeleton.size());
+  ASSERT_TRUE((anim::LocalToModelJob{&c.skeleton, &pose, model}.Run()));
+  std::vector<Eigen::Matrix4f> skin(c.skeleton.size());
+  ASSERT_TRUE((anim::SkinningMatricesJob{&c.skeleton, model, skin, {}}.Run()));
+  double lower_lip_drop = 0, upper_lip_move = 0;
+  for (const anim::Mesh& m : c.meshes) {
+    if (m.name != "face_lips") continue;
+    std::vector<Eigen::Vector3f> out(m.vertex_count());
+    ASSERT_TRUE((anim::SkinningJob{&m, anim::SkinningMethod::kLinear, skin, {}, out, {}}.Run()));
+    for (int v = 0; v < m.vertex_count(); ++v) {
+      const bool lower = m.joints[v][0] == jaw && m.weights[v][0] > 0.5f;
+      if (lower) lower_lip_drop = std::max(lower_lip_drop, static_cast<double>(m.positions[v].y() - out[v].y()));
+      else upper_lip_move = std::max(upper_lip_move, static_cast<double>((out[v] - m.positions[v]).norm()));
+    }
+  }
+  EXPECT_GT(lower_lip_drop, 0.015);  // the lips part by more than the 9 mm of the two lips' height
+  EXPECT_EQ(upper_lip_move, 0.0);
+}
+
 }  // namespace
 }  // namespace arview::figure
