@@ -124,19 +124,19 @@ GazeBehaviour::GazeBehaviour(const GazeOptions& options) : options_(options), st
   p_mutual_ = MutualChance(*stats_);
 }
 
-void GazeBehaviour::Restart() {
+void GazeBehaviour::Restart(double origin) {
   saccade_rng_.seed(options_.seed);
   blink_rng_.seed(options_.seed ^ 0x9e3779b97f4a7c15ull);
   from_ = to_ = Eigen::Vector2d::Zero();
-  saccade_start_ = saccade_end_ = 0;
+  saccade_start_ = saccade_end_ = origin;
   target_mutual_ = true;
-  fixation_end_ = DrawFixation(true);
+  fixation_end_ = origin + DrawFixation(true);
   last_blink_ = -1e9;
   blinks_started_ = 0;
-  next_blink_ = 0;
+  next_blink_ = origin;
   ScheduleNextBlink();
   if (log_) *log_ = GazeLog{};
-  now_ = 0;
+  now_ = origin;
 }
 
 double GazeBehaviour::DrawFixation(bool mutual) {
@@ -201,7 +201,10 @@ void GazeBehaviour::NextFixation() {
 void GazeBehaviour::Advance(double t) {
   if (!std::isfinite(t)) t = std::max(now_, 0.0);
   t = std::max(t, 0.0);
-  if (now_ < 0 || t < now_) Restart();
+  if (now_ < 0 || t < now_) Restart(0);
+  // A jump of more than an hour (a single render at --time 1e9) starts the walk afresh there
+  // rather than walking every event since 0: about one a second.
+  if (t - now_ > kLongestWalkSeconds) Restart(t);
   for (;;) {
     if (next_blink_ <= fixation_end_) {
       if (next_blink_ > t) break;

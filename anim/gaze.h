@@ -7,7 +7,8 @@
 // Two parts:
 //   - GazeBehaviour: the seeded event process alone (saccades between mutual gaze and gaze
 //     away, fixation lengths, blinks), as offsets from the viewer's direction. Deterministic in
-//     (seed, t) like the idle synthesizer: sampling earlier than the last time restarts it.
+//     (seed, t) like the idle synthesizer: sampling earlier than the last time restarts it
+//     (a jump forward of more than an hour restarts it at the new time).
 //   - Gaze: poses a skeleton's eye and lid joints each frame from it, after the look-at chain
 //     has placed the head (the head-eye split: the eyes take the first ±35° sideways, 20° up and
 //     25° down of the turn toward their target; the look-at chain took the rest, unchanged).
@@ -109,9 +110,12 @@ class GazeBehaviour {
 
   // Large gaze shifts (drawn magnitude at least this, degrees) bring the next blink forward.
   static constexpr double kBlinkShiftDeg = 10;
+  // Advance walks every event from the last time (or 0) on; a later time than this beyond it
+  // restarts the walk there instead (the state is then that of the seed's start, moved there).
+  static constexpr double kLongestWalkSeconds = 3600;
 
  private:
-  void Restart();
+  void Restart(double origin);  // the seed's first fixation (on the viewer) begins at `origin`
   void NextFixation();  // at fixation_end_: the next target, a saccade to it, its fixation
   void BlinkAt(double t, bool with_saccade);
   void ScheduleNextBlink();

@@ -205,6 +205,19 @@ TEST(GazeBehaviour, SeededAndReproducibleWhenSampledBackwards) {
   EXPECT_NE(seven.saccades.front().start, eight.saccades.front().start);
 }
 
+// A render at a far time does not walk every event since 0: it starts there, on the viewer.
+TEST(GazeBehaviour, AFarJumpStartsAfreshAtTheNewTime) {
+  GazeOptions options;
+  GazeBehaviour far(options), near(options);
+  far.Advance(1e12);
+  near.Advance(0);
+  EXPECT_TRUE(far.mutual());
+  EXPECT_EQ(far.offset_deg(), near.offset_deg());
+  far.Advance(1e12 + 30);
+  near.Advance(30);
+  EXPECT_EQ(far.blinks_started(), near.blinks_started());
+}
+
 TEST(GazeBehaviour, BlinkShutsInFiftyMillisecondsAndOpensByTwoHundredFifty) {
   EXPECT_EQ(BlinkClosure(-0.01), 0);
   EXPECT_NEAR(BlinkClosure(0.05), 1, 1e-12);
