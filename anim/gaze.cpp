@@ -332,9 +332,9 @@ void Gaze::Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const 
   frame_.active = true;
   frame_.eyes_on_viewer = in_range && behaviour_.mutual();
   frame_.blinking = behaviour_.blinking();
-  // Restarted (time went back): the blinks since the restart.
+  // Restarted (time went back, or a jump of over an hour): the blinks since the restart.
   const long now = behaviour_.blinks_started();
-  frame_.blinks_begun = static_cast<int>(t < time_before ? now : now - blinks_before);
+  frame_.blinks_begun = static_cast<int>(t < time_before || now < blinks_before ? now : now - blinks_before);
 }
 
 }  // namespace arview::anim
