@@ -174,6 +174,7 @@ void RenderStage::AnimateAndCompose(InFlight& item) {
     }
     log.idle_weight = compose.animations.front()->idle_weight();
     log.actions_triggered = compose.animations.front()->triggered;
+    log.eyes = compose.animations.front()->gaze;
     if (localized) {
       log.gaze_error_deg = GazeErrorDeg(animators_.front()->character(), compose.animations.front()->model,
                                         item.track.center);
@@ -264,6 +265,7 @@ void SinkStage::Count(FrameLog&& log, Clock::time_point written) {
     report_.gaze_error_deg.Add(*log.gaze_error_deg);
     report_.gaze_within_20_deg += *log.gaze_error_deg <= 20.0;
   }
+  CountEyes(log, report_);
   if (options_.keep_frame_logs) report_.frames.push_back(std::move(log));
 }
 
