@@ -91,8 +91,10 @@ struct Scored {
   std::vector<double> mean_px, max_px;
 };
 
+// Per associated frame, over the points in front of both cameras (and, with only_in_image, in
+// the true camera's image).
 Scored ScoreFrames(const AccuracyReport& a, const Trajectory& groundtruth, const calib::Camera& camera,
-                   const std::vector<Eigen::Vector3d>& points_gt) {
+                   const std::vector<Eigen::Vector3d>& points_gt, bool only_in_image) {
   Scored s;
   for (const auto& [i, j] : a.pairs) {
     double sum = 0, worst = 0;
@@ -100,7 +102,7 @@ Scored ScoreFrames(const AccuracyReport& a, const Trajectory& groundtruth, const
     for (const Eigen::Vector3d& x : points_gt) {
       const auto estimated = ProjectInFront(camera, a.aligned_estimate[i].pose, x);
       const auto truth = ProjectInFront(camera, groundtruth[j].pose, x);
-      if (!estimated || !truth) continue;
+      if (!estimated || !truth || (only_in_image && !camera.InImage(*truth))) continue;
       const double e = (*estimated - *truth).norm();
       sum += e;
       worst = std::max(worst, e);
@@ -260,10 +262,15 @@ RegistrationReport EvaluateRegistration(const AccuracyReport& a, const Trajector
     if (lag) r.lag_frames = *lag / MedianInterval(raw);
   }
   r.points = static_cast<int>(o.points.size());
+  if (!o.groundtruth_points.empty()) {
+    const Scored geometry = ScoreFrames(a, groundtruth, camera, o.groundtruth_points, true);
+    r.geometry_frames = static_cast<int>(geometry.mean_px.size());
+    r.geometry_mean_px = Summarize(geometry.mean_px);
+  }
   if (o.points.empty()) return r;
   std::vector<Eigen::Vector3d> points_gt;
   for (const Eigen::Vector3d& x : o.points) points_gt.push_back(a.alignment(x));
-  const Scored scored = ScoreFrames(a, groundtruth, camera, points_gt);
+  const Scored scored = ScoreFrames(a, groundtruth, camera, points_gt, false);
   if (scored.mean_px.empty()) {
     throw RecordingError("registration: no associated frame has any of the " + std::to_string(o.points.size()) +
                          " points in front of both its estimated and its true camera");
@@ -295,6 +302,10 @@ std::string RegistrationToJson(const RegistrationReport& r) {
     j["share_over"] = r.share_over;
   }
   if (r.fast_error_px) j["fast_error_px"] = *r.fast_error_px;
+  if (r.geometry_frames > 0) {
+    j["geometry_frames"] = r.geometry_frames;
+    j["geometry_mean_px"] = PixelStatsJson(r.geometry_mean_px);
+  }
   nlohmann::ordered_json stills = nlohmann::ordered_json::array();
   for (const StillSegment& s : r.stills) {
     nlohmann::ordered_json one = {{"start_s", s.start_s},         {"end_s", s.end_s},
@@ -334,6 +345,13 @@ std::string RegistrationToText(const RegistrationReport& r) {
   if (r.fast_error_px) {
     std::snprintf(buf, sizeof buf, "fast error  %.3g px RMS: the anchor's error less its 1 s trend, moving frames\n",
                   *r.fast_error_px);
+    o << buf;
+  }
+  if (r.geometry_frames > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "geometry    %d frames, the true scene's points each frame sees: mean per frame median %.3g px  p95 "
+                  "%.3g px  max %.3g px\n",
+                  r.geometry_frames, r.geometry_mean_px.median, r.geometry_mean_px.p95, r.geometry_mean_px.max);
     o << buf;
   }
   for (const StillSegment& s : r.stills) {

@@ -13,7 +13,7 @@
 // The points are mapped into the ground truth's world by the accuracy report's alignment and
 // projected there with the aligned estimate and the true pose; a similarity changes no
 // projection, so the error is the one the estimate made in the map. Without points only the
-// recall and the lag are computed. Throws RecordingError on input it cannot judge (points but no
+// recall and the lag are computed (and the ground-truth geometry's error, when given). Throws RecordingError on input it cannot judge (points but no
 // frame with one in front of both cameras).
 
 #include <optional>
@@ -36,6 +36,10 @@ struct StampedCentre {
 
 struct RegistrationOptions {
   std::vector<Eigen::Vector3d> points;  // estimate's world; points[0] is the anchor
+  // Points of the scene's true geometry, in the ground truth's world (a rendered room's
+  // surfaces): each frame is scored on those its true camera sees in the image, as DCRE
+  // (Brachmann et al. 2021) scores a frame's own depth points.
+  std::vector<Eigen::Vector3d> groundtruth_points;
   double over_px = 5.0;                 // the share of frames over this error is reported
   double trend_window_s = 1.0;          // jitter: the anchor's projection less its mean over this window
   double min_still_s = 1.0;             // a still segment of the ground truth at least this long is judged
@@ -73,6 +77,8 @@ struct RegistrationReport {
   // The anchor's error vector less its mean over the trend window, RMS, over the frames outside
   // still segments: the part of the error faster than the window (the moving camera's jitter).
   std::optional<double> fast_error_px;
+  int geometry_frames = 0;         // frames with a ground-truth point in the true image
+  ErrorStats geometry_mean_px;     // per frame: the mean error over those points
   std::vector<StillSegment> stills;
   // The shift of the raw centres that best matches the smoothed ones (least squares over the
   // moving frames, the cross-correlation's peak), in frames of the median frame interval;

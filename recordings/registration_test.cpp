@@ -66,6 +66,27 @@ TEST(Registration, AnEstimateOffByOneCentimetreSidewaysIsOffByFOverDistanceInPix
   EXPECT_DOUBLE_EQ(r.recall[2].recall, 1.0);
 }
 
+TEST(Registration, TheTrueGeometryIsScoredOnThePointsEachTrueViewSees) {
+  const Trajectory truth = WalkThenStill(30, 0);
+  Trajectory estimate = truth;
+  for (StampedPose& p : estimate) p.pose = LookingAlongY(p.pose.Center() + Eigen::Vector3d(0.01, 0, 0));
+  Sim3 map_to_world;  // the estimate's world is the truth's moved: the ground-truth points are not
+  map_to_world.t = {5, 0, 0};
+  Trajectory in_map = estimate, truth_in_map = truth;
+  for (StampedPose& p : in_map) p.pose = Transform(map_to_world.Inverse(), p.pose);
+  for (StampedPose& p : truth_in_map) p.pose = Transform(map_to_world.Inverse(), p.pose);
+  AccuracyOptions o;
+  o.align_with = &truth_in_map;
+  RegistrationOptions reg;
+  // 2 m ahead in view (2.5 px off), 1 m ahead far outside the image (left out), behind (left out).
+  reg.groundtruth_points = {{0.2, 2, 0}, {-4, 1, 0}, {0, -2, 0}};
+  const RegistrationReport r = EvaluateRegistration(EvaluateTrajectory(in_map, truth, o), in_map, truth, TestCamera(), reg);
+  EXPECT_EQ(r.geometry_frames, 30);
+  EXPECT_NEAR(r.geometry_mean_px.max, 2.5, 1e-6);
+  EXPECT_NEAR(r.geometry_mean_px.median, 2.5, 1e-6);
+  EXPECT_EQ(r.frames, 0);  // no scene points
+}
+
 TEST(Registration, TheErrorIsTheSameAfterASimilarityOfTheEstimatesWorld) {
   const Trajectory truth = WalkThenStill(60, 0);
   Trajectory estimate = truth;

@@ -1,6 +1,7 @@
 // arview eval <estimate.txt> <groundtruth.txt> [--align sim3|se3|none] [--align-with <poses.txt>]
 //             [--plot plot.png] [--json] [--max-dt S] [--rpe-delta N]
-//             [--camera camera.yaml (--scene scene.yaml | --points points.txt)] [--smoothed stats.json]
+//             [--camera camera.yaml (--scene scene.yaml | --points points.txt | --room-points)]
+//             [--smoothed stats.json]
 
 #include <algorithm>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include "calib/camera.h"
 #include "recordings/accuracy.h"
 #include "recordings/registration.h"
+#include "synth/synth_room.h"
 
 namespace arview::app {
 
@@ -33,6 +35,8 @@ struct EvalArgs {
   std::string scene;
   std::string points;
   std::string smoothed;
+  bool room_points = false;
+  std::string room_photos = synth::kOpenCvDocData;
   double over_px = 5.0;
 };
 
@@ -73,6 +77,7 @@ recordings::RegistrationOptions RegistrationInputs(const EvalArgs& args, std::ve
       const std::vector<Eigen::Vector3d> listed = ReadPointsFile(args.points);
       options.points.insert(options.points.end(), listed.begin(), listed.end());
     }
+    if (args.room_points) options.groundtruth_points = RoomGeometryPoints(args.groundtruth, args.room_photos);
   } catch (const CommandError&) {
     throw;
   } catch (const Error& e) {
@@ -183,12 +188,17 @@ void AddEvalCommand(CLI::App& app) {
   cmd->add_option("--points", args->points, "Text file of points to project, x y z a line in the map's frame");
   cmd->add_option("--smoothed", args->smoothed,
                   "stats.json of replay or track: the smoothed centres, for the smoothing's lag and jitter");
+  cmd->add_flag("--room-points", args->room_points,
+                "On a room rendered by 'arview synth room': also score each frame on the points of the room's true "
+                "surfaces its true camera sees (photo corners, edge midpoints, centres), as DCRE");
+  cmd->add_option("--room-photos", args->room_photos, "With --room-points: the room's photos (opencv-doc's examples)")
+      ->capture_default_str();
   cmd->add_option("--over-px", args->over_px, "Report the share of frames whose worst point is over this, pixels")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   cmd->callback([args] {
-    if ((!args->scene.empty() || !args->points.empty()) && args->camera.empty()) {
-      throw CommandError("--scene and --points need --camera (the recording's camera.yaml)");
+    if ((!args->scene.empty() || !args->points.empty() || args->room_points) && args->camera.empty()) {
+      throw CommandError("--scene, --points and --room-points need --camera (the recording's camera.yaml)");
     }
     RunEval(*args);
   });

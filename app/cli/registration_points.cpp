@@ -9,6 +9,7 @@
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
 #include "base/error.h"
+#include "synth/synth_room.h"
 
 namespace arview::app {
 
@@ -53,6 +54,29 @@ std::vector<Eigen::Vector3d> ReadPointsFile(const std::filesystem::path& file) {
     points.push_back(p);
   }
   if (points.empty()) throw Error(file.string() + ": holds no points (x y z a line)");
+  return points;
+}
+
+std::vector<Eigen::Vector3d> RoomGeometryPoints(const std::filesystem::path& groundtruth,
+                                                const std::filesystem::path& photos) {
+  std::ifstream in(groundtruth);
+  std::string header;
+  if (!in || !std::getline(in, header)) throw Error(groundtruth.string() + ": cannot read the ground truth");
+  if (header.rfind("# arview synth room", 0) != 0) {
+    throw Error(groundtruth.string() + ": not the ground truth of a room rendered by 'arview synth room' (its first "
+                "line says so); --room-points needs that room's geometry");
+  }
+  const synth::SynthLighting light =
+      header.find("window light") != std::string::npos ? synth::SynthLighting::kWindow : synth::SynthLighting::kEven;
+  std::vector<Eigen::Vector3d> points;
+  for (const synth::RoomPanel& panel : synth::MakeRoomScene(photos, light).panels) {
+    const Eigen::Vector3d* c = panel.corners;
+    for (int k = 0; k < 4; ++k) {
+      points.push_back(c[k]);
+      points.push_back(0.5 * (c[k] + c[(k + 1) % 4]));
+    }
+    points.push_back(0.25 * (c[0] + c[1] + c[2] + c[3]));
+  }
   return points;
 }
 

@@ -24,4 +24,12 @@ std::vector<Eigen::Vector3d> SceneMarks(const std::filesystem::path& scene);
 // and line of anything else, or a file without points.
 std::vector<Eigen::Vector3d> ReadPointsFile(const std::filesystem::path& file);
 
+// Points on the true surfaces of a room rendered by `arview synth room`, in its world (the
+// ground truth's): the corners, edge midpoints and centre of every photo on its walls, floor,
+// ceiling and boxes. The room's light (which decides whether a window replaces a photo) is read
+// from the ground truth's header; a file without `arview synth room`'s header is refused, naming
+// it. `photos`: the folder MakeRoomScene reads (opencv-doc's examples).
+std::vector<Eigen::Vector3d> RoomGeometryPoints(const std::filesystem::path& groundtruth,
+                                                const std::filesystem::path& photos);
+
 }  // namespace arview::app

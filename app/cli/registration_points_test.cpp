@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include "base/error.h"
+#include "synth/synth_room.h"
+#include "tests/support/test_data.h"
 
 namespace arview::app {
 namespace {
@@ -46,6 +48,31 @@ TEST(RegistrationPoints, APointsFileIsThreeNumbersALineAndNamesTheLineItRefuses)
   }
   std::ofstream(file) << "# nothing\n";
   EXPECT_THROW(ReadPointsFile(file), Error);
+  fs::remove(file);
+}
+
+TEST(RegistrationPoints, TheRoomsTrueSurfacesOnlyForARenderedRoom) {
+  const fs::path file = fs::temp_directory_path() / ("arview_room_gt_" + std::to_string(::getpid()) + ".txt");
+  std::ofstream(file) << "# timestamp tx ty tz qx qy qz qw\n0 0 0 0 0 0 0 1\n";
+  try {
+    RoomGeometryPoints(file, synth::kOpenCvDocData);
+    FAIL() << "a ground truth not made by synth room was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not the ground truth of a room rendered by 'arview synth room'"),
+              std::string::npos)
+        << e.what();
+  }
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(synth::kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  std::ofstream(file) << "# arview synth room, seed 1, window light, world: metres, z up, floor z = 0\n";
+  const std::vector<Eigen::Vector3d> points = RoomGeometryPoints(file, synth::kOpenCvDocData);
+  const size_t panels = synth::MakeRoomScene(synth::kOpenCvDocData, synth::SynthLighting::kWindow).panels.size();
+  EXPECT_EQ(points.size(), 9 * panels);  // 4 corners, 4 edge midpoints, the centre
+  for (const Eigen::Vector3d& p : points) {
+    EXPECT_LE(std::abs(p.x()), 3.5 + 1e-9);
+    EXPECT_LE(std::abs(p.y()), 2.5 + 1e-9);
+    EXPECT_GE(p.z(), -1e-9);
+    EXPECT_LE(p.z(), 2.8 + 1e-9);
+  }
   fs::remove(file);
 }
 
