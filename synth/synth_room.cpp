@@ -379,6 +379,10 @@ void ValidateOptions(const SynthRoomOptions& o) {
   if (!(o.gain_drift >= 0 && o.gain_drift < 1)) fail("--gain-drift must be in [0, 1)");
   if (!(o.rolling_shutter_s >= 0 && o.rolling_shutter_s <= 1.0 / o.fps))
     fail("--rolling-shutter must be in [0, 1/fps] seconds");
+  if (!(o.still_s >= 0 && o.still_s <= 3600)) fail("--still must be in [0, 3600] seconds");
+  if (!(o.still_at_s >= 0 && o.still_at_s <= o.frames / o.fps)) {
+    fail("--still-at must be within the walk, [0, " + std::to_string(o.frames / o.fps) + "] seconds");
+  }
   if (!o.board.empty()) {
     if (!(o.board.square > 0 && o.board.square <= 1)) fail("--square must be in (0, 1] metres");
     const double reach = 0.5 * o.board.square * std::hypot(o.board.inner_corners.width + 3, o.board.inner_corners.height + 3);
@@ -387,15 +391,16 @@ void ValidateOptions(const SynthRoomOptions& o) {
   }
 }
 
-// The walk's frames to render, in order: every one, or the --subset's.
+// The recording's frames to render, in order: every one, or the --subset's.
 std::vector<int> FramesToRender(const SynthRoomOptions& o) {
+  const int frames = RecordingFrames(o);
   if (o.frames_subset.empty()) {
-    std::vector<int> every(o.frames);
-    for (int i = 0; i < o.frames; ++i) every[i] = i;
+    std::vector<int> every(frames);
+    for (int i = 0; i < frames; ++i) every[i] = i;
     return every;
   }
   try {
-    return recordings::ParseFrameSpec(o.frames_subset, o.frames);
+    return recordings::ParseFrameSpec(o.frames_subset, frames);
   } catch (const Error& e) {
     throw render::RenderError(std::string("synth room: --subset: ") + e.what());
   }
@@ -472,7 +477,22 @@ std::string BoardText(const FloorBoard& board) {
   return text;
 }
 
+// The still segment in the ground truth's header.
+std::string StillText(const SynthRoomOptions& o) {
+  if (o.still_s <= 0) return "";
+  char text[96];
+  std::snprintf(text, sizeof text, ", still for %.4g s from %.4g s", o.still_s, o.still_at_s);
+  return text;
+}
+
 }  // namespace
+
+int RecordingFrames(const SynthRoomOptions& o) { return o.frames + static_cast<int>(std::lround(o.still_s * o.fps)); }
+
+double WalkTime(const SynthRoomOptions& o, double t) {
+  if (t < o.still_at_s) return t;
+  return std::max(o.still_at_s, t - o.still_s);
+}
 
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
   ValidateOptions(o);
@@ -484,7 +504,10 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   RoomRenderer renderer(*context, scene, camera, o.samples);
   const RoomPath room_path(o.frames / o.fps, o.seed);
   const OrbitWalk orbit_walk(o.frames / o.fps, o.seed, o.orbit);
-  const PoseAt path = [&](double t) { return o.walk == RoomWalk::kOrbit ? orbit_walk.At(t) : room_path.At(t); };
+  const PoseAt path = [&](double t) {
+    const double w = WalkTime(o, t);
+    return o.walk == RoomWalk::kOrbit ? orbit_walk.At(w) : room_path.At(w);
+  };
 
   std::vector<recordings::FrameEntry> entries;
   recordings::Trajectory groundtruth;
@@ -525,7 +548,7 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   recordings::WriteFramesTxt(o.out, entries);
   recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
                        "arview synth room, seed " + std::to_string(o.seed) + (o.light == SynthLighting::kWindow ? ", window light" : "") +
-                           BoardText(o.board) + ", world: metres, z up, floor z = 0");
+                           BoardText(o.board) + StillText(o) + ", world: metres, z up, floor z = 0");
   return {context->Description(), static_cast<int>(indices.size())};
 }
 

@@ -119,10 +119,22 @@ struct SynthRoomOptions {
   // and every rendered frame are exactly those of the full recording: a subset makes sizes
   // whose frames take seconds each affordable (a sparse first lap to map, a dense stretch to track).
   std::string frames_subset;
+  // A tripod (`--still S --still-at T`): at the walk's time `still_at_s` the camera stops for
+  // `still_s` seconds, then walks on; the recording is that much longer than the `frames`-long
+  // walk, and its still frames differ only by the sensor's noise and compression (a still
+  // camera's jitter is measured there: `arview eval`). 0: no still segment.
+  double still_s = 0.0;
+  double still_at_s = 0.0;
   bool overwrite = false;        // replace an existing recording in `out`
   std::filesystem::path data_dir = kOpenCvDocData;
   render::OffscreenOptions gl;
 };
+
+// The recording's frame count: the walk's `frames` and the still segment's.
+int RecordingFrames(const SynthRoomOptions& options);
+// The walk's time at the recording's time t: t before the still segment, its start during it, t
+// less its length after.
+double WalkTime(const SynthRoomOptions& options, double t);
 
 struct SynthRoomReport {
   std::string gl_description;

@@ -270,6 +270,39 @@ TEST(SynthRoom, SubsetRendersTheWholeRecordingsFrames) {
   EXPECT_FALSE(fs::exists(bad.path / "frames.txt"));
 }
 
+// A tripod inserted into the walk: its frames repeat one pose exactly (only the noise differs),
+// and the walk goes on after it where it stopped.
+TEST(SynthRoom, AStillSegmentHoldsOnePoseAndTheWalkResumesWhereItStopped) {
+  ARVIEW_REQUIRE_DATA_PATH(fs::path(kOpenCvDocData) / "building.jpg", "Debian package opencv-doc");
+  TempDir dir;
+  SynthRoomOptions options = FourNoisyFrames(dir.path);
+  options.width = 160;
+  options.height = 120;
+  options.still_at_s = 1 / 30.0;
+  options.still_s = 2 / 30.0;
+  EXPECT_EQ(RecordingFrames(options), 6);
+  EXPECT_EQ(SynthesizeRoom(options).frames, 6);
+  const recordings::Recording r = recordings::LoadRecording(dir.path);
+  ASSERT_EQ(r.groundtruth->size(), 6u);
+  const RoomPath walk(4 / 30.0, 5);
+  const auto& gt = *r.groundtruth;
+  for (int i : {1, 2, 3}) {
+    EXPECT_LT((gt[i].pose.Center() - walk.At(1 / 30.0).Center()).norm(), 1e-9) << i;
+    EXPECT_LT(gt[i].pose.q_cw.angularDistance(walk.At(1 / 30.0).q_cw), 1e-9) << i;
+  }
+  EXPECT_LT((gt[5].pose.Center() - walk.At(3 / 30.0).Center()).norm(), 1e-9);
+  EXPECT_NEAR(gt[5].timestamp, 5 / 30.0, 1e-9);  // as the TUM file prints it
+  cv::Mat diff;
+  cv::absdiff(r.ReadImage(1), r.ReadImage(2), diff);
+  const double mean_diff = cv::mean(diff)[0];
+  EXPECT_GT(mean_diff, 0.5) << "the sensor's noise differs from frame to frame";
+  EXPECT_LT(mean_diff, 4.0) << "but the picture does not move";
+  EXPECT_NE(Bytes(dir.path / "groundtruth.txt").find("still for 0.06667 s from 0.03333 s"), std::string::npos);
+  options.still_at_s = 1.0;  // after the 4-frame walk's end
+  options.overwrite = true;
+  EXPECT_THROW(SynthesizeRoom(options), render::RenderError);
+}
+
 // The realistic-footage flags: a 1280x720 camera with the same field of view, JPEG frames, a
 // gain change and a rolling shutter, each changing the image and none the ground truth.
 TEST(SynthRoom, RealisticFootageFlags) {

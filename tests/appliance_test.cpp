@@ -128,6 +128,16 @@ TEST(Appliance, TempleRingReplayCompositesEveryFrameAndTheHeadFollowsTheCamera) 
   ASSERT_TRUE(std::regex_search(stats, m, std::regex(R"("max_error_deg": ([0-9.]+))")));
   EXPECT_LE(std::stod(m[1]), 20.0);
 
+  // What the viewer sees, from the replay's own files: the character's anchor and box corners
+  // projected with the estimated and the true pose, the smoothed centres read from its stats.
+  const auto seen = run({"eval", (dir / "traj.txt").string(), (dir / "temple" / "groundtruth.txt").string(), "--align-with",
+                         (dir / "map" / "keyframes.txt").string(), "--camera", (dir / "temple" / "camera.yaml").string(),
+                         "--scene", (dir / "scene.yaml").string(), "--smoothed", (dir / "stats.json").string()});
+  EXPECT_NE(seen.out.find("registration 9 points, 23 frames"), std::string::npos) << seen.out;
+  EXPECT_NE(seen.out.find("smoothing   lags the raw centre by"), std::string::npos) << seen.out;
+  ASSERT_TRUE(std::regex_search(seen.out, m, std::regex(R"(mean per frame median ([0-9.]+) px)"))) << seen.out;
+  EXPECT_LT(std::stod(m[1]), 5.0) << "templeRing's poses are within a few mm: a few pixels at most";
+
   // The HUD is drawn on the sink's thread (FrameCompositor::DeferredOverlay): the same frames
   // with and without it differ, and only in the HUD's places, the character's pixels the same.
   for (const char* name : {"plain", "hud"}) {

@@ -1,12 +1,22 @@
 // arview eval <estimate.txt> <groundtruth.txt> [--align sim3|se3|none] [--align-with <poses.txt>]
 //             [--plot plot.png] [--json] [--max-dt S] [--rpe-delta N]
+//             [--camera camera.yaml (--scene scene.yaml | --points points.txt | --room-points)]
+//             [--smoothed stats.json]
 
+#include <algorithm>
+#include <fstream>
 #include <iostream>
 #include <optional>
 
+#include <nlohmann/json.hpp>
+
 #include "app/cli/commands.h"
+#include "app/cli/registration_points.h"
 #include "base/geometry.h"
+#include "calib/camera.h"
 #include "recordings/accuracy.h"
+#include "recordings/registration.h"
+#include "synth/synth_room.h"
 
 namespace arview::app {
 
@@ -21,7 +31,64 @@ struct EvalArgs {
   bool json = false;
   double max_dt = 0.02;
   int rpe_delta = 1;
+  std::string camera;
+  std::string scene;
+  std::string points;
+  std::string smoothed;
+  bool room_points = false;
+  std::string room_photos = synth::kOpenCvDocData;
+  double over_px = 5.0;
 };
+
+// The smoothed centres of the frames in a stats.json of `arview replay` or `arview track`
+// (each localized frame's `timestamp` and `smoothed_center`), in time order.
+std::vector<recordings::StampedCentre> ReadSmoothedCentres(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw CommandError(file + ": cannot read the stats file (--smoothed)");
+  nlohmann::json stats;
+  try {
+    stats = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw CommandError(file + ": not a finished stats.json (--smoothed): " + e.what());
+  }
+  std::vector<recordings::StampedCentre> centres;
+  if (stats.contains("frames") && stats["frames"].is_array()) {
+    for (const nlohmann::json& frame : stats["frames"]) {
+      if (!frame.contains("smoothed_center") || !frame.contains("timestamp")) continue;
+      const auto& c = frame["smoothed_center"];
+      centres.push_back({frame["timestamp"].get<double>(), {c[0].get<double>(), c[1].get<double>(), c[2].get<double>()}});
+    }
+  }
+  if (centres.empty()) {
+    throw CommandError(file + ": no frame has a smoothed_center (--smoothed takes the --stats file of replay or track)");
+  }
+  std::sort(centres.begin(), centres.end(), [](const auto& a, const auto& b) { return a.timestamp < b.timestamp; });
+  return centres;
+}
+
+// What the registration measures need beside the two trajectories: the camera, the scene's
+// points, the smoothed centres. Recall needs none of them.
+recordings::RegistrationOptions RegistrationInputs(const EvalArgs& args, std::vector<recordings::StampedCentre>& smoothed) {
+  recordings::RegistrationOptions options;
+  options.over_px = args.over_px;
+  try {
+    if (!args.scene.empty()) options.points = SceneMarks(args.scene);
+    if (!args.points.empty()) {
+      const std::vector<Eigen::Vector3d> listed = ReadPointsFile(args.points);
+      options.points.insert(options.points.end(), listed.begin(), listed.end());
+    }
+    if (args.room_points) options.groundtruth_points = RoomGeometryPoints(args.groundtruth, args.room_photos);
+  } catch (const CommandError&) {
+    throw;
+  } catch (const Error& e) {
+    throw CommandError(e.what());
+  }
+  if (!args.smoothed.empty()) {
+    smoothed = ReadSmoothedCentres(args.smoothed);
+    options.smoothed = &smoothed;
+  }
+  return options;
+}
 
 // An alignment needs positions that span at least a plane (base/geometry.h EstimateSim3). Each
 // trajectory the alignment is fitted on is checked by itself first, so that the error names
@@ -65,10 +132,17 @@ void RunEval(const EvalArgs& args) {
     }
     const recordings::AccuracyReport report = recordings::EvaluateTrajectory(estimate, groundtruth, options);
     if (!args.plot.empty()) recordings::PlotTrajectories(report, groundtruth, args.plot);
+    std::vector<recordings::StampedCentre> smoothed;
+    const recordings::RegistrationOptions registration_options = RegistrationInputs(args, smoothed);
+    const calib::Camera camera = args.camera.empty() ? calib::Camera{} : calib::LoadCamera(args.camera);
+    const recordings::RegistrationReport registration =
+        recordings::EvaluateRegistration(report, estimate, groundtruth, camera, registration_options);
     if (args.json) {
-      std::cout << recordings::ReportToJson(report);
+      nlohmann::ordered_json j = nlohmann::ordered_json::parse(recordings::ReportToJson(report));
+      j["registration"] = nlohmann::ordered_json::parse(recordings::RegistrationToJson(registration));
+      std::cout << j.dump(2) << "\n";
     } else {
-      std::cout << recordings::ReportToText(report);
+      std::cout << recordings::ReportToText(report) << recordings::RegistrationToText(registration);
       if (!args.plot.empty()) std::cout << "plot        " << args.plot << "\n";
     }
   } catch (const recordings::RecordingError& e) {
@@ -78,7 +152,8 @@ void RunEval(const EvalArgs& args) {
     if (message.rfind("alignment", 0) == 0 && !args.align_with.empty()) {
       throw CommandError(args.align_with + " (--align-with) against " + args.groundtruth + ": " + message);
     }
-    if (message.rfind("alignment", 0) == 0 || message.rfind("evaluation", 0) == 0) {
+    if (message.rfind("alignment", 0) == 0 || message.rfind("evaluation", 0) == 0 ||
+        message.rfind("registration", 0) == 0) {
       throw CommandError(args.estimate + " against " + args.groundtruth + ": " + message);
     }
     throw CommandError(message);
@@ -106,7 +181,27 @@ void AddEvalCommand(CLI::App& app) {
   cmd->add_option("--rpe-delta", args->rpe_delta, "RPE interval, in associated poses")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
-  cmd->callback([args] { RunEval(*args); });
+  cmd->add_option("--camera", args->camera,
+                  "The recording's camera.yaml: with --scene or --points, registration error in pixels and jitter");
+  cmd->add_option("--scene", args->scene,
+                  "Scene file: each character's anchor and its rest pose's bounding-box corners are projected (map frame)");
+  cmd->add_option("--points", args->points, "Text file of points to project, x y z a line in the map's frame");
+  cmd->add_option("--smoothed", args->smoothed,
+                  "stats.json of replay or track: the smoothed centres, for the smoothing's lag and jitter");
+  cmd->add_flag("--room-points", args->room_points,
+                "On a room rendered by 'arview synth room': also score each frame on the points of the room's true "
+                "surfaces its true camera sees (photo corners, edge midpoints, centres), as DCRE");
+  cmd->add_option("--room-photos", args->room_photos, "With --room-points: the room's photos (opencv-doc's examples)")
+      ->capture_default_str();
+  cmd->add_option("--over-px", args->over_px, "Report the share of frames whose worst point is over this, pixels")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->callback([args] {
+    if ((!args->scene.empty() || !args->points.empty() || args->room_points) && args->camera.empty()) {
+      throw CommandError("--scene, --points and --room-points need --camera (the recording's camera.yaml)");
+    }
+    RunEval(*args);
+  });
 }
 
 }  // namespace arview::app

@@ -93,6 +93,14 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--rolling-shutter", o.rolling_shutter_s,
                    "Rolling-shutter readout time top to bottom, seconds (0 = global shutter)")
       ->default_val(o.rolling_shutter_s);
+  room->add_option("--still", o.still_s,
+                   "A tripod: the camera stops for this many seconds (sensor noise and compression as on every frame), "
+                   "then walks on; the recording is that much longer (0 = none)")
+      ->default_val(o.still_s)
+      ->check(CLI::Range(0.0, 3600.0));
+  room->add_option("--still-at", o.still_at_s, "Where the walk stops for --still: the walk's time, seconds")
+      ->default_val(o.still_at_s)
+      ->check(CLI::Range(0.0, 1e6));
   AddGlFlags(room, args->gl);
   room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
   room->add_option("--path", o.walk,

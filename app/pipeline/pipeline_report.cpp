@@ -95,6 +95,12 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
                                   {"rms_px", f.track.rms_px},
                                   {"track_ms", f.track.times.total_ms},
                                   {"idle_weight", f.idle_weight}};
+  if (f.track.status != tracker::TrackStatus::kLost) {
+    // The raw centre places the character in the image, the smoothed one drives its animation:
+    // `arview eval --smoothed` measures the smoothing's lag from both.
+    frame["center"] = {f.track.center[0], f.track.center[1], f.track.center[2]};
+    frame["smoothed_center"] = {f.track.smoothed_center[0], f.track.smoothed_center[1], f.track.smoothed_center[2]};
+  }
   if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
   if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
   if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
