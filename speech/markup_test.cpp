@@ -106,6 +106,35 @@ TEST(Markup, TagsAreTimedAtTheStartOfTheirWord) {
   EXPECT_LT(timed[0].time_s, timed[1].time_s);
 }
 
+// Flite's tokens against the line's words on what people write: abbreviations, numbers,
+// symbols, quotes and brackets, punctuation alone, UTF-8, tabs and line breaks.
+TEST(Markup, EveryWordFindsFlitesTokenInOrdinaryText) {
+  const char* const lines[] = {"U.S.A. is big.",
+                               "Send an e-mail at 5:30pm, for $20.",
+                               "Dr. Smith... 'quoted' words",
+                               "Hello,world and (parens) [x] {y}",
+                               "\xc2\xbfQu\xc3\xa9 tal? caf\xc3\xa9",
+                               "\"'Nested' quotes,\" she said!!",
+                               "a -- b - c ... d ?! e",
+                               "x1 2nd 3.14 1,000,000 #tag @you 50%",
+                               "it's o'clock ''double'' `tick`",
+                               "tab\there\nnewline",
+                               "'(hello)' ((x))",
+                               "!!! ??? ... ,,,"};
+  const Synthesizer synthesizer(Voice::kSlt);
+  for (const char* text : lines) {
+    const MarkedLine line = ParseMarkup(std::string(text) + " <gaze at=\"viewer\"/>end", "test");
+    const SpokenLine spoken = synthesizer.Synthesize(line.text);
+    std::vector<TimedTag> timed;
+    EXPECT_NO_THROW(timed = TimeTags(line, spoken, "test")) << text;
+    ASSERT_EQ(timed.size(), 1u) << text;
+    // "end" is the last word: it starts after the leading pause (right after it when nothing
+    // before it is spoken) and before the last phone.
+    EXPECT_GE(timed[0].time_s, spoken.phones.front().end_s) << text;
+    EXPECT_LT(timed[0].time_s, spoken.phones.back().start_s) << text;
+  }
+}
+
 TEST(Markup, ATagAtTheEndIsTimedAtTheLinesEnd) {
   const MarkedLine line = ParseMarkup("Goodbye. <gesture name=\"Bow\"/>", "test");
   const SpokenLine spoken = Synthesizer(Voice::kSlt).Synthesize(line.text);
