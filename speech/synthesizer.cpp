@@ -3,6 +3,7 @@
 #include <flite/flite.h>
 
 #include <array>
+#include <csetjmp>
 #include <cstdlib>
 #include <memory>
 #include <mutex>
@@ -43,7 +44,7 @@ cst_voice* RegisteredVoice(Voice voice) {
   return nullptr;
 }
 
-// Flite's clustergen voices draw the noise of unvoiced sounds from rand() (cst_mlsa.c). Each
+// Flite's clustergen voices draw the noise of unvoiced sounds from the C library's rand(). Each
 // line's synthesis swaps in a generator of its own, started from one seed, and gives the
 // caller's back after: the same line gives the same samples, and a seeded rand() elsewhere in
 // the process (map/descriptor_index.cpp) keeps its sequence unless it draws while a line is
@@ -60,6 +61,23 @@ class SeededRand {
   std::array<char, 256> state_{};
   char* previous_;
 };
+
+// Flite's internal errors call exit(-1) unless its global cst_errjmp points at a jump buffer
+// (cst_error.h); with one, they longjmp back here and the line is refused instead of the process
+// ending. Only C calls run between setjmp and its return, so the jump skips no C++ destructor.
+// Called with FliteMutex held (cst_errjmp is one global).
+cst_utterance* SynthesizeOrNull(const char* text, cst_voice* voice) {
+  jmp_buf on_error;
+  jmp_buf* const previous = cst_errjmp;
+  if (setjmp(on_error) != 0) {
+    cst_errjmp = previous;
+    return nullptr;
+  }
+  cst_errjmp = &on_error;
+  cst_utterance* const utterance = flite_synth_text(text, voice);
+  cst_errjmp = previous;
+  return utterance;
+}
 
 struct UtteranceDeleter {
   void operator()(cst_utterance* utterance) const { delete_utterance(utterance); }
@@ -130,8 +148,8 @@ SpokenLine Synthesizer::Synthesize(std::string_view text) const {
   const std::lock_guard lock(FliteMutex());
   const SeededRand seeded_rand;
   const std::unique_ptr<cst_utterance, UtteranceDeleter> utterance(
-      flite_synth_text(c_text.c_str(), static_cast<cst_voice*>(flite_voice_)));
-  if (!utterance) throw SpeechError("speech: Flite could not synthesize \"" + c_text + "\"");
+      SynthesizeOrNull(c_text.c_str(), static_cast<cst_voice*>(flite_voice_)));
+  if (!utterance) throw SpeechError("speech: Flite failed on the line \"" + c_text + "\" (its message above)");
   SpokenLine line;
   line.samples = SamplesOf(utterance.get(), voice_);
   line.phones = PhonesOf(utterance.get());
