@@ -2,8 +2,9 @@
 // Text to speech through Flite: 16 kHz mono 16-bit audio, each phone's start and end, and the
 // start of each token Flite read (docs/speech.md). Flite keeps process-wide state that is not
 // guarded (its list of voices, its error jump buffer, each voice library's one registered voice,
-// the lexicon, rand()), so every call into Flite in this module holds one process-wide lock: any number
-// of Synthesizers on any threads are safe, and they synthesize one line at a time between them.
+// the lexicon, rand()), so every call into Flite in this module holds one process-wide lock:
+// any number of Synthesizers on any threads are safe, and they synthesize one line at a time
+// between them.
 
 #include <cstdint>
 #include <optional>
