@@ -17,6 +17,7 @@ PACKAGES=(
   ffmpeg
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libyaml-cpp-dev nlohmann-json3-dev
+  flite1-dev
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
