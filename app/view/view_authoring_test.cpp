@@ -128,7 +128,7 @@ TEST(SpliceKeys, RefusesFlowStyleKeysAndMismatches) {
 
 TEST(MakeKey, RoundsToHundredthsOfADegreeAndFreezesPosesInTheClip) {
   anim::Character asset;
-  asset.clips.push_back({"Walk", 0.708, 1000, {}});
+  asset.clips.push_back({"Walk", 0.708, 1000, {}, {}});
   authoring::CharacterSpec spec;
   const Eigen::Vector3d v = anim::DirectionFromAzimuthElevation(33.333333, 12.345678);
   const authoring::KeySpec k = MakeKey(v, {authoring::KeySpec::Source::kStaticPose, "Walk", ""}, asset, spec, 2.0);
