@@ -1,5 +1,48 @@
+# _arview_label_discovered(<test target> <labels> <tsan regex>)
+#
+# Labels the tests that the last gtest_discover_tests call of <test target> found, once ctest
+# has read them: <labels> (a list: gtest_discover_tests (CMake 3.25) splits a list-valued
+# property) on each, and `tsan` besides on those whose name matches <tsan regex> (empty: none).
+function(_arview_label_discovered target labels tsan_regex)
+  get_property(counter TARGET ${target} PROPERTY CTEST_DISCOVERED_TEST_COUNTER)
+  set(tests_file "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_tests.cmake")
+  set(labels_script "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_labels.cmake")
+  file(WRITE "${labels_script}" "
+if(EXISTS \"${tests_file}\")
+  file(STRINGS \"${tests_file}\" lines REGEX \"^add_test\\\\(\")
+  foreach(line IN LISTS lines)
+    if(NOT line MATCHES \"^add_test\\\\(\\\\[=\\\\[([^]]*)\\\\]=\\\\]\")
+      continue()
+    endif()
+    set(name \"\${CMAKE_MATCH_1}\")
+    set(labels \"${labels}\")
+    if(NOT \"${tsan_regex}\" STREQUAL \"\" AND name MATCHES \"${tsan_regex}\")
+      list(APPEND labels tsan)
+    endif()
+    if(labels)
+      set_tests_properties(\"\${name}\" PROPERTIES LABELS \"\${labels}\")
+    endif()
+  endforeach()
+endif()
+")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_script}")
+endfunction()
+
+# The regular expression a test name matches when a gtest filter ("A.*:B.C?") selects it.
+function(_arview_gtest_filter_regex filter out)
+  set(regex "")
+  if(filter)
+    string(REPLACE "." "\\\\." regex "${filter}")
+    string(REPLACE "*" ".*" regex "${regex}")
+    string(REPLACE "?" "." regex "${regex}")
+    string(REPLACE ":" "|" regex "${regex}")
+    set(regex "^(${regex})$")
+  endif()
+  set(${out} "${regex}" PARENT_SCOPE)
+endfunction()
+
 # arview_discover_tests(<test target> [DATA <gtest filter>] [SLOW_DATA <gtest filter>]
-#                       [SLOW <gtest filter>] [ENVIRONMENT <VAR=value>])
+#                       [SLOW <gtest filter>] [TSAN <gtest filter>] [ENVIRONMENT <VAR=value>])
 #
 # Registers a GoogleTest binary's tests with ctest, labelled so that `ctest -LE slow` is the
 # quick loop and `ctest -L data` runs what reads ../shared/data:
@@ -9,8 +52,11 @@
 # Filters are gtest patterns joined by ':' (e.g. "TempleMapTest.*:Import.Fox"), disjoint; every
 # other test of the binary is registered without a label. Each group is one gtest_discover_tests
 # call with a TEST_FILTER, so a binary can mix quick and slow tests.
+#   TSAN       tests that run threads of ours, whichever group they are in: label `tsan` besides,
+#              run under ThreadSanitizer by `ctest --preset tsan` (scripts/test.sh --tsan)
 function(arview_discover_tests target)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;ENVIRONMENT" "" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;TSAN;ENVIRONMENT" "" ${ARGN})
+  _arview_gtest_filter_regex("${ARG_TSAN}" tsan_regex)
   # One variable: gtest_discover_tests (CMake 3.25) would split a list of them.
   set(environment "ARVIEW_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
   if(ARG_ENVIRONMENT)
@@ -31,41 +77,31 @@ function(arview_discover_tests target)
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     PROPERTIES ENVIRONMENT "${environment}"
     DISCOVERY_TIMEOUT 60)
+  if(tsan_regex)
+    _arview_label_discovered(${target} "" "${tsan_regex}")
+  endif()
   foreach(group DATA SLOW_DATA SLOW)
     if(NOT ARG_${group})
       continue()
     endif()
-    set(label data)
-    if(NOT group STREQUAL "DATA")
-      set(label slow)
+    set(labels data)
+    if(group STREQUAL "SLOW_DATA")
+      set(labels data slow)
+    elseif(group STREQUAL "SLOW")
+      set(labels slow)
     endif()
     gtest_discover_tests(${target} TEST_FILTER "${ARG_${group}}"
       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-      PROPERTIES ENVIRONMENT "${environment}" LABELS ${label}
+      PROPERTIES ENVIRONMENT "${environment}"
       DISCOVERY_TIMEOUT 60)
-    if(group STREQUAL "SLOW_DATA")
-      # gtest_discover_tests (CMake 3.25) splits a list-valued property, so a second label is set
-      # by a ctest script that runs after the discovered tests are added.
-      get_property(counter TARGET ${target} PROPERTY CTEST_DISCOVERED_TEST_COUNTER)
-      set(tests_file "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_tests.cmake")
-      set(labels_script "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_labels.cmake")
-      file(WRITE "${labels_script}" "
-if(EXISTS \"${tests_file}\")
-  file(STRINGS \"${tests_file}\" lines REGEX \"^add_test\\\\(\")
-  foreach(line IN LISTS lines)
-    if(line MATCHES \"^add_test\\\\(\\\\[=\\\\[([^]]*)\\\\]=\\\\]\")
-      set_tests_properties(\"\${CMAKE_MATCH_1}\" PROPERTIES LABELS \"data;slow\")
-    endif()
-  endforeach()
-endif()
-")
-      set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${labels_script}")
-    endif()
+    # Set by a ctest script that runs after the discovered tests are added: one list-valued
+    # property would be split by gtest_discover_tests.
+    _arview_label_discovered(${target} "${labels}" "${tsan_regex}")
   endforeach()
 endfunction()
 
 # arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>] [BENCH_DEPS <targets...>]
-#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>])
+#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>] [TSAN <filter>])
 #
 # One library per top-level folder: every *.cpp in the folder except *_test.cpp and
 # bench_*.cpp goes into the library `arview_<name>` (alias arview::<name>).
@@ -75,7 +111,7 @@ endfunction()
 # TEST_DEPS / BENCH_DEPS: what the tests / benchmarks link beyond the library (e.g. a runtime
 # library's tests loading assets through its authoring library).
 function(arview_module name)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;TSAN" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
   file(GLOB all_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(lib_sources "")
   set(test_sources "")
@@ -106,7 +142,8 @@ function(arview_module name)
   if(ARVIEW_BUILD_TESTS AND test_sources)
     add_executable(${name}_tests ${test_sources})
     target_link_libraries(${name}_tests PRIVATE arview_${name} arview_testing ${ARG_TEST_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
-    arview_discover_tests(${name}_tests DATA "${ARG_DATA}" SLOW_DATA "${ARG_SLOW_DATA}" SLOW "${ARG_SLOW}")
+    arview_discover_tests(${name}_tests DATA "${ARG_DATA}" SLOW_DATA "${ARG_SLOW_DATA}" SLOW "${ARG_SLOW}"
+                          TSAN "${ARG_TSAN}")
   endif()
 
   if(ARVIEW_BUILD_BENCHMARKS AND bench_sources)

@@ -1,11 +1,23 @@
 #!/usr/bin/env bash
 # The README's test command: installs the Debian packages, builds the release preset and runs
-# every test with ctest (which prints its summary line). Pass --asan to use the sanitizer preset.
+# every test with ctest (which prints its summary line). Pass --asan to use the AddressSanitizer
+# preset (every test), --tsan for the ThreadSanitizer preset: it builds the binaries that hold
+# the tests labelled `tsan` (the ones that run threads of ours) and runs those, with the
+# suppressions of tests/tsan.supp (docs/reliability.md, "Round 4: sanitizers").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=release
-[ "${1:-}" = "--asan" ] && preset=asan
+case "${1:-}" in
+  --asan) preset=asan ;;
+  --tsan) preset=tsan ;;
+  "") ;;
+  *) echo "usage: scripts/test.sh [--asan | --tsan]" >&2; exit 2 ;;
+esac
 bash scripts/install-deps.sh
 cmake --preset "$preset"
 cmake --build --preset "$preset"
-ctest --preset "$preset"
+if [ "$preset" = tsan ]; then
+  ctest --preset tsan -L tsan
+else
+  ctest --preset "$preset"
+fi
