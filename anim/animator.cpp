@@ -57,6 +57,7 @@ Animator::Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Sch
     if (!t.action.object || t.action.object->joint_count() != skeleton_->size())
       throw Error("distance trigger '" + t.action.name + "': its object does not fit the skeleton");
   }
+  if (options_.gaze && options_.gaze->rig.valid()) gaze_.emplace(*skeleton_, options_.gaze->rig, options_.gaze->options);
   armed_.assign(options_.triggers.size(), true);
   fired_ids_.reserve(16);
   buffers_ = FrameBuffers(*skeleton_);
@@ -114,6 +115,15 @@ bool Animator::SetMorphWeight(int target, float weight) {
   return true;
 }
 
+void Animator::Look(double time, const Eigen::Vector3d* viewer) {
+  if (viewer) viewer_ = *viewer;
+  // The head where the schedule (the look-at chain) put it, then the eyes from there.
+  MustRun(LocalToModelJob{skeleton_.get(), &buffers_.local[0], buffers_.model}, "animator: local to model before gaze");
+  gaze_->Apply(time, viewer_, buffers_.model, buffers_.local[0]);
+  frame_.gaze = gaze_->frame();
+  frame_.gaze.eyes_on_viewer = frame_.gaze.eyes_on_viewer && viewer != nullptr;
+}
+
 const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {
   if (!std::isfinite(time)) time = last_time_.value_or(0.0);
   if (last_time_ && time < *last_time_) {  // a restart (replay from the beginning)
@@ -129,6 +139,7 @@ const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {
   inputs_ = inputs;
   inputs_.viewpoint = viewpoint_;  // held while lost
   if (!schedule_->Sample(time, inputs_, buffers_.local[0])) throw Error("animator: an action's object refused its inputs");
+  if (gaze_) Look(time, inputs.tracking && inputs.viewer.allFinite() ? &inputs.viewer : nullptr);
   buffers_.Finish(*skeleton_, frame_, "animator: local to model", "animator: skinning matrices");
   frame_.key_weights = view_ ? view_->weights() : std::span<const double>();
   frame_.view_gain = view_id_ >= 0 ? schedule_->Gain(view_id_, time) : 0.0;

@@ -14,11 +14,16 @@
 //   const AnimatorFrame& f = animator.Update(time_s, in);   // per frame, no allocation
 //   f.skinning_matrices / f.skinning_dual_quats → the renderer
 //
+// With gaze (AnimatorOptions::gaze), the eyes and lids are posed after the schedule, from the
+// head the look-at chain placed, toward FrameInputs::viewer (anim/gaze.h).
+//
 // Update allocates only when a distance trigger fires (it adds an action to the schedule).
 
+#include "anim/gaze.h"
 #include "anim/schedule.h"
 #include "anim/view_adaptive.h"
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -46,6 +51,8 @@ struct AnimatorOptions {
   double fade_seconds = 1.0;
   std::vector<DistanceTrigger> triggers;
   std::vector<DistanceWeight> distance_weights;
+  // Eyes and lids posed after the schedule (anim/gaze.h); nothing for a character without eyes.
+  std::optional<GazeSetup> gaze;
 };
 
 // The one description of an animated frame, from the animator (or PlacedCharacter::Update) to the
@@ -64,6 +71,7 @@ struct AnimatorFrame {
   // One weight per morph target (Skeleton::morph_targets; empty without targets): the playing
   // clips' weight tracks blended, then whatever a face layer set (Animator::SetMorphWeight).
   std::span<const float> morph_weights;
+  GazeFrame gaze;                             // eyes on the viewer, blinking (Animator with gaze)
 
   // The weight of the layers below the view-adaptive action (the idle): 0 while the viewer is
   // tracked, 1 once the view-adaptive action has faded out (or where there is none).
@@ -109,6 +117,7 @@ class Animator {
  private:
   void Track(double time, bool tracking);
   void Distance(double time, double distance);
+  void Look(double time, const Eigen::Vector3d* viewer);  // poses the eyes and lids (gaze_)
 
   std::shared_ptr<const Skeleton> skeleton_;
   std::shared_ptr<Schedule> schedule_;
@@ -123,6 +132,8 @@ class Animator {
   bool fading_out_ = false;
   Eigen::Vector3d viewpoint_ = Eigen::Vector3d::UnitZ();
   FrameInputs inputs_;
+  Eigen::Vector3d viewer_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  // held while lost
+  std::optional<Gaze> gaze_;
   FrameBuffers buffers_;
   AnimatorFrame frame_;
 };

@@ -12,10 +12,16 @@
 //   BM_MorphWeights/<targets>    Animator::Update of tests/support/face_schedule.h: three clips
 //                                keying <targets> morph target weights (0: none), sampled and
 //                                blended, and a face layer's write
+//   BM_GazeApply                 Gaze::Apply alone on builtin:figure (eyes, lids, the saccade and
+//                                blink process), the viewer moving in front
+//   BM_FigureUpdate/<gaze>       Animator::Update of builtin:figure with 8 look-at keys, without (0)
+//                                or with (1) gaze: what the eyes add to a frame
 // The 27-joint skeleton and its clips are synthetic and seeded (the paper's character had 27
 // joints); the Fox benchmark uses the real asset from ../shared/data when it is there.
 
+#include "anim_authoring/animator_builder.h"
 #include "anim_authoring/character_builder.h"
+#include "figure/humanoid.h"
 #include "anim/pose.h"
 #include "anim/animator.h"
 #include "anim_authoring/scene.h"
@@ -261,6 +267,56 @@ void BM_MorphWeights(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(face.Step(1.0 / 60).morph_weights.data());
 }
 BENCHMARK(BM_MorphWeights)->Arg(0)->Arg(16)->Arg(52)->Arg(128)->ArgName("targets");
+std::string FigureScene(bool gaze) {
+  std::string text = std::string("characters:\n  - asset: builtin:figure\n    lookat: {base_clip: Idle}\n    gaze: {enabled: ") +
+                     (gaze ? "true" : "false") + ", mode: talking}\n    keys:\n";
+  for (int k = 0; k < 8; ++k) text += "      - azimuth: " + std::to_string(45 * k) + "\n        generate: lookat\n";
+  return text;
+}
+
+// The viewer 1.2 m away at eye height, going round the front (±40°) every 10 s.
+FrameInputs ViewerInFront(double t) {
+  const double azimuth = 40 * std::sin(2 * M_PI * t / 10) * M_PI / 180;
+  const Eigen::Vector3d camera(1.2 * std::sin(azimuth), 1.64, 1.2 * std::cos(azimuth));
+  FrameInputs in;
+  in.viewpoint = camera.normalized();
+  in.distance = 1.2;
+  in.viewer = camera;
+  return in;
+}
+
+void BM_GazeApply(benchmark::State& state) {
+  const Character figure = figure::MakeHumanoid();
+  const Skeleton& sk = figure.skeleton;
+  GazeOptions options;
+  options.mode = GazeMode::kTalking;
+  Gaze gaze(sk, FindGazeRig(sk), options);
+  LocalPose pose = LocalPose::Rest(sk);
+  std::vector<Eigen::Matrix4d> model(sk.size());
+  MustRun(LocalToModelJob{&sk, &pose, model}, "bench");
+  double t = 0;
+  for (auto _ : state) {
+    t += 1.0 / 60;
+    gaze.Apply(t, ViewerInFront(t).viewer, model, pose);
+    benchmark::DoNotOptimize(pose.rigid.data());
+  }
+  state.SetLabel("builtin:figure, 2 eyes and 4 lids, talking");
+}
+BENCHMARK(BM_GazeApply);
+
+void BM_FigureUpdate(benchmark::State& state) {
+  figure::RegisterBuiltinCharacters();
+  authoring::AnimatedCharacter ch(authoring::ParseScene(FigureScene(state.range(0) != 0), "bench.yaml").characters[0]);
+  const std::unique_ptr<Animator> animator = authoring::BuildAnimator(ch);
+  double t = 0;
+  for (auto _ : state) {
+    t += 1.0 / 60;
+    const AnimatorFrame& f = animator->Update(t, ViewerInFront(t));
+    benchmark::DoNotOptimize(f.skinning_matrices.data());
+  }
+  state.SetLabel(std::string("builtin:figure, 38 joints, 8 look-at keys, DLB") + (state.range(0) ? ", gaze" : ""));
+}
+BENCHMARK(BM_FigureUpdate)->Arg(0)->Arg(1)->ArgName("gaze");
 
 }  // namespace
 }  // namespace arview::anim

@@ -30,6 +30,9 @@ struct FrameInputs {
   Eigen::Vector3d viewpoint = Eigen::Vector3d::UnitZ();  // unit, character frame (view-adaptive)
   double distance = -1;                                   // viewer to character, metres; < 0 unknown
   bool tracking = true;                                   // whether the viewer is tracked
+  // The viewer's eyes (the camera centre) in model space, for gaze (anim/gaze.h); not finite
+  // when unknown.
+  Eigen::Vector3d viewer = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 class Blendable {

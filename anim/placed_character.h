@@ -13,13 +13,16 @@
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "anim/animator.h"
 #include "anim/chains.h"
 #include "anim/character.h"
+#include "anim/gaze.h"
 #include "anim/placement.h"
 #include "anim/view_adaptive.h"
 
@@ -36,6 +39,7 @@ struct PlacedCharacterParts {
   std::vector<std::string> key_labels;   // what each key plays ("Survey", "lookat", ...), for the overlay
   LookAtChain lookat;                    // empty joints without look-at keys
   ArmChain arm;                          // joints −1 without gesture keys
+  std::optional<GazeSetup> gaze;         // eyes and lids toward the viewer (none without eyes)
 };
 
 class PlacedCharacter {
@@ -62,11 +66,17 @@ class PlacedCharacter {
 
   // Weights for `viewpoint` (character frame), then every key clip sampled at `time_seconds`,
   // blended, and converted to skinning transforms. Valid until the next call; no allocation.
-  const AnimatorFrame& Update(const Eigen::Vector3d& viewpoint, double time_seconds);
+  // With gaze (parts.gaze), the eyes turn toward `viewer` (the camera centre in model space,
+  // Placement::MapToModel) as the Animator turns them; not finite: they look ahead.
+  const AnimatorFrame& Update(const Eigen::Vector3d& viewpoint, double time_seconds,
+                              const Eigen::Vector3d& viewer = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  // The gaze setup (none for a character without eyes or with gaze off).
+  const std::optional<GazeSetup>& gaze() const { return parts_.gaze; }
 
  private:
   PlacedCharacterParts parts_;
   FrameBuffers buffers_;
+  std::optional<Gaze> gaze_;
   AnimatorFrame frame_;
 };
 

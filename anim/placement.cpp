@@ -19,6 +19,10 @@ Eigen::Vector3d Placement::ViewpointFromCamera(const Eigen::Vector3d& camera_cen
   return n > 1e-12 ? Eigen::Vector3d(d / n) : Eigen::Vector3d::Zero();
 }
 
+Eigen::Vector3d Placement::MapToModel(const Eigen::Vector3d& point_map) const {
+  return Rotation().transpose() * (point_map - anchor.position) / ModelScale();
+}
+
 double Placement::FloorDistance(const Eigen::Vector3d& camera_center_map) const {
   // The anchor's rotation as the scene holds it (unit already): the distances are those of the
   // appliance before Placement, to the last digit.

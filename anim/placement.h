@@ -35,6 +35,9 @@ struct Placement {
   // 1.5 m" of a standing character means on the ground, not from the eyes to its feet (at eye
   // height that would never be closer than ~1.6 m).
   double FloorDistance(const Eigen::Vector3d& camera_center_map) const;
+  // A point of the map in model space (the inverse of ModelToMap): where the camera's centre,
+  // the viewer's eyes, is for the character's gaze (anim/gaze.h).
+  Eigen::Vector3d MapToModel(const Eigen::Vector3d& point_map) const;
   // Model units to map units: anchor.scale · scale.
   double ModelScale() const { return anchor.scale * scale; }
 };

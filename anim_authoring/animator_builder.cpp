@@ -36,6 +36,7 @@ class AnimatorBuilder {
     options.view_action = spec_.schedule.view_action;
     options.hold_seconds = overrides_.hold_seconds.value_or(spec_.schedule.hold_seconds);
     options.fade_seconds = overrides_.fade_seconds.value_or(spec_.schedule.fade_seconds);
+    options.gaze = ch_.gaze();
     for (std::size_t i = 0; i < actions.size(); ++i) {
       ActionSpec a = actions[i];
       if (a.name.empty()) a.name = "action" + std::to_string(i + 1);

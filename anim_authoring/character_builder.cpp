@@ -131,6 +131,10 @@ anim::PlacedCharacterParts BuildParts(std::shared_ptr<const anim::Character> cha
   }
   parts.lookat = std::move(built.lookat);
   parts.arm = built.arm;
+  if (spec.gaze.enabled) {
+    anim::GazeSetup gaze{anim::FindGazeRig(parts.character->skeleton, spec.forward, spec.up), spec.gaze.options};
+    if (gaze.rig.valid()) parts.gaze = gaze;  // a character without eyes: nothing (gaze.h)
+  }
   return parts;
 }
 

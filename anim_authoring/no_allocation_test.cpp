@@ -7,6 +7,8 @@
 
 #include "anim/balance_shift.h"
 #include "tests/support/face_schedule.h"
+#include "anim/gaze.h"
+#include "tests/support/eyed_head.h"
 #include "tests/support/four_action_schedule.h"
 #include "tests/support/standing_recording.h"
 #include "tests/support/test_data.h"
@@ -139,6 +141,33 @@ TEST(NoAllocation, BalanceLayerOverTheIdleSynthesizer) {
   EXPECT_TRUE(sampled);
   EXPECT_GT(transitions, 100);
   EXPECT_EQ(allocations, 0) << "allocations in 36000 samples";
+#endif
+}
+
+// Gaze (anim/gaze.h) on a head with two eyes and their lids: 10 minutes at 60 Hz of saccades,
+// fixations and blinks, the viewer moving in front, one backward jump (a replay's restart).
+TEST(NoAllocation, GazeOverTenMinutes) {
+#ifndef ARVIEW_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "allocations are not counted in sanitizer builds (they replace malloc)";
+#else
+  const anim::Skeleton sk = testing::EyedHead();
+  anim::GazeOptions options;
+  options.mode = anim::GazeMode::kTalking;
+  anim::Gaze gaze(sk, anim::FindGazeRig(sk), options);
+  anim::LocalPose pose = anim::LocalPose::Rest(sk);
+  std::vector<Eigen::Matrix4d> model(sk.size());
+  anim::MustRun(anim::LocalToModelJob{&sk, &pose, model}, "test");
+  gaze.Apply(0, Eigen::Vector3d(0, 1.6, 1), model, pose);
+  const long before = g_allocations.load();
+  int blinks = 0;
+  for (int frame = 1; frame <= 36000; ++frame) {
+    const double t = frame / 60.0;
+    gaze.Apply(frame == 18000 ? 1.0 : t, Eigen::Vector3d(std::sin(t), 1.6, 1.2), model, pose);
+    blinks += gaze.frame().blinks_begun;
+  }
+  const long allocations = g_allocations.load() - before;
+  EXPECT_GT(blinks, 200);
+  EXPECT_EQ(allocations, 0) << "allocations in 36000 Gaze::Apply calls";
 #endif
 }
 

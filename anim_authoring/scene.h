@@ -42,6 +42,12 @@
 //           gesture: point           # ... or a look-at key with the arm pointing along the viewpoint ...
 //         - azimuth: 180
 //           pose: rest               # ... or a static pose: rest, or "<clip>@<seconds>"
+//       gaze:                        # eyes and lids (anim/gaze.h); only characters with eye joints
+//         enabled: true              # default true
+//         mode: listening            # listening | talking | rest (Eyes Alive's statistics)
+//         blink_rate: 26             # per minute; default 17 at rest, 26 listening or talking
+//         eye_range: {sideways: 35, up: 20, down: 25}   # degrees about the head's forward
+//         seed: 1
 //
 // Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
 
@@ -55,6 +61,7 @@
 #include "anim/pose.h"
 #include "anim/animator.h"
 #include "anim/blending_params.h"
+#include "anim/gaze.h"
 #include "anim/idle.h"
 #include "anim/view_adaptive.h"
 #include "anim/view_sphere.h"
@@ -174,6 +181,14 @@ struct GestureSpec {
   anim::ArmLimits limits;
 };
 
+// The character's gaze (anim/gaze.h): on by default; only a character with LeftEye and
+// RightEye joints (the built-in figure) has eyes to turn.
+struct GazeSpec {
+  bool enabled = true;
+  anim::GazeOptions options;
+  int line = 0;
+};
+
 struct CharacterSpec {
   std::string where;  // "scene.yaml:3", for messages
   std::string name;
@@ -194,6 +209,7 @@ struct CharacterSpec {
   anim::ScopeTable scopes;       // `scopes:` added to the built-in ones
   IdleSpec idle;           // `idle:`
   ScheduleSpec schedule;   // `schedule:`
+  GazeSpec gaze;           // `gaze:`
 
   // Where it stands, as the per-frame path takes it (anim/placement.h): anchor, scale, forward, up.
   anim::Placement placement() const;

@@ -92,7 +92,7 @@ class SceneReader {
 
   CharacterSpec Character(const Node& n, const fs::path& base_dir) const {
     OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "gesture",
-                 "keys", "scopes", "idle", "schedule"},
+                 "keys", "scopes", "idle", "schedule", "gaze"},
              "a character");
     CharacterSpec c;
     c.where = file_ + ":" + std::to_string(n.line);
@@ -169,7 +169,38 @@ class SceneReader {
     if (const Node* x = n.Find("scopes")) c.scopes = Scopes(*x);
     if (const Node* x = n.Find("idle")) c.idle = Idle(*x, base_dir);
     if (const Node* x = n.Find("schedule")) c.schedule = ScheduleOf(*x);
+    if (const Node* x = n.Find("gaze")) c.gaze = GazeOf(*x);
     return c;
+  }
+
+  GazeSpec GazeOf(const Node& n) const {
+    OnlyKeys(n, {"enabled", "mode", "blink_rate", "eye_range", "seed"}, "gaze");
+    GazeSpec g;
+    g.line = n.line;
+    if (const Node* x = n.Find("enabled")) g.enabled = Bool(*x, "gaze.enabled");
+    if (const Node* x = n.Find("mode"))
+      g.options.mode = Choice<anim::GazeMode>(*x, "gaze.mode", {{"listening", anim::GazeMode::kListening},
+                                                                {"talking", anim::GazeMode::kTalking},
+                                                                {"rest", anim::GazeMode::kRest}});
+    if (const Node* x = n.Find("blink_rate")) {
+      g.options.blink_rate_per_min = Number(*x, "gaze.blink_rate");
+      if (!(g.options.blink_rate_per_min > 0) || g.options.blink_rate_per_min > 100)
+        Fail(*x, "gaze.blink_rate: blinks per minute, in (0, 100]");
+    }
+    if (const Node* x = n.Find("eye_range")) {
+      OnlyKeys(*x, {"sideways", "up", "down"}, "gaze.eye_range");
+      auto angle = [&](const char* key, double& out) {
+        if (const Node* y = x->Find(key)) {
+          out = Number(*y, std::string("gaze.eye_range.") + key);
+          if (!(out > 0) || out > 60) Fail(*y, std::string("gaze.eye_range.") + key + ": degrees, in (0, 60]");
+        }
+      };
+      angle("sideways", g.options.range.sideways_deg);
+      angle("up", g.options.range.up_deg);
+      angle("down", g.options.range.down_deg);
+    }
+    if (const Node* x = n.Find("seed")) g.options.seed = static_cast<std::uint64_t>(Integer(*x, "gaze.seed", 0, 2147483647));
+    return g;
   }
 
   bool Bool(const Node& n, const std::string& what) const {

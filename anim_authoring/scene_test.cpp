@@ -103,6 +103,29 @@ TEST(Scene, ParseErrors) {
   EXPECT_THROW(LoadScene("/nonexistent/scene.yaml"), anim::Error);
 }
 
+TEST(Scene, GazeSection) {
+  const std::string keys = "    keys:\n      - azimuth: 0\n        clip: x\n";
+  const Scene defaults = ParseScene("characters:\n  - asset: a.glb\n" + keys, "g.yaml");
+  EXPECT_TRUE(defaults.characters[0].gaze.enabled);
+  EXPECT_EQ(defaults.characters[0].gaze.options.mode, anim::GazeMode::kListening);
+  const Scene s = ParseScene("characters:\n  - asset: a.glb\n    gaze: {enabled: false, mode: talking, blink_rate: 12, "
+                             "eye_range: {sideways: 30, up: 15, down: 20}, seed: 9}\n" + keys,
+                             "g.yaml");
+  const GazeSpec& g = s.characters[0].gaze;
+  EXPECT_FALSE(g.enabled);
+  EXPECT_EQ(g.options.mode, anim::GazeMode::kTalking);
+  EXPECT_EQ(g.options.blink_rate_per_min, 12);
+  EXPECT_EQ(g.options.range.sideways_deg, 30);
+  EXPECT_EQ(g.options.range.up_deg, 15);
+  EXPECT_EQ(g.options.range.down_deg, 20);
+  EXPECT_EQ(g.options.seed, 9u);
+  ExpectSceneError("characters:\n  - asset: a.glb\n    gaze: {mode: dreaming}\n" + keys,
+                   "bad.yaml:3: gaze.mode: 'dreaming' is not one of");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    gaze: {blink_rate: 0}\n" + keys, "bad.yaml:3: gaze.blink_rate");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    gaze: {eye_range: {up: 90}}\n" + keys, "bad.yaml:3: gaze.eye_range.up");
+  ExpectSceneError("characters:\n  - asset: a.glb\n    gaze: {wink: 1}\n" + keys, "bad.yaml:3: unknown key 'wink'");
+}
+
 TEST(Scene, ParseViewpoint) {
   EXPECT_LT((ParseViewpoint("0,0,2") - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
   EXPECT_LT((ParseViewpoint(" 1, 0 ,0") - Eigen::Vector3d::UnitX()).norm(), 1e-12);

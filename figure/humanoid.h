@@ -8,16 +8,20 @@
 //
 // The figure ("builtin:figure"): 1.72 m tall, in metres, +Y up, facing +Z (its left is +X),
 // standing on y = 0; the bind pose is the rest pose (arms 15° from the body).
-// - Skeleton: 33 joints with Mixamo's names without the "mixamorig:" prefix (Hips, Spine,
+// - Skeleton: 38 joints with Mixamo's names without the "mixamorig:" prefix (Hips, Spine,
 //   Spine1, Spine2, Neck, Head, HeadTop_End, Left/RightShoulder, Arm, ForeArm, Hand,
 //   HandIndex1, HandThumb1, Left/RightUpLeg, Leg, Foot, ToeBase, Toe_End), which CMU's BVH
 //   names share (Hips, Spine, Spine1, Neck, Head, LeftArm, LeftForeArm, LeftUpLeg, ...), so
 //   look-at chains, arm chains and humanoid masks find head, neck, spine, arms and legs by
 //   name. Every rest rotation is the identity: joint frames are parallel to the model frame.
+//   After the body's 29, the face's 9 under Head: Left/RightEye, Left/RightUpperLid,
+//   Left/RightLowerLid, Left/RightBrow, Jaw; no clip moves them (gaze turns the eyes and lids,
+//   anim/gaze.h).
 // - Skin: smooth tubes along the limbs and the torso (elliptic cross-sections, rounded ends),
-//   an ellipsoid head with eyes, brows, nose, mouth and hair, mitten hands with thumbs, shoes;
-//   about 9 000 triangles in 18 meshes, each with its material's colour (skin, shirt,
-//   trousers, shoes, hair, eyes, lips). Vertices near a joint blend the two bones on either
+//   an ellipsoid head with eyes (white, iris, pupil) and their lids, brows, nose, lips over a
+//   mouth and hair, mitten hands with thumbs, shoes; about 10 000 triangles in 26 meshes, each
+//   with its material's colour (skin, shirt, trousers, shoes, hair, eyes, lips, eye white,
+//   iris, mouth). Vertices near a joint blend the two bones on either
 //   side of it (smoothstep over a band as wide as the limb), so bends stay smooth under
 //   linear and dual-quaternion skinning.
 // - Clips (30 keys per second): Idle (4 s loop: breathing, relaxed arms, small head motion),

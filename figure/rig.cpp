@@ -28,7 +28,22 @@ Rig BuildRig() {
     r.Add(Sided(side, "ToeBase"), Sided(side, "Foot"), {side * 0.09, 0.03, 0.12});
     r.Add(Sided(side, "Toe_End"), Sided(side, "ToeBase"), {side * 0.09, 0.03, 0.185});
   }
+  AddFaceJoints(r);
   return r;
+}
+
+void AddFaceJoints(Rig& r) {
+  // After the body's joints, so that their indices stay what they were before the face had
+  // joints. The eyes, lids and brows hang from the head; each lid turns about its eye's centre.
+  const Vector3d c = HeadCentre(r);
+  for (int side : {1, -1}) {
+    const Vector3d eye = c + kEyeOffset.cwiseProduct(Vector3d(side, 1, 1));
+    r.Add(Sided(side, "Eye"), "Head", eye);
+    r.Add(Sided(side, "UpperLid"), "Head", eye);
+    r.Add(Sided(side, "LowerLid"), "Head", eye);
+    r.Add(Sided(side, "Brow"), "Head", c + Vector3d(side * 0.033, 0.040, 0.080));
+  }
+  r.Add("Jaw", "Head", c + kJawOffset);
 }
 
 }  // namespace arview::figure

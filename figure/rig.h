@@ -68,7 +68,16 @@ inline std::string Sided(int side, const char* part) { return std::string(SideNa
 // Unit direction of the upper arm in the bind pose, for side +1 (left, +X) or −1.
 inline Vector3d ArmDirection(int side) { return Vector3d(side * std::sin(Rad(kArmAbduction)), -std::cos(Rad(kArmAbduction)), 0); }
 
+// The head's ellipsoid centre, the eyes' centres (x for the left eye, +X) and the jaw's pivot
+// from it: the face's geometry and its joints share them.
+inline Vector3d HeadCentre(const Rig& r) { return r.At("Head") + Vector3d(0, 0.085, 0.01); }
+inline const Vector3d kEyeOffset(0.031, 0.010, 0.084);
+inline const Vector3d kJawOffset(0, -0.030, 0.0);
+inline constexpr double kEyeRadius = 0.012;
+
 Rig BuildRig();
+// The face's joints: per side Eye, UpperLid, LowerLid, Brow, then Jaw (all children of Head).
+void AddFaceJoints(Rig& r);
 // The figure's materials and skinned meshes, added to `character` (whose skeleton is the rig's).
 void AddSkin(const Rig& rig, anim::Character& character);
 // Idle, WeightShift, Wave, Point and Nod, sampled at kKeysPerSecond.

@@ -10,7 +10,7 @@ namespace {
 // material; its normals are averaged over all of its triangles before it is split into one
 // mesh per material, so that a colour boundary (a sleeve's end) is not a shading seam.
 
-enum MaterialSlot { kSkin, kShirt, kTrousers, kShoes, kHair, kEyes, kLips, kMaterialCount };
+enum MaterialSlot { kSkin, kShirt, kTrousers, kShoes, kHair, kEyes, kLips, kEyeWhite, kIris, kMouth, kMaterialCount };
 
 struct MaterialSpec {
   const char* name;
@@ -20,7 +20,8 @@ struct MaterialSpec {
 const MaterialSpec kMaterials[kMaterialCount] = {
     {"skin", {0.87f, 0.67f, 0.53f, 1}},     {"shirt", {0.80f, 0.24f, 0.20f, 1}}, {"trousers", {0.17f, 0.22f, 0.38f, 1}},
     {"shoes", {0.88f, 0.88f, 0.85f, 1}},    {"hair", {0.24f, 0.14f, 0.08f, 1}},  {"eyes", {0.07f, 0.05f, 0.05f, 1}},
-    {"lips", {0.72f, 0.36f, 0.36f, 1}},
+    {"lips", {0.72f, 0.36f, 0.36f, 1}},     {"eye_white", {0.96f, 0.95f, 0.92f, 1}}, {"iris", {0.22f, 0.40f, 0.55f, 1}},
+    {"mouth", {0.30f, 0.08f, 0.09f, 1}},
 };
 
 struct Influence {
@@ -180,6 +181,7 @@ struct EllipsoidSpec {
   int slot = kSkin;
   std::function<Influence(const Vector3d&)> influence;
   std::function<bool(const Vector3d&)> keep;  // triangles whose three corners pass; all if empty
+  std::function<int(const Vector3d&)> slot_at;  // a triangle's material from its centroid; `slot` if empty
 };
 
 void AddEllipsoid(Surface& s, const EllipsoidSpec& e) {
@@ -191,8 +193,9 @@ void AddEllipsoid(Surface& s, const EllipsoidSpec& e) {
   const bool flip = e.axes.determinant() < 0;
   auto triangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     if (e.keep && !(e.keep(s.positions[a]) && e.keep(s.positions[b]) && e.keep(s.positions[c]))) return;
-    if (flip) s.Triangle(a, c, b, e.slot);
-    else s.Triangle(a, b, c, e.slot);
+    const int slot = e.slot_at ? e.slot_at((s.positions[a] + s.positions[b] + s.positions[c]) / 3) : e.slot;
+    if (flip) s.Triangle(a, c, b, slot);
+    else s.Triangle(a, b, c, slot);
   };
   const std::uint32_t north = vertex(point(0, 0));
   std::vector<std::uint32_t> ring_start;
@@ -252,8 +255,6 @@ void AddNeck(Surface& s, const Rig& r) {
           o);
 }
 
-Vector3d HeadCentre(const Rig& r) { return r.At("Head") + Vector3d(0, 0.085, 0.01); }
-
 void AddHead(Surface& s, const Rig& r) {
   const int head = r.Index("Head");
   const Vector3d c = HeadCentre(r);
@@ -262,8 +263,14 @@ void AddHead(Surface& s, const Rig& r) {
   skull.axes = Axes({0.080, 0, 0}, {0, 0, 0.098}, {0, 0.105, 0});  // poles on y: x, z, y is left-handed
   skull.stacks = 14;
   skull.slices = 22;
-  skull.influence = [head](const Vector3d&) { return Rigid(head); };
+  const int jaw = r.Index("Jaw");
+  // The chin, below the mouth and in front, follows the jaw; the rest is the head's.
+  skull.influence = [head, jaw, c](const Vector3d& p) {
+    const Vector3d q = p - c;
+    return Influence{head, jaw, SmoothStep((-0.052 - q.y()) / 0.02) * SmoothStep((q.z() - 0.03) / 0.04)};
+  };
   AddEllipsoid(s, skull);
+  skull.influence = [head](const Vector3d&) { return Rigid(head); };
   for (int side : {1, -1}) {  // ears
     EllipsoidSpec ear = skull;
     ear.centre = c + Vector3d(side * 0.078, 0.0, -0.005);
@@ -281,23 +288,58 @@ void AddHead(Surface& s, const Rig& r) {
 }
 
 void AddFace(Surface& s, const Rig& r) {
-  const int head = r.Index("Head");
   const Vector3d c = HeadCentre(r);
-  auto feature = [&](const Vector3d& offset, const Vector3d& radii, int slot) {
+  auto feature = [&](const Vector3d& offset, const Vector3d& radii, int slot, int joint) {
     EllipsoidSpec e;
     e.centre = c + offset;
     e.axes = Axes({radii.x(), 0, 0}, {0, 0, radii.z()}, {0, radii.y(), 0});
     e.stacks = 5;
     e.slices = 10;
     e.slot = slot;
-    e.influence = [head](const Vector3d&) { return Rigid(head); };
+    e.influence = [joint](const Vector3d&) { return Rigid(joint); };
     AddEllipsoid(s, e);
   };
-  for (int side : {1, -1}) {
-    feature({side * 0.031, 0.010, 0.082}, {0.013, 0.012, 0.011}, kEyes);
-    feature({side * 0.033, 0.040, 0.080}, {0.021, 0.005, 0.008}, kHair);  // brows
+  for (int side : {1, -1}) feature({side * 0.033, 0.040, 0.080}, {0.021, 0.005, 0.008}, kHair, r.Index(Sided(side, "Brow")));
+  // The lips meet at rest; the lower one opens with the jaw over the dark of the mouth.
+  const int head = r.Index("Head"), jaw = r.Index("Jaw");
+  feature({0, -0.046, 0.083}, {0.023, 0.0045, 0.009}, kLips, head);
+  feature({0, -0.0545, 0.082}, {0.021, 0.005, 0.009}, kLips, jaw);
+  feature({0, -0.050, 0.077}, {0.019, 0.008, 0.008}, kMouth, head);
+}
+
+// An eyeball (white, iris, pupil about its forward axis) and its two lids, shells a little
+// larger than the eye that turn about its centre: the upper lid's edge 20° above the eye's
+// axis, the lower's 30° below (on the shells' 10° rings, so the edges are straight); a blink
+// turns the upper one down over the eye and the lower one up to meet it.
+void AddEye(Surface& s, const Rig& r, int side) {
+  const int eye = r.Index(Sided(side, "Eye"));
+  const Vector3d centre = r.At(Sided(side, "Eye"));
+  EllipsoidSpec ball;
+  ball.centre = centre;
+  ball.axes = Axes(Vector3d::UnitX() * kEyeRadius, Vector3d::UnitY() * kEyeRadius, Vector3d::UnitZ() * kEyeRadius);
+  ball.stacks = 18;  // 10° rings from the front pole: the pupil one ring, the iris three
+  ball.slices = 16;
+  ball.influence = [eye](const Vector3d&) { return Rigid(eye); };
+  ball.slot_at = [centre](const Vector3d& p) {
+    const double from_axis = std::acos(std::clamp((p - centre).normalized().z(), -1.0, 1.0)) * 180 / kPi;
+    return from_axis < 10 ? kEyes : from_axis < 30 ? kIris : kEyeWhite;
+  };
+  AddEllipsoid(s, ball);
+  const double lid_radius = kEyeRadius * 1.07;
+  for (const char* lid : {"UpperLid", "LowerLid"}) {
+    const bool upper = lid[0] == 'U';
+    const int joint = r.Index(Sided(side, lid));
+    EllipsoidSpec shell;
+    shell.centre = centre;
+    // Poles on y, so that the rings run level and a lid's edge is one of them.
+    shell.axes = Axes(Vector3d::UnitX() * lid_radius, Vector3d::UnitZ() * lid_radius, Vector3d::UnitY() * lid_radius);
+    shell.stacks = 18;
+    shell.slices = 16;
+    shell.influence = [joint](const Vector3d&) { return Rigid(joint); };
+    const double edge = lid_radius * std::sin(Rad(upper ? 20 : -30));
+    shell.keep = [centre, edge, upper](const Vector3d& p) { return upper ? p.y() - centre.y() > edge - 1e-6 : p.y() - centre.y() < edge + 1e-6; };
+    AddEllipsoid(s, shell);
   }
-  feature({0, -0.050, 0.082}, {0.023, 0.006, 0.009}, kLips);
 }
 
 void AddHair(Surface& s, const Rig& r) {
@@ -444,6 +486,7 @@ void AddSkin(const Rig& rig, anim::Character& character) {
   AddNeck(surface("neck"), rig);
   AddHead(surface("head"), rig);
   AddFace(surface("face"), rig);
+  for (int side : {1, -1}) AddEye(surface(Sided(side, "Eye")), rig, side);
   AddHair(surface("hair"), rig);
   for (int side : {1, -1}) {
     const std::string s = Sided(side, "");

@@ -177,6 +177,11 @@ void DrawLines(cv::Mat& frame, const std::vector<std::string>& lines, bool botto
 
 }  // namespace
 
+std::string EyeContactLine(const anim::GazeFrame& eyes) {
+  if (!eyes.active) return {};
+  return std::string(eyes.eyes_on_viewer ? "eye contact" : "eyes away") + (eyes.blinking ? "  (blink)" : "");
+}
+
 cv::Scalar WeightColour(double weight) {
   // Dark blue → green → yellow (BGR), a ramp that stays readable on grey floors and video.
   const double w = std::clamp(std::isfinite(weight) ? weight : 0.0, 0.0, 1.0);

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "anim/gaze.h"
 #include "anim/placement.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
@@ -52,6 +53,11 @@ HudSphere HudSphereFor(const anim::Placement& placement, const std::string& name
                        std::span<const Eigen::Vector3d> key_directions, std::span<const std::string> key_labels,
                        std::span<const double> weights, const Eigen::Vector3d& viewpoint, double height,
                        int highlighted_key = -1);
+
+// The status line of a character's eyes (anim/gaze.h): "eye contact" while they are on the
+// viewer, "eyes away" otherwise, with "  (blink)" during a blink; empty for a character without
+// gaze.
+std::string EyeContactLine(const anim::GazeFrame& eyes);
 
 // BGR colour for a weight in [0, 1].
 cv::Scalar WeightColour(double weight);

@@ -62,3 +62,20 @@ TEST(Hud, TextPanelsDarkenWhatIsBehindThem) {
 
 }  // namespace
 }  // namespace arview::render
+
+namespace arview::render {
+namespace {
+
+TEST(Hud, EyeContactLineSaysWhereTheEyesAreAndABlink) {
+  anim::GazeFrame eyes;
+  EXPECT_EQ(EyeContactLine(eyes), "");  // a character without gaze
+  eyes.active = true;
+  EXPECT_EQ(EyeContactLine(eyes), "eyes away");
+  eyes.eyes_on_viewer = true;
+  EXPECT_EQ(EyeContactLine(eyes), "eye contact");
+  eyes.blinking = true;
+  EXPECT_EQ(EyeContactLine(eyes), "eye contact  (blink)");
+}
+
+}  // namespace
+}  // namespace arview::render

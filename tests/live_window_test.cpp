@@ -280,7 +280,14 @@ TEST(AnimationClock, ARecordingStampedWithUnixTimesAnimatesAsOneStampedFromZero)
   ASSERT_EQ(stats[1]["frames"].size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) {
     EXPECT_EQ(stats[0]["frames"][i]["idle_weight"], stats[1]["frames"][i]["idle_weight"]) << "frame " << i;
+    // The figure has eyes (anim/gaze.h): every frame says whether they were on the viewer, the
+    // same on both clocks.
+    ASSERT_TRUE(stats[0]["frames"][i].contains("eyes_on_viewer")) << "frame " << i;
+    EXPECT_EQ(stats[0]["frames"][i]["eyes_on_viewer"], stats[1]["frames"][i]["eyes_on_viewer"]) << "frame " << i;
+    EXPECT_EQ(stats[0]["frames"][i]["blinking"], stats[1]["frames"][i]["blinking"]) << "frame " << i;
   }
+  EXPECT_EQ(stats[0]["eyes"]["frames"].get<int>(), kFrames) << stats[0]["eyes"];
+  EXPECT_EQ(stats[0]["eyes"], stats[1]["eyes"]);
   // Building 1.7e9 s of idle motion took far longer than this; from the first frame it is nothing.
   EXPECT_LT(stats[1]["stages"]["animate"]["max_ms"].get<double>(), 1000.0) << stats[1]["stages"]["animate"];
   fs::remove_all(dir);

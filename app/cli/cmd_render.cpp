@@ -113,7 +113,9 @@ void RunRender(const RenderArgs& args) {
     std::vector<const anim::AnimatorFrame*> frames;
     for (auto& c : characters) {
       renderer.AddCharacter(c->character(), c->spec().placement());
-      frames.push_back(&c->Update(c->spec().placement().ViewpointFromCamera(pose.Center()), args.time));
+      const anim::Placement placement = c->spec().placement();
+      // The viewer's eyes are the camera: a character with gaze looks at it (anim/gaze.h).
+      frames.push_back(&c->Update(placement.ViewpointFromCamera(pose.Center()), args.time, placement.MapToModel(pose.Center())));
     }
     const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
                                    : renderer.Render(background, pose, frames);

@@ -48,6 +48,7 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
   } else if (!input.animations.empty()) {
     std::snprintf(line, sizeof line, "idle weight %.2f", input.animations.front()->idle_weight());
     status.push_back(line);
+    if (std::string eyes = render::EyeContactLine(input.animations.front()->gaze); !eyes.empty()) status.push_back(eyes);
   }
   return status;
 }

@@ -161,6 +161,7 @@ void AnimateAndCompose(InFlight& item, std::span<LayeredAnimator* const> animato
     }
     log.idle_weight = compose.animations.front()->idle_weight();
     log.actions_triggered = compose.animations.front()->triggered;
+    log.eyes = compose.animations.front()->gaze;
     if (localized) {
       log.gaze_error_deg = GazeErrorDeg(animators.front()->character(), compose.animations.front()->model,
                                         item.track.center);
@@ -344,6 +345,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
         report.gaze_error_deg.Add(*log.gaze_error_deg);
         report.gaze_within_20_deg += *log.gaze_error_deg <= 20.0;
       }
+      CountEyes(log, report);
       if (options.keep_frame_logs) report.frames.push_back(std::move(log));
       if (on_frame) on_frame(report);
     }

@@ -108,6 +108,7 @@ struct FrameLog {
   double idle_weight = 0;
   std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
   int actions_triggered = 0;  // first character: distance-triggered actions started (a greeting)
+  anim::GazeFrame eyes;       // first character: its eyes on the viewer, blinks (anim/gaze.h; inactive: none)
 };
 
 struct PipelineReport {
@@ -142,6 +143,10 @@ struct PipelineReport {
   std::map<std::string, StreamingSummary> track_ms_by_status;
   StreamingSummary gaze_error_deg;
   size_t gaze_within_20_deg = 0;
+  // The first character's eyes (anim/gaze.h), where it has them: frames with gaze, frames with
+  // its eyes on the viewer, blinks begun.
+  size_t eye_frames = 0, eye_contact_frames = 0;
+  long blinks = 0;
   tracker::LossSummary losses;                  // the lost frames' causes (PipelineOptions::diagnoser)
   recordings::Trajectory trajectory;            // raw poses of localized frames
 };
@@ -154,6 +159,10 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
                            FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,
                            const std::function<void(const PipelineReport&)>& on_frame = {},
                            const std::function<bool()>& stop = {});
+
+// Adds a frame's eyes (FrameLog::eyes) to the report's eye-contact and blink counts
+// (pipeline_report.cpp).
+void CountEyes(const FrameLog& frame, PipelineReport& report);
 
 // Angle in degrees between the head's forward axis and the direction from the head to the camera
 // centre, in map coordinates. Nothing when the character has no look-at chain.

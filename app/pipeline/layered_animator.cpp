@@ -15,6 +15,7 @@ const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Ve
   if (camera_center) {
     inputs.viewpoint = placement.ViewpointFromCamera(*camera_center);
     inputs.distance = placement.FloorDistance(*camera_center);
+    inputs.viewer = placement.MapToModel(*camera_center);
   } else {
     inputs.viewpoint = Eigen::Vector3d::Zero();  // held by the animator
   }

@@ -24,6 +24,13 @@ GazeSummary SummarizeGaze(const PipelineReport& report) {
   return g;
 }
 
+void CountEyes(const FrameLog& frame, PipelineReport& report) {
+  if (!frame.eyes.active) return;
+  ++report.eye_frames;
+  report.eye_contact_frames += frame.eyes.eyes_on_viewer;
+  report.blinks += frame.eyes.blinks_begun;
+}
+
 nlohmann::ordered_json TimingJson(const TimingSummary& s) {
   return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"p99_ms", s.p99}, {"mean_ms", s.mean}, {"max_ms", s.max}};
 }
@@ -55,6 +62,11 @@ nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& r, const std::s
                {"median_error_deg", g.median_deg},
                {"max_error_deg", g.max_deg},
                {"frames_within_20_deg", g.within_20_deg}};
+  if (r.eye_frames > 0)
+    j["eyes"] = {{"frames", r.eye_frames},
+                 {"on_viewer_frames", r.eye_contact_frames},
+                 {"on_viewer_share", static_cast<double>(r.eye_contact_frames) / r.eye_frames},
+                 {"blinks", r.blinks}};
   nlohmann::ordered_json& lost_by_cause = j["lost_by_cause"] = nlohmann::ordered_json::object();
   for (const auto& [cause, name] : EnumNames(tracker::LossCause{})) {
     if (r.losses.count(cause) > 0) lost_by_cause[std::string(name)] = r.losses.count(cause);
@@ -86,6 +98,11 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
   if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
   if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
   if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;
+  if (f.eyes.active) {
+    frame["eyes_on_viewer"] = f.eyes.eyes_on_viewer;
+    frame["blinking"] = f.eyes.blinking;
+    if (f.eyes.blinks_begun) frame["blinks_begun"] = f.eyes.blinks_begun;
+  }
   if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
   if (f.loss) frame["cause"] = {{"kind", ToString(f.loss->cause)}, {"numbers", f.loss->detail}};
   return frame;
@@ -174,6 +191,11 @@ std::string PipelineReportText(const PipelineReport& r) {
   if (g.frames) {
     std::snprintf(line, sizeof(line), "gaze: head forward vs camera, median %.1f deg, max %.1f deg, %zu/%zu within 20 deg\n",
                   g.median_deg, g.max_deg, g.within_20_deg, g.frames);
+    out += line;
+  }
+  if (r.eye_frames) {
+    std::snprintf(line, sizeof(line), "eyes: on the viewer in %zu of %zu frames (%.0f%%), %ld blinks\n", r.eye_contact_frames,
+                  r.eye_frames, 100.0 * r.eye_contact_frames / r.eye_frames, r.blinks);
     out += line;
   }
   return out;

@@ -21,6 +21,7 @@ struct GazeSummary {
 };
 
 GazeSummary SummarizeGaze(const PipelineReport& report);
+
 // The timing object of stats.json: {count, median_ms, p95_ms, mean_ms, max_ms}.
 nlohmann::ordered_json TimingJson(const TimingSummary& summary);
 // stats.json's summary: every key but "frames" (counts, timings, "stages",

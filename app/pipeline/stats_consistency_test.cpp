@@ -53,5 +53,34 @@ TEST(OneMedian, StatsJsonAndEvalGiveTheSameMedianOfTheSameNumbers) {
   EXPECT_DOUBLE_EQ(from_stats, from_eval);
 }
 
+// A character with eyes (anim/gaze.h): each frame's record says whether they were on the viewer
+// and which blinks began, the summary and the report count them; without eyes, nothing.
+TEST(StatsConsistency, EyesOnTheViewerAndBlinksAreRecordedPerFrameAndCounted) {
+  PipelineReport report;
+  FrameLog plain;
+  EXPECT_FALSE(FrameLogJson(plain).contains("eyes_on_viewer"));
+  CountEyes(plain, report);
+  EXPECT_FALSE(PipelineSummaryJson(report, "test").contains("eyes"));
+  EXPECT_EQ(PipelineReportText(report).find("eyes:"), std::string::npos);
+  for (int i = 0; i < 4; ++i) {
+    FrameLog f;
+    f.eyes.active = true;
+    f.eyes.eyes_on_viewer = i != 2;
+    f.eyes.blinking = i == 1;
+    f.eyes.blinks_begun = i == 1 ? 1 : 0;
+    const nlohmann::ordered_json j = FrameLogJson(f);
+    EXPECT_EQ(j.at("eyes_on_viewer").get<bool>(), i != 2);
+    EXPECT_EQ(j.at("blinking").get<bool>(), i == 1);
+    EXPECT_EQ(j.contains("blinks_begun"), i == 1);
+    CountEyes(f, report);
+  }
+  const nlohmann::ordered_json summary = PipelineSummaryJson(report, "test");
+  EXPECT_EQ(summary.at("eyes").at("frames").get<int>(), 4);
+  EXPECT_EQ(summary.at("eyes").at("on_viewer_frames").get<int>(), 3);
+  EXPECT_DOUBLE_EQ(summary.at("eyes").at("on_viewer_share").get<double>(), 0.75);
+  EXPECT_EQ(summary.at("eyes").at("blinks").get<int>(), 1);
+  EXPECT_NE(PipelineReportText(report).find("eyes: on the viewer in 3 of 4 frames (75%), 1 blinks"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace arview::app
