@@ -78,7 +78,7 @@ Vector3d MouthSmile(const FaceVertex& v, int side) {
   const double c = Corner(v) * OnSide(v, side);
   return c * Vector3d(side * 4 * kMm, 5 * kMm, -3 * kMm) + Cheek(v, side) * Vector3d(side * 1 * kMm, 3 * kMm, 1.5 * kMm);
 }
-Vector3d MouthFrown(const FaceVertex& v, int side) { return Corner(v) * OnSide(v, side) * Vector3d(side * 1 * kMm, -4.5 * kMm, 0); }
+Vector3d MouthFrown(const FaceVertex& v, int side) { return Corner(v) * OnSide(v, side) * Vector3d(side * 1 * kMm, -6 * kMm, 0); }
 Vector3d MouthStretch(const FaceVertex& v, int side) {
   return Corner(v) * OnSide(v, side) * Vector3d(side * 6 * kMm, -1.5 * kMm, -1 * kMm);
 }
@@ -100,11 +100,11 @@ Vector3d CheekPuff(const FaceVertex& v) {
   const double c = std::max(Cheek(v, 1), Cheek(v, -1));
   return c * Vector3d(Side(v) * 5 * kMm, 0, 3 * kMm);
 }
-// The lower lid raised over the eye (turned 12° about the eye's centre) and the cheek below it.
+// The lower lid raised over the eye (turned 20° about the eye's centre) and the cheek below it.
 Vector3d EyeSquint(const FaceVertex& v, int side) {
   if (v.part == Part::kLowerLid && Side(v) == side) {
     const Vector3d r = v.q - v.eye_centre;
-    return Rx(-12) * r - r;
+    return Rx(-20) * r - r;
   }
   return Cheek(v, side) * Vector3d(0, 2 * kMm, 0.5 * kMm);
 }
