@@ -559,5 +559,14 @@ TEST(Cli, RenderSetsMorphTargetWeightsByNameOrExpression) {
   std::filesystem::remove_all(dir);
 }
 
+// `arview anim info builtin:figure` lists the figure's 35 targets, the ARKit ones and the visemes.
+TEST(Cli, AnimInfoListsTheFiguresMorphTargets) {
+  const auto r = RunArview({"anim", "info", "builtin:figure"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nmorph targets: 35\n"), std::string::npos) << r.out;
+  for (const char* name : {"] jawOpen:", "] mouthSmileLeft:", "] browInnerUp:", "] eyeSquintRight:", "] viseme_PP:", "] viseme_ou:"})
+    EXPECT_NE(r.out.find(name), std::string::npos) << name;
+}
+
 }  // namespace
 }  // namespace arview
