@@ -3,16 +3,19 @@
 // camera in the image, and on a blink frame the lids hide the eyes.
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
 #include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
+#include "figure/face_targets.h"
 #include "figure/humanoid.h"
 #include "render/ar_renderer.h"
 #include "render/test_scene.h"
@@ -33,7 +36,8 @@ struct Shot {
 };
 
 // The figure at `t`, seen from 0.6 m in front of its eyes, 20° toward its left (+X), at eye height.
-Shot Render(const std::string& gaze, double t, bool* eyes_on_viewer = nullptr) {
+// `morph`: target weights set over the frame's (none by default).
+Shot Render(const std::string& gaze, double t, bool* eyes_on_viewer = nullptr, const std::vector<TargetWeight>& morph = {}) {
   RegisterBuiltinCharacters();
   const authoring::Scene scene = authoring::ParseScene(RestScene(gaze), "face.yaml");
   authoring::AnimatedCharacter figure(scene.characters[0]);
@@ -52,8 +56,10 @@ Shot Render(const std::string& gaze, double t, bool* eyes_on_viewer = nullptr) {
   const calib::Pose pose = calib::Pose::FromCameraToWorld(Eigen::Quaterniond(r), camera_at);
   const calib::Camera camera = calib::Camera::Pinhole(640, 480, 600, 600, 320, 240);
   const anim::Placement placement = scene.characters[0].placement();
-  const anim::AnimatorFrame& frame =
-      figure.Update(placement.ViewpointFromCamera(camera_at), t, placement.MapToModel(camera_at));
+  anim::AnimatorFrame frame = figure.Update(placement.ViewpointFromCamera(camera_at), t, placement.MapToModel(camera_at));
+  std::vector<float> weights(frame.morph_weights.begin(), frame.morph_weights.end());
+  for (const TargetWeight& w : morph) weights.at(sk.FindMorphTarget(w.target)) = w.weight;
+  frame.morph_weights = weights;
   if (eyes_on_viewer) *eyes_on_viewer = frame.gaze.eyes_on_viewer;
   render::ArOptions options;
   options.shadow = false;
@@ -134,6 +140,44 @@ TEST(FigureFaceRender, IrisesTurnTowardTheCameraAndLidsCloseOnABlink) {
     EXPECT_LE(closed.iris, open.iris / 10) << "eye " << eye;
     EXPECT_LE(closed.white, open.white / 10 + 2) << "eye " << eye;
   }
+}
+
+// The pixels that differ by more than 30 levels (any channel) between two shots.
+int ChangedPixels(const cv::Mat& a, const cv::Mat& b) {
+  cv::Mat diff;
+  cv::absdiff(a, b, diff);
+  int changed = 0;
+  for (int v = 0; v < diff.rows; ++v)
+    for (int u = 0; u < diff.cols; ++u) {
+      const cv::Vec3b& d = diff.at<cv::Vec3b>(v, u);
+      changed += std::max({d[0], d[1], d[2]}) > 30;
+    }
+  return changed;
+}
+
+// A weighted target changes the face's pixels (the vertex shader applies it), and only there:
+// the changed pixels lie below the eyes for jawOpen, around and above them for browInnerUp.
+TEST(FigureFaceRender, AWeightedTargetChangesTheFacesPixels) {
+  const Shot rest = Render("{enabled: false}", 0.5);
+  const Shot jaw = Render("{enabled: false}", 0.5, nullptr, {{"jawOpen", 1.0f}});
+  const Shot happy = Render("{enabled: false}", 0.5, nullptr, ExpressionWeights(Expression::kHappy, 1));
+  Save(jaw, "face_jawOpen.png");
+  Save(happy, "face_happy.png");
+  const int eye_row = static_cast<int>(std::max(rest.eye_px[0].y(), rest.eye_px[1].y()));
+  cv::Mat diff;
+  cv::absdiff(rest.image, jaw.image, diff);
+  int above = 0, below = 0;
+  for (int v = 0; v < diff.rows; ++v)
+    for (int u = 0; u < diff.cols; ++u) {
+      const cv::Vec3b& d = diff.at<cv::Vec3b>(v, u);
+      if (std::max({d[0], d[1], d[2]}) > 30) (v > eye_row ? below : above) += 1;
+    }
+  const int changed_happy = ChangedPixels(rest.image, happy.image);
+  std::printf("[face] jawOpen changes %d px below the eyes and %d above; happy changes %d px\n", below, above, changed_happy);
+  EXPECT_GT(below, 300);
+  EXPECT_EQ(above, 0);
+  EXPECT_GT(changed_happy, 100);
+  EXPECT_EQ(ChangedPixels(rest.image, Render("{enabled: false}", 0.5).image), 0) << "the same render twice";
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ anim::Character MakeHumanoid() {
   c.source = "builtin:figure";
   c.skeleton = rig.skeleton;
   AddSkin(rig, c);
+  AddFaceTargets(rig, c);
 
   c.clips = MakeClips(rig);
   return c;

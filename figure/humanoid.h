@@ -24,6 +24,9 @@
 //   iris, mouth). Vertices near a joint blend the two bones on either
 //   side of it (smoothstep over a band as wide as the limb), so bends stay smooth under
 //   linear and dual-quaternion skinning.
+// - Morph targets (figure/face_targets.h): 20 ARKit-named face shapes, then the 15 visemes
+//   viseme_sil ... viseme_ou, on the face's small meshes (lips, mouth, brows, lids, head skin);
+//   Ekman's six expressions are weights of the ARKit ones (ExpressionWeights).
 // - Clips (30 keys per second): Idle (4 s loop: breathing, relaxed arms, small head motion),
 //   WeightShift (6 s loop: the weight moves from leg to leg, the free knee bends, the feet
 //   stay planted), Wave (3.2 s: the right arm rises, the hand waves three times, lowers),

@@ -80,6 +80,8 @@ Rig BuildRig();
 void AddFaceJoints(Rig& r);
 // The figure's materials and skinned meshes, added to `character` (whose skeleton is the rig's).
 void AddSkin(const Rig& rig, anim::Character& character);
+// The face's morph targets (figure/face_targets.h) on the skin's face meshes; after AddSkin.
+void AddFaceTargets(const Rig& rig, anim::Character& character);
 // Idle, WeightShift, Wave, Point and Nod, sampled at kKeysPerSecond.
 std::vector<anim::Clip> MakeClips(const Rig& rig);
 

@@ -11,6 +11,9 @@
 #include <functional>
 #include <regex>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "map/map_file.h"
 #include "mapping/map_check.h"
 #include "tests/support/folder_bytes.h"
@@ -597,6 +600,57 @@ TEST_F(Round4BadInputs, EvalRefusesTwoPosesAtOneTimeAndItsJsonSaysWhenNoRpeWasCo
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"rpe_translation\": null"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"rpe_not_computed\": \"fewer than 2 associated poses\""), std::string::npos) << r.out;
+
+// Issue 52: `render --morph` and `--expression` set the figure's morph target weights for a still
+// frame: the face 0.6 m in front changes with viseme_aa and with happy; an unknown target, an
+// unknown expression or a weight outside [0, 1] is one line naming it, and no image is written.
+TEST(Cli, RenderSetsMorphTargetWeightsByNameOrExpression) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("arview_cli_render_morph_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "scene.yaml").string(), camera = (dir / "camera.yaml").string();
+  std::ofstream(scene) << "characters:\n  - asset: builtin:figure\n    gaze: {enabled: false}\n    keys: [{azimuth: 0, pose: rest}]\n";
+  std::ofstream(camera) << "%YAML:1.0\n---\nimage_width: 320\nimage_height: 240\ncamera_matrix: !!opencv-matrix\n"
+                           "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 300., 0., 160., 0., 300., 120., 0., 0., 1. ]\n";
+  auto render = [&](const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", "--scene", scene, "--camera", camera, "--pose", "0 1.635 0.694 1 0 0 0",
+                                     "--lighting", "fixed", "--out", (dir / out).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunArview(args);
+  };
+  for (const auto& [extra, says] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{"--morph", "noSuchTarget=1"}, "builtin:figure: no morph target 'noSuchTarget'"},
+           {{"--morph", "jawOpen=1.5"}, "--morph: \"jawOpen=1.5\": the weight must be a number in [0, 1]"},
+           {{"--morph", "jawOpen"}, "--morph: \"jawOpen\" needs a weight"},
+           {{"--expression", "glad"}, "--expression: no expression \"glad\""}}) {
+    const auto r = render("bad.png", extra);
+    EXPECT_NE(r.exit_code, 0) << says;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+  }
+  ASSERT_EQ(render("rest.png", {}).exit_code, 0);
+  ASSERT_EQ(render("aa.png", {"--morph", "viseme_aa=1"}).exit_code, 0);
+  ASSERT_EQ(render("happy.png", {"--expression", "happy=1"}).exit_code, 0);
+  const cv::Mat rest = cv::imread((dir / "rest.png").string()), aa = cv::imread((dir / "aa.png").string()),
+                happy = cv::imread((dir / "happy.png").string());
+  ASSERT_FALSE(rest.empty());
+  auto changed = [&](const cv::Mat& other) {
+    cv::Mat diff;
+    cv::absdiff(rest, other, diff);
+    return cv::countNonZero(diff.reshape(1) > 30);
+  };
+  EXPECT_GT(changed(aa), 50);
+  EXPECT_GT(changed(happy), 20);
+  std::filesystem::remove_all(dir);
+}
+
+// `arview anim info builtin:figure` lists the figure's 35 targets, the ARKit ones and the visemes.
+TEST(Cli, AnimInfoListsTheFiguresMorphTargets) {
+  const auto r = RunArview({"anim", "info", "builtin:figure"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\nmorph targets: 35\n"), std::string::npos) << r.out;
+  for (const char* name : {"] jawOpen:", "] mouthSmileLeft:", "] browInnerUp:", "] eyeSquintRight:", "] viseme_PP:", "] viseme_ou:"})
+    EXPECT_NE(r.out.find(name), std::string::npos) << name;
 }
 
 }  // namespace

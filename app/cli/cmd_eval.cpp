@@ -71,18 +71,12 @@ std::vector<recordings::StampedCentre> ReadSmoothedCentres(const std::string& fi
 recordings::RegistrationOptions RegistrationInputs(const EvalArgs& args, std::vector<recordings::StampedCentre>& smoothed) {
   recordings::RegistrationOptions options;
   options.over_px = args.over_px;
-  try {
-    if (!args.scene.empty()) options.points = SceneMarks(args.scene);
-    if (!args.points.empty()) {
-      const std::vector<Eigen::Vector3d> listed = ReadPointsFile(args.points);
-      options.points.insert(options.points.end(), listed.begin(), listed.end());
-    }
-    if (args.room_points) options.groundtruth_points = RoomGeometryPoints(args.groundtruth, args.room_photos);
-  } catch (const CommandError&) {
-    throw;
-  } catch (const Error& e) {
-    throw CommandError(e.what());
+  if (!args.scene.empty()) options.points = SceneMarks(args.scene);
+  if (!args.points.empty()) {
+    const std::vector<Eigen::Vector3d> listed = ReadPointsFile(args.points);
+    options.points.insert(options.points.end(), listed.begin(), listed.end());
   }
+  if (args.room_points) options.groundtruth_points = RoomGeometryPoints(args.groundtruth, args.room_photos);
   if (!args.smoothed.empty()) {
     smoothed = ReadSmoothedCentres(args.smoothed);
     options.smoothed = &smoothed;

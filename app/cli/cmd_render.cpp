@@ -3,6 +3,7 @@
 #include "anim_authoring/character_builder.h"
 #include "base/image_file.h"
 //               [--background image.png] [--time s] [--hmd --ipd m] --out out.png
+//               [--expression happy=0.8] [--morph "jawOpen=0.5,viseme_PP=1"]
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -18,6 +19,7 @@
 #include "app/cli/gl_flags.h"
 #include "app/placement/scene_lighting.h"
 #include "calib/camera.h"
+#include "figure/face_targets.h"
 #include "map/map_file.h"
 #include "render/ar_renderer.h"
 #include "render/prt_cache.h"
@@ -36,8 +38,68 @@ struct RenderArgs {
   bool no_shadow = false;
   std::string lighting = "auto", light;
   bool no_cast_shadow = false, no_occlusion = false;
+  std::string expression, morph;
   GlFlags gl;
 };
+
+struct MorphSetting {
+  std::string target;
+  float weight;
+};
+
+// "NAME=W": a target's name and its weight, a finite number in [0, 1] (for --expression, "NAME"
+// alone is intensity 1).
+MorphSetting ParseNameWeight(const std::string& item, const char* flag, bool weight_optional) {
+  const std::size_t eq = item.find('=');
+  const std::string name = item.substr(0, eq);
+  if (name.empty()) throw CommandError(std::string(flag) + ": \"" + item + "\" has no name before '='");
+  if (eq == std::string::npos) {
+    if (weight_optional) return {name, 1.0f};
+    throw CommandError(std::string(flag) + ": \"" + item + "\" needs a weight: NAME=W with W in [0, 1]");
+  }
+  std::istringstream in(item.substr(eq + 1));
+  double w = 0;
+  std::string rest;
+  if (!(in >> w) || (in >> rest) || !std::isfinite(w) || w < 0 || w > 1)
+    throw CommandError(std::string(flag) + ": \"" + item + "\": the weight must be a number in [0, 1]");
+  return {name, static_cast<float>(w)};
+}
+
+// The weights --expression and --morph set, in order (--morph's after, so they override).
+std::vector<MorphSetting> ParseMorphSettings(const RenderArgs& args) {
+  std::vector<MorphSetting> out;
+  if (!args.expression.empty()) {
+    const MorphSetting e = ParseNameWeight(args.expression, "--expression", true);
+    bool known = false;
+    std::string names;
+    for (figure::Expression expression : figure::kExpressions) {
+      names += std::string(names.empty() ? "" : ", ") + figure::ExpressionName(expression);
+      if (e.target != figure::ExpressionName(expression)) continue;
+      known = true;
+      for (const figure::TargetWeight& w : figure::ExpressionWeights(expression, e.weight)) out.push_back({w.target, w.weight});
+    }
+    if (!known) throw CommandError("--expression: no expression \"" + e.target + "\" (known: " + names + ")");
+  }
+  std::istringstream items(args.morph);
+  for (std::string item; std::getline(items, item, ',');)
+    if (!item.empty()) out.push_back(ParseNameWeight(item, "--morph", false));
+  return out;
+}
+
+// `frame`'s weights with `settings` applied, in `weights`; throws naming the asset and the
+// target when the character has no such target.
+void SetMorphWeights(const anim::Character& character, const std::vector<MorphSetting>& settings, const anim::AnimatorFrame& frame,
+                     std::vector<float>& weights) {
+  weights.assign(frame.morph_weights.begin(), frame.morph_weights.end());
+  weights.resize(character.skeleton.morph_targets.size(), 0.0f);
+  for (const MorphSetting& s : settings) {
+    const int target = character.skeleton.FindMorphTarget(s.target);
+    if (target < 0)
+      throw CommandError(character.source + ": no morph target '" + s.target + "' (arview anim info " + character.source +
+                         " lists them)");
+    weights[target] = s.weight;
+  }
+}
 
 // "tx ty tz qx qy qz qw", camera-to-world as in TUM trajectories.
 calib::Pose ParsePose(const std::string& text) {
@@ -83,6 +145,7 @@ void RunRender(const RenderArgs& args) {
   }
   const std::string ext = std::filesystem::path(args.out).extension().string();
   if (ext != ".png" && ext != ".jpg" && ext != ".jpeg") throw CommandError(args.out + ": --out must end in .png or .jpg");
+  const std::vector<MorphSetting> morph_settings = ParseMorphSettings(args);
   const authoring::Scene scene = authoring::LoadScene(args.scene);
   if (scene.characters.empty()) throw CommandError(args.scene + ": the scene has no characters");
   const SceneLighting lighting = ResolveSceneLighting(args.scene, args.lighting, args.light);
@@ -102,11 +165,22 @@ void RunRender(const RenderArgs& args) {
   render::ArRenderer renderer(*context, camera, options);
   if (lighting.light) renderer.SetRoomLight(*lighting.light);
   std::vector<const anim::AnimatorFrame*> frames;
-  for (auto& c : characters) {
+  // Copies of the frames with --expression's and --morph's weights, and the weights they point at.
+  std::vector<anim::AnimatorFrame> set_frames(characters.size());
+  std::vector<std::vector<float>> set_weights(characters.size());
+  for (std::size_t i = 0; i < characters.size(); ++i) {
+    auto& c = characters[i];
     renderer.AddCharacter(c->character(), c->spec().placement());
     const anim::Placement placement = c->spec().placement();
     // The viewer's eyes are the camera: a character with gaze looks at it (anim/gaze.h).
-    frames.push_back(&c->Update(placement.ViewpointFromCamera(pose.Center()), args.time, placement.MapToModel(pose.Center())));
+    const anim::AnimatorFrame& frame =
+        c->Update(placement.ViewpointFromCamera(pose.Center()), args.time, placement.MapToModel(pose.Center()));
+    frames.push_back(&frame);
+    if (morph_settings.empty()) continue;
+    SetMorphWeights(c->character(), morph_settings, frame, set_weights[i]);
+    set_frames[i] = frame;
+    set_frames[i].morph_weights = set_weights[i];
+    frames.back() = &set_frames[i];
   }
   const cv::Mat image = args.hmd ? renderer.RenderSideBySide(background, pose, frames, args.ipd)
                                  : renderer.Render(background, pose, frames);
@@ -150,6 +224,12 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--light", args->light, "Room light file (default: the scene's <scene>.light.yml)");
   cmd->add_flag("--no-cast-shadow", args->no_cast_shadow, "No shadow from the room's dominant light");
   cmd->add_flag("--no-occlusion", args->no_occlusion, "Do not let the scene proxy hide the character");
+  cmd->add_option("--expression", args->expression,
+                  "NAME[=INTENSITY]: the built-in figure's expression (happy, sad, angry, surprised, afraid, disgusted) "
+                  "at an intensity in [0, 1] (default 1), as its morph targets' weights (docs/figure.md)");
+  cmd->add_option("--morph", args->morph,
+                  "\"NAME=W[,NAME=W...]\": morph target weights in [0, 1] on every character, over the animation's "
+                  "and --expression's (arview anim info lists a character's targets)");
   AddGlFlags(cmd, args->gl);
   cmd->callback([args] { RunRender(*args); });
 }
