@@ -50,6 +50,9 @@ class PlacedCharacter {
   std::shared_ptr<const Character> shared_character() const { return parts_.character; }
   std::shared_ptr<const Skeleton> shared_skeleton() const { return {parts_.character, &parts_.character->skeleton}; }
   const Placement& placement() const { return parts_.placement; }
+  // Moves the character (a first run stands it in front of the first view it is seen from). The
+  // renderer keeps its own copy: ArRenderer::MoveCharacter.
+  void SetPlacement(const Placement& placement) { parts_.placement = placement; }
   const std::string& name() const { return parts_.name; }
   const std::string& where() const { return parts_.where; }
   const ViewSphere& view_sphere() const { return parts_.blend->view_sphere(); }

@@ -32,6 +32,14 @@ ArRenderer::ArRenderer(OffscreenContext& context, const calib::Camera& camera, c
   }
 }
 
+void ArRenderer::MoveCharacter(int index, const anim::Placement& placement) {
+  if (index < 0 || index >= static_cast<int>(characters_.size())) {
+    throw RenderError("MoveCharacter: no character " + std::to_string(index) + " (" +
+                      std::to_string(characters_.size()) + " added)");
+  }
+  characters_[index].placement = placement;
+}
+
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::Placement& placement) {
   characters_.push_back({&character, placement, std::make_unique<CharacterRenderer>(context_->gl(), character),
                          FitShadowCapsules(character), false, LightView{}, cv::Mat()});

@@ -86,6 +86,8 @@ class ArRenderer {
 
   // The character must outlive the renderer; its placement is copied. Returns its index for Render's frames.
   int AddCharacter(const anim::Character& character, const anim::Placement& placement);
+  // Where character `index` (AddCharacter's) stands from the next Render on.
+  void MoveCharacter(int index, const anim::Placement& placement);
 
   // One augmented frame, BGR at the camera's size. `background`: the camera image (8-bit BGR or
   // grey, the camera's size) or empty; `pose`: the camera, world → camera; `frames[i]`: the

@@ -8,6 +8,7 @@
 #include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
 #include "render/ar_renderer.h"
+#include "render/render_error.h"
 #include "render/test_scene.h"
 #include "tests/support/fox_view.h"
 #include "tests/support/test_data.h"
@@ -119,6 +120,29 @@ TEST_F(FoxTest, GpuSkinningMatchesCpuSkinningForBothMethods) {
       EXPECT_GE(iou, 0.97);
     }
   }
+}
+
+// A first run moves its figure once it is seen (ArRenderer::MoveCharacter): drawn as a renderer
+// given the new placement from the start draws it, not where it was.
+TEST_F(FoxTest, AMovedCharacterIsDrawnWhereItWasMovedTo) {
+  const calib::Camera camera = TestCamera();
+  const calib::Pose pose = LookingAtFox();
+  const anim::Placement before = fox_->spec().placement();
+  anim::Placement after = before;
+  after.anchor.rotation = before.anchor.rotation * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY());
+  const anim::AnimatorFrame* frame = &Frame(0.2, pose);
+  ArRenderer moved(testing::SharedContext(), camera, SilhouetteOptions(anim::SkinningMethod::kDualQuaternion));
+  moved.AddCharacter(fox_->character(), before);
+  const cv::Mat where_it_was = NotBackground(moved.Render({}, pose, {&frame, 1}), kMagenta);
+  moved.MoveCharacter(0, after);
+  const cv::Mat where_it_is = NotBackground(moved.Render({}, pose, {&frame, 1}), kMagenta);
+  ArRenderer placed(testing::SharedContext(), camera, SilhouetteOptions(anim::SkinningMethod::kDualQuaternion));
+  placed.AddCharacter(fox_->character(), after);
+  const cv::Mat expected = NotBackground(placed.Render({}, pose, {&frame, 1}), kMagenta);
+  ASSERT_GT(cv::countNonZero(expected), 1000) << "the fox should be in view";
+  EXPECT_EQ(cv::countNonZero(where_it_is != expected), 0);
+  EXPECT_LT(Iou(where_it_was, expected), 0.9) << "turned a quarter, its silhouette differs";
+  EXPECT_THROW(moved.MoveCharacter(1, after), RenderError);
 }
 
 TEST_F(FoxTest, CompositesOverTheBackgroundWithAShadowBelow) {

@@ -231,6 +231,32 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
   EXPECT_FALSE(std::filesystem::exists(tmp + "/arview_cli_seed"));
 }
 
+// `place --at x,y,z --facing x,y,z` (what a first run without a scene prints): three finite
+// numbers each, and --facing only with --at; refused before the map is read.
+TEST(Cli, PlaceAtAndFacingAreThreeNumbersNamingTheFlag) {
+  const std::string out = (std::filesystem::temp_directory_path() / "arview_cli_at.yaml").string();
+  const std::vector<std::string> place = {"place", "/nonexistent/map", "--character", "builtin:figure", "--out", out};
+  struct Case {
+    std::vector<std::string> flags;
+    std::string said;
+  } cases[] = {
+      {{"--at", "nan,0,0"}, "--at"},
+      {{"--at", "1,2"}, "--at"},
+      {{"--at", "1,2,3,4"}, "--at"},
+      {{"--facing", "1,2,3"}, "--facing needs --at (where the character stands)"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = place;
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    const auto r = RunArview(args);
+    EXPECT_NE(r.exit_code, 0) << c.said;
+    EXPECT_EQ(LineCount(r.err), 1) << c.said << ": " << r.err;
+    EXPECT_NE(r.err.find(c.said), std::string::npos) << c.said << ": " << r.err;
+    EXPECT_EQ(r.err.find("/nonexistent/map"), std::string::npos) << "refused before the map is read: " << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 // Messages quote text from files (a token, a name): a line break in it must not split the line,
 // and an escape sequence in a hostile file must not reach the terminal.
 TEST(Cli, TextQuotedFromAFileStaysOneLineWithoutControlCharacters) {

@@ -19,13 +19,9 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "calib/camera.h"
 #include "map/map_file.h"
-#include "recordings/recording.h"
-#include "recordings/trajectory.h"
 #include "tests/support/emulated_camera.h"
+#include "tests/support/graffiti_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
 #include "tracker/test_planar_scene.h"
@@ -98,8 +94,8 @@ class LocalizeOnly : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("arview_localize_only_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    WriteMapFolder(dir_ / "map");
-    WriteRecording(dir_ / "views");
+    testing::WriteGraffitiMapFolder(dir_ / "map");
+    testing::WriteGraffitiViews(dir_ / "views");
   }
   void TearDown() override {
     std::error_code ec;
@@ -108,42 +104,6 @@ class LocalizeOnly : public ::testing::Test {
       fs::permissions(item.path(), fs::perms::owner_write, fs::perm_options::add, ec);
     }
     if (!HasFailure()) fs::remove_all(dir_);
-  }
-
-  // The plane's map as `arview map` leaves a folder, less COLMAP's own files: map.arvmap, the
-  // keyframes' poses, a picture, and the keyframes' images where a video map keeps them.
-  static void WriteMapFolder(const fs::path& folder) {
-    const tracker::testing::GraffitiPlane& plane = *tracker::testing::SharedGraffitiPlane();
-    map::Map map = plane.map;
-    fs::create_directories(folder / "images");
-    recordings::Trajectory keyframes;
-    for (map::Keyframe& keyframe : map.keyframes) {
-      keyframe.name += ".png";
-      ASSERT_TRUE(cv::imwrite((folder / "images" / keyframe.name).string(), plane.world.Render(keyframe.pose)));
-      keyframes.push_back({keyframe.timestamp, keyframe.pose});
-    }
-    map::SaveMap(map, folder / map::kMapFileName);
-    recordings::WriteTum(keyframes, folder / "keyframes.txt", "keyframes");
-    ASSERT_TRUE(cv::imwrite((folder / "map.png").string(), plane.texture));
-  }
-
-  // 24 views along a slow arc over the plane at 10 frames a second, the first 6 at a twentieth of
-  // the light (first: no motion prior carries the tracker over them).
-  static void WriteRecording(const fs::path& folder) {
-    const tracker::testing::GraffitiPlane& plane = *tracker::testing::SharedGraffitiPlane();
-    recordings::PrepareRecordingFolder(folder, false);
-    calib::SaveCamera(plane.world.camera(), folder / "camera.yaml");
-    std::vector<recordings::FrameEntry> frames;
-    for (int i = 0; i < 24; ++i) {
-      const double a = 0.004 * i;
-      cv::Mat view = plane.world.Render(tracker::testing::LookAt({-0.15 + a, 0.05 * std::sin(3 * a), -0.8 - 0.1 * a}, {0.02, 0, 0}));
-      if (i < 6) view.convertTo(view, -1, 0.05);
-      char name[32];
-      std::snprintf(name, sizeof name, "frames/%06d.png", i);
-      ASSERT_TRUE(cv::imwrite((folder / name).string(), view));
-      frames.push_back({0.1 * i, name});
-    }
-    recordings::WriteFramesTxt(folder, frames);
   }
 
   // track, replay and run against `map`, each leaving it as it was; each localizes the views

@@ -21,7 +21,13 @@ struct PlaceArgs {
   std::optional<double> height;
   std::string recording;  // where still keyframe images are (video maps keep theirs in <map>/images)
   bool no_light = false;
+  std::vector<double> at, facing;  // x,y,z in map units, or empty
 };
+
+std::optional<Eigen::Vector3d> PointOrNone(const std::vector<double>& xyz) {
+  if (xyz.size() != 3) return std::nullopt;
+  return Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+}
 
 // A --base-clip the asset lacks is refused before the map is read and before a scene naming it
 // is written (the scene would only fail when loaded, far from the command that made it).
@@ -61,9 +67,20 @@ void AddPlaceCommand(CLI::App& app) {
   cmd->add_option("--seed", a->options.seed, "Seed of the plane RANSAC")->capture_default_str();
   cmd->add_option("--recording", a->recording,
                   "Recording the map was built from, for its keyframe images (the room's light; video maps need none)");
+  cmd->add_option("--at", a->at,
+                  "x,y,z in map units: stand the character on the floor where this point falls instead of the "
+                  "floor's middle ('arview run' without --scene prints the --at and --facing that keep its figure)")
+      ->expected(3)
+      ->delimiter(',');
+  cmd->add_option("--facing", a->facing, "x,y,z in map units: the point the character faces (default: the first keyframe)")
+      ->expected(3)
+      ->delimiter(',');
   cmd->add_flag("--no-light", a->no_light, "Do not estimate the room's light (no <scene>.light.yml)");
   cmd->callback([a] {
     if (a->elevation) a->options.key_elevation_deg = *a->elevation;
+    a->options.stand_at = PointOrNone(a->at);
+    a->options.facing = PointOrNone(a->facing);
+    if (a->options.facing && !a->options.stand_at) throw CommandError("--facing needs --at (where the character stands)");
     RequireBaseClip(a->character, a->options.base_clip);
     const map::Map map = map::LoadMap(a->map_dir);
     if (map.frame.metric()) {

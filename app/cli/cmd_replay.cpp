@@ -7,6 +7,7 @@
 #include "app/session/ar_session.h"
 #include "app/cli/commands.h"
 #include "app/cli/output_flags.h"
+#include "app/cli/first_run_figure.h"
 #include "base/atomic_file.h"
 #include "app/cli/session_flags.h"
 #include "base/cancellation.h"
@@ -97,6 +98,7 @@ void AddReplayCommand(CLI::App& app) {
     o.recording = &recording;
     recordings::RecordingSource source(recording, replay);
     const map::Map map = map::LoadMap(a->map_dir);
+    if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();
     std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());

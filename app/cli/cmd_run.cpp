@@ -6,6 +6,7 @@
 #include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
 #include "app/cli/output_flags.h"
+#include "app/cli/first_run_figure.h"
 #include "app/pipeline/pipeline_report.h"
 #include "app/cli/numeric_flags.h"
 #include "app/cli/session_flags.h"
@@ -95,6 +96,7 @@ void AddRunCommand(CLI::App& app) {
       std::fprintf(stderr, "note: the map's camera, calibrated at %s, is scaled exactly to %s (fx %.1f -> %.1f)\n",
                    SizeText(calibrated.Size()).c_str(), SizeText(source.size()).c_str(), calibrated.fx, map.camera.fx);
     }
+    if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
     std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
     std::printf("output: %s\n", result.output.c_str());

@@ -18,7 +18,10 @@ void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
 }
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
-  cmd->add_option("--scene", f.scene, "Scene file (see 'arview place'); without it only the video is tracked");
+  cmd->add_option("--scene", f.scene,
+                  "Scene file (see 'arview place'); without it the built-in figure stands on the map's floor in front "
+                  "of the first localized view, and the line saying where gives the 'arview place' command that keeps it");
+  cmd->add_flag("--no-figure", f.no_figure, "Without --scene: no character, only the video tracked");
   cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)")
       ->check(OutputFileCheck());
   cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON")
@@ -69,6 +72,7 @@ void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
 }
 
 void ApplySessionFlags(const SessionFlags& f, bool live_source, SessionOptions& o) {
+  if (f.no_figure && !f.scene.empty()) throw CommandError("--no-figure is for a session without --scene");
   o.scene_file = f.scene;
   o.trajectory_out = f.trajectory;
   o.stats_out = f.stats;

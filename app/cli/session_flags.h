@@ -16,6 +16,7 @@ struct SessionFlags {
   bool hmd = false, hud = false, stereo_character = false;
   std::string hmd_profile, window_output;
   bool fullscreen = false;
+  bool no_figure = false;  // without --scene: no built-in figure (FirstRunFigure)
   double ipd = 0.064, hold = 0.5, fade = 1.0;
   // tracker::TrackingOptions::prefetch_below; -1: tracker::kBackgroundPrefetchBelow with the
   // tracking worker, else 0 (off)

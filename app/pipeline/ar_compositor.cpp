@@ -136,6 +136,11 @@ double ArCompositor::WarmUp() {
 void ArCompositor::BindToThread() { context_->MakeCurrent(); }
 void ArCompositor::UnbindFromThread() { context_->ReleaseCurrent(); }
 
+void ArCompositor::MoveCharacter(size_t index, const anim::Placement& placement) {
+  renderer_->MoveCharacter(static_cast<int>(index), placement);
+  heights_.at(index) = anim::RestHeightInMap(characters_.at(index)->character(), placement);
+}
+
 ArCompositor::~ArCompositor() {
   // The renderer's GL objects are deleted on this thread: the context must be current here.
   try {

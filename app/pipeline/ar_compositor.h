@@ -45,6 +45,9 @@ class ArCompositor : public FrameCompositor {
   // thread (the context made current there and released again): the shaders' compilation and
   // llvmpipe's first draw, otherwise paid by the first live frame (1-3 s). Returns the seconds.
   double WarmUp();
+  // Where character `index` stands from the next frame on; the character (constructor's) is
+  // moved by the caller (anim::PlacedCharacter::SetPlacement). On the render thread.
+  void MoveCharacter(size_t index, const anim::Placement& placement);
   void BindToThread() override;
   void UnbindFromThread() override;
   cv::Mat Compose(const FrameToCompose& input) override;

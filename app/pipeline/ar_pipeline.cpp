@@ -64,7 +64,7 @@ PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tr
 
   StageThread<CaptureStage> capture("arview-capture", run, source, options, start, queues.to_track);
   StageThread<TrackStage> track("arview-track", run, tracker, options.diagnoser, queues.to_track, queues.to_render);
-  StageThread<RenderStage> render("arview-render", run, animators, compositor, options.keep_trajectory,
+  StageThread<RenderStage> render("arview-render", run, animators, compositor, options,
                                   queues.to_render, queues.to_sink);
   StageThread<SinkStage> write("arview-sink", run, sink, source, options, on_frame, stop, run, queues);
   capture.Start();

@@ -83,6 +83,10 @@ struct PipelineOptions {
   // frame, 3.4 ms a 1920x1080 one): the HUD shows it, the report counts the causes. Null: lost
   // frames have no cause.
   const tracker::LossDiagnoser* diagnoser = nullptr;
+  // Called once, on the render thread, with the first localized frame before its characters are
+  // animated (inside its `animate` time): a first run without a scene stands its figure in front
+  // of that view here (app/session). Null: nothing.
+  std::function<void(const tracker::FrameResult&)> on_first_localized;
 };
 
 // A frame's way through the pipeline, in milliseconds since its capture.

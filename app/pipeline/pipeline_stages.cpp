@@ -122,8 +122,13 @@ void TrackStage::Run(std::stop_token stop) {
 }
 
 RenderStage::RenderStage(std::span<LayeredAnimator* const> animators, FrameCompositor& compositor,
-                         bool keep_trajectory, FrameQueue& in, FrameQueue& out)
-    : animators_(animators), compositor_(compositor), keep_trajectory_(keep_trajectory), in_(in), out_(out) {}
+                         const PipelineOptions& options, FrameQueue& in, FrameQueue& out)
+    : animators_(animators),
+      compositor_(compositor),
+      keep_trajectory_(options.keep_trajectory),
+      on_first_localized_(options.on_first_localized),
+      in_(in),
+      out_(out) {}
 
 void RenderStage::Run(std::stop_token stop) {
   const std::stop_callback unblock(stop, [this] {
@@ -165,6 +170,10 @@ void RenderStage::AnimateAndCompose(InFlight& item) {
   FrameToCompose compose{&item.frame, &item.track, {}, log.loss ? &*log.loss : nullptr};
   if (!animators_.empty()) {
     const ScopedStageTimer timer(stats_, "animate");
+    if (localized && !localized_before_) {
+      localized_before_ = true;
+      if (on_first_localized_) on_first_localized_(item.track);
+    }
     std::optional<Eigen::Vector3d> centre;
     if (localized) centre = item.track.smoothed_center;
     if (!first_timestamp_) first_timestamp_ = item.frame.timestamp;

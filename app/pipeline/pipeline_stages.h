@@ -183,7 +183,7 @@ class TrackStage {
 // `arview-render`: the characters animated, composed over the video; the trajectory.
 class RenderStage {
  public:
-  RenderStage(std::span<LayeredAnimator* const> animators, FrameCompositor& compositor, bool keep_trajectory,
+  RenderStage(std::span<LayeredAnimator* const> animators, FrameCompositor& compositor, const PipelineOptions& options,
               FrameQueue& in, FrameQueue& out);
   void Run(std::stop_token stop);
   recordings::Trajectory TakeTrajectory() { return std::move(trajectory_); }
@@ -195,6 +195,8 @@ class RenderStage {
   std::span<LayeredAnimator* const> animators_;
   FrameCompositor& compositor_;
   const bool keep_trajectory_;
+  const std::function<void(const tracker::FrameResult&)> on_first_localized_;  // PipelineOptions'
+  bool localized_before_ = false;
   FrameQueue& in_;
   FrameQueue& out_;
   // The animation's clock starts at the first frame composed (AnimateAndCompose).

@@ -65,6 +65,7 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
   } else {
     placed.key_elevation_deg = o.key_elevation_deg.value_or(0.0);
   }
+  if (o.stand_at) placed.anchor = StandAt(placed.anchor, *o.stand_at, o.facing.value_or(centres.empty() ? *o.stand_at : centres.front()));
   placed.key_count = o.keys;
   placed.base_clip = o.base_clip;
   if (placed.base_clip.empty() && !character.clips.empty()) placed.base_clip = character.clips.front().name;

@@ -32,6 +32,10 @@ struct PlaceCharacterOptions {
   // the dominant plane, e.g. where the demo's walk circles; the keys are still fitted to the
   // map's cameras.
   std::optional<Anchor> anchor;
+  // Given: the character then moves on its floor to stand where `stand_at` (map units) falls on
+  // it, facing `facing` (default: the first keyframe), its scale and keys unchanged (StandAt):
+  // `arview place --at --facing`, and what `run` without --scene says to keep its figure.
+  std::optional<Eigen::Vector3d> stand_at, facing;
 };
 
 // The height in metres a character of `asset_height` (its own units) gets on a metric map.

@@ -36,4 +36,23 @@ Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
                             const PlacementOptions& options);
 
+// The same character moved on its floor: standing where `at` falls on the floor of `on_floor`
+// (its position a point of the floor, its up the floor's normal), upright, facing `towards`
+// (any direction along the floor if `towards` is straight above or below). The scale is kept.
+// `arview place --at --facing` and the first run without a scene (`run`, `replay`) share it.
+Anchor StandAt(const Anchor& on_floor, const Eigen::Vector3d& at, const Eigen::Vector3d& towards);
+
+// How far along the floor a character stands from the camera that first sees it, in its own
+// heights: where the line of sight meets the floor, held within these (a camera looking level
+// or up meets it far away, or never), and no farther than the floor's middle (`place`'s spot)
+// when that is nearer, so that it stays in the mapped room.
+inline constexpr double kFirstViewDistanceInHeights[2] = {1.0, 2.0};
+
+// Where a character of `height` (map units) stands when put in front of a view: on the floor of
+// `on_floor` where the camera at `camera_centre` looking along `view_direction` (map frame)
+// sees it, its distance along the floor within kFirstViewDistanceInHeights and no farther than
+// `on_floor.position` is from the camera (but at least the near limit), facing the camera.
+Anchor StandInFrontOfView(const Anchor& on_floor, double height, const Eigen::Vector3d& camera_centre,
+                          const Eigen::Vector3d& view_direction);
+
 }  // namespace arview::app

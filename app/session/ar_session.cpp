@@ -123,8 +123,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
   std::vector<LayeredAnimator*> animator_ptrs;
   std::vector<const anim::PlacedCharacter*> character_ptrs;
-  if (!o.scene_file.empty()) {
-    const authoring::Scene scene = authoring::LoadScene(o.scene_file);
+  const bool first_view = o.scene_file.empty() && o.first_view;
+  if (!o.scene_file.empty() || first_view) {
+    const authoring::Scene scene = first_view ? o.first_view->scene : authoring::LoadScene(o.scene_file);
     for (const authoring::CharacterSpec& spec : scene.characters) {
       characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
       animators.push_back(MakeLayeredAnimator(*characters.back(), "", o.fade));
@@ -146,6 +147,19 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.quiet && !tracker->index_note().empty()) std::cerr << "note: " << tracker->index_note() << "\n";
   if (const auto note = CameraNote(*diagnoser, source_size); note && !o.quiet) std::cerr << "note: " << *note << "\n";
   pipeline.diagnoser = &*diagnoser;
+  if (first_view && !characters.empty()) {
+    // Once, on the render thread (which alone animates and draws the characters), before the
+    // first localized frame is animated: its cost is that frame's `animate` time.
+    pipeline.on_first_localized = [&o, &characters, &compositor](const tracker::FrameResult& frame) {
+      const Clock::time_point start = Clock::now();
+      anim::Placement placement = characters.front()->placement();
+      placement.anchor = o.first_view->stand_in_front_of(frame.pose);
+      characters.front()->SetPlacement(placement);
+      compositor.MoveCharacter(0, placement);
+      const double milliseconds = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+      if (o.first_view->on_placed) o.first_view->on_placed(placement.anchor, frame.pose, milliseconds);
+    };
+  }
   sink->SetKeyHandler([&compositor](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
   });

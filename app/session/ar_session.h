@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -12,14 +13,29 @@
 #include "base/cancellation.h"
 #include "app/pipeline/ar_pipeline.h"
 #include "app/pipeline/layered_animator.h"
+#include "anim_authoring/scene.h"
+#include "base/geometry.h"
 #include "map/map.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
 
 namespace arview::app {
 
+// A first run without a scene (`run`, `replay` without --scene): its character is stood in
+// front of the first localized view. Placing is app/placement's, which app/session may not use
+// (a layer beside the pipeline, docs/architecture.md), so the command hands both parts down.
+struct FirstViewCharacter {
+  authoring::Scene scene;  // one character, standing on the map's floor (where `arview place` stands it)
+  // The anchor it takes for the first localized view (world → camera), on the render thread,
+  // before that frame is animated.
+  std::function<Anchor(const calib::Pose& view)> stand_in_front_of;
+  // Told where it now stands, the view, and what moving it took (ms), on the render thread.
+  std::function<void(const Anchor& anchor, const calib::Pose& view, double milliseconds)> on_placed;
+};
+
 struct SessionOptions {
-  std::filesystem::path scene_file;          // empty: no character (tracking + video only)
+  std::filesystem::path scene_file;          // empty: `first_view`'s character, or none
+  std::optional<FirstViewCharacter> first_view;  // used without a scene file; nothing: video + tracking only
   std::string sink = "window";               // video::OpenSink target
   video::WindowPlacement window;             // for a window sink: its output, fullscreen
   double sink_fps = 30;
