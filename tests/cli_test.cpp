@@ -626,6 +626,7 @@ TEST_F(Round4BadInputs, EvalRefusesTwoPosesAtOneTimeAndItsJsonSaysWhenNoRpeWasCo
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"rpe_translation\": null"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("\"rpe_not_computed\": \"fewer than 2 associated poses\""), std::string::npos) << r.out;
+}
 
 // Issue 52: `render --morph` and `--expression` set the figure's morph target weights for a still
 // frame: the face 0.6 m in front changes with viseme_aa and with happy; an unknown target, an
