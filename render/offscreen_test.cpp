@@ -87,7 +87,7 @@ TEST(Offscreen, ANamedDeviceThatDoesNotExistIsRefused) {
     OffscreenContext::Create(options);
     FAIL() << "device 64 accepted";
   } catch (const RenderError& e) {
-    EXPECT_NE(std::string(e.what()).find("GL device 64 does not exist"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("GL device 64 (--gl-device 64) does not exist"), std::string::npos) << e.what();
   }
 }
 
