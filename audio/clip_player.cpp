@@ -80,7 +80,7 @@ bool ClipPlayer::Idle() const {
 }
 
 void ClipPlayer::WritePeriod(std::vector<Active>& active, std::int64_t position, TimePoint heard_next,
-                             std::vector<std::int16_t>& period) {
+                             std::optional<Clock::duration> queued, std::vector<std::int16_t>& period) {
   std::fill(period.begin(), period.end(), std::int16_t{0});
   std::vector<const Active*> starting;
   for (Active& a : active) {
@@ -119,6 +119,7 @@ void ClipPlayer::WritePeriod(std::vector<Active>& active, std::int64_t position,
   }
   const TimePoint written = Clock::now();
   std::lock_guard lock(mutex_);
+  if (queued) stats_.least_queued = std::min(stats_.least_queued, *queued);
   stats_.frames_written += period_frames_;
   stats_.underruns += underruns;
   for (const Active* a : starting) {
@@ -136,6 +137,7 @@ void ClipPlayer::Run(const std::stop_token& stop) {
   // For a device that reports no delay: when the next frame will be heard, by the player's count.
   std::optional<TimePoint> counted_next;
   bool device_reports_delay = false;
+  bool lead_reached = false;  // the queue was filled up to the lead once
   try {
     while (!stop.stop_requested()) {
       snd_pcm_sframes_t delay = 0;
@@ -152,7 +154,9 @@ void ClipPlayer::Run(const std::stop_token& stop) {
       const TimePoint now = Clock::now();
       if (delay > 0) device_reports_delay = true;
       TimePoint heard_next = now + SpeechDuration(std::max<snd_pcm_sframes_t>(delay, 0));
+      TimePoint queue_end = heard_next;  // where the queue ends, by ALSA or by the count
       if (!device_reports_delay && counted_next) {
+        queue_end = *counted_next;
         if (*counted_next < now) {
           std::lock_guard lock(mutex_);
           ++stats_.underruns;  // by the count, the queue ran dry before this write
@@ -161,6 +165,7 @@ void ClipPlayer::Run(const std::stop_token& stop) {
         }
       }
       if (heard_next - now > lead_) {
+        lead_reached = true;
         std::unique_lock lock(mutex_);
         wake_.wait_until(lock, stop, heard_next - lead_, [] { return false; });
         continue;
@@ -172,7 +177,7 @@ void ClipPlayer::Run(const std::stop_token& stop) {
           incoming_.pop_front();
         }
       }
-      WritePeriod(active, position, heard_next, period);
+      WritePeriod(active, position, heard_next, lead_reached ? std::optional(queue_end - now) : std::nullopt, period);
       position += period_frames_;
       counted_next = heard_next + SpeechDuration(period_frames_);
       const auto finished = std::erase_if(active, [&](const Active& a) {

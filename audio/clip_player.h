@@ -4,7 +4,7 @@
 // at which its first sample must be heard: a line of speech due when the mouth starts to move.
 //
 // How a clip is heard on time: the player keeps the device fed with silence and writes one
-// period (10 ms) at a time, keeping `lead` (60 ms) queued. Before each write it asks
+// period (10 ms) at a time, keeping `lead` (100 ms) queued. Before each write it asks
 // snd_pcm_delay how many frames are queued ahead of the next one: that frame will be heard at
 // now + delay / 16000 s. A clip whose time falls in the period being written starts at the
 // sample that will be heard at its time (to the sample); a clip whose time has passed starts at
@@ -30,6 +30,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -49,7 +50,10 @@ struct TimedClip {
 struct PlayerOptions {
   std::string device = "default";
   std::chrono::milliseconds period{10};  // one write
-  std::chrono::milliseconds lead{60};    // queued ahead of the clock: a late wake-up's margin
+  // Queued ahead of the clock: the margin for a late wake-up (docs/audio.md: 60 ms underran once in
+  // two minutes on the loaded build machine). Clips are placed by their time whatever the lead;
+  // a clip must be given at least this long before its time not to start late.
+  std::chrono::milliseconds lead{100};
 };
 
 // When a clip's first sample went out.
@@ -67,6 +71,10 @@ struct PlayerStats {
   std::int64_t clips_played = 0;    // clips whose last sample was written
   std::int64_t clips_late = 0;
   std::int64_t clips_dropped = 0;   // played after a device failure
+  // The least audio queued ahead of the clock found before a write once the queue first reached the lead:
+  // how close the player came to an underrun (the lead less its worst late wake-up; negative:
+  // the queue ran dry).
+  Clock::duration least_queued = Clock::duration::max();
   std::string error;                // the device's failure, one line; empty while it works
 };
 
@@ -93,7 +101,10 @@ class ClipPlayer {
  private:
   struct Active;  // a clip being written: its samples and the stream position of its first
   void Run(const std::stop_token& stop);
-  void WritePeriod(std::vector<Active>& active, std::int64_t position, TimePoint heard_next, std::vector<std::int16_t>& period);
+  // `queued`: how much was queued ahead of the clock before this write (negative: ran dry); none
+  // while the queue is first filled up to the lead.
+  void WritePeriod(std::vector<Active>& active, std::int64_t position, TimePoint heard_next,
+                   std::optional<Clock::duration> queued, std::vector<std::int16_t>& period);
 
   const std::string device_;
   std::unique_ptr<OpenedPcm> pcm_;

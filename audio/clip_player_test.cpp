@@ -81,7 +81,7 @@ TEST(ClipPlayer, WritesTheClipsSamplesExactlyAtTheirTimes) {
                 Ms(r.heard - r.scheduled), Ms(r.written - r.scheduled));
     EXPECT_LE(std::abs(Ms(r.heard - r.scheduled)), 1000.0 / kSpeechRate);
     EXPECT_LT(r.written, r.scheduled);
-    EXPECT_LT(Ms(r.scheduled - r.written), 60 + 10 + 5);
+    EXPECT_LT(Ms(r.scheduled - r.written), 100 + 10 + 5);
     EXPECT_FALSE(r.late);
   }
 }
@@ -146,9 +146,10 @@ TEST(ClipPlayer, ContinuousClipsNeverUnderrun) {
   for (const ClipReport& r : player.TakeReports()) worst_heard_ms = std::max(worst_heard_ms, std::abs(Ms(r.heard - r.scheduled)));
   const PlayerStats stats = player.Stats();
   std::printf("%d s of clips: %lld underruns, %lld late, %lld frames written, worst |heard - due| %.3f ms, "
-              "written %.1f to %.1f ms before due\n",
+              "written %.1f to %.1f ms before due, least queued %.1f ms\n",
               seconds, static_cast<long long>(stats.underruns), static_cast<long long>(stats.clips_late),
-              static_cast<long long>(stats.frames_written), worst_heard_ms, least_written_early_ms, worst_written_early_ms);
+              static_cast<long long>(stats.frames_written), worst_heard_ms, least_written_early_ms, worst_written_early_ms,
+              Ms(stats.least_queued));
   EXPECT_EQ(stats.underruns, 0);
   EXPECT_EQ(stats.clips_late, 0);
   EXPECT_EQ(stats.clips_played, seconds);
