@@ -65,8 +65,8 @@ TEST(WavFileSource, DeliversEverySampleInBlocksTimedByTheClock) {
   JumpingClock clock;
   const TimePoint start = clock.Now();
   const auto samples = Counting(16000 + 100);
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   WavFileSource source(samples, clock, 320);
-  Collected got;
   source.Start(got.OnBlock(), got.OnEnd());
   source.Join();
   ASSERT_TRUE(got.ended);
@@ -85,8 +85,8 @@ TEST(WavFileSource, DeliversEverySampleInBlocksTimedByTheClock) {
 
 TEST(WavFileSource, IsPacedToRealTimeByTheSteadyClock) {
   SteadyPacingClock clock;
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   WavFileSource source(Counting(3200), clock, 320);  // 200 ms
-  Collected got;
   const TimePoint start = Clock::now();
   source.Start(got.OnBlock(), got.OnEnd());
   source.Join();
@@ -98,8 +98,8 @@ TEST(WavFileSource, IsPacedToRealTimeByTheSteadyClock) {
 
 TEST(WavFileSource, StopsBetweenBlocksWhenAskedAndStillSaysItEnded) {
   SteadyPacingClock clock;
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   WavFileSource source(Counting(16000 * 60), clock, 320);
-  Collected got;
   source.Start(got.OnBlock(), got.OnEnd());
   std::this_thread::sleep_for(50ms);
   const TimePoint asked = Clock::now();
@@ -116,8 +116,8 @@ TEST(WavFileSource, AFileOfAnotherFormatIsRefusedOrConverted) {
   WriteWav(file, PcmAudio{8000, 1, std::vector<std::int16_t>(800, 100)});
   JumpingClock clock;
   EXPECT_THROW(WavFileSource(file, clock), AudioError);
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   WavFileSource source(file, clock, WavSourceOptions{320, SpeechConversion::kResample});
-  Collected got;
   source.Start(got.OnBlock(), got.OnEnd());
   source.Join();
   EXPECT_EQ(got.samples.size(), 1600u);
@@ -140,8 +140,8 @@ class FailingSource final : public AudioSource {
 };
 
 TEST(AudioSource, ADeviceThatDisappearsEndsTheSourceWithItsLine) {
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   FailingSource source(3);
-  Collected got;
   source.Start(got.OnBlock(), got.OnEnd());
   source.Join();
   ASSERT_TRUE(got.ended);
@@ -151,16 +151,16 @@ TEST(AudioSource, ADeviceThatDisappearsEndsTheSourceWithItsLine) {
 }
 
 TEST(AudioSource, ACallbackThatThrowsEndsTheSourceNotTheProcess) {
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   FailingSource source(100);
-  Collected got;
   source.Start([](const CapturedBlock&) { throw std::runtime_error("recognizer: out of memory"); }, got.OnEnd());
   source.Join();
   EXPECT_EQ(got.end.error, "recognizer: out of memory");
 }
 
 TEST(AudioSource, StartingTwiceIsRefused) {
+  Collected got;  // before the source: its thread calls into it until the source is destroyed
   FailingSource source(1);
-  Collected got;
   source.Start(got.OnBlock(), got.OnEnd());
   EXPECT_THROW(source.Start(got.OnBlock(), got.OnEnd()), AudioError);
 }
