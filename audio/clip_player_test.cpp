@@ -86,6 +86,38 @@ TEST(ClipPlayer, WritesTheClipsSamplesExactlyAtTheirTimes) {
   }
 }
 
+// Through ALSA's plug at 48 kHz (as `default` usually is): the device takes 16 kHz, ALSA converts,
+// and the clip's place and length come out three times as many samples.
+TEST(ClipPlayer, ADeviceAtAnotherRateIsConvertedByAlsa) {
+  EmulatedSound sound(Folder("plug"));
+  const auto clip = Chirp(8000, 400);
+  {
+    PlayerOptions options;
+    options.device = EmulatedSound::kSpeaker48k;
+    ClipPlayer player(options);
+    const TimePoint start = Clock::now() + 300ms;
+    player.Play(TimedClip{1, clip, start});
+    player.Play(TimedClip{2, clip, start + 1s});
+    while (!player.Idle()) std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(100ms);
+    EXPECT_EQ(player.Stats().error, "");
+    EXPECT_EQ(player.Stats().underruns, 0);
+  }
+  const auto played = sound.Played48k();
+  // Each clip is a run of sound of about 3 x 8000 samples; the two start 48000 apart.
+  std::vector<std::size_t> starts;
+  std::size_t at = 0;
+  while ((at = FirstSound(played, at)) < played.size()) {
+    std::size_t end = at;
+    std::size_t silent = 0;
+    while (end < played.size() && silent < 48) silent = played[end++] == 0 ? silent + 1 : 0;
+    if (end - at > 1000) starts.push_back(at);
+    at = end;
+  }
+  ASSERT_EQ(starts.size(), 2u);
+  EXPECT_NEAR(static_cast<double>(starts[1] - starts[0]), 48000.0, 3.0);
+}
+
 TEST(ClipPlayer, OverlappingClipsAreMixed) {
   EmulatedSound sound(Folder("mix"));
   {

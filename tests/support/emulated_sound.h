@@ -23,6 +23,7 @@ namespace arview::testing {
 class EmulatedSound {
  public:
   static constexpr const char* kSpeaker = "arview_speaker";
+  static constexpr const char* kSpeaker48k = "arview_speaker48k";  // behind ALSA's plug, at 48 kHz
   static constexpr const char* kMicrophone = "arview_mic";
   static constexpr const char* kMissing = "arview_no_such_device";
 
@@ -32,6 +33,7 @@ class EmulatedSound {
     if (!in) throw std::runtime_error("cannot read tests/support/emulated.asoundrc");
     std::string config((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     Replace(config, "@PLAYED@", played().string());
+    Replace(config, "@PLAYED48@", played48k().string());
     Replace(config, "@SPOKEN@", spoken().string());
     const std::filesystem::path asoundrc = folder_ / "asoundrc";
     std::ofstream(asoundrc) << config;
@@ -43,10 +45,12 @@ class EmulatedSound {
   // Where the speaker's samples land; what the microphone reads.
   std::filesystem::path played() const { return folder_ / "played.raw"; }
   std::filesystem::path spoken() const { return folder_ / "spoken.raw"; }
+  std::filesystem::path played48k() const { return folder_ / "played48k.raw"; }
 
   // What the speaker received (complete once the player is destroyed: ALSA's file plugin writes
   // in periods and flushes on close).
   std::vector<std::int16_t> Played() const { return ReadRaw(played()); }
+  std::vector<std::int16_t> Played48k() const { return ReadRaw(played48k()); }
   void SetMicrophoneInput(std::span<const std::int16_t> samples) const {
     std::ofstream out(spoken(), std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(samples.data()), static_cast<std::streamsize>(samples.size_bytes()));
