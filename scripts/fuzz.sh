@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 seconds=${1:-20}
 shift || true
-all_targets=(fuzz_camera fuzz_recording fuzz_trajectory fuzz_eval fuzz_map_file fuzz_colmap_model fuzz_colmap_database fuzz_scene fuzz_gltf fuzz_flags fuzz_image fuzz_room_light fuzz_speech_markup)
+all_targets=(fuzz_camera fuzz_recording fuzz_trajectory fuzz_eval fuzz_map_file fuzz_colmap_model fuzz_colmap_database fuzz_scene fuzz_gltf fuzz_flags fuzz_image fuzz_room_light fuzz_speech_markup fuzz_wav)
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=("${all_targets[@]}")
 data=${ARVIEW_DATA_DIR:-$root/../shared/data}

@@ -18,6 +18,7 @@ PACKAGES=(
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   libyaml-cpp-dev nlohmann-json3-dev
   flite1-dev
+  libasound2-dev libswresample-dev
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool

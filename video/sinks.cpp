@@ -74,7 +74,8 @@ class WindowSink final : public FrameSink {
 
 class VideoSink final : public FrameSink {
  public:
-  VideoSink(const fs::path& path, cv::Size size, double fps) : path_(path), size_(size) {
+  VideoSink(const fs::path& path, cv::Size size, double fps, const std::optional<AudioTrackOptions>& audio)
+      : path_(path), size_(size) {
     if (!(fps > 0 && fps <= 1000)) throw VideoError(path.string() + ": frame rate must be in (0, 1000]");
     if (path.has_parent_path() && !fs::is_directory(path.parent_path())) {
       throw VideoError(path.string() + ": folder " + path.parent_path().string() + " does not exist");
@@ -82,11 +83,15 @@ class VideoSink final : public FrameSink {
     // H.264 through libx264 at a fast preset (video/h264_writer.h says why not OpenCV's writer);
     // without libx264, OpenCV's writer: H.264 if its FFmpeg has another encoder for it, else
     // MPEG-4 part 2, which every FFmpeg build has.
-    h264_ = H264Writer::Open(path, size, fps);
+    H264Options options;
+    options.audio = audio;
+    h264_ = H264Writer::Open(path, size, fps, options);
     if (h264_) {
-      codec_ = "H.264, libx264 " + H264Options{}.preset;
+      codec_ = "H.264, libx264 " + options.preset + (audio ? ", AAC" : "");
+      has_audio_ = audio.has_value();
       return;
     }
+    if (audio) throw VideoError(path.string() + ": no libx264 in this FFmpeg for a video with sound (OpenCV's writer has no audio)");
     for (const char* codec : {"avc1", "mp4v"}) {
       writer_.open(path.string(), cv::CAP_FFMPEG, cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]), fps,
                    size, true);
@@ -117,10 +122,17 @@ class VideoSink final : public FrameSink {
     closed_ = true;
   }
   std::string Describe() const override { return path_.string() + " (" + codec_ + ")"; }
+  bool HasAudio() const override { return h264_ && has_audio_; }
+  void WriteAudio(std::int64_t first_sample, std::span<const std::int16_t> samples) override {
+    if (!HasAudio()) FrameSink::WriteAudio(first_sample, samples);
+    else h264_->WriteAudio(first_sample, samples);
+  }
+  std::int64_t AudioSamplesDropped() const override { return h264_ ? h264_->AudioSamplesDropped() : 0; }
 
  private:
   fs::path path_;
   cv::Size size_;
+  bool has_audio_ = false;
   std::unique_ptr<H264Writer> h264_;
   cv::VideoWriter writer_;
   std::string codec_;
@@ -175,8 +187,12 @@ bool HasDisplay() {
   return value != nullptr && *value != '\0';
 }
 
+void FrameSink::WriteAudio(std::int64_t, std::span<const std::int16_t>) {
+  throw VideoError(Describe() + ": has no audio track");
+}
+
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
-                                    const WindowPlacement& window) {
+                                    const WindowPlacement& window, const std::optional<AudioTrackOptions>& audio) {
   if (frame_size.width <= 0 || frame_size.height <= 0) throw VideoError("sink: frame size must be positive");
   if (IsWindowTarget(target)) {
     return std::make_unique<WindowSink>(target.size() > 7 ? target.substr(7) : "arview", frame_size, window);
@@ -186,7 +202,7 @@ std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_si
   const fs::path path(target);
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".mp4" || ext == ".avi" || ext == ".mkv") return std::make_unique<VideoSink>(path, frame_size, fps);
+  if (ext == ".mp4" || ext == ".avi" || ext == ".mkv") return std::make_unique<VideoSink>(path, frame_size, fps, audio);
   if (target.back() == '/' || ext.empty() || fs::is_directory(path)) {
     return std::make_unique<PngSequenceSink>(path, frame_size);
   }

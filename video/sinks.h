@@ -8,10 +8,14 @@
 
 #include <opencv2/core.hpp>
 
+#include "video/h264_writer.h"
 #include "video/window.h"
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 
 namespace arview::video {
@@ -28,6 +32,17 @@ class FrameSink {
   // call from any thread.
   virtual bool StopRequested() const { return false; }
   virtual std::string Describe() const = 0;
+
+  // Whether the sink writes an audio track: an MP4, MKV or AVI file opened with one (OpenSink's
+  // `audio`) through libx264's writer. The others have none.
+  virtual bool HasAudio() const { return false; }
+  // Mono samples at the track's rate, the first heard first_sample / rate seconds after the first
+  // frame (H264Writer::WriteAudio: overlaps summed, gaps silent, late audio dropped and counted).
+  // Called on the thread that writes the frames, between frames. A sink without audio throws
+  // VideoError naming its target.
+  virtual void WriteAudio(std::int64_t first_sample, std::span<const std::int16_t> samples);
+  // Samples WriteAudio dropped: before the start, or in audio already written.
+  virtual std::int64_t AudioSamplesDropped() const { return 0; }
 
   // A window is used by one thread at a time: it is opened by OpenSink, then Write, PumpEvents
   // and SetStatus come from the thread that writes the frames, then Close from the opener once
@@ -47,9 +62,12 @@ class FrameSink {
   std::function<void(const std::string&)> key_handler_;
 };
 
-// `window` places a window target (video/window.h); other targets ignore it.
+// `window` places a window target (video/window.h); other targets ignore it. `audio`: a video
+// file gets an AAC track with these options (a VideoError naming the file when only OpenCV's
+// writer is at hand, which writes no audio); other targets have none (HasAudio is false).
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,
-                                    const WindowPlacement& window = {});
+                                    const WindowPlacement& window = {},
+                                    const std::optional<AudioTrackOptions>& audio = std::nullopt);
 
 // Whether `target` names a window ("window" or "window:<title>").
 bool IsWindowTarget(const std::string& target);

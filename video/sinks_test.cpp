@@ -27,6 +27,27 @@ cv::Mat Frame(int i) {
   return m;
 }
 
+TEST(Sinks, AnMp4OpenedWithAudioTakesItAndOtherSinksRefuseItNamingThemselves) {
+  const fs::path file = Scratch("with-audio.mp4");
+  auto sink = OpenSink(file.string(), {160, 120}, 25.0, {}, AudioTrackOptions{});
+  ASSERT_TRUE(sink->HasAudio());
+  EXPECT_NE(sink->Describe().find("AAC"), std::string::npos);
+  sink->WriteAudio(0, std::vector<std::int16_t>(1600, 1000));
+  for (int i = 0; i < 5; ++i) sink->Write(Frame(i));
+  sink->Close();
+  EXPECT_EQ(sink->AudioSamplesDropped(), 0);
+  auto plain = OpenSink(Scratch("plain.mp4").string(), {160, 120}, 25.0);
+  EXPECT_FALSE(plain->HasAudio());
+  auto null_sink = OpenSink("null", {160, 120}, 25.0, {}, AudioTrackOptions{});
+  EXPECT_FALSE(null_sink->HasAudio());
+  try {
+    null_sink->WriteAudio(0, std::vector<std::int16_t>(10, 1));
+    FAIL() << "no error";
+  } catch (const VideoError& error) {
+    EXPECT_EQ(std::string(error.what()), null_sink->Describe() + ": has no audio track");
+  }
+}
+
 TEST(Sinks, Mp4FileReadsBackWithEveryFrame) {
   const fs::path file = Scratch("out.mp4");
   {
