@@ -101,6 +101,23 @@ std::string BaseWord(std::string word) {
   return word;
 }
 
+// The phones of a word, or of each word of a key phrase (keyword spotting gives the phrase as
+// one segment); a word the dictionary lacks counts one.
+std::size_t PhonesOf(ps_decoder_t* ps, const std::string& words) {
+  std::size_t phones = 0;
+  std::size_t start = 0;
+  while (start < words.size()) {
+    const std::size_t end = std::min(words.find(' ', start), words.size());
+    if (end > start) {
+      char* pronunciation = ps_lookup_word(ps, words.substr(start, end - start).c_str());
+      phones += pronunciation ? CountPhones(pronunciation) : 1;
+      std::free(pronunciation);
+    }
+    start = end + 1;
+  }
+  return phones;
+}
+
 }  // namespace
 
 struct Decoder::Handles {
@@ -229,16 +246,14 @@ Hypothesis Decoder::EndUtterance() {
     ps_seg_prob(seg, &word_acoustic, &language, &backoff);
     acoustic += word_acoustic;
     word_frames += last - first + 1;
-    char* pronunciation = ps_lookup_word(ps, word.c_str());
-    phones += pronunciation ? CountPhones(pronunciation) : 1;
-    std::free(pronunciation);
+    phones += PhonesOf(ps, word);
     if (!result.text.empty()) result.text += ' ';
     result.text += word;
     result.words.push_back({word, first, last});
   }
   if (word_frames > 0) {
     result.score_per_frame = static_cast<double>(acoustic) / word_frames;
-    result.confidence = std::exp(result.score_per_frame * kScoreShift * std::log(logmath_get_base(logmath)));
+    result.confidence = searching_wake_ ? 0.0 : std::exp(result.score_per_frame * kScoreShift * std::log(logmath_get_base(logmath)));
     result.frames_per_phone = static_cast<double>(word_frames) / static_cast<double>(phones);
     result.posterior = searching_wake_ ? 1.0 : logmath_exp(logmath, ps_get_prob(ps));
   }

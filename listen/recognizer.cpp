@@ -239,11 +239,11 @@ void Recognizer::KeepAudio(std::span<const std::int16_t> samples, std::int64_t f
   }
 }
 
-double Recognizer::VoicedFractionOf(std::int64_t start_sample, std::int64_t end_sample) const {
+Voicing Recognizer::VoicingOf(std::int64_t start_sample, std::int64_t end_sample) const {
   const std::int64_t audio_end = audio_first_sample_ + static_cast<std::int64_t>(audio_.size());
   const std::int64_t first = std::clamp(start_sample, audio_first_sample_, audio_end) - audio_first_sample_;
   const std::int64_t last = std::clamp(end_sample, audio_first_sample_, audio_end) - audio_first_sample_;
-  return VoicedFraction(std::span<const std::int16_t>(audio_).subspan(
+  return MeasureVoicing(std::span<const std::int16_t>(audio_).subspan(
       static_cast<std::size_t>(first), static_cast<std::size_t>(last - first)));
 }
 
@@ -276,8 +276,9 @@ void Recognizer::DecodeVoiceActivity(std::span<const std::int16_t> samples, std:
     decoder_.Process(samples.subspan(done, count));
     const std::int64_t at = first_sample + static_cast<std::int64_t>(done + count);
     if (decoder_.WakePhraseSpotted()) {
-      FinishUtterance(at, HeardKind::kWakePhrase);
-      awake_until_ = at + static_cast<std::int64_t>(options_.wake_window_s * kSampleRate);
+      if (FinishUtterance(at, HeardKind::kWakePhrase)) {
+        awake_until_ = at + static_cast<std::int64_t>(options_.wake_window_s * kSampleRate);
+      }
       RestartVoiceActivity(at);
       continue;
     }
@@ -287,8 +288,9 @@ void Recognizer::DecodeVoiceActivity(std::span<const std::int16_t> samples, std:
     } else if (!speech && in_speech_) {
       const bool command = !decoder_.HasWakePhrase() || awake_until_ >= 0;
       if (command) {
-        FinishUtterance(at, HeardKind::kCommand);
-        awake_until_ = -1;
+        // An accepted command closes the wake window; words it refused (the end of the sentence
+        // that held the wake phrase, a cough) leave it open until it runs out.
+        if (FinishUtterance(at, HeardKind::kCommand)) awake_until_ = -1;
       } else {
         decoder_.EndUtterance();  // speech without the wake phrase: not for us
       }
@@ -301,7 +303,7 @@ void Recognizer::DecodeVoiceActivity(std::span<const std::int16_t> samples, std:
   }
 }
 
-void Recognizer::FinishUtterance(std::int64_t at_sample, HeardKind kind) {
+bool Recognizer::FinishUtterance(std::int64_t at_sample, HeardKind kind) {
   const Hypothesis hypothesis = decoder_.EndUtterance();
   Recognition recognition;
   recognition.kind = kind;
@@ -317,13 +319,19 @@ void Recognizer::FinishUtterance(std::int64_t at_sample, HeardKind kind) {
   recognition.end_sample = recognition.words.empty() ? at_sample : recognition.words.back().end_sample;
   recognition.ended_at_sample = at_sample;
   if (!recognition.words.empty()) {
-    recognition.voiced_fraction = VoicedFractionOf(recognition.start_sample, recognition.end_sample);
+    const Voicing voicing = VoicingOf(recognition.start_sample, recognition.end_sample);
+    recognition.voiced_fraction = voicing.voiced_fraction;
+    recognition.steady_pitch_s = voicing.longest_steady_pitch_s;
   }
-  recognition.accepted = kind == HeardKind::kWakePhrase ||
-                         (!recognition.text.empty() && recognition.confidence >= options_.min_confidence &&
-                          recognition.seconds_per_phone <= options_.max_seconds_per_phone &&
-                          recognition.voiced_fraction >= options_.min_voiced_fraction);
+  const bool sounds_like_a_voice = !recognition.words.empty() &&
+                                   recognition.seconds_per_phone <= options_.max_seconds_per_phone &&
+                                   recognition.voiced_fraction >= options_.min_voiced_fraction &&
+                                   recognition.steady_pitch_s <= options_.max_steady_pitch_s;
+  recognition.accepted = sounds_like_a_voice &&
+                         (kind == HeardKind::kWakePhrase || recognition.confidence >= options_.min_confidence);
+  const bool accepted = recognition.accepted;
   Publish(std::move(recognition));
+  return accepted;
 }
 
 void Recognizer::Publish(Recognition recognition) {
@@ -331,7 +339,7 @@ void Recognizer::Publish(Recognition recognition) {
   {
     const std::lock_guard lock(result_mutex_);
     ++statistics_.utterances;
-    if (recognition.kind == HeardKind::kWakePhrase) ++statistics_.wake_phrases;
+    if (recognition.kind == HeardKind::kWakePhrase && recognition.accepted) ++statistics_.wake_phrases;
     if (recognition.kind == HeardKind::kCommand && recognition.accepted) ++statistics_.accepted;
     if (results_.size() == kMaxResults) {
       results_.pop_front();

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "listen/decoder.h"
+#include "listen/voicing.h"
 
 namespace arview::listen {
 
@@ -40,18 +41,23 @@ struct RecognizerOptions {
   // speech outside the grammar forced onto it score low (docs/listen.md, "Confidence").
   double min_confidence = 0.06;
   // Results whose words last longer than this per phone, on average, are not accepted: a
-  // grammar forced onto noise stretches a word over seconds; speech's phones last 50 to 150 ms.
-  double max_seconds_per_phone = 0.25;
+  // grammar forced onto noise stretches a word over seconds; the test data's speech runs 0.07 to
+  // 0.25 s per phone (a pause inside a phrase counts with its words).
+  double max_seconds_per_phone = 0.4;
   // Results whose words' audio is voiced (voicing.h) in fewer than this share of its frames are
   // not accepted: hiss and rumble forced onto a grammar have no pitch.
   double min_voiced_fraction = 0.1;
+  // Results whose pitch holds still to the sample for longer than this are not accepted: a held
+  // note's period does not move, a voice's drifts.
+  double max_steady_pitch_s = 0.12;
   // The words a `*` may stand for; empty: the wildcard_vocabulary_size most probable words of
   // the language model below that the dictionary knows.
   std::vector<std::string> wildcard_words;
   std::filesystem::path language_model = "/usr/share/pocketsphinx/model/en-us/en-us.lm.bin";
   std::size_t wildcard_vocabulary_size = 500;
   // Voice activity only: when not empty, recognition waits for this phrase (keyword spotting)
-  // and then takes the next utterance, within wake_window_s, as a command.
+  // and then takes utterances as commands until one is accepted or wake_window_s has passed
+  // since the phrase.
   std::string wake_phrase;
   double wake_window_s = 6.0;
   // Input waiting for the worker, at most; a block that would go beyond is dropped and counted.
@@ -70,12 +76,14 @@ struct Recognition {
   HeardKind kind = HeardKind::kCommand;
   std::string text;               // the words heard, lowercase; empty when nothing matched
   std::vector<HeardWord> words;
-  double confidence = 0;          // (0, 1]: see Hypothesis::confidence
+  double confidence = 0;          // (0, 1]: see Hypothesis::confidence (0 for a wake phrase)
   double posterior = 0;           // PocketSphinx's lattice posterior
   double seconds_per_phone = 0;   // the words' length over their phones
-  double voiced_fraction = 0;     // VoicedFraction of the words' audio
-  // text not empty, confidence ≥ min_confidence, seconds_per_phone ≤ max_seconds_per_phone,
-  // voiced_fraction ≥ min_voiced_fraction (a wake phrase: spotted, PocketSphinx's threshold)
+  double voiced_fraction = 0;     // MeasureVoicing of the words' audio
+  double steady_pitch_s = 0;      // its longest_steady_pitch_s
+  // Commands: text not empty and confidence ≥ min_confidence; both kinds: seconds_per_phone ≤
+  // max_seconds_per_phone, voiced_fraction ≥ min_voiced_fraction, steady_pitch_s ≤
+  // max_steady_pitch_s. A wake phrase not accepted does not open the wake window.
   bool accepted = false;
   // The utterance's speech in the input's sample clock: its first word's start and last word's
   // end (an utterance without words: where it began and ended).
@@ -93,7 +101,7 @@ struct RecognizerStatistics {
   std::int64_t samples_decoded = 0;
   std::int64_t utterances = 0;
   std::int64_t accepted = 0;
-  std::int64_t wake_phrases = 0;
+  std::int64_t wake_phrases = 0;       // accepted ones
   std::int64_t results_dropped = 0;    // the oldest results, when kMaxResults were not taken
   double decode_seconds = 0;           // the worker's wall time in the decoder
   std::string error;                   // the worker's failure (it stops decoding), else empty
@@ -156,12 +164,12 @@ class Recognizer {
   void Handle(Grammar& grammar);
   void DecodeVoiceActivity(std::span<const std::int16_t> samples, std::int64_t first_sample);
   void BeginUtterance(std::int64_t at_sample);
-  void FinishUtterance(std::int64_t at_sample, HeardKind kind);
+  bool FinishUtterance(std::int64_t at_sample, HeardKind kind);  // whether accepted
   void RestartVoiceActivity(std::int64_t at_sample);
   void ApplyPendingGrammar();
   void Publish(Recognition recognition);
   void KeepAudio(std::span<const std::int16_t> samples, std::int64_t first_sample);
-  double VoicedFractionOf(std::int64_t start_sample, std::int64_t end_sample) const;
+  Voicing VoicingOf(std::int64_t start_sample, std::int64_t end_sample) const;
   void CheckWords(const std::vector<std::string>& words, const std::string& where) const;
   std::string CheckedJsgf(const std::vector<std::string>& patterns) const;
 
