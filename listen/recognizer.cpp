@@ -1,5 +1,7 @@
 #include "listen/recognizer.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <utility>
 
@@ -17,6 +19,12 @@ constexpr std::size_t kVoiceActivityChunk = 320;
 // Voice activity outside speech keeps at most this much input for the voicing check: the
 // detector's 20 frames before speech, and more.
 constexpr std::size_t kKeptBeforeSpeech = kSampleRate;
+
+double ThreadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
 
 DecoderOptions DecoderOptionsFor(const RecognizerOptions& options) {
   DecoderOptions decoder = options.decoder;
@@ -165,6 +173,7 @@ void Recognizer::Run(std::stop_token stop) {
     }
     if (!failed_) {
       const auto begun = std::chrono::steady_clock::now();
+      const double cpu_begun = ThreadCpuSeconds();
       try {
         std::visit([this](auto& item) { Handle(item); }, input);
       } catch (const ListenError& error) {
@@ -173,8 +182,10 @@ void Recognizer::Run(std::stop_token stop) {
         statistics_.error = error.what();
       }
       const std::chrono::duration<double> spent = std::chrono::steady_clock::now() - begun;
+      const double cpu_spent = ThreadCpuSeconds() - cpu_begun;
       const std::lock_guard lock(result_mutex_);
       statistics_.decode_seconds += spent.count();
+      statistics_.decode_cpu_seconds += cpu_spent;
     }
     {
       const std::lock_guard lock(input_mutex_);

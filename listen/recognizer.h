@@ -104,6 +104,7 @@ struct RecognizerStatistics {
   std::int64_t wake_phrases = 0;       // accepted ones
   std::int64_t results_dropped = 0;    // the oldest results, when kMaxResults were not taken
   double decode_seconds = 0;           // the worker's wall time in the decoder
+  double decode_cpu_seconds = 0;       // the worker thread's CPU time in it
   std::string error;                   // the worker's failure (it stops decoding), else empty
 };
 
