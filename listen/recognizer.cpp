@@ -1,5 +1,6 @@
 #include "listen/recognizer.h"
 
+#include <pthread.h>
 #include <time.h>
 
 #include <algorithm>
@@ -159,6 +160,7 @@ RecognizerStatistics Recognizer::Statistics() const {
 }
 
 void Recognizer::Run(std::stop_token stop) {
+  pthread_setname_np(pthread_self(), "arview-listen");  // shown by top -H
   while (true) {
     Input input;
     {

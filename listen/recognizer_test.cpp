@@ -183,6 +183,9 @@ TEST(RecognizerOnTestdata, SpeechOutsideTheGrammarIsNotAccepted) {
   for (const auto& entry : std::filesystem::directory_iterator(kTestdata / "librivox")) {
     if (entry.path().extension() != ".wav") continue;
     const Recognition heard = HearWithTheKeyHeld(recognizer, testing::LoadTestWav(entry.path()));
+    std::printf("  %s heard as \"%s\": confidence %.4f, %.3f s/phone, voiced %.2f, steady pitch %.2f s\n",
+                entry.path().filename().c_str(), heard.text.c_str(), heard.confidence, heard.seconds_per_phone,
+                heard.voiced_fraction, heard.steady_pitch_s);
     EXPECT_FALSE(heard.accepted) << entry.path() << " heard as \"" << heard.text << "\", confidence "
                                  << heard.confidence;
   }
