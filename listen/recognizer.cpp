@@ -4,6 +4,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <sstream>
 #include <utility>
 
 #include "listen/grammar.h"
@@ -33,6 +34,36 @@ DecoderOptions DecoderOptionsFor(const RecognizerOptions& options) {
   return decoder;
 }
 
+[[noreturn]] void RefuseOption(const std::string& field, double value, const std::string& range) {
+  std::ostringstream line;
+  line << "listen: RecognizerOptions::" << field << " must be " << range << ", not " << value;
+  throw ListenError(line.str());
+}
+
+RecognizerOptions CheckedOptions(RecognizerOptions options) {
+  const auto within = [](double value, double low, double high) { return value >= low && value <= high; };
+  if (!within(options.min_confidence, 0, 1)) RefuseOption("min_confidence", options.min_confidence, "in [0, 1]");
+  if (!within(options.min_voiced_fraction, 0, 1)) {
+    RefuseOption("min_voiced_fraction", options.min_voiced_fraction, "in [0, 1]");
+  }
+  if (!(options.max_seconds_per_phone > 0)) {
+    RefuseOption("max_seconds_per_phone", options.max_seconds_per_phone, "above 0");
+  }
+  if (!(options.max_steady_pitch_s > 0)) RefuseOption("max_steady_pitch_s", options.max_steady_pitch_s, "above 0");
+  if (!(options.max_queued_s > 0)) RefuseOption("max_queued_s", options.max_queued_s, "above 0");
+  if (!(options.wake_window_s > 0)) RefuseOption("wake_window_s", options.wake_window_s, "above 0");
+  if (options.decoder.vad_postspeech_frames < 1) {
+    RefuseOption("decoder.vad_postspeech_frames", options.decoder.vad_postspeech_frames, "at least 1");
+  }
+  if (!(options.decoder.wake_threshold > 0)) {
+    RefuseOption("decoder.wake_threshold", options.decoder.wake_threshold, "above 0");
+  }
+  if (options.wildcard_words.empty() && options.wildcard_vocabulary_size == 0) {
+    throw ListenError("listen: RecognizerOptions::wildcard_vocabulary_size must be at least 1 when no wildcard_words are given");
+  }
+  return options;
+}
+
 bool HasWildcard(const std::vector<std::string>& patterns) {
   return std::any_of(patterns.begin(), patterns.end(),
                      [](const std::string& p) { return p.find('*') != std::string::npos; });
@@ -41,13 +72,10 @@ bool HasWildcard(const std::vector<std::string>& patterns) {
 }  // namespace
 
 Recognizer::Recognizer(RecognizerOptions options, const std::vector<std::string>& patterns)
-    : options_(std::move(options)), decoder_(DecoderOptionsFor(options_)),
+    : options_(CheckedOptions(std::move(options))), decoder_(DecoderOptionsFor(options_)),
       wildcard_words_(options_.wildcard_words) {
   if (wildcard_words_.empty()) {
     wildcard_words_ = MostProbableWords(options_.language_model, options_.wildcard_vocabulary_size, decoder_);
-  }
-  if (!(options_.min_confidence >= 0 && options_.min_confidence <= 1)) {
-    throw ListenError("listen: the confidence threshold must lie in [0, 1], not " + std::to_string(options_.min_confidence));
   }
   decoder_.UseGrammar(CheckedJsgf(patterns));
   if (!options_.wake_phrase.empty()) {

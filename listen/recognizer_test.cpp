@@ -259,6 +259,17 @@ TEST(RecognizerOnTestdata, AWakePhraseIsCheckedAgainstTheDictionaryAndTheMode) {
             "listen: a wake phrase (\"hey figure\") needs voice-activity mode: push-to-talk's key already says when to listen");
 }
 
+TEST(ListenErrors, AnOptionOutOfItsRangeIsOneLineNamingIt) {
+  RecognizerOptions options;
+  options.min_confidence = 1.5;
+  EXPECT_EQ(ErrorOf([&] { Recognizer(options, {"yes"}); }),
+            "listen: RecognizerOptions::min_confidence must be in [0, 1], not 1.5");
+  options = RecognizerOptions{};
+  options.decoder.vad_postspeech_frames = 0;
+  EXPECT_EQ(ErrorOf([&] { Recognizer(options, {"yes"}); }),
+            "listen: RecognizerOptions::decoder.vad_postspeech_frames must be at least 1, not 0");
+}
+
 // A missing model needs no model installed: these run everywhere.
 TEST(ListenErrors, AMissingModelIsOneLineNamingTheFolder) {
   RecognizerOptions options;
