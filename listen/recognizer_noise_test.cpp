@@ -82,6 +82,10 @@ std::vector<Recognition> HearNoise(const RecognizerOptions& options) {
         std::printf("  ACCEPTED from %s: \"%s\" confidence %.3f\n", kind.name.c_str(), heard->text.c_str(), heard->confidence);
         accepted.push_back(*heard);
       }
+      if (heard->kind == HeardKind::kWakePhrase && !heard->accepted) {
+        std::printf("  the wake phrase spotted in %s, refused: %.3f s/phone, voiced %.2f, steady pitch %.2f s\n",
+                    kind.name.c_str(), heard->seconds_per_phone, heard->voiced_fraction, heard->steady_pitch_s);
+      }
       if (heard->text.empty() || heard->kind != HeardKind::kCommand) continue;
       ++closest.with_words;
       const RecognizerOptions defaults;
