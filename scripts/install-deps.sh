@@ -19,6 +19,7 @@ PACKAGES=(
   libyaml-cpp-dev nlohmann-json3-dev
   flite1-dev
   libasound2-dev libswresample-dev
+  libpocketsphinx-dev libsphinxbase-dev pocketsphinx-en-us pocketsphinx-testdata
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
