@@ -16,7 +16,7 @@ DialogueManager::DialogueManager(Dialogue dialogue, std::uint64_t seed)
 
 bool DialogueManager::Holds(const Condition& c, const Running& run, const DialogueInput& input, bool heard_available,
                             std::vector<std::string>& captures) const {
-  const ViewerInput& viewer = input.viewer;
+  if (const std::optional<bool> viewer_holds = ViewerConditionHolds(c, input.viewer)) return *viewer_holds;
   switch (c.kind) {
     case Condition::Kind::kHeard:
       if (!heard_available) return false;
@@ -31,13 +31,8 @@ bool DialogueManager::Holds(const Condition& c, const Running& run, const Dialog
     case Condition::Kind::kVariableEquals: return *Variable(c.variable) == c.text;
     case Condition::Kind::kVariableDiffers: return *Variable(c.variable) != c.text;
     case Condition::Kind::kInStateLongerThan: return run.seconds_in_state > c.value;
-    case Condition::Kind::kViewerCloserThan: return viewer.tracked && viewer.distance_m < c.value;
-    case Condition::Kind::kViewerFartherThan: return viewer.tracked && viewer.distance_m > c.value;
-    case Condition::Kind::kViewerSide: return viewer.tracked && viewer.in_front == (c.side == Side::kFront);
-    case Condition::Kind::kViewerGaze: return viewer.tracked && viewer.gaze_on_character == c.flag;
-    case Condition::Kind::kViewerTracked: return viewer.tracked == c.flag;
+    default: return false;  // the viewer's, above
   }
-  return false;
 }
 
 std::optional<DialogueManager::Enabled> DialogueManager::FirstEnabled(std::size_t machine, const DialogueInput& input,

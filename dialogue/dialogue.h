@@ -27,14 +27,6 @@ namespace arview::dialogue {
 // (through variables or emotions: a cycle without conditions is refused when the file is read).
 inline constexpr int kMaxTransitionsPerUpdate = 64;
 
-// What the tracker says of the viewer this update (the camera is the viewer's eye).
-struct ViewerInput {
-  bool tracked = false;            // false: the tracker lost the camera; nothing below is known
-  double distance_m = 0;           // from the character, along the floor (the map's unit)
-  bool in_front = true;            // on the character's front half (the side it faces)
-  bool gaze_on_character = false;  // the camera looks at the character
-};
-
 struct DialogueInput {
   double dt_s = 0;                   // time since the last update (the emotions decay over it)
   std::optional<std::string> heard;  // what the viewer said, when a phrase ended this update

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <set>
@@ -406,13 +407,54 @@ struct Reader {
   }
 };
 
-// A cycle of transitions that always fire (no condition), with a cyclic machine's final states
-// leading back to its start: the machine would run round it forever within one update.
-std::vector<std::size_t> AlwaysFiringCycle(const Machine& m) {
+// The viewer's situations that the machine's conditions tell apart: tracked or not, each side,
+// gaze or not, and a distance in each interval its distance thresholds make (at and between
+// them). Within one update the viewer does not move, so these are all the cases to try.
+std::vector<ViewerInput> ViewerSituations(const Machine& m) {
+  std::vector<double> thresholds;
+  for (const Transition& t : m.transitions) {
+    const bool viewer_only = std::all_of(t.conditions.begin(), t.conditions.end(), [](const Condition& c) {
+      return ViewerConditionHolds(c, ViewerInput{}).has_value();
+    });
+    if (!viewer_only) continue;  // never fires twice in an update on the viewer alone
+    for (const Condition& c : t.conditions)
+      if (c.kind == Condition::Kind::kViewerCloserThan || c.kind == Condition::Kind::kViewerFartherThan) thresholds.push_back(c.value);
+  }
+  std::sort(thresholds.begin(), thresholds.end());
+  thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
+  std::vector<double> distances{0.0};
+  for (std::size_t i = 0; i < thresholds.size(); ++i) {
+    distances.push_back(thresholds[i]);
+    distances.push_back(i + 1 < thresholds.size() ? (thresholds[i] + thresholds[i + 1]) / 2 : thresholds[i] + 1);
+  }
+  std::vector<ViewerInput> situations{{false, 0.0, true, false}};
+  for (const double distance : distances)
+    for (const bool in_front : {true, false})
+      for (const bool gaze : {true, false}) situations.push_back({true, distance, in_front, gaze});
+  return situations;
+}
+
+std::string Describe(const ViewerInput& v) {
+  if (!v.tracked) return "while the viewer is lost";
+  char distance[32];
+  std::snprintf(distance, sizeof distance, "%g", v.distance_m);
+  return std::string("while the viewer is ") + distance + " away, " + (v.in_front ? "in front" : "behind") + ", " +
+         (v.gaze_on_character ? "looking at the character" : "looking away");
+}
+
+// A cycle of transitions that can all fire in `viewer`'s situation without anything else
+// changing: no heard text (taken once an update), no time in a state (0 after a transition), no
+// emotion or variable (an action on the way may change them; the manager's step limit catches
+// those). A cyclic machine's final states lead back to its start.
+std::vector<std::size_t> CycleWaitingOnlyOnTheViewer(const Machine& m, const ViewerInput& viewer) {
   const std::size_t n = m.states.size();
   std::vector<std::vector<std::size_t>> next(n);
-  for (const Transition& t : m.transitions)
-    if (t.conditions.empty()) next[t.from].push_back(t.to);
+  for (const Transition& t : m.transitions) {
+    const bool fires = std::all_of(t.conditions.begin(), t.conditions.end(), [&](const Condition& c) {
+      return ViewerConditionHolds(c, viewer).value_or(false);
+    });
+    if (fires) next[t.from].push_back(t.to);
+  }
   if (m.cyclic)
     for (std::size_t s = 0; s < n; ++s)
       if (m.final[s]) next[s].push_back(m.start);
@@ -439,21 +481,40 @@ std::vector<std::size_t> AlwaysFiringCycle(const Machine& m) {
   return {};
 }
 
-void RefuseAlwaysFiringCycles(const Dialogue& d) {
+void RefuseEndlessCycles(const Dialogue& d) {
   for (const Machine& m : d.machines) {
-    const std::vector<std::size_t> cycle = AlwaysFiringCycle(m);
-    if (cycle.empty()) continue;
-    std::string states;
-    for (const std::size_t s : cycle) states += (states.empty() ? "" : " -> ") + m.states[s];
-    throw DialogueError(d.file + ":" + std::to_string(m.line) + ": machine '" + m.name + "', state '" +
-                        m.states[cycle.front()] + "': " + states +
-                        " is a cycle of transitions without a condition" + (m.cyclic ? " (a final state restarts it)" : "") +
-                        (m.strong ? ": the strong machine would never release the conversation"
-                                  : ": the machine would never wait for anything"));
+    for (const ViewerInput& viewer : ViewerSituations(m)) {
+      const std::vector<std::size_t> cycle = CycleWaitingOnlyOnTheViewer(m, viewer);
+      if (cycle.empty()) continue;
+      bool viewer_conditions = false;
+      std::string states;
+      for (std::size_t i = 0; i < cycle.size(); ++i) {
+        states += (i ? " -> " : "") + m.states[cycle[i]];
+        for (const Transition& t : m.transitions)
+          if (i + 1 < cycle.size() && t.from == cycle[i] && t.to == cycle[i + 1]) viewer_conditions = viewer_conditions || !t.conditions.empty();
+      }
+      const std::string what = viewer_conditions ? " is a cycle of transitions that wait only on the viewer: " + Describe(viewer) + ","
+                                                 : " is a cycle of transitions without a condition:";
+      throw DialogueError(d.file + ":" + std::to_string(m.line) + ": machine '" + m.name + "', state '" +
+                          m.states[cycle.front()] + "': " + states + (m.cyclic ? " (a final state restarts it)" : "") + what +
+                          (m.strong ? " the strong machine would never release the conversation"
+                                    : " the machine would never wait for anything"));
+    }
   }
 }
 
 }  // namespace
+
+std::optional<bool> ViewerConditionHolds(const Condition& c, const ViewerInput& viewer) {
+  switch (c.kind) {
+    case Condition::Kind::kViewerCloserThan: return viewer.tracked && viewer.distance_m < c.value;
+    case Condition::Kind::kViewerFartherThan: return viewer.tracked && viewer.distance_m > c.value;
+    case Condition::Kind::kViewerSide: return viewer.tracked && viewer.in_front == (c.side == Side::kFront);
+    case Condition::Kind::kViewerGaze: return viewer.tracked && viewer.gaze_on_character == c.flag;
+    case Condition::Kind::kViewerTracked: return viewer.tracked == c.flag;
+    default: return std::nullopt;
+  }
+}
 
 std::size_t Transition::Captures() const {
   std::optional<std::size_t> fewest;
@@ -482,7 +543,7 @@ Dialogue ParseDialogue(std::string_view text, const std::string& file) {
     if (!machines) throw DialogueError(file + ": the dialogue has no 'machines'");
     for (const YAML::Node& item : Items(machines, reader.place, "machines")) reader.ReadMachine(item);
     if (reader.d.machines.empty()) throw DialogueError(file + ": the dialogue has no machines");
-    RefuseAlwaysFiringCycles(reader.d);
+    RefuseEndlessCycles(reader.d);
     return std::move(reader.d);
   });
 }

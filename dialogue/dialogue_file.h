@@ -22,6 +22,14 @@ inline constexpr int kDialogueFormatVersion = 1;
 // Dialogue files are hand-written, a few kilobytes; 1 MiB is thousands of transitions.
 inline constexpr std::size_t kMaxDialogueFileBytes = 1u << 20;
 
+// What the tracker says of the viewer in an update (the camera is the viewer's eye).
+struct ViewerInput {
+  bool tracked = false;            // false: the tracker lost the camera; nothing below is known
+  double distance_m = 0;           // from the character, along the floor (the map's unit)
+  bool in_front = true;            // on the character's front half (the side it faces)
+  bool gaze_on_character = false;  // the camera looks at the character
+};
+
 enum class Side { kFront, kBehind };
 constexpr auto EnumNames(Side) { return EnumTable<Side, 2>{{{Side::kFront, "front"}, {Side::kBehind, "behind"}}}; }
 
@@ -50,6 +58,9 @@ struct Condition {
   bool flag = true;
   int line = 0;
 };
+
+// Whether a viewer condition (kViewer*) holds for `viewer`; nothing for the other kinds.
+std::optional<bool> ViewerConditionHolds(const Condition& condition, const ViewerInput& viewer);
 
 struct Action {
   enum class Kind {
@@ -106,9 +117,9 @@ struct Dialogue {
 // Parses and validates a dialogue. Every problem is a DialogueError whose message is one line
 // naming the file and line, the machine and the state where there is one: a YAML error, an
 // unknown key, action, condition, emotion or trait, a value out of range, a pattern that cannot
-// compile, a state, variable or capture ($n) that is not defined, and a cycle of transitions
-// without a condition (a strong machine on it would never release the conversation; any machine
-// on it would never wait for anything).
+// compile, a state, variable or capture ($n) that is not defined, and a cycle of transitions that
+// wait for nothing but the viewer, who can stand where all of them hold (a strong machine on it
+// would never release the conversation; any machine on it would never wait for anything).
 Dialogue ParseDialogue(std::string_view text, const std::string& file);
 // The file read (a regular file of at most kMaxDialogueFileBytes) and parsed.
 Dialogue LoadDialogue(const std::filesystem::path& path);

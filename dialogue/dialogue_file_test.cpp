@@ -91,6 +91,16 @@ TEST(DialogueFile, EveryMistakeIsOneLineNamingTheFileMachineAndState) {
       {Header() + OneMachine("      - from: s\n        to: t\n", "    cyclic: true\n    final: [t]\n"),
        {"machine 'm'", "s -> t -> s", "a final state restarts it", "never wait"}},
       {Header() + OneMachine("      - from: s\n        to: s\n"), {"s -> s", "never wait"}},
+      {Header() + OneMachine("      - from: s\n        to: t\n        when:\n          - viewer_tracked: false\n"
+                             "      - from: t\n        to: s\n        when:\n          - viewer_gaze: false\n"
+                             "      - from: t\n        to: s\n        when:\n          - viewer_tracked: false\n",
+                             "    strong: true\n"),
+       {"machine 'm', state 's'", "s -> t -> s is a cycle of transitions that wait only on the viewer",
+        "while the viewer is lost", "never release the conversation"}},
+      {Header() + OneMachine("      - from: s\n        to: t\n        when:\n          - viewer_farther_than: 3\n"
+                             "      - from: t\n        to: s\n        when:\n          - viewer_closer_than: 5\n"
+                             "          - viewer_side: behind\n"),
+       {"s -> t -> s", "while the viewer is 4 away, behind", "never wait"}},
       {Header() + OneMachine("      - from: t\n        to: s\n        when:\n          - heard: hi\n", "    final: [t]\n"),
        {"final state 't' has a transition out of it"}},
       {Header() + OneMachine(kHello, "    priority: -1\n"), {"priority -1 is negative"}},
@@ -124,6 +134,20 @@ TEST(DialogueFile, EveryMistakeIsOneLineNamingTheFileMachineAndState) {
       for (const std::string& part : c.expected) EXPECT_NE(message.find(part), std::string::npos) << message << "\n  lacks: " << part;
     }
   }
+}
+
+TEST(DialogueFile, ACycleOnViewerConditionsThatCannotAllHoldAtOnceIsAccepted) {
+  // Lost then found, near then far, in front then behind: the viewer must move between them.
+  const Dialogue d = ParseDialogue(
+      Header() + OneMachine("      - from: s\n        to: t\n        when:\n          - viewer_tracked: false\n"
+                            "      - from: t\n        to: s\n        when:\n          - viewer_tracked: true\n"
+                            "          - viewer_closer_than: 2\n          - viewer_side: front\n",
+                            "    strong: true\n") +
+          "  - name: n\n    states: [near, far]\n    transitions:\n"
+          "      - {from: near, to: far, when: [{viewer_farther_than: 2}]}\n"
+          "      - {from: far, to: near, when: [{viewer_closer_than: 2}]}\n",
+      "d.yaml");
+  EXPECT_EQ(d.machines.size(), 2u);
 }
 
 TEST(DialogueFile, AMissingOrSpecialFileIsOneLineNamingIt) {
