@@ -53,7 +53,7 @@ std::string SetViewer(std::istringstream& words, ViewerInput& viewer) {
 }  // namespace
 
 std::string StatusLine(const DialogueManager& manager) {
-  const EmotionSummary s = manager.Emotion();
+  const EmotionSummary s = manager.EmotionNow();
   const std::string machine = manager.SelectedMachine();
   std::string line = "[" + (machine.empty() ? std::string("-") : machine) + "] ";
   if (!s.dominant) return line + "neutral, activation " + Fixed(s.activation);

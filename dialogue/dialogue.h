@@ -65,7 +65,8 @@ class DialogueManager {
 
   const Dialogue& dialogue() const { return dialogue_; }
   const EmotionalState& emotions() const { return emotions_; }
-  EmotionSummary Emotion() const { return Summarize(emotions_); }
+  // The dominant emotion, the face's expression, the disc and the activation now.
+  EmotionSummary EmotionNow() const { return Summarize(emotions_); }
   // The machine that made the last transition ("" before any).
   std::string SelectedMachine() const;
   // A machine's current state ("" for an unknown machine); a finished one stays in its final state.

@@ -167,7 +167,7 @@ TEST(DialogueManager, EmotionsTheDialogueSendsAndThresholdsItReads) {
   EXPECT_EQ(Said(feel.Update(Heard("you are nice", 0))), "");
   EXPECT_NEAR(feel.emotions().Intensity(Emotion::kJoy), 0.25, 1e-12);
   EXPECT_EQ(Said(feel.Update(Heard("you are kind", 0))), "mood: I feel great");
-  EXPECT_EQ(*feel.Emotion().expression, Expression::kHappy);
+  EXPECT_EQ(*feel.EmotionNow().expression, Expression::kHappy);
   feel.Update(Heard("", 2.0));  // decay: 0.5 − 0.2
   EXPECT_NEAR(feel.emotions().Intensity(Emotion::kJoy), 0.3, 1e-12);
 }
@@ -217,7 +217,7 @@ TEST(DialogueManager, PraiseRaisesJoyAndTheFaceShowsItInASeededRun) {
   EXPECT_EQ(praise.steps.at(0).machine, "feelings");
   const double after = m.emotions().Intensity(Emotion::kJoy);
   EXPECT_GT(after, before + 0.2) << before << " -> " << after;
-  const EmotionSummary face = m.Emotion();
+  const EmotionSummary face = m.EmotionNow();
   ASSERT_TRUE(face.expression);
   EXPECT_EQ(*face.expression, Expression::kHappy);
   EXPECT_GT(face.expression_intensity, 0.4);
