@@ -181,6 +181,14 @@ std::pair<std::string, YAML::Node> OneKey(const YAML::Node& item, const Place& p
 struct Reader {
   Dialogue d;
   Place place;
+  // Set by CheckDialogueFile: undefined names are listed here, every one, instead of thrown; a
+  // transition whose `from` or `to` is undefined is then left out of the dialogue.
+  std::vector<CheckFinding>* undefined_names = nullptr;
+
+  void Undefined(const YAML::Node& node, const std::string& what) const {
+    if (!undefined_names) place.Fail(node, what);
+    undefined_names->push_back({place.machine, place.state, place.At(node) + what, true});
+  }
 
   const Variable* FindVariable(const std::string& name) const {
     for (const Variable& v : d.variables)
@@ -189,7 +197,7 @@ struct Reader {
   }
 
   void RequireVariable(const YAML::Node& node, const std::string& name) const {
-    if (!FindVariable(name)) place.Fail(node, "variable '" + name + "' is not defined (under 'variables:')");
+    if (!FindVariable(name)) Undefined(node, "variable '" + name + "' is not defined (under 'variables:')");
   }
 
   // $1..$9 within the transition's captures, ${name} a defined variable, $$ a dollar.
@@ -202,8 +210,8 @@ struct Reader {
       } else if (next >= '1' && next <= '9') {
         const std::size_t n = static_cast<std::size_t>(next - '0');
         if (n > captures)
-          place.Fail(node, "$" + std::string(1, next) + " is not defined: the transition's heard patterns capture " +
-                               std::to_string(captures) + " wildcard(s)");
+          Undefined(node, "$" + std::string(1, next) + " is not defined: the transition's heard patterns capture " +
+                              std::to_string(captures) + " wildcard(s)");
         ++i;
       } else if (next == '{') {
         const std::size_t close = text.find('}', i);
@@ -333,21 +341,24 @@ struct Reader {
     return a;
   }
 
-  std::size_t StateIndex(const Machine& m, const YAML::Node& node, const std::string& what) const {
+  // Nothing when the state is not defined (and the reader collects undefined names).
+  std::optional<std::size_t> StateIndex(const Machine& m, const YAML::Node& node, const std::string& what) const {
     const std::string name = Name(node, place, what);
     const auto it = std::find(m.states.begin(), m.states.end(), name);
-    if (it == m.states.end()) place.Fail(node, what + " '" + name + "' is not one of the machine's states");
-    return static_cast<std::size_t>(it - m.states.begin());
+    if (it != m.states.end()) return static_cast<std::size_t>(it - m.states.begin());
+    Undefined(node, what + " '" + name + "' is not one of the machine's states");
+    return std::nullopt;
   }
 
-  Transition ReadTransition(Machine& m, const YAML::Node& node) {
+  // Nothing when its `from` or `to` is not defined (and the reader collects undefined names).
+  std::optional<Transition> ReadTransition(Machine& m, const YAML::Node& node) {
     place.state.clear();
     const auto entries = Entries(node, place, "a transition", {"from", "to", "when", "do"});
     Transition t;
     t.line = node.Mark().line + 1;
-    t.from = StateIndex(m, Required(entries, node, place, "from", "a transition"), "from");
-    place.state = m.states[t.from];
-    t.to = StateIndex(m, Required(entries, node, place, "to", "a transition"), "to");
+    const std::optional<std::size_t> from = StateIndex(m, Required(entries, node, place, "from", "a transition"), "from");
+    if (from) place.state = m.states[*from];
+    const std::optional<std::size_t> to = StateIndex(m, Required(entries, node, place, "to", "a transition"), "to");
     for (const auto& [key, value] : entries)
       if (key == "when")
         for (const YAML::Node& item : Items(value, place, "when")) t.conditions.push_back(ReadCondition(item));
@@ -356,6 +367,9 @@ struct Reader {
         for (const YAML::Node& item : Items(value, place, "do")) t.actions.push_back(ReadAction(item, t.Captures()));
     if (std::count_if(t.conditions.begin(), t.conditions.end(), [](const Condition& c) { return c.kind == Condition::Kind::kHeard; }) > 1)
       place.Fail(node, "a transition hears once: put the patterns in one heard list");
+    if (!from || !to) return std::nullopt;
+    t.from = *from;
+    t.to = *to;
     return t;
   }
 
@@ -390,15 +404,17 @@ struct Reader {
       } else if (key == "strong") {
         m.strong = Flag(value, place, "strong");
       } else if (key == "start") {
-        m.start = StateIndex(m, value, "start");
+        m.start = StateIndex(m, value, "start").value_or(m.start);
       } else if (key == "final") {
-        for (const YAML::Node& state : Items(value, place, "final")) m.final[StateIndex(m, state, "final state")] = true;
+        for (const YAML::Node& state : Items(value, place, "final"))
+          if (const std::optional<std::size_t> s = StateIndex(m, state, "final state")) m.final[*s] = true;
       }
     }
     if (m.final[m.start]) place.Fail(node, "the start state '" + m.states[m.start] + "' cannot be final");
     for (const auto& [key, value] : entries)
       if (key == "transitions")
-        for (const YAML::Node& item : Items(value, place, "transitions")) m.transitions.push_back(ReadTransition(m, item));
+        for (const YAML::Node& item : Items(value, place, "transitions"))
+          if (std::optional<Transition> t = ReadTransition(m, item)) m.transitions.push_back(std::move(*t));
     for (const Transition& t : m.transitions)
       if (m.final[t.from])
         place.Fail(t.line, "machine '" + m.name + "': final state '" + m.states[t.from] +
@@ -527,13 +543,16 @@ bool Transition::Hears() const {
   return std::any_of(conditions.begin(), conditions.end(), [](const Condition& c) { return c.kind == Condition::Kind::kHeard; });
 }
 
-Dialogue ParseDialogue(std::string_view text, const std::string& file) {
+namespace {
+
+Dialogue Read(std::string_view text, const std::string& file, std::vector<CheckFinding>* undefined_names) {
   return NamingInput<DialogueError>(file, [&] {
     if (text.size() > kMaxDialogueFileBytes)
       throw DialogueError(file + ": " + std::to_string(text.size()) + " bytes; dialogue files are limited to " +
                           std::to_string(kMaxDialogueFileBytes));
     const YAML::Node root = ParseYaml(text, file);
     Reader reader;
+    reader.undefined_names = undefined_names;
     reader.d.file = file;
     reader.place.file = &reader.d.file;
     if (!root.IsMap()) throw DialogueError(file + ": not a dialogue file (a mapping with dialogue: " +
@@ -547,6 +566,10 @@ Dialogue ParseDialogue(std::string_view text, const std::string& file) {
     return std::move(reader.d);
   });
 }
+
+}  // namespace
+
+Dialogue ParseDialogue(std::string_view text, const std::string& file) { return Read(text, file, nullptr); }
 
 Dialogue LoadDialogue(const std::filesystem::path& path) {
   return NamingInput<DialogueError>(path.string(), [&] {
@@ -587,6 +610,16 @@ std::vector<CheckFinding> CheckDialogue(const Dialogue& d) {
       findings.push_back({"", "", d.file + ": variable '" + v.name + "' is defined but no machine reads or sets it", false});
   }
   return findings;
+}
+
+std::vector<CheckFinding> CheckDialogueFile(const std::filesystem::path& path) {
+  std::vector<CheckFinding> findings;
+  const Dialogue d = NamingInput<DialogueError>(path.string(), [&] {
+    return Read(ReadFileUpTo(path, kMaxDialogueFileBytes), path.string(), &findings);
+  });
+  // With a transition left out, a state it leads to would be named unreachable for no reason.
+  if (!findings.empty()) return findings;
+  return CheckDialogue(d);
 }
 
 }  // namespace arview::dialogue

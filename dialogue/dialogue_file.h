@@ -134,5 +134,9 @@ struct CheckFinding {
 // States that no path of transitions from the machine's start reaches, and variables declared
 // but never read or set.
 std::vector<CheckFinding> CheckDialogue(const Dialogue& dialogue);
+// `arview dialogue check`: the file read as LoadDialogue reads it, except that every undefined
+// name (a state, a variable, a capture $n) is a finding, not only the first; when there is none,
+// CheckDialogue's findings. Every other problem is thrown as LoadDialogue throws it.
+std::vector<CheckFinding> CheckDialogueFile(const std::filesystem::path& path);
 
 }  // namespace arview::dialogue

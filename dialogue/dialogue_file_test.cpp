@@ -1,6 +1,9 @@
 #include "dialogue/dialogue_file.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
 
 #include "dialogue/test_dialogues.h"
 
@@ -158,6 +161,30 @@ TEST(DialogueFile, AMissingOrSpecialFileIsOneLineNamingIt) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/d.yaml"), std::string::npos) << e.what();
   }
   EXPECT_THROW(LoadDialogue("/dev/zero"), Error);
+}
+
+TEST(DialogueCheck, AFileWithSeveralUndefinedNamesHasEachNamedWhereTheLoaderStopsAtTheFirst) {
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("arview_check_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(file) << Header("name: x") +
+                             "  - name: m\n    states: [s, t]\n    start: begin\n    final: [end, t]\n    transitions:\n"
+                             "      - {from: s, to: nowhere, when: [{variable: {name: mood, equals: calm}}]}\n"
+                             "      - {from: elsewhere, to: t, do: [{say: '$2 ${name}'}]}\n"
+                             "      - {from: s, to: t, when: [{heard: 'hi *'}], do: [{set: {name: colour, value: $1}}]}\n";
+  const std::vector<CheckFinding> findings = CheckDialogueFile(file);
+  std::vector<std::string> lines;
+  for (const CheckFinding& f : findings) lines.push_back(f.what);
+  ASSERT_EQ(findings.size(), 7u) << ::testing::PrintToString(lines);
+  EXPECT_NE(lines[0].find(":8: machine 'm': start 'begin' is not one of"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find(":9: machine 'm': final state 'end' is not one of"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find(":11: machine 'm', state 's': to 'nowhere'"), std::string::npos) << lines[2];
+  EXPECT_NE(lines[3].find(":11: machine 'm', state 's': variable 'mood' is not defined"), std::string::npos) << lines[3];
+  EXPECT_NE(lines[4].find(":12: machine 'm': from 'elsewhere'"), std::string::npos) << lines[4];
+  EXPECT_NE(lines[5].find(":12: machine 'm': $2 is not defined"), std::string::npos) << lines[5];
+  EXPECT_NE(lines[6].find(":13: machine 'm', state 's': variable 'colour' is not defined"), std::string::npos) << lines[6];
+  for (const CheckFinding& f : findings) EXPECT_TRUE(f.error);
+  // The loader stops at the first.
+  EXPECT_THROW(LoadDialogue(file), DialogueError);
+  std::filesystem::remove(file);
 }
 
 TEST(DialogueCheck, NamesUnreachableStatesAndUnusedVariables) {

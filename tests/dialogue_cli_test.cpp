@@ -45,7 +45,22 @@ TEST(DialogueCli, CheckNamesUnreachableStatesAndExitsNonZero) {
   EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("machine 'm', state 'island': unreachable"), std::string::npos) << r.out;
   EXPECT_EQ(LineCount(r.err), 1) << r.err;
-  EXPECT_NE(r.err.find("1 unreachable state(s)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 error(s)"), std::string::npos) << r.err;
+  std::filesystem::remove(file);
+}
+
+TEST(DialogueCli, CheckNamesEveryUndefinedName) {
+  const std::string file = WriteTemp("undefined.yaml", kHeader +
+                                                           "  - name: m\n    states: [s, t]\n    transitions:\n"
+                                                           "      - {from: s, to: nowhere}\n"
+                                                           "      - {from: s, to: t, do: [{say: 'hi ${who} $1'}]}\n");
+  const auto r = RunArview({"dialogue", "check", file});
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_NE(r.out.find("error: " + file + ":8: machine 'm', state 's': to 'nowhere' is not one of the machine's states"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("state 's': variable 'who' is not defined"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("state 's': $1 is not defined"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("3 error(s)"), std::string::npos) << r.err;
   std::filesystem::remove(file);
 }
 

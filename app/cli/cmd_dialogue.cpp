@@ -25,6 +25,12 @@ struct DialogueArgs {
 };
 
 void RunCheck(const DialogueArgs& args) {
+  int errors = 0;
+  for (const dialogue::CheckFinding& finding : dialogue::CheckDialogueFile(args.file)) {
+    std::cout << (finding.error ? "error: " : "warning: ") << finding.what << "\n";
+    errors += finding.error;
+  }
+  if (errors > 0) throw CommandError(args.file + ": " + std::to_string(errors) + " error(s): undefined names or unreachable states");
   const dialogue::Dialogue d = dialogue::LoadDialogue(args.file);
   std::size_t states = 0;
   std::size_t transitions = 0;
@@ -32,18 +38,8 @@ void RunCheck(const DialogueArgs& args) {
     states += m.states.size();
     transitions += m.transitions.size();
   }
-  int errors = 0;
-  for (const dialogue::CheckFinding& finding : dialogue::CheckDialogue(d)) {
-    std::cout << (finding.error ? "error: " : "warning: ") << finding.what << "\n";
-    errors += finding.error;
-  }
   std::cout << args.file << ": " << d.machines.size() << " machines, " << states << " states, " << transitions
-            << " transitions, " << d.variables.size() << " variables";
-  if (errors > 0) {
-    std::cout << "\n";
-    throw CommandError(args.file + ": " + std::to_string(errors) + " unreachable state(s)");
-  }
-  std::cout << ": ok\n";
+            << " transitions, " << d.variables.size() << " variables: ok\n";
 }
 
 void RunChatCommand(const DialogueArgs& args) {
