@@ -12,6 +12,10 @@ bool IsWordByte(char c) {
   return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '\'' || byte >= 0x80;
 }
 
+// What a pattern's words may hold: what the recogniser's dictionary spells words with
+// (listen/grammar.h: ASCII letters and apostrophes, numbers spelled out).
+bool IsPatternLetter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '\''; }
+
 char Lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
 
 std::string Shown(char c) {
@@ -63,10 +67,12 @@ Pattern Pattern::Compile(std::string_view text, const std::string& origin) {
         return fail("two wildcards side by side" + at + " (which words each takes would be a guess)");
       p.tokens_.push_back("*");
       if (++p.wildcards_ > kMaxWildcards) return fail("more than " + std::to_string(kMaxWildcards) + " wildcards");
-    } else if (IsWordByte(c)) {
+    } else if (IsPatternLetter(c)) {
       word += Lower(c);
+    } else if (c >= '0' && c <= '9') {
+      return fail(Shown(c) + at + ": numbers are spelled out ('ten', not '10'), as the recogniser's dictionary has them");
     } else {
-      return fail(Shown(c) + at + " is not a letter, digit, apostrophe, space or '*'");
+      return fail(Shown(c) + at + " is not a letter a-z, an apostrophe, a space or '*'");
     }
   }
   end_word();

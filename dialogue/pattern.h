@@ -23,7 +23,8 @@ inline constexpr std::size_t kMaxHeardBytes = 4096;
 class Pattern {
  public:
   // Throws DialogueError("<origin>: pattern '<text>' cannot compile: <why>") for an empty
-  // pattern, a character other than letters, digits, apostrophes, spaces and '*', a '*' inside a
+  // pattern, a character other than ASCII letters, apostrophes, spaces and '*' (numbers are
+  // spelled out, as the recogniser's grammar needs: listen/grammar.h), a '*' inside a
   // word, two wildcards side by side (their split would be a guess), more than nine wildcards, or more
   // than kMaxPatternTokens words and wildcards.
   static Pattern Compile(std::string_view text, const std::string& origin);

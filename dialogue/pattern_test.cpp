@@ -11,6 +11,7 @@ using Words = std::vector<std::string>;
 
 TEST(Pattern, CapturesTheWordsOfAWildcardWhateverThePunctuationAndCase) {
   const Pattern p = Pattern::Compile("Hello my name is *", "test");
+  EXPECT_EQ(Pattern::Compile("i am *", "test").Match("I am 25"), Words{"25"});  // heard digits are words
   EXPECT_EQ(p.text(), "hello my name is *");
   EXPECT_EQ(p.wildcards(), 1u);
   EXPECT_EQ(p.Match("Hello, my name is Ann!"), Words{"ann"});
@@ -55,7 +56,9 @@ TEST(Pattern, WhatCannotCompileIsOneLineSayingWhy) {
   } cases[] = {
       {"", "no word"},
       {"   ", "no word"},
-      {"hello, *", "',' at character 6"},
+      {"hello, *", "',' at character 6 is not a letter a-z"},
+      {"i am 25", "numbers are spelled out"},
+      {"caf\xc3\xa9 *", "not a letter a-z"},
       {"hel*o", "inside a word"},
       {"hello *there", "inside a word"},
       {"* *", "side by side"},
