@@ -14,7 +14,7 @@
 # Bottom to top: "module:layer". A module may include a module of a lower layer only.
 set(ARVIEW_LAYERS
   base:0
-  calib:1 anim:1 speech:1 audio:1 listen:1
+  calib:1 anim:1 speech:1 audio:1 listen:1 dialogue:1
   recordings:2 map:2 anim_authoring:2 room:2
   mapping:3 tracker:3 figure:3 render:3
   synth:4 video:4

@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 seconds=${1:-20}
 shift || true
-all_targets=(fuzz_camera fuzz_recording fuzz_trajectory fuzz_eval fuzz_map_file fuzz_colmap_model fuzz_colmap_database fuzz_scene fuzz_gltf fuzz_flags fuzz_image fuzz_room_light fuzz_speech_markup fuzz_wav)
+all_targets=(fuzz_camera fuzz_recording fuzz_trajectory fuzz_eval fuzz_map_file fuzz_colmap_model fuzz_colmap_database fuzz_scene fuzz_gltf fuzz_flags fuzz_image fuzz_room_light fuzz_speech_markup fuzz_wav fuzz_dialogue)
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=("${all_targets[@]}")
 data=${ARVIEW_DATA_DIR:-$root/../shared/data}
@@ -45,7 +45,7 @@ seed_from_data() {
 max_len_of() {
   case $1 in
     fuzz_gltf) echo 80000 ;;   # RiggedSimple.glb is 69 kB
-    fuzz_map_file | fuzz_colmap_model) echo 16384 ;;
+    fuzz_map_file | fuzz_colmap_model | fuzz_dialogue) echo 16384 ;;
     fuzz_speech_markup) echo 4096 ;;
     *) echo 8192 ;;
   esac

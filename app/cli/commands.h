@@ -35,5 +35,6 @@ void AddReplayCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);
 void AddDemoCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
+void AddDialogueCommand(CLI::App& app);
 
 }  // namespace arview::app

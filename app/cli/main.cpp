@@ -62,6 +62,7 @@ int main(int argc, char** argv) {
   AddRunCommand(app);
   AddDemoCommand(app);
   AddInfoCommand(app);
+  AddDialogueCommand(app);
   GuardNumericOptions(app);  // NaN, infinities and negative unsigned values are refused
 
   // CLI11 would report an unknown command as a missing subcommand; name it instead.

@@ -35,12 +35,13 @@ inline std::string ReadWholeFile(const std::string& path) {
   return ss.str();
 }
 
-inline CommandResult RunArview(const std::vector<std::string>& args) {
+// `stdin_path`: what the command reads as its standard input (a script for `dialogue chat`).
+inline CommandResult RunArview(const std::vector<std::string>& args, const std::string& stdin_path = "/dev/null") {
   const char* bin = std::getenv("ARVIEW_BIN");
   std::string cmd = ShellQuote(bin ? bin : "arview");
   for (const std::string& a : args) cmd += " " + ShellQuote(a);
   const std::string base = "/tmp/arview_cmd_" + std::to_string(::getpid());
-  cmd += " >" + base + ".out 2>" + base + ".err </dev/null";
+  cmd += " >" + base + ".out 2>" + base + ".err <" + ShellQuote(stdin_path);
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
