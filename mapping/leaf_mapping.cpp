@@ -40,8 +40,13 @@ struct LeafPlan {
 
 std::string RefineFlag(const MapBuildOptions& options) { return options.refine_intrinsics ? "1" : "0"; }
 
+// The merge's alignment counts an observation as agreeing within 4 px (the mapper's own
+// filter_max_reproj_error), not model_merger's default 64 px: with 64, templeRing's leaves were
+// merged 1.5 degrees apart, a misalignment too large for the triangulation's 4 px filter to keep
+// any track across it, so the bundle adjustment after could not close it (docs/mapping.md).
 Command MergeCommand(const fs::path& a, const fs::path& b, const fs::path& out) {
-  return {"model_merger", "--input_path1", a.string(), "--input_path2", b.string(), "--output_path", out.string()};
+  return {"model_merger", "--input_path1", a.string(), "--input_path2", b.string(), "--output_path", out.string(),
+          "--max_reproj_error", "4"};
 }
 
 Command TriangulateCommand(const MapBuildOptions& options, const LeafMappingPaths& paths, const fs::path& in,
