@@ -42,20 +42,23 @@ function(_arview_gtest_filter_regex filter out)
 endfunction()
 
 # arview_discover_tests(<test target> [DATA <gtest filter>] [SLOW_DATA <gtest filter>]
-#                       [SLOW <gtest filter>] [TSAN <gtest filter>] [ENVIRONMENT <VAR=value>])
+#                       [SLOW <gtest filter>] [SLURM <gtest filter>] [TSAN <gtest filter>]
+#                       [ENVIRONMENT <VAR=value>])
 #
 # Registers a GoogleTest binary's tests with ctest, labelled so that `ctest -LE slow` is the
 # quick loop and `ctest -L data` runs what reads ../shared/data:
 #   DATA       tests that read ../shared/data             label `data`
 #   SLOW_DATA  tests that read it and run over 30 s        labels `data` and `slow`
 #   SLOW       tests over 30 s that read no shared data    label `slow`
+#   SLURM      tests that submit jobs to the Slurm cluster of scripts/slurm-local.sh (and read
+#              the data, over 30 s)                       labels `data`, `slow` and `slurm`
 # Filters are gtest patterns joined by ':' (e.g. "TempleMapTest.*:Import.Fox"), disjoint; every
 # other test of the binary is registered without a label. Each group is one gtest_discover_tests
 # call with a TEST_FILTER, so a binary can mix quick and slow tests.
 #   TSAN       tests that run threads of ours, whichever group they are in: label `tsan` besides,
 #              run under ThreadSanitizer by `ctest --preset tsan` (scripts/test.sh --tsan)
 function(arview_discover_tests target)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;TSAN;ENVIRONMENT" "" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN;ENVIRONMENT" "" ${ARGN})
   _arview_gtest_filter_regex("${ARG_TSAN}" tsan_regex)
   # One variable: gtest_discover_tests (CMake 3.25) would split a list of them.
   set(environment "ARVIEW_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
@@ -63,7 +66,7 @@ function(arview_discover_tests target)
     set(environment "${ARG_ENVIRONMENT}")
   endif()
   set(labelled "")
-  foreach(group DATA SLOW_DATA SLOW)
+  foreach(group DATA SLOW_DATA SLOW SLURM)
     if(ARG_${group})
       list(APPEND labelled ${ARG_${group}})
     endif()
@@ -80,7 +83,7 @@ function(arview_discover_tests target)
   if(tsan_regex)
     _arview_label_discovered(${target} "" "${tsan_regex}")
   endif()
-  foreach(group DATA SLOW_DATA SLOW)
+  foreach(group DATA SLOW_DATA SLOW SLURM)
     if(NOT ARG_${group})
       continue()
     endif()
@@ -89,6 +92,8 @@ function(arview_discover_tests target)
       set(labels data slow)
     elseif(group STREQUAL "SLOW")
       set(labels slow)
+    elseif(group STREQUAL "SLURM")
+      set(labels data slow slurm)
     endif()
     gtest_discover_tests(${target} TEST_FILTER "${ARG_${group}}"
       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
@@ -101,17 +106,17 @@ function(arview_discover_tests target)
 endfunction()
 
 # arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>] [BENCH_DEPS <targets...>]
-#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>] [TSAN <filter>])
+#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>] [SLURM <filter>] [TSAN <filter>])
 #
 # One library per top-level folder: every *.cpp in the folder except *_test.cpp and
 # bench_*.cpp goes into the library `arview_<name>` (alias arview::<name>).
 # *_test.cpp files form one GoogleTest binary `<name>_tests`, run by ctest (DATA, SLOW_DATA,
-# SLOW: see arview_discover_tests).
+# SLOW, SLURM: see arview_discover_tests).
 # bench_*.cpp files form the Google Benchmark binary `bench_<name>`.
 # TEST_DEPS / BENCH_DEPS: what the tests / benchmarks link beyond the library (e.g. a runtime
 # library's tests loading assets through its authoring library).
 function(arview_module name)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;TSAN" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
   file(GLOB all_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(lib_sources "")
   set(test_sources "")
@@ -143,7 +148,7 @@ function(arview_module name)
     add_executable(${name}_tests ${test_sources})
     target_link_libraries(${name}_tests PRIVATE arview_${name} arview_testing ${ARG_TEST_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
     arview_discover_tests(${name}_tests DATA "${ARG_DATA}" SLOW_DATA "${ARG_SLOW_DATA}" SLOW "${ARG_SLOW}"
-                          TSAN "${ARG_TSAN}")
+                          SLURM "${ARG_SLURM}" TSAN "${ARG_TSAN}")
   endif()
 
   if(ARVIEW_BUILD_BENCHMARKS AND bench_sources)

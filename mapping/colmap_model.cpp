@@ -279,6 +279,9 @@ std::vector<ColmapPoint> ReadPoints(const fs::path& file, const CancellationToke
   return points;
 }
 
+// COLMAP's pair id: image_id1 * kMaxNumImages + image_id2, image_id1 < image_id2.
+constexpr sqlite3_int64 kMaxNumImages = 2147483647;
+
 // The database, read-only.
 class Database {
  public:
@@ -329,8 +332,6 @@ class Database {
       return pairs;
     }
     const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> st(raw, sqlite3_finalize);
-    // COLMAP's pair id: image_id1 * kMaxNumImages + image_id2, image_id1 < image_id2.
-    constexpr sqlite3_int64 kMaxNumImages = 2147483647;
     while (sqlite3_step(st.get()) == SQLITE_ROW) {
       const sqlite3_int64 pair_id = sqlite3_column_int64(st.get(), 0);
       const void* blob = sqlite3_column_blob(st.get(), 2);
@@ -347,6 +348,37 @@ class Database {
       pairs.push_back(g);
     }
     return pairs;
+  }
+
+  // Every verified pair with its inlier count, whatever its configuration (the match graph).
+  std::vector<VerifiedPair> VerifiedPairs() {
+    std::vector<VerifiedPair> pairs;
+    Statement st(*this, "SELECT pair_id, rows FROM two_view_geometries WHERE rows > 0");
+    int rc = SQLITE_ROW;
+    while ((rc = sqlite3_step(st.get())) == SQLITE_ROW) {
+      const sqlite3_int64 pair_id = sqlite3_column_int64(st.get(), 0);
+      if (pair_id < 0) Fail("a two-view geometry has the negative pair id " + std::to_string(pair_id));
+      pairs.push_back({static_cast<std::uint32_t>(pair_id / kMaxNumImages),
+                       static_cast<std::uint32_t>(pair_id % kMaxNumImages),
+                       static_cast<int>(std::min<sqlite3_int64>(sqlite3_column_int64(st.get(), 1), 1 << 30))});
+    }
+    if (rc != SQLITE_DONE) Fail("reading two_view_geometries");
+    return pairs;
+  }
+
+  // Every image's id and name, by id.
+  std::vector<std::pair<std::uint32_t, std::string>> Images() {
+    std::vector<std::pair<std::uint32_t, std::string>> images;
+    Statement st(*this, "SELECT image_id, name FROM images ORDER BY image_id");
+    int rc = SQLITE_ROW;
+    while ((rc = sqlite3_step(st.get())) == SQLITE_ROW) {
+      const sqlite3_int64 id = sqlite3_column_int64(st.get(), 0);
+      if (id <= 0 || id > kMaxNumImages) Fail("an image has the id " + std::to_string(id) + ", not one COLMAP gives");
+      const unsigned char* text = sqlite3_column_text(st.get(), 1);
+      images.emplace_back(static_cast<std::uint32_t>(id), text ? reinterpret_cast<const char*>(text) : "");
+    }
+    if (rc != SQLITE_DONE) Fail("reading images");
+    return images;
   }
 
   std::uint32_t ImageId(const std::string& name) {
@@ -644,6 +676,11 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
     result.push_back({a->second, b->second, pair.inliers, pair.essential});
   }
   return result;
+}
+
+DatabaseMatchGraph ReadMatchGraph(const fs::path& database) {
+  Database db(database);
+  return {db.Images(), db.VerifiedPairs()};
 }
 
 namespace {

@@ -71,6 +71,19 @@ std::vector<cv::Mat> ReadImageDescriptors(const std::filesystem::path& database,
 // a database without the table gives none. Throws MapError when the database cannot be opened.
 std::vector<TwoViewGeometry> ReadTwoViewGeometries(const std::filesystem::path& database, const map::Map& map);
 
+// One pair of images COLMAP verified (two_view_geometries), by COLMAP's image ids.
+struct VerifiedPair {
+  std::uint32_t image_a = 0, image_b = 0;
+  int inliers = 0;
+};
+// Every image of a database (id, name; by id) and every verified pair with inliers, for the match
+// graph (mapping/match_graph.h). Throws MapError when the database cannot be read.
+struct DatabaseMatchGraph {
+  std::vector<std::pair<std::uint32_t, std::string>> images;
+  std::vector<VerifiedPair> pairs;
+};
+DatabaseMatchGraph ReadMatchGraph(const std::filesystem::path& database);
+
 // Throws MapError naming the file of `sparse_dir` (images.bin, points3D.bin) that holds the first
 // value a map may not hold.
 void RequireModelValuesInRange(const map::Map& map, const std::filesystem::path& sparse_dir);

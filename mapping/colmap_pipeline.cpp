@@ -21,6 +21,7 @@
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
+#include "mapping/leaf_mapping.h"
 #include "mapping/map_extend.h"
 #include "mapping/pair_matching.h"
 #include "recordings/trajectory.h"
@@ -978,10 +979,16 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
 
   const std::vector<std::string> mapper_args = ColmapMapperArgs(options, database, images.root, sparse);
-  inputs += "--\n" + Joined(mapper_args);
+  const bool in_leaves = options.leaf_size > 0 && n > options.leaf_size;  // mapping/leaf_mapping.h
+  inputs += "--\n" + Joined(mapper_args) +
+            (in_leaves ? "leaves " + std::to_string(options.leaf_size) + " " + std::to_string(options.leaf_overlap) + "\n" : "");
   const std::string mapper_inputs = inputs;
   // `extra_args`: a retry's start (RetryFoldedMap), appended to the command and its inputs.
   const auto mapper = [&](const std::vector<std::string>& extra_args) {
+    if (in_leaves) {  // sparse/ is replaced only once the leaves are merged
+      const auto run = [&](std::vector<StageTiming>* steps) { MapInLeaves(options, {database, images.root, out_dir}, cb, steps); };
+      return stage("map", mapper_inputs, [] {}, run, fs::is_directory(sparse), nullptr);
+    }
     std::vector<std::string> args = mapper_args;
     args.insert(args.end(), extra_args.begin(), extra_args.end());
     stage(
@@ -1022,7 +1029,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   mapper({});
   t0 = std::chrono::steady_clock::now();
   read_model();
-  if (Folded(result.check) && options.fold_retries > 0) {
+  if (Folded(result.check) && options.fold_retries > 0 && !in_leaves) {
     // The kept model stands for the default command's outcome: a re-run skips the stage.
     const auto remember_stages = [&] { stages.Save("map", mapper_inputs); };
     RetryFoldedMap(options.fold_retries, out_dir, colmap.log(), stages, cb, mapper, read_model, remember_stages,

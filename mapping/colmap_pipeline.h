@@ -21,6 +21,7 @@
 #include "mapping/map_check.h"
 #include "mapping/metric_frame.h"
 #include "mapping/pair_matching.h"
+#include "mapping/slurm_engine.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -47,6 +48,15 @@ constexpr auto EnumNames(MatchEngine) {
       {{MatchEngine::kAuto, "auto"}, {MatchEngine::kArview, "arview"}, {MatchEngine::kColmap, "colmap"}}};
 }
 MatchEngine ParseMatchEngine(const std::string& text);  // throws MapError
+
+// Where the leaves of a map built in parts are mapped (MapBuildOptions::leaf_size,
+// mapping/leaf_mapping.h): one after another as child processes, or as jobs on a Slurm cluster
+// (mapping/slurm_engine.h).
+enum class MapEngine { kLocal, kSlurm };
+constexpr auto EnumNames(MapEngine) {
+  return EnumTable<MapEngine, 2>{{{MapEngine::kLocal, "local"}, {MapEngine::kSlurm, "slurm"}}};
+}
+MapEngine ParseMapEngine(const std::string& text);  // throws MapError (mapping/leaf_mapping.cpp)
 
 // Where a map's metres and up come from (mapping/metric_frame.h).
 enum class ScaleFrom { kNone, kBoard, kKnownDistance, kCameraHeight };
@@ -95,6 +105,15 @@ struct MapBuildOptions {
   // keep_folded: then the least folded model is written, with the warning.
   int fold_retries = 2;
   bool keep_folded = false;
+  // A venue in parts (mapping/leaf_mapping.h): with more frames than leaf_size, the match graph
+  // is cut into leaves of at most leaf_size frames (METIS on the inliers), each grown by
+  // leaf_overlap frames most strongly tied to it; each leaf is mapped alone (on `engine`) and
+  // the leaves merged (COLMAP's model_merger, point_triangulator, bundle_adjuster). The fold
+  // retries do not apply to a merged map. 0: one mapper over every frame (today's path).
+  int leaf_size = 0;
+  int leaf_overlap = 10;
+  MapEngine engine = MapEngine::kLocal;
+  SlurmOptions slurm;
   // The map made metric and upright before it is written (the COLMAP model too). A board that
   // cannot be used falls back to the camera-height estimate, and MapBuildResult::scale_failure
   // says why; with kCameraHeight, a map without a floor stays in COLMAP's frame (a note says so).

@@ -23,6 +23,8 @@ PACKAGES=(
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
+  libmetis-dev
+  slurmctld slurmd slurm-client munge
 )
 
 missing=()

@@ -617,6 +617,16 @@ TEST_F(Round4BadInputs, MapScaleRefusesOneRayAndAnotherMapsModelAndChangesNothin
                 At("map") + "/sparse/0: not the COLMAP model of " + At("map") + "/map.arvmap", 1);
 }
 
+// Issue 55: the venue flags of `arview map` refused before anything is written.
+TEST_F(Round4BadInputs, MapEngineFlagsThatDoNotGoTogetherAreRefused) {
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "slurm"},
+                "map: --engine slurm maps leaves as jobs: it needs --leaf-size", 2);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "cloud", "--leaf-size", "10"},
+                "--engine: cloud not in {local,slurm}", kFlagCheck);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--leaf-size", "-1"}, "--leaf-size", kFlagCheck);
+  EXPECT_FALSE(std::filesystem::exists(At("venue")));
+}
+
 TEST_F(Round4BadInputs, EvalRefusesTwoPosesAtOneTimeAndItsJsonSaysWhenNoRpeWasComputed) {
   std::ofstream(At("twice.txt")) << "1 0 0 0 0 0 0 1\n2 1 0 0 0 0 0 1\n2 1.5 0 0 0 0 0 1\n3 0 1 0 0 0 0 1\n";
   std::ofstream(At("one.txt")) << "1 0 0 0 0 0 0 1\n";

@@ -1,6 +1,7 @@
 // arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
 //            [--fold-retries N] [--keep-folded] [--board CxR --square M [--board-off-floor] | --no-metric]
+//            [--leaf-size N [--leaf-overlap N] [--engine local|slurm [--slurm-partition P] [--slurm-cpus N]]]
 // arview map info <map-dir>
 // arview map scale <map-dir> [<recording>] (--board CxR --square M [--board-off-floor] | --distance M --from .. --to ..)
 
@@ -45,6 +46,12 @@ struct MapArgs {
   int max_features = 0;  // 0: the preset's
   int fold_retries = mapping::MapBuildOptions().fold_retries;
   bool keep_folded = false;
+  // A venue in leaves (mapping/leaf_mapping.h).
+  int leaf_size = 0;
+  int leaf_overlap = mapping::MapBuildOptions().leaf_overlap;
+  std::string engine = "local";
+  std::string slurm_partition;
+  int slurm_cpus = 0;
   std::string info_dir;
   bool info_recheck = false;
   // Metres and up (mapping/metric_frame.h).
@@ -105,6 +112,12 @@ void RunMap(const MapArgs& args) {
   if (args.max_features > 0) options.max_num_features = args.max_features;
   options.fold_retries = args.fold_retries;
   options.keep_folded = args.keep_folded;
+  options.leaf_size = args.leaf_size;
+  options.leaf_overlap = args.leaf_overlap;
+  options.slurm.partition = args.slurm_partition;
+  options.slurm.cpus_per_task = args.slurm_cpus;
+  if (args.engine == "slurm" && args.leaf_size == 0)
+    throw CommandError("map: --engine slurm maps leaves as jobs: it needs --leaf-size", 2);
   if (!args.board.empty()) {
     if (args.no_metric) throw CommandError("map: --board and --no-metric exclude each other", 2);
     options.scale.from = mapping::ScaleFrom::kBoard;
@@ -119,6 +132,7 @@ void RunMap(const MapArgs& args) {
   try {
     options.matcher = mapping::ParseMatcherKind(args.matcher);
     options.match_engine = mapping::ParseMatchEngine(args.match_engine);
+    options.engine = mapping::ParseMapEngine(args.engine);
     const recordings::Recording recording = recordings::LoadRecording(args.recording);
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
     bar.Finish();
@@ -286,6 +300,24 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_flag("--keep-folded", args->keep_folded,
                 "Write the map even when it is still folded after --fold-retries (the least folded model, with "
                 "the warning); by default such a map is refused");
+  cmd->add_option("--leaf-size", args->leaf_size,
+                  "Map in parts: with more frames than this, cut the match graph (METIS on the inliers) into leaves "
+                  "of at most this many frames, map each alone and merge them (0: one mapper over every frame)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
+  cmd->add_option("--leaf-overlap", args->leaf_overlap,
+                  "Frames added to each leaf from its neighbours, the most strongly matched first, for the merge")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
+  cmd->add_option("--engine", args->engine,
+                  "Where the leaves are mapped: local (one after another here) or slurm (a job array and a merge job "
+                  "through sbatch; the map folder must be on a filesystem every node sees)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"local", "slurm"}));
+  cmd->add_option("--slurm-partition", args->slurm_partition, "The Slurm partition of the jobs (default: the cluster's)");
+  cmd->add_option("--slurm-cpus", args->slurm_cpus, "CPUs each Slurm job asks for (0: --threads)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();

@@ -1,0 +1,43 @@
+#pragma once
+// `arview map --leaf-size N`: COLMAP's mapper run on leaves of the match graph instead of every
+// frame at once, and the leaves merged, as COLMAP's hierarchical mapper does, so that the leaves
+// can run on several machines (`--engine slurm`, mapping/slurm_engine.h). Internal to mapping/:
+// BuildMap's map stage calls it in place of the one mapper.
+//
+//   partition   the database's match graph cut with METIS (mapping/match_graph.h)
+//   leaves      <out>/leaves/<i>/images.txt, COLMAP mapper on those images (one model:
+//               --Mapper.multiple_models 0) ─► <out>/leaves/<i>/sparse/0
+//   merge       model_merger leaf by leaf (each next the leaf sharing the most images with those
+//               merged), then point_triangulator (tracks from the database's matches again)
+//               and bundle_adjuster over everything ─► <out>/leaves/adjusted
+//   check       every image some leaf registered is in each merge's output (model_merger exits 0
+//               when it cannot merge); then <out>/sparse is replaced by the adjusted model
+//
+// On any failure <out>/sparse is left as it was; the logs stay in <out>/leaves.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "mapping/colmap_pipeline.h"
+#include "mapping/match_graph.h"
+
+namespace arview::mapping {
+
+struct LeafMappingPaths {
+  std::filesystem::path database;    // the extracted and matched COLMAP database
+  std::filesystem::path image_root;  // the images COLMAP reads
+  std::filesystem::path out_dir;     // the map folder: leaves/ and sparse/ in it
+};
+
+// Maps the leaves on options.engine and merges them into <out_dir>/sparse/0; `steps` receives
+// the time of the leaves and of the merge. Throws MapError naming the leaf or merge step that
+// failed and why (ColmapStageError, SlurmError), CancelledError.
+void MapInLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb,
+                 std::vector<StageTiming>* steps);
+
+// The order the leaves are merged in: leaf 0 first, then each time the leaf sharing the most
+// images (core and overlap) with those merged so far.
+std::vector<int> MergeOrder(const Partition& partition);
+
+}  // namespace arview::mapping

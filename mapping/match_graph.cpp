@@ -1,0 +1,148 @@
+#include "mapping/match_graph.h"
+
+#include <metis.h>
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+#include "map/map.h"
+
+namespace arview::mapping {
+
+namespace {
+
+// The subgraph on `vertices` in METIS's compressed form (local indices).
+struct CsrGraph {
+  std::vector<idx_t> xadj{0}, adjncy, adjwgt;
+};
+
+CsrGraph InducedSubgraph(const std::vector<std::vector<std::pair<int, int>>>& adjacency, const std::vector<int>& vertices) {
+  std::unordered_map<int, idx_t> local;
+  for (std::size_t i = 0; i < vertices.size(); ++i) local[vertices[i]] = static_cast<idx_t>(i);
+  CsrGraph csr;
+  for (const int v : vertices) {
+    for (const auto& [u, weight] : adjacency[v]) {
+      const auto it = local.find(u);
+      if (it == local.end()) continue;
+      csr.adjncy.push_back(it->second);
+      csr.adjwgt.push_back(weight);
+    }
+    csr.xadj.push_back(static_cast<idx_t>(csr.adjncy.size()));
+  }
+  return csr;
+}
+
+// `vertices` cut in two halves of (nearly) equal size where the edges are weakest.
+std::pair<std::vector<int>, std::vector<int>> Bisect(const std::vector<std::vector<std::pair<int, int>>>& adjacency,
+                                                     const std::vector<int>& vertices) {
+  CsrGraph csr = InducedSubgraph(adjacency, vertices);
+  idx_t n = static_cast<idx_t>(vertices.size()), constraints = 1, parts = 2, cut = 0;
+  std::vector<idx_t> part(vertices.size(), 0);
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_SEED] = 1;
+  options[METIS_OPTION_NUMBERING] = 0;
+  const int rc = METIS_PartGraphRecursive(&n, &constraints, csr.xadj.data(), csr.adjncy.data(), nullptr, nullptr,
+                                          csr.adjwgt.data(), &parts, nullptr, nullptr, options, &cut, part.data());
+  if (rc != METIS_OK) {
+    throw map::MapError("METIS could not partition the match graph of " + std::to_string(vertices.size()) +
+                        " images (METIS error " + std::to_string(rc) + ")");
+  }
+  std::pair<std::vector<int>, std::vector<int>> halves;
+  for (std::size_t i = 0; i < vertices.size(); ++i) (part[i] == 0 ? halves.first : halves.second).push_back(vertices[i]);
+  // METIS may leave a half empty on a graph without edges: split it in the middle then.
+  if (halves.first.empty() || halves.second.empty()) {
+    const auto middle = vertices.begin() + static_cast<std::ptrdiff_t>(vertices.size() / 2);
+    halves = {std::vector<int>(vertices.begin(), middle), std::vector<int>(middle, vertices.end())};
+  }
+  return halves;
+}
+
+void SplitUntilSmall(const std::vector<std::vector<std::pair<int, int>>>& adjacency, const std::vector<int>& vertices,
+                     int leaf_size, std::vector<Leaf>* leaves) {
+  if (static_cast<int>(vertices.size()) <= leaf_size) {
+    leaves->push_back({vertices, {}});
+    return;
+  }
+  const auto [first, second] = Bisect(adjacency, vertices);
+  SplitUntilSmall(adjacency, first, leaf_size, leaves);
+  SplitUntilSmall(adjacency, second, leaf_size, leaves);
+}
+
+// The `count` outside vertices with the strongest single edge into the leaf (as COLMAP's scene
+// clustering picks its overlapping images), strongest first; ties by vertex.
+std::vector<int> StrongestOutside(const std::vector<std::vector<std::pair<int, int>>>& adjacency,
+                                  const std::vector<int>& core, int count) {
+  std::vector<char> inside(adjacency.size(), 0);
+  for (const int v : core) inside[v] = 1;
+  std::unordered_map<int, int> strongest;
+  for (const int v : core) {
+    for (const auto& [u, weight] : adjacency[v]) {
+      if (!inside[u]) strongest[u] = std::max(strongest[u], weight);
+    }
+  }
+  std::vector<std::pair<int, int>> ranked(strongest.begin(), strongest.end());
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& x, const auto& y) { return x.second != y.second ? x.second > y.second : x.first < y.first; });
+  std::vector<int> chosen;
+  for (std::size_t i = 0; i < ranked.size() && static_cast<int>(i) < count; ++i) chosen.push_back(ranked[i].first);
+  return chosen;
+}
+
+}  // namespace
+
+std::vector<int> Leaf::All() const {
+  std::vector<int> all = core;
+  all.insert(all.end(), overlap.begin(), overlap.end());
+  return all;
+}
+
+MatchGraph BuildMatchGraph(const DatabaseMatchGraph& database, int min_inliers) {
+  MatchGraph graph;
+  std::unordered_map<std::uint32_t, int> vertex_of_image;
+  for (const auto& [id, name] : database.images) {
+    vertex_of_image[id] = static_cast<int>(graph.names.size());
+    graph.names.push_back(name);
+  }
+  for (const auto& pair : database.pairs) {
+    if (pair.inliers < min_inliers || pair.image_a == pair.image_b) continue;
+    const auto a = vertex_of_image.find(pair.image_a), b = vertex_of_image.find(pair.image_b);
+    if (a == vertex_of_image.end() || b == vertex_of_image.end()) continue;  // a pair of an image no longer listed
+    graph.edges.push_back({a->second, b->second, pair.inliers});
+  }
+  return graph;
+}
+
+Partition PartitionMatchGraph(const MatchGraph& graph, const PartitionOptions& options) {
+  if (options.leaf_size < 2) throw map::MapError("a leaf must hold at least 2 images (leaf size " + std::to_string(options.leaf_size) + ")");
+  if (options.overlap < 0) throw map::MapError("the leaves' overlap cannot be negative (" + std::to_string(options.overlap) + ")");
+  std::vector<std::vector<std::pair<int, int>>> adjacency(graph.names.size());
+  for (const auto& e : graph.edges) {
+    adjacency[e.a].emplace_back(e.b, e.weight);
+    adjacency[e.b].emplace_back(e.a, e.weight);
+  }
+  std::vector<int> all(graph.names.size());
+  std::iota(all.begin(), all.end(), 0);
+  Partition partition;
+  SplitUntilSmall(adjacency, all, options.leaf_size, &partition.leaves);
+  std::vector<int> group(graph.names.size(), 0);
+  for (std::size_t l = 0; l < partition.leaves.size(); ++l) {
+    for (const int v : partition.leaves[l].core) group[v] = static_cast<int>(l);
+  }
+  partition.cut_weight = CutWeight(graph, group);
+  if (partition.leaves.size() > 1) {
+    for (auto& leaf : partition.leaves) leaf.overlap = StrongestOutside(adjacency, leaf.core, options.overlap);
+  }
+  return partition;
+}
+
+long long CutWeight(const MatchGraph& graph, const std::vector<int>& group) {
+  long long cut = 0;
+  for (const auto& e : graph.edges) {
+    if (group[e.a] != group[e.b]) cut += e.weight;
+  }
+  return cut;
+}
+
+}  // namespace arview::mapping

@@ -1,0 +1,76 @@
+#pragma once
+// Running `arview map`'s parallel stages on a Slurm cluster (`--engine slurm`,
+// docs/mapping.md, "A venue in leaves"): one job array whose tasks are independent commands (each
+// leaf's COLMAP mapper), then one job that runs after all of them succeeded (afterok: the merge),
+// submitted with sbatch and followed with squeue until they end. The job scripts and logs live in
+// a work folder every node must see (the map folder on a shared filesystem).
+//
+// A task or job that fails, is cancelled or times out cancels every other (scancel: no job is
+// left queued on a dependency that can never be met) and is one SlurmError naming it and the last
+// line it printed. A cancelled token (Ctrl-C) cancels the jobs the same way.
+
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "base/cancellation.h"
+#include "map/map.h"
+
+namespace arview::mapping {
+
+struct SlurmError : map::MapError {
+  using map::MapError::MapError;
+};
+
+struct SlurmOptions {
+  std::string sbatch = "sbatch", squeue = "squeue", scancel = "scancel";
+  std::string partition;  // --slurm-partition; empty: the cluster's default
+  int cpus_per_task = 0;  // --slurm-cpus; 0: the command's --threads (1 when --threads is -1)
+  std::chrono::milliseconds poll{1000};
+  // squeue failing (slurmctld down, unreachable) for this long fails the run.
+  std::chrono::seconds unanswered_limit{60};
+};
+
+using Command = std::vector<std::string>;
+
+// The job array and the job after it.
+struct SlurmJobPlan {
+  std::filesystem::path work_dir;     // job scripts and logs (created)
+  std::string job_name = "arview";
+  std::vector<Command> tasks;         // array task i runs tasks[i]
+  std::vector<std::string> task_names;  // for messages: "leaf 2 (12 images)"
+  std::vector<Command> final_commands;  // run one after another by the job after the array
+  std::string final_name = "the final job";
+  // A line that, printed by a final command, fails the job (COLMAP's model_merger exits 0 when
+  // it cannot merge and says "=> Merge failed"). Empty: none.
+  std::string final_failure_marker;
+};
+
+// Where the job of `plan` writes its output: task i's log, the final job's log.
+std::filesystem::path TaskLog(const SlurmJobPlan& plan, int task);
+std::filesystem::path FinalLog(const SlurmJobPlan& plan);
+
+// Submits the plan and waits until every job ended. `progress(done, total)` counts finished
+// tasks and the final job. Throws SlurmError (a job failed, sbatch refused, squeue stopped
+// answering), CancelledError (the jobs cancelled first), ProcessError (sbatch not found).
+void RunSlurmJobs(const SlurmJobPlan& plan, const SlurmOptions& options, int cpus_per_task,
+                  const CancellationToken& cancel, const std::function<void(int done, int total)>& progress);
+
+// A word quoted for bash ('...' with ' as '\''); a command line of such words.
+std::string ShellQuoted(const std::string& word);
+std::string ShellLine(const Command& command);
+
+// Parses squeue's "-h -r -o %i|%T" lines: job id (array tasks as <job>_<task>) and state.
+struct SlurmJobState {
+  std::string id;
+  std::string state;  // PENDING, RUNNING, COMPLETED, FAILED, CANCELLED, ...
+};
+std::vector<SlurmJobState> ParseSqueue(const std::vector<std::string>& lines);
+// Whether a state is final and a failure (FAILED, CANCELLED, TIMEOUT, NODE_FAIL, OUT_OF_MEMORY,
+// BOOT_FAIL, DEADLINE, PREEMPTED), final and a success (COMPLETED).
+bool SlurmStateFailed(const std::string& state);
+bool SlurmStateCompleted(const std::string& state);
+
+}  // namespace arview::mapping
