@@ -899,6 +899,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   // Absolute paths in COLMAP's command lines: the stage records then do not depend on the
   // working directory, and the database names a folder COLMAP's GUI finds from anywhere.
   const fs::path out_dir = fs::absolute(out_dir_arg).lexically_normal();
+  options.Check(OptionNames().Nested("mapping"));
   CandidateFrames(recording, options);  // a bad --frames fails before anything is written
   std::error_code ec;
   fs::create_directories(out_dir, ec);

@@ -16,6 +16,7 @@
 
 #include "base/cancellation.h"
 #include "base/enum_table.h"
+#include "base/option_check.h"
 #include "map/map.h"
 #include "mapping/frame_selection.h"
 #include "mapping/map_check.h"
@@ -132,6 +133,10 @@ struct MapBuildOptions {
   // Cancelled (Ctrl-C, SIGTERM): the running COLMAP stage is stopped, BuildMap throws
   // CancelledError, and the stages finished before stay recorded for a re-run.
   CancellationToken cancel;
+
+  // Throws OptionError naming the first bad field (base/option_check.h); BuildMap and ExtendMap
+  // call it before anything is written (mapping/map_build_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 // A COLMAP stage that failed: the message says which and why; `log_tail` holds the last lines

@@ -669,6 +669,7 @@ std::optional<Sim3> RequireOwnModel(const fs::path& model_dir, const map::Map& m
 MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recording& recording,
                           const MapExtendOptions& options_arg, const MapBuildCallbacks& cb) {
   const fs::path map_dir = fs::absolute(map_dir_arg).lexically_normal();
+  options_arg.build.Check(OptionNames().Nested("mapping"));
   const OldMap old = RequireExtendableMap(map_dir);
   RequireSameCamera(old.map.camera, recording, cb);
   if (FindExecutable(options_arg.build.colmap).empty())

@@ -360,7 +360,18 @@ OffscreenContext::OffscreenContext(GlBackend backend, int device, int threads) {
   info_.threads = threads;
 }
 
+void OffscreenOptions::Check(const OptionNames& names) const {
+  // Only auto and egl-device choose among EGL's devices: taken with another, it would be ignored.
+  if (device && backend != GlBackend::kAuto && backend != GlBackend::kEglDevice) {
+    throw OptionError(names("device") + " " + std::to_string(*device) + " picks an EGL device: it needs " +
+                      names("backend") + " auto or egl-device (" + names("backend") + " " + ToString(backend) +
+                      " renders without one)");
+  }
+  RequireOption(threads >= 0, names("threads"), "0 (the calling thread) or more", threads);
+}
+
 std::unique_ptr<OffscreenContext> OffscreenContext::Create(const OffscreenOptions& options) {
+  options.Check(OptionNames().Nested("gl"));
   const bool uses_devices = options.backend == GlBackend::kAuto || options.backend == GlBackend::kEglDevice;
   const char* environment = std::getenv("ARVIEW_GL_DEVICE");
   const std::optional<int> requested = uses_devices ? RequestedGlDevice(options.device, environment) : std::nullopt;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "base/option_check.h"
 #include "render/gl_api.h"
 #include "render/gl_selection.h"
 #include "render/render_error.h"
@@ -43,6 +44,10 @@ struct OffscreenOptions {
   // Tests: create EGL contexts as for a driver without EGL_KHR_no_config_context and
   // EGL_KHR_surfaceless_context (a chosen config and a 1x1 pbuffer), the path other drivers take.
   bool egl_config_and_pbuffer = false;
+
+  // Throws OptionError naming the first bad field (base/option_check.h): a `device` with a
+  // backend that uses none, negative `threads`. OffscreenContext::Create calls it first.
+  void Check(const OptionNames& names = {}) const;
 };
 
 // What the context renders on, for start-up lines, --stats and `arview info gl`.

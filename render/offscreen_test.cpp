@@ -79,6 +79,37 @@ TEST(Offscreen, DescribesTheRendererItTookAndWhatItTriedBefore) {
   }
 }
 
+// OffscreenOptions::Check: an EGL device with a backend that uses none would be ignored; the
+// context is not even tried.
+TEST(OffscreenOptionsCheck, ADeviceWithABackendThatUsesNoneIsRefusedNamingBoth) {
+  OffscreenOptions options;
+  options.backend = GlBackend::kOsMesa;
+  options.device = 5;
+  try {
+    OffscreenContext::Create(options);
+    FAIL() << "device 5 with osmesa accepted";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "gl.device 5 picks an EGL device: it needs gl.backend auto or egl-device (gl.backend osmesa "
+                           "renders without one)");
+  }
+  try {
+    options.Check(OptionNames({{"device", "--gl-device"}, {"backend", "--gl"}}));
+    FAIL() << "device 5 with osmesa accepted";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "--gl-device 5 picks an EGL device: it needs --gl auto or egl-device (--gl osmesa renders "
+                           "without one)");
+  }
+  options.backend = GlBackend::kEglDevice;
+  EXPECT_NO_THROW(options.Check());
+  options.threads = -1;
+  try {
+    options.Check();
+    FAIL() << "threads -1 accepted";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "threads must be 0 (the calling thread) or more (got -1)");
+  }
+}
+
 TEST(Offscreen, ANamedDeviceThatDoesNotExistIsRefused) {
   testing::SharedContext();
   try {

@@ -604,6 +604,26 @@ TEST_F(Round4BadInputs, FlagsThatWereTakenAndIgnoredAreRefused) {
                 "--gl-device 5 picks an EGL device: it needs --gl auto or egl-device", 2);
 }
 
+// The checks the options structs hold (TrackerOptions::Check, CompositorOptions::Check), met
+// through the flags that set them: the line names the flags, with the status the command gave
+// them before the checks moved into the structs (track: usage, 2; replay: 1).
+TEST_F(Round4BadInputs, OptionsChecksNameTheFlagsThatSetTheFields) {
+  const std::vector<std::string> track = {"track", At("rec"), "--map", At("map"), "--out", At("t.txt")};
+  auto with = [](std::vector<std::string> args, const std::vector<std::string>& more) {
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  };
+  ExpectRefused(with(track, {"--working-size", "32"}), "arview: --working-size must be 0 (full resolution) or at least 64 (got 32)", 2);
+  ExpectRefused(with(track, {"--sift-size", "63"}), "arview: --sift-size must be 0 (the working resolution) or at least 64 (got 63)", 2);
+  ExpectRefused(with(track, {"--reloc-sift-size", "10"}), "arview: --reloc-sift-size must be 0 (as --sift-size) or at least 64 (got 10)", 2);
+  EXPECT_FALSE(std::filesystem::exists(At("t.txt")));
+  const std::vector<std::string> replay = {"replay", At("rec"), "--map", At("map"), "--out", "null"};
+  ExpectRefused(with(replay, {"--stereo-character"}), "arview: --stereo-character needs --hmd or --hmd-profile", 1);
+  ExpectRefused(with(replay, {"--tracking-worker", "on", "--prefetch-below", "0"}),
+                "arview: --prefetch-below 0 needs --tracking-worker off: with the worker, guided matching's SIFT is "
+                "extracted only ahead", 1);
+}
+
 TEST_F(Round4BadInputs, MapScaleRefusesOneRayAndAnotherMapsModelAndChangesNothing) {
   // The stub's keyframes are frames/000001.png and frames/000002.png.
   ExpectRefused({"map", "scale", At("map"), "--distance", "0.5", "--from", "000001.png@100,80", "000001.png@100,80",

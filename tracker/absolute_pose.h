@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "base/option_check.h"
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "tracker/ransac_p3p.h"
@@ -37,6 +38,9 @@ struct AbsolutePoseOptions {
   // Inlier world points whose second principal extent is below this fraction of the first lie
   // on a line: rotation about that line is unobservable.
   double min_collinearity_ratio = 0.02;
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 enum class PoseFailure {

@@ -7,6 +7,8 @@
 
 #include <vector>
 
+#include "base/option_check.h"
+
 namespace arview::tracker {
 
 struct FeatureOptions {
@@ -18,6 +20,9 @@ struct FeatureOptions {
   double contrast_threshold = 0.04;
   double edge_threshold = 10;
   double sigma = 1.6;
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 struct Features {

@@ -5,12 +5,17 @@
 
 #include <Eigen/Core>
 
+#include "base/option_check.h"
+
 namespace arview::tracker {
 
 struct OneEuroOptions {
   double min_cutoff_hz = 1.0;  // cutoff at rest: lower = smoother, more lag
   double beta = 0.5;           // cutoff growth per unit of speed (units/s): higher = less lag
   double derivative_cutoff_hz = 1.0;
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 class OneEuroFilter {

@@ -21,6 +21,9 @@ struct MatchOptions {
   // are fetched to find the nearest other point.
   double ratio = 0.8;
   int knn = 4;
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 // A frame keypoint matched to a map point.
@@ -85,6 +88,9 @@ struct RelocalizerOptions {
   // (docs/tracker.md, "RANSAC at 2 px when relocalising"). Tracking's RANSAC
   // keeps its own threshold (TrackingOptions::ransac_threshold_px).
   AbsolutePoseOptions pose = RelocalizationPoseOptions();
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 
 struct RelocalizationResult {

@@ -25,11 +25,17 @@ void CopyStats(const AbsolutePoseResult& pose, FrameResult* result) {
   result->times.refine_ms += pose.stats.refine_ms;
 }
 
+// The options, once they passed their Check(): the tracker's members are built from them.
+const TrackerOptions& Checked(const TrackerOptions& options) {
+  options.Check(OptionNames().Nested("tracker"));
+  return options;
+}
+
 }  // namespace
 
 Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
     : map_(map),
-      options_(options),
+      options_(Checked(options)),  // before any member is built from them
       resolution_(map.camera, options.working_long_side),
       rms_gate_(options.tracking.rms_gate),
       smoother_(options.smoothing) {

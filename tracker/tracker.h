@@ -135,6 +135,9 @@ struct TrackingOptions {
   // `background` (a live session).
   double fresh_features_after_s = 0.25;
   double fresh_max_rotation_deg = 3;
+
+  // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
+  void Check(const OptionNames& names = {}) const;
 };
 // TrackingOptions::prefetch_below of a live session (TrackingOptions::background), where guided
 // matching's SIFT is only ever extracted ahead (docs/tracker.md, "The tracking worker").
@@ -162,6 +165,10 @@ struct TrackerOptions {
   // Where the map's descriptor index is kept between sessions (map::DescriptorIndex::Cached);
   // empty: built every time. The same index either way.
   std::filesystem::path index_cache_folder;
+
+  // Throws OptionError naming the first bad field, of this struct or a member's (the Tracker
+  // calls it at construction; `arview track` first, with its flags' names).
+  void Check(const OptionNames& names = {}) const;
 };
 
 struct StageTimes {
@@ -212,8 +219,9 @@ struct FrameResult {
 // only the map and its index, which both only read (tracker/tracking_worker.h).
 class Tracker {
  public:
-  // Validates the map and builds its descriptor index. `map` must outlive the tracker.
-  // Throws TrackerError when the map has too few points or inconsistent descriptors.
+  // Checks the options (OptionError naming the field, as "tracker.<path>"), validates the map and
+  // builds its descriptor index. `map` must outlive the tracker. Throws TrackerError when the map
+  // has too few points or inconsistent descriptors.
   Tracker(const map::Map& map, const TrackerOptions& options = {});
   ~Tracker();
 

@@ -36,16 +36,17 @@ struct MapArgs {
   std::string recording;
   std::string out;
   std::string frames;
-  std::string matcher = "auto";
-  std::string match_engine = "auto";
-  int max_frames = 300;
-  bool refine_intrinsics = false;
-  int threads = 2;
-  std::string colmap = "colmap";
+  // The defaults are MapBuildOptions' own.
+  std::string matcher = ToString(mapping::MapBuildOptions().matcher);
+  std::string match_engine = ToString(mapping::MapBuildOptions().match_engine);
+  int max_frames = mapping::MapBuildOptions().max_frames;
+  bool refine_intrinsics = mapping::MapBuildOptions().refine_intrinsics;
+  int threads = mapping::MapBuildOptions().threads;
+  std::string colmap = mapping::MapBuildOptions().colmap;
   std::string preset = "quality";
   int max_features = 0;  // 0: the preset's
   int fold_retries = mapping::MapBuildOptions().fold_retries;
-  bool keep_folded = false;
+  bool keep_folded = mapping::MapBuildOptions().keep_folded;
   // A venue in leaves (mapping/leaf_mapping.h).
   int leaf_size = 0;
   int leaf_overlap = mapping::MapBuildOptions().leaf_overlap;

@@ -20,12 +20,13 @@ struct ExtendArgs {
   std::string map_dir;
   std::string recording;
   std::string frames;
-  int max_frames = 300;
-  std::string matcher = "auto";
+  // The defaults are MapExtendOptions' own.
+  int max_frames = mapping::MapExtendOptions().build.max_frames;
+  std::string matcher = ToString(mapping::MapExtendOptions().build.matcher);
   int old_neighbours = mapping::MapExtendOptions().old_neighbours;
   int max_features = 0;  // 0: the map's own
-  int threads = 2;
-  std::string colmap = "colmap";
+  int threads = mapping::MapExtendOptions().build.threads;
+  std::string colmap = mapping::MapExtendOptions().build.colmap;
 };
 
 using mapping::Fixed;

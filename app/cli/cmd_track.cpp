@@ -15,6 +15,7 @@
 
 #include "app/cli/commands.h"
 #include "app/cli/numeric_flags.h"
+#include "app/cli/option_flags.h"
 #include "app/cli/output_flags.h"
 #include "base/progress.h"
 #include "app/cli/session_flags.h"
@@ -39,74 +40,17 @@ struct TrackArgs {
   std::string out;
   std::string frames;
   std::string stats;
-  std::string solver = "kneip";
-  int max_features = tracker::RelocalizerOptions{}.features.max_features;
-  double sift_contrast = tracker::RelocalizerOptions{}.features.contrast_threshold;
-  int reduced_max_features = tracker::RelocalizerOptions{}.reduced_features.max_features;
-  double reduced_sift_contrast = tracker::RelocalizerOptions{}.reduced_features.contrast_threshold;
-  double guided_sift_contrast = tracker::TrackingOptions{}.guided_contrast_threshold;
-  double ratio = 0.8;
-  double ransac_threshold_px = tracker::RelocalizerOptions{}.pose.ransac_threshold_px;
-  double inlier_threshold_px = tracker::RelocalizerOptions{}.pose.inlier_threshold_px;
-  double tracking_ransac_threshold_px = tracker::TrackingOptions{}.ransac_threshold_px;
-  int ransac_iterations = 1000;
-  int min_inliers = 12;
-  double max_rms_px = 2.5;
-  int tracking_min_inliers = 30;
-  int replenish_below = 150;
-  double fresh_features_after = tracker::TrackingOptions{}.fresh_features_after_s;
-  int prefetch_below = tracker::TrackingOptions{}.prefetch_below;
-  int prefetch_lag = tracker::TrackingOptions{}.prefetch_lag_frames;
-  double guided_radius_px = 10;
-  int lk_window = tracker::TrackingOptions{}.lk_window_px;
-  int lk_levels = tracker::TrackingOptions{}.lk_pyramid_levels;
-  double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
-  int index_checks = 32;
-  unsigned seed = 0;
+  std::string solver = ToString(tracker::RelocalizerOptions{}.pose.solver);
   int threads = 1;
-  double smoothing_min_cutoff = 1.0;
-  double smoothing_beta = 0.5;
-  int working_size = tracker::TrackerOptions{}.working_long_side;
-  int sift_size = tracker::RelocalizerOptions{}.sift_long_side;
-  int reloc_sift_size = tracker::RelocalizerOptions{}.reloc_sift_long_side;
+  // The tracker flags are bound to these fields: their defaults are TrackerOptions' own.
+  tracker::TrackerOptions options;
+  OptionFlags flags;
 };
 
 tracker::TrackerOptions MakeOptions(const TrackArgs& a) {
-  tracker::TrackerOptions o;
-  try {
-    o.relocalization.pose.solver = tracker::ParseMinimalSolver(a.solver);
-  } catch (const Error& e) {
-    throw CommandError(std::string("--solver: ") + e.what());
-  }
-  o.relocalization.features.max_features = a.max_features;
-  o.relocalization.features.contrast_threshold = a.sift_contrast;
-  o.relocalization.reduced_features.max_features = a.reduced_max_features;
-  o.relocalization.reduced_features.contrast_threshold = a.reduced_sift_contrast;
-  o.relocalization.matching.ratio = a.ratio;
-  o.relocalization.pose.ransac_threshold_px = a.ransac_threshold_px;
-  o.relocalization.pose.inlier_threshold_px = a.inlier_threshold_px;
-  o.tracking.ransac_threshold_px = a.tracking_ransac_threshold_px;
-  o.relocalization.pose.ransac_max_iterations = a.ransac_iterations;
-  o.relocalization.pose.min_inliers = a.min_inliers;
-  o.relocalization.pose.max_rms_px = a.max_rms_px;
-  o.relocalization.pose.seed = a.seed;
-  o.tracking.min_inliers = a.tracking_min_inliers;
-  o.tracking.replenish_below = a.replenish_below;
-  o.tracking.fresh_features_after_s = a.fresh_features_after;
-  o.tracking.prefetch_below = a.prefetch_below;
-  o.tracking.prefetch_lag_frames = a.prefetch_lag;
-  o.tracking.guided_radius_px = a.guided_radius_px;
-  o.tracking.guided_contrast_threshold = a.guided_sift_contrast;
-  o.tracking.lk_window_px = a.lk_window;
-  o.tracking.lk_pyramid_levels = a.lk_levels;
-  o.tracking.align_max_seconds = a.align_max_seconds;
-  o.smoothing.min_cutoff_hz = a.smoothing_min_cutoff;
-  o.smoothing.beta = a.smoothing_beta;
-  o.index.seed = a.seed;
-  o.index.checks = a.index_checks;
-  o.working_long_side = a.working_size;
-  o.relocalization.sift_long_side = a.sift_size;
-  o.relocalization.reloc_sift_long_side = a.reloc_sift_size;
+  tracker::TrackerOptions o = a.options;
+  o.relocalization.pose.solver = tracker::ParseMinimalSolver(a.solver);  // --solver's check let only these through
+  o.index.seed = o.relocalization.pose.seed;  // --seed: RANSAC's and the FLANN index's
   return o;
 }
 
@@ -183,15 +127,8 @@ void WriteStatsJson(const std::filesystem::path& path, const TrackArgs& args,
 
 void RunTrack(const TrackArgs& args) {
   RequireDistinctOutputs({{"--out", args.out}, {"--stats", args.stats}});
-  if (args.working_size != 0 && args.working_size < 64)
-    throw CommandError("--working-size must be 0 (full resolution) or at least 64 (got " +
-                       std::to_string(args.working_size) + ")", 2);
-  if (args.sift_size != 0 && args.sift_size < 64)
-    throw CommandError("--sift-size must be 0 (the working resolution) or at least 64 (got " +
-                       std::to_string(args.sift_size) + ")", 2);
-  if (args.reloc_sift_size != 0 && args.reloc_sift_size < 64)
-    throw CommandError("--reloc-sift-size must be 0 (as --sift-size) or at least 64 (got " +
-                       std::to_string(args.reloc_sift_size) + ")", 2);
+  const tracker::TrackerOptions options = MakeOptions(args);
+  args.flags.Check(options, 2);  // before any file is read; a bad value is a usage error
   const ScopedSignalCancellation signals;
   cv::setNumThreads(args.threads);
   recordings::Recording rec;
@@ -208,7 +145,6 @@ void RunTrack(const TrackArgs& args) {
         << args.map << " was built for " << map.camera.width << "x" << map.camera.height;
     throw CommandError(msg.str());
   }
-  const tracker::TrackerOptions options = MakeOptions(args);
   std::unique_ptr<tracker::Tracker> tracker;
   try {
     tracker = std::make_unique<tracker::Tracker>(map, options);
@@ -280,97 +216,115 @@ void RunTrack(const TrackArgs& args) {
 void AddTrackCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("track", "Track a recording against a map and write its trajectory");
   auto a = std::make_shared<TrackArgs>();
+  tracker::TrackerOptions& o = a->options;
+  OptionFlags& f = a->flags;
   cmd->add_option("recording", a->recording, "Recording folder")->required();
   cmd->add_option("--map", a->map, "Map directory (or its map.arvmap)")->required();
-  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")->required()->check(OutputFileCheck());
+  cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")
+      ->required()
+      ->check(OutputFileCheck());
   cmd->add_option("--frames", a->frames, "Frames to track, e.g. 1-46:2 (default: all)");
   cmd->add_option("--stats", a->stats, "Per-frame statistics and summary as JSON")->check(OutputFileCheck());
   cmd->add_option("--solver", a->solver, "Minimal solver in RANSAC: kneip | gao | epnp")
-      ->capture_default_str()->check(CLI::IsMember({"kneip", "gao", "epnp"}));
-  cmd->add_option("--max-features", a->max_features,
-                  "SIFT keypoints relocalization extracts (strongest kept) on frames SIFT sees at their own size "
-                  "(--sift-size does not reduce them) and that have no prior pose: a set of photos, a video's first "
-                  "frame and those after a loss")
-      ->capture_default_str()->check(CLI::Range(50, 100000));
-  cmd->add_option("--sift-contrast", a->sift_contrast,
-                  "SIFT contrast threshold (OpenCV's definition) of relocalization on frames SIFT sees at their own "
-                  "size; 0.02 is the test of COLMAP's default peak threshold, with which the map's features were "
-                  "extracted (OpenCV's default: 0.04). Below --guided-sift-contrast, flow does not follow a "
-                  "relocalization's keypoints: the next frame starts from guided matching")
-      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
-  cmd->add_option("--reduced-max-features", a->reduced_max_features,
-                  "SIFT keypoints relocalization uses when --sift-size reduces the working frame (its own SIFT "
-                  "keeps this many; guided matching's features are matched globally through their strongest this many)")
-      ->capture_default_str()->check(CLI::Range(50, 100000));
-  cmd->add_option("--reduced-sift-contrast", a->reduced_sift_contrast,
-                  "SIFT contrast threshold of relocalization when --sift-size reduces the working frame "
-                  "(OpenCV's default 0.04: fewer, stronger keypoints, quicker)")
-      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
-  cmd->add_option("--ratio", a->ratio, "Ratio test of global matching")->capture_default_str()->check(CLI::Range(0.1, 1.0));
-  cmd->add_option("--ransac-threshold", a->ransac_threshold_px,
-                  "RANSAC's inlier threshold when relocalising, working pixels (the pose is refined on its inliers)")
-      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
-  cmd->add_option("--tracking-ransac-threshold", a->tracking_ransac_threshold_px,
-                  "RANSAC's inlier threshold when tracking and in the wide search, working pixels")
-      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
-  cmd->add_option("--inlier-threshold", a->inlier_threshold_px,
-                  "Inlier threshold after refinement (the inliers counted, followed and gated), working pixels")
-      ->capture_default_str()->check(CLI::Range(0.1, 50.0));
-  cmd->add_option("--ransac-iterations", a->ransac_iterations, "RANSAC iterations when relocalising")
-      ->capture_default_str()->check(CLI::Range(1, 1000000));
-  cmd->add_option("--min-inliers", a->min_inliers, "Inliers needed to accept a relocalization")
-      ->capture_default_str()->check(CLI::Range(6, 100000));
-  cmd->add_option("--max-rms", a->max_rms_px, "Largest inlier RMS reprojection error accepted, pixels")
-      ->capture_default_str()->check(CLI::Range(0.01, 50.0));
-  cmd->add_option("--tracking-min-inliers", a->tracking_min_inliers, "Inliers needed to keep tracking")
-      ->capture_default_str()->check(CLI::Range(6, 100000));
-  cmd->add_option("--replenish-below", a->replenish_below, "Run guided matching when fewer flow tracks survive")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
-  cmd->add_option("--fresh-features-after", a->fresh_features_after,
-                  "A tracked frame that comes more than this many seconds after the last posed one is posed again "
-                  "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
-                  "the tracked pose: frames far apart (a sub-sampled clip, photos), where optical flow drifts; one SIFT "
-                  "extraction a frame more. 0: every tracked frame; -1: never")
-      ->capture_default_str()->check(CLI::Range(-1.0, 1e9))->check(NeverOrNotNegative());
-  cmd->add_option("--prefetch-below", a->prefetch_below,
-                  "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
-                  "(in the frame that needs it)")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
-  cmd->add_option("--prefetch-lag", a->prefetch_lag, "Frames after which features extracted ahead are used")
-      ->capture_default_str()->check(CLI::Range(1, 1000));
-  cmd->add_option("--guided-sift-contrast", a->guided_sift_contrast,
-                  "SIFT contrast threshold of guided matching and the wide search (any working size)")
-      ->capture_default_str()->check(CLI::Range(0.001, 0.5));
-  cmd->add_option("--guided-radius", a->guided_radius_px, "Search radius of guided matching, pixels")
-      ->capture_default_str()->check(CLI::Range(1.0, 200.0));
-  cmd->add_option("--lk-window", a->lk_window,
-                  "Optical flow window side, working pixels (larger follows blur and noise better, costs more)")
-      ->capture_default_str()->check(CLI::Range(5, 61));
-  cmd->add_option("--lk-levels", a->lk_levels,
-                  "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")
-      ->capture_default_str()->check(CLI::Range(0, 6));
-  AddAlignMaxSecondsOption(cmd, a->align_max_seconds);
-  cmd->add_option("--index-checks", a->index_checks, "FLANN leaves visited per query (speed vs recall of global matching)")
-      ->capture_default_str()->check(CLI::Range(1, 100000));
-  cmd->add_option("--working-size", a->working_size,
-                  "Longest side of the image the tracker works on (frames larger are reduced; pixel "
-                  "options are at this size); 0: full resolution")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
-  cmd->add_option("--sift-size", a->sift_size,
-                  "Longest side of the image SIFT runs on (relocalization, guided matching; smaller "
-                  "working frames are kept as they are); 0: the working resolution")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
-  cmd->add_option("--reloc-sift-size", a->reloc_sift_size,
-                  "Longest side of the image relocalization's own SIFT runs on when --sift-size reduces "
-                  "the working frame (working frames up to --sift-size are kept as they are); 0: as --sift-size")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
-  cmd->add_option("--seed", a->seed, "Seed of RANSAC and of the FLANN index")->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::IsMember({"kneip", "gao", "epnp"}));
+  f.Add(cmd, "--max-features", ARVIEW_OPTION_FIELD(o, relocalization.features.max_features),
+        "SIFT keypoints relocalization extracts (strongest kept) on frames SIFT sees at their own size "
+        "(--sift-size does not reduce them) and that have no prior pose: a set of photos, a video's first "
+        "frame and those after a loss")
+      ->check(CLI::Range(50, 100000));
+  f.Add(cmd, "--sift-contrast", ARVIEW_OPTION_FIELD(o, relocalization.features.contrast_threshold),
+        "SIFT contrast threshold (OpenCV's definition) of relocalization on frames SIFT sees at their own "
+        "size; 0.02 is the test of COLMAP's default peak threshold, with which the map's features were "
+        "extracted (OpenCV's default: 0.04). Below --guided-sift-contrast, flow does not follow a "
+        "relocalization's keypoints: the next frame starts from guided matching")
+      ->check(CLI::Range(0.001, 0.5));
+  f.Add(cmd, "--reduced-max-features", ARVIEW_OPTION_FIELD(o, relocalization.reduced_features.max_features),
+        "SIFT keypoints relocalization uses when --sift-size reduces the working frame (its own SIFT "
+        "keeps this many; guided matching's features are matched globally through their strongest this many)")
+      ->check(CLI::Range(50, 100000));
+  f.Add(cmd, "--reduced-sift-contrast", ARVIEW_OPTION_FIELD(o, relocalization.reduced_features.contrast_threshold),
+        "SIFT contrast threshold of relocalization when --sift-size reduces the working frame "
+        "(OpenCV's default 0.04: fewer, stronger keypoints, quicker)")
+      ->check(CLI::Range(0.001, 0.5));
+  f.Add(cmd, "--ratio", ARVIEW_OPTION_FIELD(o, relocalization.matching.ratio), "Ratio test of global matching")
+      ->check(CLI::Range(0.1, 1.0));
+  f.Add(cmd, "--ransac-threshold", ARVIEW_OPTION_FIELD(o, relocalization.pose.ransac_threshold_px),
+        "RANSAC's inlier threshold when relocalising, working pixels (the pose is refined on its inliers)")
+      ->check(CLI::Range(0.1, 50.0));
+  f.Add(cmd, "--tracking-ransac-threshold", ARVIEW_OPTION_FIELD(o, tracking.ransac_threshold_px),
+        "RANSAC's inlier threshold when tracking and in the wide search, working pixels")
+      ->check(CLI::Range(0.1, 50.0));
+  f.Add(cmd, "--inlier-threshold", ARVIEW_OPTION_FIELD(o, relocalization.pose.inlier_threshold_px),
+        "Inlier threshold after refinement (the inliers counted, followed and gated), working pixels")
+      ->check(CLI::Range(0.1, 50.0));
+  f.Add(cmd, "--ransac-iterations", ARVIEW_OPTION_FIELD(o, relocalization.pose.ransac_max_iterations),
+        "RANSAC iterations when relocalising")
+      ->check(CLI::Range(1, 1000000));
+  f.Add(cmd, "--min-inliers", ARVIEW_OPTION_FIELD(o, relocalization.pose.min_inliers),
+        "Inliers needed to accept a relocalization")
+      ->check(CLI::Range(6, 100000));
+  f.Add(cmd, "--max-rms", ARVIEW_OPTION_FIELD(o, relocalization.pose.max_rms_px),
+        "Largest inlier RMS reprojection error accepted, pixels")
+      ->check(CLI::Range(0.01, 50.0));
+  f.Add(cmd, "--tracking-min-inliers", ARVIEW_OPTION_FIELD(o, tracking.min_inliers), "Inliers needed to keep tracking")
+      ->check(CLI::Range(6, 100000));
+  f.Add(cmd, "--replenish-below", ARVIEW_OPTION_FIELD(o, tracking.replenish_below),
+        "Run guided matching when fewer flow tracks survive")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--fresh-features-after", ARVIEW_OPTION_FIELD(o, tracking.fresh_features_after_s),
+        "A tracked frame that comes more than this many seconds after the last posed one is posed again "
+        "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
+        "the tracked pose: frames far apart (a sub-sampled clip, photos), where optical flow drifts; one SIFT "
+        "extraction a frame more. 0: every tracked frame; -1: never")
+      ->check(CLI::Range(-1.0, 1e9))
+      ->check(NeverOrNotNegative());
+  f.Add(cmd, "--prefetch-below", ARVIEW_OPTION_FIELD(o, tracking.prefetch_below),
+        "Extract guided matching's SIFT ahead, on a worker thread, when fewer flow tracks survive; 0: off "
+        "(in the frame that needs it)")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--prefetch-lag", ARVIEW_OPTION_FIELD(o, tracking.prefetch_lag_frames),
+        "Frames after which features extracted ahead are used")
+      ->check(CLI::Range(1, 1000));
+  f.Add(cmd, "--guided-sift-contrast", ARVIEW_OPTION_FIELD(o, tracking.guided_contrast_threshold),
+        "SIFT contrast threshold of guided matching and the wide search (any working size)")
+      ->check(CLI::Range(0.001, 0.5));
+  f.Add(cmd, "--guided-radius", ARVIEW_OPTION_FIELD(o, tracking.guided_radius_px),
+        "Search radius of guided matching, pixels")
+      ->check(CLI::Range(1.0, 200.0));
+  f.Add(cmd, "--lk-window", ARVIEW_OPTION_FIELD(o, tracking.lk_window_px),
+        "Optical flow window side, working pixels (larger follows blur and noise better, costs more)")
+      ->check(CLI::Range(5, 61));
+  f.Add(cmd, "--lk-levels", ARVIEW_OPTION_FIELD(o, tracking.lk_pyramid_levels),
+        "Optical flow pyramid levels above the frame (each doubles the motion followed beyond the prediction)")
+      ->check(CLI::Range(0, 6));
+  AddAlignMaxSecondsOption(cmd, o.tracking.align_max_seconds);
+  f.Name("tracking.align_max_seconds", "--align-max-seconds");
+  f.Add(cmd, "--index-checks", ARVIEW_OPTION_FIELD(o, index.checks),
+        "FLANN leaves visited per query (speed vs recall of global matching)")
+      ->check(CLI::Range(1, 100000));
+  f.Add(cmd, "--working-size", ARVIEW_OPTION_FIELD(o, working_long_side),
+        "Longest side of the image the tracker works on (frames larger are reduced; pixel "
+        "options are at this size); 0: full resolution")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--sift-size", ARVIEW_OPTION_FIELD(o, relocalization.sift_long_side),
+        "Longest side of the image SIFT runs on (relocalization, guided matching; smaller "
+        "working frames are kept as they are); 0: the working resolution")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--reloc-sift-size", ARVIEW_OPTION_FIELD(o, relocalization.reloc_sift_long_side),
+        "Longest side of the image relocalization's own SIFT runs on when --sift-size reduces "
+        "the working frame (working frames up to --sift-size are kept as they are); 0: as --sift-size")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--seed", ARVIEW_OPTION_FIELD(o, relocalization.pose.seed), "Seed of RANSAC and of the FLANN index");
+  f.Name("index.seed", "--seed");
   cmd->add_option("--threads", a->threads, "OpenCV threads (1 for the measured figures)")
-      ->capture_default_str()->check(CLI::Range(1, 256));
-  cmd->add_option("--smooth-min-cutoff", a->smoothing_min_cutoff, "One Euro filter: cutoff at rest, Hz")
-      ->capture_default_str()->check(CLI::Range(0.001, 1000.0));
-  cmd->add_option("--smooth-beta", a->smoothing_beta, "One Euro filter: speed coefficient")
-      ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
+  f.Add(cmd, "--smooth-min-cutoff", ARVIEW_OPTION_FIELD(o, smoothing.min_cutoff_hz),
+        "One Euro filter: cutoff at rest, Hz")
+      ->check(CLI::Range(0.001, 1000.0));
+  f.Add(cmd, "--smooth-beta", ARVIEW_OPTION_FIELD(o, smoothing.beta), "One Euro filter: speed coefficient")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->callback([a] { RunTrack(*a); });
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/cli/commands.h"
+#include "app/cli/option_flags.h"
 
 namespace arview::app {
 
@@ -24,16 +25,15 @@ void AddGlFlags(CLI::App* cmd, GlFlags& f) {
 render::OffscreenOptions ToOffscreenOptions(const GlFlags& f) {
   render::OffscreenOptions o;
   o.backend = render::ParseGlBackend(f.backend);
-  // Only auto and egl-device choose among EGL's devices: taken with another, it would be ignored.
-  if (f.device >= 0 && o.backend != render::GlBackend::kAuto && o.backend != render::GlBackend::kEglDevice) {
-    throw CommandError("--gl-device " + std::to_string(f.device) + " picks an EGL device: it needs --gl auto or "
-                       "egl-device (--gl " + f.backend + " renders without one)",
-                       2);
-  }
   o.threads = f.threads;
   if (f.device >= 0) o.device = f.device;
   o.verbose = f.verbose;
   o.on_note = [](const std::string& note) { std::fprintf(stderr, "note: gl: %s\n", note.c_str()); };
+  OptionFlags names;
+  names.Name("device", "--gl-device");
+  names.Name("backend", "--gl");
+  names.Name("threads", "--gl-threads");
+  names.Check(o, 2);  // flags that do not go together: the usage status
   return o;
 }
 

@@ -20,8 +20,8 @@ struct GlFlags {
 };
 
 void AddGlFlags(CLI::App* cmd, GlFlags& flags);
-// Throws render::RenderError on a bad --gl value, CommandError on --gl-device with --gl osmesa or
-// egl (which use no EGL device).
+// Throws render::RenderError on a bad --gl value, CommandError (OffscreenOptions::Check under the
+// flags' names, usage status 2) on --gl-device with --gl osmesa or egl (which use no EGL device).
 render::OffscreenOptions ToOffscreenOptions(const GlFlags& flags);
 
 }  // namespace arview::app

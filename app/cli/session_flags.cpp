@@ -9,6 +9,22 @@
 
 namespace arview::app {
 
+namespace {
+
+// The flags' names for SessionOptions::Check()'s messages: the path of each field they set.
+OptionNames SessionFlagNames() {
+  return OptionNames({{"compositor.stereo_character", "--stereo-character"},
+                      {"compositor.hmd", "--hmd or --hmd-profile"},
+                      {"compositor.ipd_m", "--ipd"},
+                      {"fade.hold_seconds", "--hold"},
+                      {"fade.fade_seconds", "--fade"},
+                      {"tracker.tracking.background", "--tracking-worker"},
+                      {"tracker.tracking.prefetch_below", "--prefetch-below"},
+                      {"tracker.tracking.align_max_seconds", "--align-max-seconds"}});
+}
+
+}  // namespace
+
 void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
   cmd->add_option("--align-max-seconds", seconds,
                   "Whip-pans: a frame no feature step can pose takes its rotation from image alignment with the "
@@ -79,20 +95,20 @@ void ApplySessionFlags(const SessionFlags& f, bool live_source, SessionOptions& 
   o.compositor.gl = ToOffscreenOptions(f.gl);
   o.compositor.hmd = f.hmd || !f.hmd_profile.empty();
   if (!f.hmd_profile.empty()) o.compositor.hmd_profile = render::LoadHmdProfile(f.hmd_profile);
-  if (f.stereo_character && !o.compositor.hmd) throw CommandError("--stereo-character needs --hmd or --hmd-profile");
   o.compositor.stereo_character = f.stereo_character;
-  o.window = {f.window_output, f.fullscreen};
   o.compositor.ipd_m = f.ipd;
   o.compositor.hud = f.hud;
+  const OptionNames names = SessionFlagNames();
+  o.compositor.Check(names.Nested("compositor"));
+  o.window = {f.window_output, f.fullscreen};
   const bool worker = f.tracking_worker == "on" || (f.tracking_worker == "auto" && live_source);
   o.tracker.tracking.background = worker;
   o.tracker.tracking.prefetch_below = f.prefetch_below >= 0 ? f.prefetch_below : worker ? tracker::kBackgroundPrefetchBelow : 0;
-  if (worker && o.tracker.tracking.prefetch_below == 0)
-    throw CommandError("--prefetch-below 0 needs --tracking-worker off: with the worker, guided matching's SIFT is "
-                       "extracted only ahead");
   o.tracker.tracking.align_max_seconds = f.align_max_seconds;
+  o.tracker.Check(names.Nested("tracker"));  // --prefetch-below 0 with the worker
   o.compositor.ar.antialiasing = render::ParseAntialiasing(f.aa);
   o.fade = {f.hold, f.fade};
+  o.fade.Check(names.Nested("fade"));
   const SceneLighting lighting = ResolveSceneLighting(f.scene, f.lighting, f.light);
   o.compositor.ar.lighting = lighting.mode;
   o.compositor.ar.prt_cache_folder = render::DefaultPrtCacheFolder();

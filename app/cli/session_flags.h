@@ -17,7 +17,8 @@ struct SessionFlags {
   std::string hmd_profile, window_output;
   bool fullscreen = false;
   bool no_figure = false;  // without --scene: no built-in figure (FirstRunFigure)
-  double ipd = 0.064, hold = 0.5, fade = 1.0;
+  // The defaults are the options structs' own.
+  double ipd = CompositorOptions{}.ipd_m, hold = FadeOptions{}.hold_seconds, fade = FadeOptions{}.fade_seconds;
   // tracker::TrackingOptions::prefetch_below; -1: tracker::kBackgroundPrefetchBelow with the
   // tracking worker, else 0 (off)
   int prefetch_below = -1;
@@ -28,7 +29,9 @@ struct SessionFlags {
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
 // --align-max-seconds (tracker::TrackingOptions::align_max_seconds), shared with `arview track`.
 void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds);
-// Fills the session options these flags control (throws on a bad --gl value). live_source: frames
+// Fills the session options these flags control and checks them (SessionOptions::Check: an
+// OptionError naming the flag, e.g. --stereo-character without --hmd; a RenderError on a bad --gl
+// value). live_source: frames
 // come at the camera's rate whether or not the pipeline keeps up (`run`, `replay --paced`), which
 // turns the tracking worker on under --tracking-worker auto.
 void ApplySessionFlags(const SessionFlags& flags, bool live_source, SessionOptions& options);

@@ -44,8 +44,32 @@ TEST(SessionFlags, TheTrackingWorkerIsOnForALiveSourceUnlessTurnedOff) {
   EXPECT_TRUE(on.tracker.tracking.background);
   EXPECT_EQ(on.tracker.tracking.prefetch_below, 180);
   // With the worker, guided matching's features come only from extraction ahead.
-  EXPECT_THROW(Parse({"--prefetch-below", "0"}, true), CommandError);
+  try {
+    Parse({"--prefetch-below", "0"}, true);
+    ADD_FAILURE() << "--prefetch-below 0 with the worker was taken";
+  } catch (const OptionError& e) {  // TrackingOptions::Check, naming the flags
+    EXPECT_STREQ(e.what(), "--prefetch-below 0 needs --tracking-worker off: with the worker, guided matching's SIFT "
+                           "is extracted only ahead");
+  }
   EXPECT_THROW(Parse({"--tracking-worker", "sometimes"}), CLI::ValidationError);
+}
+
+TEST(SessionFlags, TheDefaultsAreTheOptionsStructsOwn) {
+  const SessionOptions defaults = Parse({});
+  EXPECT_EQ(defaults.compositor.ipd_m, CompositorOptions{}.ipd_m);
+  EXPECT_EQ(defaults.fade.hold_seconds, FadeOptions{}.hold_seconds);
+  EXPECT_EQ(defaults.fade.fade_seconds, FadeOptions{}.fade_seconds);
+}
+
+// CompositorOptions::Check, naming the flags that set the fields.
+TEST(SessionFlags, AStereoCharacterWithoutTheHmdIsRefusedNamingTheFlags) {
+  try {
+    Parse({"--stereo-character"});
+    ADD_FAILURE() << "--stereo-character without --hmd was taken";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "--stereo-character needs --hmd or --hmd-profile");
+  }
+  EXPECT_TRUE(Parse({"--stereo-character", "--hmd"}).compositor.stereo_character);
 }
 
 TEST(SessionFlags, OutOfRangeTrackerFlagsAreRefused) {

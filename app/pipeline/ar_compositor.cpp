@@ -12,6 +12,12 @@
 
 namespace arview::app {
 
+void CompositorOptions::Check(const OptionNames& names) const {
+  // One view of the character per eye needs the eyes: the side-by-side output.
+  if (stereo_character && !hmd) throw OptionError(names("stereo_character") + " needs " + names("hmd"));
+  RequireOption(ipd_m >= 0, names("ipd_m"), "0 or more", ipd_m);
+}
+
 ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::PlacedCharacter*> characters,
                            const CompositorOptions& options, std::unique_ptr<render::OffscreenContext> context)
     : camera_(camera), characters_(std::move(characters)), options_(options), hud_visible_(options.hud) {

@@ -32,6 +32,10 @@ struct CompositorOptions {
   double ipd_m = 0.064;
   std::optional<room::RoomLight> room_light;  // SH light, exposure thumbnails, occluders
   bool hud = false;   // the overlay (render/hud.h): view sphere, weights, tracking status, frame rate
+
+  // Throws OptionError naming the first bad field (base/option_check.h): a
+  // stereo character without hmd, a negative ipd.
+  void Check(const OptionNames& names = {}) const;
 };
 
 class ArCompositor : public FrameCompositor {

@@ -50,10 +50,15 @@ void FillTotals(Clock::time_point start, double cpu_start, PipelineReport& repor
 
 }  // namespace
 
+void PipelineOptions::Check(const OptionNames& names) const {
+  RequireOption(queue_capacity >= 1, names("queue_capacity"), "at least 1", queue_capacity);
+}
+
 PipelineReport RunPipeline(recordings::FrameSource& source, tracker::Tracker& tracker, std::span<LayeredAnimator* const> animators,
                            FrameCompositor& compositor, video::FrameSink& sink, const PipelineOptions& options,
                            const std::function<void(const PipelineReport&)>& on_frame,
                            const std::function<bool()>& stop) {
+  options.Check(OptionNames().Nested("pipeline"));
   const OverflowPolicy policy = options.drop_frames ? OverflowPolicy::kDropOldest : OverflowPolicy::kBlock;
   // Live: one waiting frame per stage, so that no stage ever starts on a frame older than the
   // newest one waiting.

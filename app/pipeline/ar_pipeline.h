@@ -60,7 +60,7 @@ struct PipelineOptions {
   // Live sources: a slower stage makes the older waiting frame drop, and each queue holds one
   // frame (the freshest). Replays: every frame, through queues of `queue_capacity`.
   bool drop_frames = false;
-  size_t queue_capacity = 2;
+  size_t queue_capacity = 2;  // at least 1 (PipelineOptions::Check)
   // Live sources: a source that fails while running (a camera unplugged or stalled) ends the
   // run like the end of the stream, and PipelineReport::source_fault says why; the outputs so
   // far are complete. Otherwise its error is rethrown.
@@ -87,6 +87,10 @@ struct PipelineOptions {
   // animated (inside its `animate` time): a first run without a scene stands its figure in front
   // of that view here (app/session). Null: nothing.
   std::function<void(const tracker::FrameResult&)> on_first_localized;
+
+  // Throws OptionError naming the first bad field (base/option_check.h); RunPipeline
+  // calls it first.
+  void Check(const OptionNames& names = {}) const;
 };
 
 // A frame's way through the pipeline, in milliseconds since its capture.

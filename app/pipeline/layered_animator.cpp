@@ -4,6 +4,11 @@
 
 namespace arview::app {
 
+void FadeOptions::Check(const OptionNames& names) const {
+  RequireOption(hold_seconds >= 0, names("hold_seconds"), "0 or more", hold_seconds);
+  RequireOption(fade_seconds >= 0, names("fade_seconds"), "0 or more", fade_seconds);
+}
+
 LayeredAnimator::LayeredAnimator(const anim::PlacedCharacter& character, std::unique_ptr<anim::Animator> animator,
                                  const anim::Clip* idle_clip, std::vector<std::string> notes)
     : character_(character), idle_(idle_clip), animator_(std::move(animator)), notes_(std::move(notes)) {}

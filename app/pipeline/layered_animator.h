@@ -23,12 +23,16 @@
 
 #include "anim/animator.h"
 #include "anim/placed_character.h"
+#include "base/option_check.h"
 
 namespace arview::app {
 
 struct FadeOptions {
   double hold_seconds = 0.5;
   double fade_seconds = 1.0;
+
+  // Throws OptionError naming the first bad field (base/option_check.h).
+  void Check(const OptionNames& names = {}) const;
 };
 
 class LayeredAnimator {

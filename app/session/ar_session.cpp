@@ -61,9 +61,18 @@ std::optional<std::string> CameraNote(const tracker::LossDiagnoser& diagnoser, c
 
 }  // namespace
 
+void SessionOptions::Check(const OptionNames& names) const {
+  RequireOption(sink_fps > 0, names("sink_fps"), "above 0", sink_fps);
+  compositor.Check(names.Nested("compositor"));
+  fade.Check(names.Nested("fade"));
+  pipeline.Check(names.Nested("pipeline"));
+  tracker.Check(names.Nested("tracker"));
+}
+
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& o) {
   const Clock::time_point command_start = o.command_start.value_or(Clock::now());
+  o.Check();
   if (source_size != map.camera.Size()) {
     throw Error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
                              std::to_string(source_size.height) + " but the map " + map_name +

@@ -63,6 +63,10 @@ struct SessionOptions {
   bool quiet = false;
   // When the command started, for "first frame shown after ..." (default: RunSession's start).
   std::optional<Clock::time_point> command_start;
+
+  // Throws OptionError naming the first bad field, its own or a member's ("tracker.tracking.
+  // prefetch_below"); RunSession calls it first, app/cli with its flags' names.
+  void Check(const OptionNames& names = {}) const;
 };
 
 struct SessionResult {
