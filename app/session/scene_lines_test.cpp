@@ -207,6 +207,27 @@ TEST(SceneLines, CuesStartTheirLines) {
   EXPECT_EQ(s.started.size(), 3u) << "near is not re-armed while the viewer stays close";
 }
 
+// Behind: the viewer more than 120° from the character's front, once until they come back
+// within 90°; a line already being said lets a cue go.
+TEST(SceneLines, WalkingBehindTheCharacterSaysItsLine) {
+  Speaker s(FigureSpec({{"behind", "Where are you going?"}}));
+  double t = 0;
+  auto run = [&](const Eigen::Vector3d& at, double seconds) {
+    for (double end = t + seconds; t < end; t += kFrame) s.animator->Update(at, t);
+  };
+  run(Eigen::Vector3d(2, 1.6, 0.5), 1);  // to the side (76° from the front)
+  EXPECT_TRUE(s.started.empty());
+  run(Eigen::Vector3d(0.5, 1.6, -2), 3);  // behind (166°)
+  ASSERT_EQ(s.started.size(), 1u);
+  EXPECT_EQ(s.started.back().origin, "lines.yaml:9");
+  run(Eigen::Vector3d(2, 1.6, -0.3), 3);  // 99°: not re-armed
+  run(Eigen::Vector3d(0.5, 1.6, -2), 3);
+  EXPECT_EQ(s.started.size(), 1u);
+  run(Eigen::Vector3d(0, 1.6, 2), 1);  // in front: re-armed
+  run(Eigen::Vector3d(0.5, 1.6, -2), 3);
+  EXPECT_EQ(s.started.size(), 2u);
+}
+
 TEST(SceneLines, TheSameLineTwiceGivesTheSameBytesAndCurves) {
   const authoring::CharacterSpec spec = FigureSpec({{"start", "<face expr=\"happy\"/>Hello! Bring me the map, please."}});
   authoring::AnimatedCharacter figure(spec);
