@@ -105,7 +105,13 @@ void CharacterSpeech::Start(std::size_t index, double time, anim::Animator& anim
   for (const anim::Action& a : line.actions) {
     anim::Action action = a;
     action.start += time;
-    animator.Play(std::move(action));
+    // The schedule has room for several lines' actions at once (PlayedActionRoom); lines said back
+    // to back whose gestures outlast them could still fill it (Add's one refusal for an action
+    // built for this skeleton at load): the gesture is let go, the line is said.
+    try {
+      animator.Play(std::move(action));
+    } catch (const anim::Error&) {
+    }
   }
   for (double g : line.gaze_at_viewer) animator.HoldGazeOnViewer(time + g, time + line.duration_s());
   speech::Utterance u;

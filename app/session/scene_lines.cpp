@@ -173,8 +173,9 @@ std::optional<anim::FaceRig> SpeakingFace(const authoring::AnimatedCharacter& ch
 int PlayedActionRoom(const authoring::CharacterSpec& spec) {
   std::size_t most = 0;
   for (const LineRequest& r : SceneLineRequests(spec)) most = std::max(most, speech::ParseMarkup(r.markup, r.origin).tags.size());
-  // A line's actions may still run while the next line's start (a gesture longer than its line).
-  return static_cast<int>(2 * most);
+  // A line's actions may still run while the next lines start (a gesture longer than its line, an
+  // expression held a second after it): room for four lines' worth.
+  return static_cast<int>(4 * most);
 }
 
 std::unique_ptr<CharacterSpeech> MakeCharacterSpeech(const authoring::AnimatedCharacter& character,
