@@ -58,6 +58,7 @@ Animator::Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Sch
       throw Error("distance trigger '" + t.action.name + "': its object does not fit the skeleton");
   }
   if (options_.gaze && options_.gaze->rig.valid()) gaze_.emplace(*skeleton_, options_.gaze->rig, options_.gaze->options);
+  if (options_.face && !options_.face->valid()) options_.face.reset();
   armed_.assign(options_.triggers.size(), true);
   fired_ids_.reserve(16);
   buffers_ = FrameBuffers(*skeleton_);
@@ -78,9 +79,8 @@ void Animator::Track(double time, bool tracking) {
   }
 }
 
-void Animator::Distance(double time, double distance) {
-  frame_.triggered = 0;
-  // Triggered actions that have ended leave the schedule (their slot is reused).
+void Animator::RemoveEndedActions(double time) {
+  // Triggered and played actions that have ended leave the schedule (their slot is reused).
   for (std::size_t i = 0; i < fired_ids_.size();) {
     const Action* a = schedule_->Find(fired_ids_[i]);
     if (!a || (!a->keep_rendering && time > a->start + a->object->Duration())) {
@@ -91,6 +91,21 @@ void Animator::Distance(double time, double distance) {
       ++i;
     }
   }
+}
+
+int Animator::Play(Action action) {
+  const int id = schedule_->Add(std::move(action));
+  fired_ids_.push_back(id);
+  return id;
+}
+
+void Animator::HoldGazeOnViewer(double from, double until) {
+  if (gaze_) gaze_->HoldOnViewer(from, until);
+}
+
+void Animator::Distance(double time, double distance) {
+  frame_.triggered = 0;
+  RemoveEndedActions(time);
   if (!(distance >= 0) || !std::isfinite(distance)) return;  // unknown: nothing distance-driven changes
   for (std::size_t i = 0; i < weight_ids_.size(); ++i)
     schedule_->SetLiveWeight(weight_ids_[i], options_.distance_weights[i].At(distance));
@@ -124,7 +139,7 @@ void Animator::Look(double time, const Eigen::Vector3d* viewer) {
   frame_.gaze.eyes_on_viewer = frame_.gaze.eyes_on_viewer && viewer != nullptr;
 }
 
-const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {
+const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs, const FaceTrack* face) {
   if (!std::isfinite(time)) time = last_time_.value_or(0.0);
   if (last_time_ && time < *last_time_) {  // a restart (replay from the beginning)
     lost_since_.reset();
@@ -139,7 +154,16 @@ const AnimatorFrame& Animator::Update(double time, const FrameInputs& inputs) {
   inputs_ = inputs;
   inputs_.viewpoint = viewpoint_;  // held while lost
   if (!schedule_->Sample(time, inputs_, buffers_.local[0])) throw Error("animator: an action's object refused its inputs");
-  if (gaze_) Look(time, inputs.tracking && inputs.viewer.allFinite() ? &inputs.viewer : nullptr);
+  const FaceTrack silent;
+  if (options_.face) frame_.face = ApplySpeechToFace(*options_.face, face ? *face : silent, buffers_.local[0]);
+  if (gaze_) {
+    // Talking switches gaze to Eyes Alive's talking statistics, and back to the scene's mode after.
+    const bool talking = frame_.face.talking > 0;
+    const GazeMode mode = talking ? GazeMode::kTalking : options_.gaze->options.mode;
+    if (gaze_->behaviour().mode() != mode) gaze_->SetMode(mode);
+    Look(time, inputs.tracking && inputs.viewer.allFinite() ? &inputs.viewer : nullptr);
+    if (options_.face) OverrideLidsWithBlink(*options_.face, frame_.gaze.blink_closure, buffers_.local[0]);
+  }
   buffers_.Finish(*skeleton_, frame_, "animator: local to model", "animator: skinning matrices");
   frame_.key_weights = view_ ? view_->weights() : std::span<const double>();
   frame_.view_gain = view_id_ >= 0 ? schedule_->Gain(view_id_, time) : 0.0;

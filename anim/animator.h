@@ -17,8 +17,14 @@
 // With gaze (AnimatorOptions::gaze), the eyes and lids are posed after the schedule, from the
 // head the look-at chain placed, toward FrameInputs::viewer (anim/gaze.h).
 //
-// Update allocates only when a distance trigger fires (it adds an action to the schedule).
+// With a face (AnimatorOptions::face), a speech layer hands Update the frame's FaceTrack: the
+// mouth's targets and the Jaw joint follow the visemes (anim/face.h), gaze switches to its
+// talking statistics while the character talks, and a blink overrides the lid targets.
+//
+// Update allocates only when a distance trigger fires (it adds an action to the schedule); Play
+// (a line's gesture or expression) allocates as it adds its action.
 
+#include "anim/face.h"
 #include "anim/gaze.h"
 #include "anim/schedule.h"
 #include "anim/view_adaptive.h"
@@ -53,6 +59,8 @@ struct AnimatorOptions {
   std::vector<DistanceWeight> distance_weights;
   // Eyes and lids posed after the schedule (anim/gaze.h); nothing for a character without eyes.
   std::optional<GazeSetup> gaze;
+  // The face speech drives (anim/face.h); nothing for a character without the 15 viseme targets.
+  std::optional<FaceRig> face;
 };
 
 // The one description of an animated frame, from the animator (or PlacedCharacter::Update) to the
@@ -72,6 +80,7 @@ struct AnimatorFrame {
   // clips' weight tracks blended, then whatever a face layer set (Animator::SetMorphWeight).
   std::span<const float> morph_weights;
   GazeFrame gaze;                             // eyes on the viewer, blinking (Animator with gaze)
+  FaceFrame face;                             // speech on the face (Animator with a face)
 
   // The weight of the layers below the view-adaptive action (the idle): 0 while the viewer is
   // tracked, 1 once the view-adaptive action has faded out (or where there is none).
@@ -102,8 +111,17 @@ class Animator {
   Animator(std::shared_ptr<const Skeleton> skeleton, std::shared_ptr<Schedule> schedule, AnimatorOptions options = {},
            std::shared_ptr<const ViewAdaptiveBlend> view = nullptr);
 
-  // `time` in seconds, monotonic (a jump backwards restarts the tracking-loss state).
-  const AnimatorFrame& Update(double time, const FrameInputs& inputs);
+  // `time` in seconds, monotonic (a jump backwards restarts the tracking-loss state). `face`:
+  // what speech does to the face this frame (nullptr: nothing, the character is silent).
+  const AnimatorFrame& Update(double time, const FrameInputs& inputs, const FaceTrack* face = nullptr);
+
+  // Adds `action` to the schedule (its start in schedule time), to leave it once it has ended, as
+  // a triggered action does: a spoken line's gesture or expression. Returns its id; throws Error
+  // when the schedule is full or the action does not fit it.
+  int Play(Action action);
+  // The eyes fixate the viewer from schedule time `from` until `until` (a line's
+  // <gaze at="viewer"/>); nothing for a character without gaze.
+  void HoldGazeOnViewer(double from, double until);
 
   // A face layer's write, after Update and before the frame is drawn: target `target`'s weight
   // in the frame Update returned (the next Update starts again from the clips). False, and
@@ -118,6 +136,7 @@ class Animator {
   void Track(double time, bool tracking);
   void Distance(double time, double distance);
   void Look(double time, const Eigen::Vector3d* viewer);  // poses the eyes and lids (gaze_)
+  void RemoveEndedActions(double time);                  // played and triggered actions past their end
 
   std::shared_ptr<const Skeleton> skeleton_;
   std::shared_ptr<Schedule> schedule_;
@@ -126,7 +145,7 @@ class Animator {
   int view_id_ = -1;
   std::vector<int> weight_ids_;      // per distance weight
   std::vector<bool> armed_;          // per trigger
-  std::vector<int> fired_ids_;       // actions added by triggers, removed once they end
+  std::vector<int> fired_ids_;       // actions added by triggers and Play, removed once they end
   std::optional<double> last_time_;
   std::optional<double> lost_since_;
   bool fading_out_ = false;

@@ -118,9 +118,16 @@ double BlinkClosure(double s) {
 
 // ---------------------------------------------------------------------------------------------
 
-GazeBehaviour::GazeBehaviour(const GazeOptions& options) : options_(options), stats_(&EyesAliveStatistics(options.mode)) {
+GazeBehaviour::GazeBehaviour(const GazeOptions& options)
+    : options_(options), mode_(options.mode), stats_(&EyesAliveStatistics(options.mode)) {
   options_.Check();
-  blink_rate_ = options_.blink_rate_per_min > 0 ? options_.blink_rate_per_min : DefaultBlinkRate(options_.mode);
+  SetMode(options_.mode);
+}
+
+void GazeBehaviour::SetMode(GazeMode mode) {
+  mode_ = mode;
+  stats_ = &EyesAliveStatistics(mode);
+  blink_rate_ = options_.blink_rate_per_min > 0 ? options_.blink_rate_per_min : DefaultBlinkRate(mode);
   p_mutual_ = MutualChance(*stats_);
 }
 
@@ -308,6 +315,8 @@ void Gaze::Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const 
   last_time_ = t;
   const bool viewer_known = viewer_model.allFinite();
   const double closure = behaviour_.blink_closure();
+  const bool held_on_viewer = t >= hold_on_viewer_from_ && t < hold_on_viewer_until_;
+  const Eigen::Vector2d offset = held_on_viewer ? Eigen::Vector2d::Zero() : behaviour_.offset_deg();
   const EyeRange& range = options_.range;
   bool in_range = viewer_known;
   for (const Eye& e : eyes_) {
@@ -318,7 +327,7 @@ void Gaze::Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const 
       toward = YawPitch(e, Rotation(parent).transpose() * (viewer_model - centre));
       in_range = in_range && std::abs(toward.x()) <= range.sideways_deg && toward.y() <= range.up_deg && toward.y() >= -range.down_deg;
     }
-    const Eigen::Vector2d target = toward + behaviour_.offset_deg();
+    const Eigen::Vector2d target = toward + offset;
     const double yaw = std::clamp(target.x(), -range.sideways_deg, range.sideways_deg);
     const double pitch = std::clamp(target.y(), -range.down_deg, range.up_deg);
     SetRotation(local, e.joint, Turn(e, yaw, pitch) * e.rest);
@@ -330,8 +339,10 @@ void Gaze::Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const 
     if (e.lower >= 0) SetRotation(local, e.lower, Turn(e, 0, lower) * e.lower_rest);
   }
   frame_.active = true;
-  frame_.eyes_on_viewer = in_range && behaviour_.mutual();
+  frame_.eyes_on_viewer = in_range && (held_on_viewer || behaviour_.mutual());
   frame_.blinking = behaviour_.blinking();
+  frame_.blink_closure = static_cast<float>(closure);
+  frame_.talking_mode = behaviour_.mode() == GazeMode::kTalking;
   // Restarted (time went back, or a jump of over an hour): the blinks since the restart.
   const long now = behaviour_.blinks_started();
   frame_.blinks_begun = static_cast<int>(t < time_before || now < blinks_before ? now : now - blinks_before);

@@ -105,6 +105,12 @@ class GazeBehaviour {
   long blinks_started() const { return blinks_started_; }
   double blink_rate_per_min() const { return blink_rate_; }
 
+  // Switches the statistics (and, unless the options set a rate, the blink rate) to `mode` from
+  // the next fixation and blink drawn on: talking switches a listening character to Eyes Alive's
+  // talking statistics (issue 53). A restart keeps the mode last set.
+  void SetMode(GazeMode mode);
+  GazeMode mode() const { return mode_; }
+
   // Records every event from the next restart (or now) into `log` (tests; allocates).
   void set_log(GazeLog* log) { log_ = log; }
 
@@ -123,6 +129,7 @@ class GazeBehaviour {
   Eigen::Vector2d DrawLookAway(double* magnitude_deg);
 
   GazeOptions options_;
+  GazeMode mode_;
   const SaccadeStatistics* stats_;
   double blink_rate_ = 0;
   double p_mutual_ = 0;  // the chance that the next fixation is on the viewer
@@ -167,6 +174,8 @@ struct GazeFrame {
   bool eyes_on_viewer = false;  // both eyes fixate the camera centre (mutual gaze, within range)
   bool blinking = false;        // a blink is under way
   int blinks_begun = 0;         // blinks that began since the previous frame (the blink events)
+  float blink_closure = 0;      // the lids' closure, 0 open to 1 shut (a blink overrides the lid targets)
+  bool talking_mode = false;    // Eyes Alive's talking statistics (the character is speaking)
 };
 
 class Gaze {
@@ -179,6 +188,15 @@ class Gaze {
   // places the lids. `model` holds `local`'s model-space joints (the head where the look-at
   // chain put it); the eye and lid joints' entries are not read. No allocation.
   void Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const Eigen::Matrix4d> model, LocalPose& local);
+
+  // The eyes fixate the viewer (no look-away) from schedule time `from` until `until` (a line's
+  // <gaze at="viewer"/>); the behaviour's draws go on underneath, so its seed's course is kept.
+  void HoldOnViewer(double from, double until) {
+    hold_on_viewer_from_ = from;
+    hold_on_viewer_until_ = until;
+  }
+  // Eyes Alive's statistics of `mode` from the next draw on (GazeBehaviour::SetMode).
+  void SetMode(GazeMode mode) { behaviour_.SetMode(mode); }
 
   const GazeFrame& frame() const { return frame_; }
   GazeBehaviour& behaviour() { return behaviour_; }
@@ -200,6 +218,7 @@ class Gaze {
   GazeBehaviour behaviour_;
   std::array<Eye, 2> eyes_;
   double last_time_ = -1;
+  double hold_on_viewer_from_ = 0, hold_on_viewer_until_ = -1e300;
   GazeFrame frame_;
 };
 

@@ -31,12 +31,14 @@ class AnimatorBuilder {
     std::vector<ActionSpec> actions = spec_.schedule.given ? spec_.schedule.actions : DefaultActions();
     int triggers = 0;
     for (const ActionSpec& a : actions) triggers += a.has_trigger;
-    auto schedule = std::make_shared<anim::Schedule>(sk_, blender, std::min<int>(60, static_cast<int>(actions.size()) + 4 * triggers + 4));
+    auto schedule = std::make_shared<anim::Schedule>(
+        sk_, blender, std::min<int>(60, static_cast<int>(actions.size()) + 4 * triggers + 4) + std::max(0, overrides_.played_actions));
     anim::AnimatorOptions options;
     options.view_action = spec_.schedule.view_action;
     options.hold_seconds = overrides_.hold_seconds.value_or(spec_.schedule.hold_seconds);
     options.fade_seconds = overrides_.fade_seconds.value_or(spec_.schedule.fade_seconds);
     options.gaze = ch_.gaze();
+    options.face = overrides_.face;
     for (std::size_t i = 0; i < actions.size(); ++i) {
       ActionSpec a = actions[i];
       if (a.name.empty()) a.name = "action" + std::to_string(i + 1);

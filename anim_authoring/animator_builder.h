@@ -18,6 +18,12 @@ namespace arview::authoring {
 struct AnimatorOverrides {
   std::string idle_clip;                  // the default schedule's idle layer: this clip (looped)
   std::optional<double> hold_seconds, fade_seconds;  // tracking loss
+  // The face speech drives (anim/face.h), built by the layer that knows the character's jaw
+  // shares (app/session for the built-in figure); nothing: the character does not speak.
+  std::optional<anim::FaceRig> face;
+  // Room in the schedule for actions played while the character runs (a line's gestures and
+  // expressions, anim::Animator::Play), beyond what the scene's own actions take.
+  int played_actions = 0;
 };
 
 // The character's animator (anim/animator.h): its scene `schedule:` built (objects, modifiers,

@@ -48,6 +48,13 @@
 //         blink_rate: 26             # per minute; default 17 at rest, 26 listening or talking
 //         eye_range: {sideways: 35, up: 20, down: 25}   # degrees about the head's forward
 //         seed: 1
+//       voice: slt                   # Flite's voice for the lines: slt | rms | awb (checked by the session)
+//       lines:                       # what the character says, and when (docs/speech.md, "Lines in scenes")
+//         - when: start              # start | near | behind | lost | found
+//           say: '<gesture name="Wave"/>Hello there!'   # the markup (speech/markup.h)
+//         - when: near
+//           near: 1.2                # metres; far: default 1.25·near + 0.1
+//           say: Come closer.
 //
 // Flow mappings `{a: 1}` and flow sequences `[1, 2]` of scalars are accepted; see yaml.h.
 
@@ -57,6 +64,7 @@
 #include "anim_authoring/gesture.h"
 #include "anim_authoring/lookat.h"
 #include "base/enum_table.h"
+#include "speech/line_cue.h"
 #include "base/geometry.h"
 #include "anim/pose.h"
 #include "anim/animator.h"
@@ -189,6 +197,18 @@ struct GazeSpec {
   int line = 0;
 };
 
+// One of the character's `lines:`: what it says (markup, parsed by the session with speech/),
+// and the cue that starts it.
+using speech::LineCue;
+struct LineSpec {
+  LineCue when = LineCue::kStart;
+  std::string say;                  // the markup, as written
+  double near = 1.5, far = 2.0;     // kNear: metres (far: the hysteresis that re-arms it)
+  int line = 0;                     // where `say:` was written
+};
+// At most this many lines per character (each is synthesized at load and kept).
+inline constexpr std::size_t kMaxLinesPerCharacter = 32;
+
 struct CharacterSpec {
   std::string where;  // "scene.yaml:3", for messages
   std::string name;
@@ -210,6 +230,9 @@ struct CharacterSpec {
   IdleSpec idle;           // `idle:`
   ScheduleSpec schedule;   // `schedule:`
   GazeSpec gaze;           // `gaze:`
+  std::string voice = "slt";  // `voice:`, Flite's (the session checks it with speech/)
+  int voice_line = 0;
+  std::vector<LineSpec> lines;  // `lines:`
 
   // Where it stands, as the per-frame path takes it (anim/placement.h): anchor, scale, forward, up.
   anim::Placement placement() const;

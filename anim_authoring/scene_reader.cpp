@@ -92,7 +92,7 @@ class SceneReader {
 
   CharacterSpec Character(const Node& n, const fs::path& base_dir) const {
     OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "gesture",
-                 "keys", "scopes", "idle", "schedule", "gaze"},
+                 "keys", "scopes", "idle", "schedule", "gaze", "voice", "lines"},
              "a character");
     CharacterSpec c;
     c.where = file_ + ":" + std::to_string(n.line);
@@ -170,7 +170,47 @@ class SceneReader {
     if (const Node* x = n.Find("idle")) c.idle = Idle(*x, base_dir);
     if (const Node* x = n.Find("schedule")) c.schedule = ScheduleOf(*x);
     if (const Node* x = n.Find("gaze")) c.gaze = GazeOf(*x);
+    if (const Node* x = n.Find("voice")) {
+      c.voice = String(*x, "voice");
+      c.voice_line = x->line;
+    }
+    if (const Node* x = n.Find("lines")) c.lines = Lines(*x);
     return c;
+  }
+
+  std::vector<LineSpec> Lines(const Node& n) const {
+    if (!n.IsSequence()) Fail(n, "lines: expected a list of {when: ..., say: ...}");
+    if (n.items.size() > kMaxLinesPerCharacter)
+      Fail(n, "lines: " + std::to_string(n.items.size()) + " lines, at most " + std::to_string(kMaxLinesPerCharacter));
+    std::vector<LineSpec> lines;
+    for (const Node& item : n.items) lines.push_back(Line(item));
+    return lines;
+  }
+
+  LineSpec Line(const Node& n) const {
+    OnlyKeys(n, {"when", "say", "near", "far"}, "a line");
+    LineSpec l;
+    const Node* say = n.Find("say");
+    if (!say) Fail(n, "a line needs 'say: <text>'");
+    l.say = String(*say, "say");
+    l.line = say->line;
+    const Node* when = n.Find("when");
+    if (!when) Fail(n, "a line needs 'when: start | near | behind | lost | found'");
+    l.when = Choice<LineCue>(*when, "when", {{"start", LineCue::kStart},
+                                             {"near", LineCue::kNear},
+                                             {"behind", LineCue::kBehind},
+                                             {"lost", LineCue::kLost},
+                                             {"found", LineCue::kFound}});
+    const Node* near = n.Find("near");
+    const Node* far = n.Find("far");
+    if (l.when != LineCue::kNear && (near || far)) Fail(near ? *near : *far, "near and far are for 'when: near' lines");
+    if (near) {
+      l.near = NonNegative(*near, "near");
+      l.far = l.near * 1.25 + 0.1;  // the distance triggers' default hysteresis
+    }
+    if (far) l.far = Number(*far, "far");
+    if (!(l.far > l.near)) Fail(far ? *far : n, "far must be beyond near (hysteresis)");
+    return l;
   }
 
   GazeSpec GazeOf(const Node& n) const {

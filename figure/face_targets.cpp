@@ -26,7 +26,7 @@ struct FaceVertex {
 using Move = std::function<Vector3d(const FaceVertex&)>;
 
 constexpr double kMm = 0.001;
-constexpr double kJawOpenDeg = 14;  // jawOpen at weight 1: the chin turned 14° about the jaw's pivot
+constexpr double kJawOpenDeg = kJawOpenDegrees;  // jawOpen at weight 1: the chin turned about the jaw's pivot
 constexpr double kLipHalfWidth = 0.023;
 
 double Side(const FaceVertex& v) { return v.q.x() >= 0 ? 1 : -1; }
@@ -279,6 +279,22 @@ const ExpressionSpec& Find(Expression expression) {
 
 std::span<const char* const> ArkitTargetNames() { return Names<ArkitTargets>(); }
 std::span<const char* const> VisemeTargetNames() { return Names<VisemeTargets>(); }
+
+std::span<const float> VisemeJawShares() {
+  static const std::vector<float> shares = [] {
+    std::vector<float> s;
+    for (const TargetSpec& t : VisemeTargets()) {
+      float share = 0;
+      for (const Term& term : t.terms) {
+        const auto* f = term.move.target<Vector3d (*)(const FaceVertex&)>();
+        if (f && *f == &JawOpen) share += static_cast<float>(term.weight);
+      }
+      s.push_back(share);
+    }
+    return s;
+  }();
+  return shares;
+}
 
 const char* ExpressionName(Expression expression) { return Find(expression).name; }
 

@@ -19,6 +19,13 @@ std::span<const char* const> ArkitTargetNames();
 // viseme_sil viseme_PP ... viseme_ou, in Meta/OpenXR's order, after the ARKit ones.
 std::span<const char* const> VisemeTargetNames();
 
+// The angle jawOpen turns the chin about the Jaw joint's pivot at weight 1, degrees.
+inline constexpr double kJawOpenDegrees = 14;
+// Each viseme target's jaw opening as a share of jawOpen, in VisemeTargetNames' order (the
+// table's jawOpen column in docs/figure.md): what a speech layer that turns the Jaw joint takes
+// out of the targets and turns the joint by instead (anim/face.h).
+std::span<const float> VisemeJawShares();
+
 enum class Expression { kHappy, kSad, kAngry, kSurprised, kAfraid, kDisgusted };
 inline constexpr Expression kExpressions[] = {Expression::kHappy,     Expression::kSad,    Expression::kAngry,
                                               Expression::kSurprised, Expression::kAfraid, Expression::kDisgusted};

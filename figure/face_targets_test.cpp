@@ -125,6 +125,16 @@ TEST(FigureTargets, PPClosesTheLipsAndJawOpenAndAaOpenThem) {
   EXPECT_LT(jaw_closed, 0.001) << "mouthClose brings the lips back together over an open jaw";
 }
 
+// The visemes' jaw shares a speech layer turns the Jaw joint by (anim/face.h) are the jawOpen
+// column of docs/figure.md's table, read from the targets themselves.
+TEST(FigureTargets, TheVisemesJawSharesAreTheirJawOpenTerms) {
+  const std::span<const float> shares = VisemeJawShares();
+  ASSERT_EQ(shares.size(), VisemeTargetNames().size());
+  const float table[] = {0, 0, 0.15f, 0.25f, 0.3f, 0.4f, 0.2f, 0.1f, 0.2f, 0.2f, 1, 0.45f, 0.3f, 0.6f, 0.25f};
+  for (std::size_t v = 0; v < shares.size(); ++v) EXPECT_FLOAT_EQ(shares[v], table[v]) << VisemeTargetNames()[v];
+  EXPECT_EQ(kJawOpenDegrees, 14);
+}
+
 // The sum of |delta| a target puts on the figure's left (+X) half of the face against its right.
 std::pair<double, double> LeftRight(const char* name) {
   const int t = Target(name);

@@ -9,10 +9,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <regex>
+#include <sstream>
+#include <tuple>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+
+#include <nlohmann/json.hpp>
 
 #include "map/map_file.h"
 #include "mapping/map_check.h"
@@ -29,7 +34,7 @@ using testing::LineCount;
 using testing::RunArview;
 
 const char* kSubcommands[] = {"calibrate", "import", "synth", "record", "camera", "map", "track", "eval",
-                              "anim", "place", "render", "view", "replay", "run", "demo", "info"};
+                              "anim", "place", "render", "say", "view", "replay", "run", "demo", "info"};
 
 TEST(Cli, HelpListsEverySubcommand) {
   const auto r = RunArview({"--help"});
@@ -698,6 +703,50 @@ TEST(Cli, RenderSetsMorphTargetWeightsByNameOrExpression) {
   };
   EXPECT_GT(changed(aa), 50);
   EXPECT_GT(changed(happy), 20);
+  std::filesystem::remove_all(dir);
+}
+
+// `arview say` renders a close-up of the figure saying a line: a PNG folder of frames while the
+// mouth moves, and with --curves the same curves and audio hash twice; a bad line or voice is one
+// line naming it, with nothing written.
+TEST(Cli, SayWritesTheSameCurvesTwice) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("arview_cli_say_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string scene = (dir / "scene.yaml").string();
+  std::ofstream(scene) << "characters:\n  - asset: builtin:figure\n    keys: [{azimuth: 0, generate: lookat}]\n";
+  auto say = [&](const std::string& text, const std::string& out, std::vector<std::string> extra) {
+    std::vector<std::string> args = {"say", "--scene", scene, text, "--out", (dir / out).string(), "--size", "160x120"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return RunArview(args);
+  };
+  const std::string line = "<gesture name=\"Wave\"/>Hello, Pam!";
+  const auto first = say(line, "a/", {"--curves", (dir / "a.json").string()});
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const auto second = say(line, "b/", {"--curves", (dir / "b.json").string()});
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  auto read = [](const std::filesystem::path& file) {
+    std::ostringstream text;
+    text << std::ifstream(file).rdbuf();
+    return text.str();
+  };
+  const std::string a = read(dir / "a.json"), b = read(dir / "b.json");
+  EXPECT_EQ(a, b) << "the same line gives the same viseme curves and the same audio hash";
+  const nlohmann::json curves = nlohmann::json::parse(a);
+  double widest = 0;
+  for (const auto& f : curves.at("frames")) widest = std::max(widest, f.at("mouth_open").get<double>());
+  EXPECT_GT(widest, 0.3) << "the mouth opens";
+  EXPECT_GT(curves.at("samples").get<int>(), 8000);
+  EXPECT_EQ(static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir / "a"), {})),
+            curves.at("frames").size());
+  for (const auto& [text, extra, says] : std::vector<std::tuple<std::string, std::vector<std::string>, std::string>>{
+           {"<gesture name=\"Dance\"/>Hi", {}, "the character 'figure' has no gesture 'Dance'"},
+           {"Hi", {"--voice", "kal"}, "--voice: speech: voice 'kal' is not one of slt, rms or awb"}}) {
+    const auto r = say(text, "bad.mp4", extra);
+    EXPECT_NE(r.exit_code, 0) << says;
+    EXPECT_EQ(LineCount(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad.mp4"));
+  }
   std::filesystem::remove_all(dir);
 }
 

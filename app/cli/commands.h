@@ -30,6 +30,7 @@ void AddEvalCommand(CLI::App& app);
 void AddAnimCommand(CLI::App& app);
 void AddPlaceCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
+void AddSayCommand(CLI::App& app);
 void AddViewCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddRunCommand(CLI::App& app);

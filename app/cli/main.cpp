@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   AddAnimCommand(app);
   AddPlaceCommand(app);
   AddRenderCommand(app);
+  AddSayCommand(app);
   AddViewCommand(app);
   AddReplayCommand(app);
   AddRunCommand(app);

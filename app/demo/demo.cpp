@@ -162,6 +162,11 @@ PlacedBehaviour DemoBehaviour(const anim::Character& asset, double greet_within_
     b.greet_clip = "Wave";
     b.greet_within = greet_within_map;
   }
+  // The greeting, spoken when the viewer is first seen, the wave on "hello" (a character that
+  // cannot speak or wave says nothing).
+  if (asset.FindClip("Wave") && asset.skeleton.FindMorphTarget("viseme_PP") >= 0)
+    b.lines.push_back({"start", "<gaze at=\"viewer\"/>Oh, <gesture name=\"Wave\"/>hello! <face expr=\"happy\" intensity=\"0.6\"/>"
+                                "I am standing right here in your room."});
   return b;
 }
 
@@ -176,6 +181,7 @@ std::string BehaviourText(const PlacedBehaviour& b, double greet_within_m) {
   } else {
     text += "looks at the viewer";
   }
+  if (!b.lines.empty()) text += ", says hello (waving on the word) when it first sees the viewer";
   if (!b.greet_clip.empty()) {
     char line[96];
     std::snprintf(line, sizeof line, ", greets (%s) when the viewer comes within %.2f m", b.greet_clip.c_str(), greet_within_m);

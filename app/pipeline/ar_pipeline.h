@@ -12,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -117,6 +118,8 @@ struct FrameLog {
   std::optional<double> gaze_error_deg;  // first character: head forward vs direction to the camera
   int actions_triggered = 0;  // first character: distance-triggered actions started (a greeting)
   anim::GazeFrame eyes;       // first character: its eyes on the viewer, blinks (anim/gaze.h; inactive: none)
+  anim::FaceFrame face;       // first character: speech on its face (anim/face.h; inactive: none)
+  std::string_view saying;    // first character: the line being said (its LayeredAnimator keeps the text), or empty
 };
 
 struct PipelineReport {

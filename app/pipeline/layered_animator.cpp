@@ -24,7 +24,15 @@ const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Ve
   } else {
     inputs.viewpoint = Eigen::Vector3d::Zero();  // held by the animator
   }
-  return animator_->Update(time, inputs);
+  if (!speech_) return animator_->Update(time, inputs);
+  SpeechCues cues;
+  cues.tracking = inputs.tracking;
+  if (camera_center) {
+    cues.distance = inputs.distance;
+    cues.viewpoint = inputs.viewpoint;
+  }
+  const anim::FaceTrack& face = speech_->Update(time, cues, *animator_);
+  return animator_->Update(time, inputs, &face);
 }
 
 }  // namespace arview::app

@@ -23,6 +23,7 @@
 
 #include "anim/animator.h"
 #include "anim/placed_character.h"
+#include "app/pipeline/character_speech.h"
 #include "base/option_check.h"
 
 namespace arview::app {
@@ -47,6 +48,13 @@ class LayeredAnimator {
   // tracker lost the frame. `time` is the video time in seconds (monotonic).
   const anim::AnimatorFrame& Update(const std::optional<Eigen::Vector3d>& camera_center, double time);
 
+  // The character's lines (app/pipeline/character_speech.h), set before the pipeline starts:
+  // each Update then lets them start a line and drive the face.
+  void SetSpeech(std::unique_ptr<CharacterSpeech> speech) { speech_ = std::move(speech); }
+  const CharacterSpeech* speech() const { return speech_.get(); }
+  // The line being said, empty when silent or without lines.
+  std::string_view saying() const { return speech_ ? speech_->saying() : std::string_view(); }
+
   // The clip of the default idle layer, or nullptr (rest pose, idle synthesizer, scene schedule).
   const anim::Clip* idle_clip() const { return idle_; }
   const anim::PlacedCharacter& character() const { return character_; }
@@ -61,6 +69,7 @@ class LayeredAnimator {
   const anim::Clip* idle_ = nullptr;
   std::unique_ptr<anim::Animator> animator_;
   std::vector<std::string> notes_;
+  std::unique_ptr<CharacterSpeech> speech_;
 };
 
 }  // namespace arview::app

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/error.h"
+#include "speech/visemes.h"
 
 namespace arview::app {
 
@@ -109,6 +110,12 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
     frame["blinking"] = f.eyes.blinking;
     if (f.eyes.blinks_begun) frame["blinks_begun"] = f.eyes.blinks_begun;
   }
+  if (f.face.active) {
+    // The mouth: its opening as a share of jawOpen (the figure's 14°), the strongest viseme while talking.
+    frame["mouth_open"] = f.face.jaw_open;
+    if (f.face.viseme >= 0) frame["viseme"] = std::string(ToString(static_cast<speech::Viseme>(f.face.viseme)));
+  }
+  if (!f.saying.empty()) frame["saying"] = std::string(f.saying);
   if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
   if (f.loss) frame["cause"] = {{"kind", ToString(f.loss->cause)}, {"numbers", f.loss->detail}};
   return frame;

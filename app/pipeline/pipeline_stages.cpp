@@ -184,6 +184,8 @@ void RenderStage::AnimateAndCompose(InFlight& item) {
     log.idle_weight = compose.animations.front()->idle_weight();
     log.actions_triggered = compose.animations.front()->triggered;
     log.eyes = compose.animations.front()->gaze;
+    log.face = compose.animations.front()->face;
+    log.saying = animators_.front()->saying();
     if (localized) {
       log.gaze_error_deg = GazeErrorDeg(animators_.front()->character(), compose.animations.front()->model,
                                         item.track.center);

@@ -84,3 +84,36 @@ TEST(StatsConsistency, EyesOnTheViewerAndBlinksAreRecordedPerFrameAndCounted) {
 
 }  // namespace
 }  // namespace arview::app
+
+namespace arview::app {
+namespace {
+
+// A character with a face speech drives (anim/face.h): each frame's record has the mouth's
+// opening, the strongest viseme while it talks, and the line being said; without a face, none.
+TEST(StatsConsistency, TheMouthTheVisemeAndTheLineAreRecordedPerFrame) {
+  FrameLog plain;
+  const nlohmann::ordered_json none = FrameLogJson(plain);
+  EXPECT_FALSE(none.contains("mouth_open"));
+  EXPECT_FALSE(none.contains("viseme"));
+  EXPECT_FALSE(none.contains("saying"));
+  FrameLog silent;
+  silent.face.active = true;
+  const nlohmann::ordered_json s = FrameLogJson(silent);
+  EXPECT_EQ(s.at("mouth_open").get<double>(), 0.0);
+  EXPECT_FALSE(s.contains("viseme"));
+  EXPECT_FALSE(s.contains("saying"));
+  FrameLog talking;
+  talking.face.active = true;
+  talking.face.talking = 1;
+  talking.face.jaw_open = 0.5f;
+  talking.face.viseme = 10;  // aa
+  const std::string line = "Hello there!";
+  talking.saying = line;
+  const nlohmann::ordered_json t = FrameLogJson(talking);
+  EXPECT_DOUBLE_EQ(t.at("mouth_open").get<double>(), 0.5);
+  EXPECT_EQ(t.at("viseme").get<std::string>(), "aa");
+  EXPECT_EQ(t.at("saying").get<std::string>(), line);
+}
+
+}  // namespace
+}  // namespace arview::app

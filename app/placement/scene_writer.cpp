@@ -19,6 +19,16 @@ void EmitVector(YAML::Emitter& y, const char* key, std::initializer_list<double>
   y << YAML::EndSeq;
 }
 
+// The character's `lines:` (docs/speech.md), each `say:` quoted as the emitter sees fit.
+void EmitLines(YAML::Emitter& y, const std::vector<PlacedBehaviour::Line>& lines) {
+  if (lines.empty()) return;
+  y << YAML::Key << "lines" << YAML::Value << YAML::BeginSeq;
+  for (const PlacedBehaviour::Line& l : lines)
+    y << YAML::BeginMap << YAML::Key << "when" << YAML::Value << l.when << YAML::Key << "say" << YAML::Value << YAML::SingleQuoted
+      << l.say << YAML::EndMap;
+  y << YAML::EndSeq;
+}
+
 void EmitBehaviour(YAML::Emitter& y, const PlacedBehaviour& b) {
   const bool idle = !b.idle_clips.empty();
   if (idle) {
@@ -74,6 +84,7 @@ void EmitBehaviour(YAML::Emitter& y, const PlacedBehaviour& b) {
     y << YAML::EndMap;
   }
   y << YAML::EndSeq << YAML::EndMap;
+  EmitLines(y, b.lines);
 }
 
 }  // namespace

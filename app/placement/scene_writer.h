@@ -34,8 +34,15 @@ struct PlacedBehaviour {
   // Tracking loss: the view-adaptive blend holds for `loss_hold` s, then fades out (cosine)
   // over `loss_fade` s, and back on relocalization.
   double loss_hold = 0.5, loss_fade = 1.0;
+  // What the character says (the scene's `lines:`, docs/speech.md): each line's cue (start, near,
+  // behind, lost, found) and its markup.
+  struct Line {
+    std::string when;
+    std::string say;
+  };
+  std::vector<Line> lines;
 
-  bool empty() const { return idle_clips.empty() && greet_clip.empty() && front_gesture.empty(); }
+  bool empty() const { return idle_clips.empty() && greet_clip.empty() && front_gesture.empty() && lines.empty(); }
 };
 
 struct ScenePlacement {

@@ -86,6 +86,20 @@ TEST(SceneWriter, BehaviourBecomesAnIdleSectionAndASchedule) {
   EXPECT_EQ(gestures, 1);  // 6 keys, 60 degrees apart: only the front one is within 50 degrees
 }
 
+// The character's lines (docs/speech.md) are written as `lines:`, each markup as it was given.
+TEST(SceneWriter, LinesAreWrittenWithTheirMarkup) {
+  ScenePlacement c = Placed();
+  c.behaviour.idle_clips = {"Survey"};
+  c.behaviour.lines = {{"start", "<gesture name=\"Wave\"/>Hello! It's me."}, {"lost", "Where did you go?"}};
+  const authoring::Scene s = authoring::ParseScene(SceneYaml(c), "/tmp/placed.yaml");
+  const std::vector<authoring::LineSpec>& lines = s.characters[0].lines;
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0].when, authoring::LineCue::kStart);
+  EXPECT_EQ(lines[0].say, "<gesture name=\"Wave\"/>Hello! It's me.");
+  EXPECT_EQ(lines[1].when, authoring::LineCue::kLost);
+  EXPECT_EQ(lines[1].say, "Where did you go?");
+}
+
 TEST(SceneWriter, NoBehaviourKeepsTheDefaultSchedule) {
   const authoring::Scene s = authoring::ParseScene(SceneYaml(Placed()), "/tmp/placed.yaml");
   EXPECT_FALSE(s.characters[0].idle.given);

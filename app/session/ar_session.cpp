@@ -1,4 +1,5 @@
 #include "app/session/ar_session.h"
+#include "app/session/scene_lines.h"
 
 #include "anim_authoring/character_builder.h"
 #include "app/session/character_setup.h"
@@ -138,6 +139,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     for (const authoring::CharacterSpec& spec : scene.characters) {
       characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
       animators.push_back(MakeLayeredAnimator(*characters.back(), "", o.fade));
+      // The lines are synthesized here, at load, on the speech queue's thread: the frames only say them.
+      if (std::unique_ptr<CharacterSpeech> speech = MakeCharacterSpeech(*characters.back(), o.on_utterance))
+        animators.back()->SetSpeech(std::move(speech));
       for (const std::string& note : animators.back()->notes()) std::cerr << "note: " << note << "\n";
       animator_ptrs.push_back(animators.back().get());
       character_ptrs.push_back(characters.back().get());
@@ -211,6 +215,10 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   result.characters_seconds = characters_seconds;
   result.renderer_seconds = renderer_seconds;
   result.warmup_seconds = warmup_seconds;
+  for (const std::unique_ptr<LayeredAnimator>& a : animators)
+    if (a->speech()) result.utterances.insert(result.utterances.end(), a->speech()->utterances().begin(), a->speech()->utterances().end());
+  std::stable_sort(result.utterances.begin(), result.utterances.end(),
+                   [](const speech::Utterance& a, const speech::Utterance& b) { return a.start_s < b.start_s; });
   if (result.report.first_output) {
     result.seconds_to_first_output = std::chrono::duration<double>(*result.report.first_output - command_start).count();
     if (result.report.first_localized_output) {

@@ -18,6 +18,7 @@
 #include "map/map.h"
 #include "recordings/frame_source.h"
 #include "recordings/recording.h"
+#include "speech/utterance.h"
 
 namespace arview::app {
 
@@ -61,6 +62,9 @@ struct SessionOptions {
   // outputs are written.
   bool cancel_ends_normally = false;
   bool quiet = false;
+  // Called on arview-render when a character starts a line (its 16 kHz samples and its start on
+  // the frame clock, speech/utterance.h): for live sound output. Must not block.
+  std::function<void(const speech::Utterance&)> on_utterance;
   // When the command started, for "first frame shown after ..." (default: RunSession's start).
   std::optional<Clock::time_point> command_start;
 
@@ -82,6 +86,9 @@ struct SessionResult {
   double tracker_seconds = 0, characters_seconds = 0, renderer_seconds = 0, warmup_seconds = 0;
   // The lost frames by cause with advice (LossAdviceText), for the command's summary.
   std::string loss_advice{};
+  // Every line the characters started, in the order they started (speech/utterance.h): for the
+  // audio track of a written video.
+  std::vector<speech::Utterance> utterances{};
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10

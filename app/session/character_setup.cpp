@@ -1,6 +1,7 @@
 #include "app/session/character_setup.h"
 
 #include "anim_authoring/animator_builder.h"
+#include "app/session/scene_lines.h"
 
 namespace arview::app {
 
@@ -20,6 +21,8 @@ std::unique_ptr<LayeredAnimator> MakeLayeredAnimator(const authoring::AnimatedCh
   overrides.idle_clip = idle_clip;
   overrides.hold_seconds = fade.hold_seconds;
   overrides.fade_seconds = fade.fade_seconds;
+  overrides.face = SpeakingFace(character);
+  overrides.played_actions = PlayedActionRoom(spec);
   std::vector<std::string> notes;
   std::unique_ptr<anim::Animator> animator = authoring::BuildAnimator(character, overrides, &notes);
   return std::make_unique<LayeredAnimator>(character, std::move(animator), idle, std::move(notes));

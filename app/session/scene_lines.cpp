@@ -1,0 +1,196 @@
+#include "app/session/scene_lines.h"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+#include "anim/blendable.h"
+#include "figure/face_targets.h"
+#include "speech/speech_queue.h"
+
+namespace arview::app {
+
+namespace {
+
+std::string Where(const std::string& origin, const speech::MarkupTag& tag) {
+  return origin + ": <" + std::string(ToString(tag.kind)) + "> at character " + std::to_string(tag.position) + ": ";
+}
+
+std::optional<figure::Expression> ExpressionNamed(const std::string& name) {
+  for (figure::Expression e : figure::kExpressions)
+    if (name == figure::ExpressionName(e)) return e;
+  return std::nullopt;
+}
+
+std::string ExpressionList() {
+  std::string list;
+  for (figure::Expression e : figure::kExpressions) list += (list.empty() ? "" : ", ") + std::string(figure::ExpressionName(e));
+  return list;
+}
+
+// <gesture name="Wave"/>: the character's clip of that name, over the idle and the view layer on
+// the upper body (the legs stay on the layers below), faded in and out.
+anim::Action GestureAction(const authoring::AnimatedCharacter& ch, const speech::TimedTag& t, const std::string& origin,
+                           const LineActionTiming& timing) {
+  const anim::Character& c = ch.character();
+  const anim::Clip* clip = c.FindClip(t.tag.target);
+  if (!clip)
+    throw anim::Error(Where(origin, t.tag) + "the character '" + ch.spec().name + "' has no gesture '" + t.tag.target +
+                      "' (its clips: " + authoring::ClipList(c) + ")");
+  anim::Action a;
+  a.object = std::make_shared<anim::ClipSource>(ch.shared_skeleton(), std::shared_ptr<const anim::Clip>(ch.shared_character(), clip));
+  a.start = t.time_s;
+  a.name = "say:gesture:" + t.tag.target;
+  a.layer = timing.gesture_layer;
+  anim::Curve fade = anim::Curve::CosineFade(std::min(timing.gesture_fade_in, clip->duration / 2),
+                                             std::min(timing.gesture_fade_out, clip->duration / 2));
+  fade.in_seconds = true;
+  a.params.curves = {fade};
+  const std::vector<int> torso = anim::ResolveScope(c.skeleton, "torso");
+  if (!torso.empty()) {
+    anim::JointMask mask = anim::JointMask::Uniform(c.skeleton.size(), 0.0);
+    mask.Set(torso, 1.0);
+    a.params.masks = {mask};
+  }
+  return a;
+}
+
+// <face expr="happy" intensity="0.6"/>: the expression's target weights held from its word to a
+// while after the line, faded in and out; it keys weights only (every joint masked out).
+anim::Action FaceAction(const authoring::AnimatedCharacter& ch, const speech::TimedTag& t, double line_end,
+                        const std::string& origin, const LineActionTiming& timing) {
+  const std::optional<figure::Expression> expression = ExpressionNamed(t.tag.target);
+  if (!expression)
+    throw anim::Error(Where(origin, t.tag) + "the expression '" + t.tag.target + "' is not one of " + ExpressionList());
+  const anim::Skeleton& sk = ch.character().skeleton;
+  const double length = std::max(line_end - t.time_s, 0.0) + timing.face_hold_after_line;
+  auto clip = std::make_shared<anim::Clip>();
+  clip->name = "say:face:" + t.tag.target;
+  clip->duration = length;
+  clip->tracks.resize(sk.size());
+  for (const figure::TargetWeight& w : figure::ExpressionWeights(*expression, t.tag.intensity)) {
+    const int target = sk.FindMorphTarget(w.target);
+    if (target < 0)
+      throw anim::Error(Where(origin, t.tag) + "the character '" + ch.spec().name + "' cannot show '" + t.tag.target +
+                        "': it has no morph target '" + w.target + "'");
+    clip->weight_tracks.push_back({target, {{0.0, w.weight}, {length, w.weight}}});
+  }
+  anim::Action a;
+  a.object = std::make_shared<anim::ClipSource>(ch.shared_skeleton(), clip);
+  a.start = t.time_s;
+  a.name = clip->name;
+  a.layer = timing.face_layer;
+  anim::Curve fade = anim::Curve::CosineFade(std::min(timing.face_fade_in, length / 2), std::min(timing.face_fade_out, length / 2));
+  fade.in_seconds = true;
+  a.params.curves = {fade};
+  a.params.masks = {anim::JointMask::Uniform(sk.size(), 0.0)};
+  return a;
+}
+
+// Every line synthesized on the queue's thread; the caller waits for all (at load).
+std::vector<speech::SpokenLine> SynthesizeAll(const std::vector<speech::MarkedLine>& marked, const std::vector<LineRequest>& requests,
+                                              speech::Voice voice) {
+  std::vector<speech::SpokenLine> spoken(marked.size());
+  if (marked.empty()) return spoken;
+  speech::SpeechQueue queue(voice, marked.size());
+  for (std::size_t i = 0; i < marked.size(); ++i) queue.Submit(i, marked[i].text);
+  for (std::size_t done = 0; done < marked.size();) {
+    std::optional<speech::SpeechResult> r = queue.TakeFinished();
+    if (!r) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      continue;
+    }
+    if (!r->error.empty()) throw speech::SpeechError(requests[r->id].origin + ": " + r->error);
+    spoken[r->id] = std::move(r->line);
+    ++done;
+  }
+  return spoken;
+}
+
+}  // namespace
+
+std::vector<LineRequest> SceneLineRequests(const authoring::CharacterSpec& spec) {
+  const std::string file = spec.where.substr(0, spec.where.rfind(':'));
+  std::vector<LineRequest> out;
+  for (const authoring::LineSpec& l : spec.lines)
+    out.push_back({file + ":" + std::to_string(l.line), l.say, l.when, l.near, l.far});
+  return out;
+}
+
+std::vector<ReadyLine> PrepareLines(const authoring::AnimatedCharacter& character, const std::vector<LineRequest>& requests,
+                                    const std::string& voice_name, const std::string& voice_origin,
+                                    const LineActionTiming& timing) {
+  speech::Voice voice;
+  try {
+    voice = speech::VoiceFromName(voice_name);
+  } catch (const speech::SpeechError& e) {
+    throw speech::SpeechError(voice_origin + ": " + e.what());
+  }
+  std::vector<speech::MarkedLine> marked;
+  for (const LineRequest& r : requests) {
+    marked.push_back(speech::ParseMarkup(r.markup, r.origin));
+    for (const speech::MarkupTag& tag : marked.back().tags)
+      if (tag.kind == speech::TagKind::kGaze && tag.target != "viewer")
+        throw speech::SpeechError(Where(r.origin, tag) + "the character can look at 'viewer' only, not '" + tag.target + "'");
+  }
+  const std::vector<speech::SpokenLine> spoken = SynthesizeAll(marked, requests, voice);
+  std::vector<ReadyLine> lines;
+  for (std::size_t i = 0; i < requests.size(); ++i) {
+    ReadyLine line;
+    line.origin = requests[i].origin;
+    line.text = marked[i].text;
+    line.cue = requests[i].cue;
+    line.near = requests[i].near;
+    line.far = requests[i].far;
+    auto sp = std::make_shared<const speech::SpokenLine>(spoken[i]);
+    line.visemes = std::make_shared<const speech::VisemeTrack>(sp->phones);
+    const double end = sp->DurationSeconds();
+    for (const speech::TimedTag& t : speech::TimeTags(marked[i], *sp, line.origin)) {
+      switch (t.tag.kind) {
+        case speech::TagKind::kGesture: line.actions.push_back(GestureAction(character, t, line.origin, timing)); break;
+        case speech::TagKind::kFace: line.actions.push_back(FaceAction(character, t, end, line.origin, timing)); break;
+        case speech::TagKind::kGaze: line.gaze_at_viewer.push_back(t.time_s); break;
+      }
+    }
+    line.spoken = std::move(sp);
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+std::optional<anim::FaceRig> SpeakingFace(const authoring::AnimatedCharacter& character) {
+  const anim::Character& c = character.character();
+  anim::FaceRig rig = anim::FindFaceRig(c.skeleton, character.spec().forward, character.spec().up);
+  if (!rig.valid()) return std::nullopt;
+  if (c.source == "builtin:figure") {
+    const std::span<const float> shares = figure::VisemeJawShares();
+    std::copy(shares.begin(), shares.end(), rig.jaw_share.begin());
+    rig.jaw_open_deg = figure::kJawOpenDegrees;
+  }
+  return rig;
+}
+
+int PlayedActionRoom(const authoring::CharacterSpec& spec) {
+  std::size_t most = 0;
+  for (const LineRequest& r : SceneLineRequests(spec)) most = std::max(most, speech::ParseMarkup(r.markup, r.origin).tags.size());
+  // A line's actions may still run while the next lines start (a gesture longer than its line, an
+  // expression held a second after it): room for four lines' worth.
+  return static_cast<int>(4 * most);
+}
+
+std::unique_ptr<CharacterSpeech> MakeCharacterSpeech(const authoring::AnimatedCharacter& character,
+                                                     std::function<void(const speech::Utterance&)> on_utterance) {
+  const authoring::CharacterSpec& spec = character.spec();
+  if (spec.lines.empty()) return nullptr;
+  const std::string voice_origin = spec.voice_line ? spec.where.substr(0, spec.where.rfind(':')) + ":" + std::to_string(spec.voice_line)
+                                                   : spec.where;
+  SpeechOptions options;
+  options.forward = spec.forward;
+  options.up = spec.up;
+  options.character = spec.name;
+  options.on_utterance = std::move(on_utterance);
+  return std::make_unique<CharacterSpeech>(PrepareLines(character, SceneLineRequests(spec), spec.voice, voice_origin),
+                                           std::move(options));
+}
+
+}  // namespace arview::app
