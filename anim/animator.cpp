@@ -132,9 +132,9 @@ bool Animator::SetMorphWeight(int target, float weight) {
 
 void Animator::Look(double time, const Eigen::Vector3d* viewer) {
   if (viewer) viewer_ = *viewer;
-  // The head where the schedule (the look-at chain) put it, then the eyes from there.
-  MustRun(LocalToModelJob{skeleton_.get(), &buffers_.local[0], buffers_.model}, "animator: local to model before gaze");
-  gaze_->Apply(time, viewer_, buffers_.model, buffers_.local[0]);
+  // The head where the schedule (the look-at chain) put it, then the eyes from there; Finish's
+  // pass over every joint comes after.
+  gaze_->PoseEyes(*skeleton_, time, viewer_, buffers_.local[0], buffers_.model);
   frame_.gaze = gaze_->frame();
   frame_.gaze.eyes_on_viewer = frame_.gaze.eyes_on_viewer && viewer != nullptr;
 }

@@ -125,18 +125,28 @@ Eigen::Vector3d ReflectPoint(const Eigen::Vector3d& p, const Eigen::Vector3d& n)
 
 }  // namespace
 
-std::vector<int> MirrorPartners(const Skeleton& sk) {
-  std::vector<int> partner(sk.size());
-  for (int j = 0; j < sk.size(); ++j) {
-    const std::string other = SwapSide(sk.names[j]);
-    const int p = other.empty() ? -1 : sk.Find(other);
-    partner[j] = p >= 0 ? p : j;
+namespace {
+
+// Per name, the index of the name with its side swapped (itself when there is none), kept only
+// where the pair is symmetric.
+std::vector<int> PartnersByName(const std::vector<std::string>& names) {
+  const int n = static_cast<int>(names.size());
+  std::vector<int> partner(n);
+  for (int i = 0; i < n; ++i) {
+    const std::string other = SwapSide(names[i]);
+    const auto at = other.empty() ? names.end() : std::find(names.begin(), names.end(), other);
+    partner[i] = at != names.end() ? static_cast<int>(at - names.begin()) : i;
   }
-  // Keep only symmetric pairs.
-  for (int j = 0; j < sk.size(); ++j)
-    if (partner[partner[j]] != j) partner[j] = j;
+  for (int i = 0; i < n; ++i)
+    if (partner[partner[i]] != i) partner[i] = i;
   return partner;
 }
+
+}  // namespace
+
+std::vector<int> MirrorPartners(const Skeleton& sk) { return PartnersByName(sk.names); }
+
+std::vector<int> MirrorTargetPartners(const Skeleton& sk) { return PartnersByName(sk.morph_targets); }
 
 Mirror::Mirror(BlendablePtr inner, std::shared_ptr<const Skeleton> skeleton, const Eigen::Vector3d& lateral)
     : inner_(std::move(inner)), skeleton_(std::move(skeleton)) {
@@ -147,6 +157,7 @@ Mirror::Mirror(BlendablePtr inner, std::shared_ptr<const Skeleton> skeleton, con
   for (int c = 0; c < 3; ++c) rp.col(c).normalize();
   n_ = (rp.transpose() * lateral).normalized();
   partner_ = MirrorPartners(*skeleton_);
+  target_partner_ = MirrorTargetPartners(*skeleton_);
   const int n = skeleton_->size();
   source_.Resize(n, skeleton_->morph_target_count());
   model_rot_.assign(n, Eigen::Quaterniond::Identity());
@@ -184,9 +195,11 @@ bool Mirror::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
     out.rigid[j] = DualQuatd::FromRotationTranslation(local, translation);
     out.scale[j] = source_.scale[partner_[j]];
   }
-  // The face as the inner object keyed it (a target is not exchanged with its mirror image).
+  // The face mirrored as the joints are: each target takes its partner's weight (eyeBlinkLeft
+  // the inner object's eyeBlinkRight), a target without a side keeps its own.
   out.morph_keyed = source_.morph_keyed && out.morph.size() == source_.morph.size();
-  if (out.morph_keyed) std::copy(source_.morph.begin(), source_.morph.end(), out.morph.begin());
+  if (out.morph_keyed)
+    for (std::size_t i = 0; i < out.morph.size(); ++i) out.morph[i] = source_.morph[target_partner_[i]];
   return true;
 }
 

@@ -121,7 +121,8 @@ class Window : public Blendable {
 // Left↔Right, _L↔_R, ...), reflected across the character's sagittal plane (normal
 // `lateral` = up × forward in model space). Done in model space against the rest pose so that
 // it holds for rigs whose left and right joint frames are not mirror images: at rest the mirror
-// returns the rest pose. Morph target weights pass through as the inner object keyed them.
+// returns the rest pose. Morph target weights are mirrored by name too: each target takes its
+// partner's weight (MirrorTargetPartners).
 class Mirror : public Blendable {
  public:
   Mirror(BlendablePtr inner, std::shared_ptr<const Skeleton> skeleton, const Eigen::Vector3d& lateral = Eigen::Vector3d::UnitX());
@@ -130,12 +131,14 @@ class Mirror : public Blendable {
   int joint_count() const override { return inner_->joint_count(); }
   // partner[j]: the joint whose motion j takes (itself for centre joints).
   const std::vector<int>& partners() const { return partner_; }
+  const std::vector<int>& target_partners() const { return target_partner_; }
 
  private:
   BlendablePtr inner_;
   std::shared_ptr<const Skeleton> skeleton_;
   Eigen::Vector3d n_;
   std::vector<int> partner_;
+  std::vector<int> target_partner_;  // per morph target, the one whose weight it takes
   std::vector<Eigen::Quaterniond> correction_;  // per joint: mirrored rest → rest
   LocalPose source_;
   std::vector<Eigen::Quaterniond> model_rot_, mirrored_rot_;
@@ -145,6 +148,9 @@ class Mirror : public Blendable {
 // Partners by name (Left↔Right, left↔right, _L↔_R, .L↔.R, L_↔R_, CMU's LThumb↔RThumb); joints
 // without a partner map to themselves.
 std::vector<int> MirrorPartners(const Skeleton& skeleton);
+// The same for the morph targets by their names (eyeBlinkLeft↔eyeBlinkRight, mouthSmileLeft↔
+// mouthSmileRight); targets without a partner (jawOpen, the visemes) map to themselves.
+std::vector<int> MirrorTargetPartners(const Skeleton& skeleton);
 
 // A rigid transform applied to the root joints (turn or move the whole animation).
 class GlobalTransform : public Blendable {

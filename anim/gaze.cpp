@@ -297,6 +297,14 @@ Gaze::Gaze(const Skeleton& skeleton, const GazeRig& rig, const GazeOptions& opti
     e.up_parent = (parent.transpose() * up_model).normalized();
     e.side_parent = e.up_parent.cross(e.forward_parent).normalized();
   }
+  const int heads[2] = {eyes_[0].parent, eyes_[1].parent};
+  head_chain_ = JointChain(skeleton, heads);
+}
+
+void Gaze::PoseEyes(const Skeleton& skeleton, double t, const Eigen::Vector3d& viewer_model, LocalPose& local,
+                    std::span<Eigen::Matrix4d> model) {
+  MustRun(JointsToModelJob{&skeleton, &local, head_chain_, model}, "gaze: the head's chain to model space");
+  Apply(t, viewer_model, model, local);
 }
 
 Eigen::Vector2d Gaze::YawPitch(const Eye& e, const Eigen::Vector3d& d) {

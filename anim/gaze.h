@@ -185,8 +185,9 @@ class Gaze {
 
   // Turns the eye joints of `local` toward the viewer (camera centre in model space; not finite:
   // unknown, the eyes look ahead) plus the behaviour's offset, within the eyes' range, and
-  // places the lids. `model` holds `local`'s model-space joints (the head where the look-at
-  // chain put it); the eye and lid joints' entries are not read. No allocation.
+  // places the lids. `model` holds the model-space matrices of `local`'s eye parents (the head
+  // where the look-at chain put it); no other entry is read (the Animator computes only the chain
+  // to them before this). No allocation.
   void Apply(double t, const Eigen::Vector3d& viewer_model, std::span<const Eigen::Matrix4d> model, LocalPose& local);
 
   // The eyes fixate the viewer (no look-away) from schedule time `from` until `until` (a line's
@@ -197,6 +198,15 @@ class Gaze {
   }
   // Eyes Alive's statistics of `mode` from the next draw on (GazeBehaviour::SetMode).
   void SetMode(GazeMode mode) { behaviour_.SetMode(mode); }
+
+  // Apply on a pose whose model-space joints are not yet computed: first only the chain from the
+  // root to the eyes' parents (head_chain(), into `model`), then Apply. The Animator and
+  // PlacedCharacter run their one pass over every joint after it. `skeleton` is the one the
+  // gaze was built for; throws Error when `local` or `model` does not fit it. No allocation.
+  void PoseEyes(const Skeleton& skeleton, double t, const Eigen::Vector3d& viewer_model, LocalPose& local,
+                std::span<Eigen::Matrix4d> model);
+  // The eyes' parents and their ancestors, increasing (JointChain).
+  std::span<const int> head_chain() const { return head_chain_; }
 
   const GazeFrame& frame() const { return frame_; }
   GazeBehaviour& behaviour() { return behaviour_; }
@@ -217,6 +227,7 @@ class Gaze {
   GazeOptions options_;
   GazeBehaviour behaviour_;
   std::array<Eye, 2> eyes_;
+  std::vector<int> head_chain_;
   double last_time_ = -1;
   double hold_on_viewer_from_ = 0, hold_on_viewer_until_ = -1e300;
   GazeFrame frame_;

@@ -1,7 +1,10 @@
 // Gaze (anim/gaze.h): a seeded 10-minute simulation per mode against Eyes Alive's statistics,
 // and the eyes of a small head turned toward a viewer within their range.
 
+#include "anim/animator.h"
+#include "anim/blendable.h"
 #include "anim/gaze.h"
+#include "anim/schedule.h"
 #include "tests/support/eyed_head.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <random>
 #include <vector>
 
 namespace arview::anim {
@@ -315,6 +320,114 @@ TEST(EyeGaze, ASkeletonWithoutEyesHasNoRig) {
   sk.names[1] = "LeftEyeball";
   EXPECT_FALSE(FindGazeRig(sk).valid());
   EXPECT_THROW(Gaze(sk, FindGazeRig(sk), GazeOptions{}), Error);
+}
+
+// A body whose eyes hang below a chain with a branch beside it (an arm) and joints after the
+// eyes (a jaw, a highlight on the left eye), under a scaled, turned root_parent.
+Skeleton EyedBody() {
+  Skeleton sk;
+  sk.names = {"Hips", "Spine", "LeftArm", "Neck", "LeftHand", "Head", "LeftEye", "LeftUpperLid",
+              "LeftLowerLid", "RightEye", "RightUpperLid", "RightLowerLid", "Jaw", "LeftEyeHighlight"};
+  sk.parents = {-1, 0, 1, 1, 2, 3, 5, 5, 5, 5, 5, 5, 5, 6};
+  sk.rest.resize(sk.names.size());
+  const double up[] = {1.0, 0.2, 0.15, 0.25, 0.3, 0.1};
+  for (int j = 0; j < 6; ++j) sk.rest[j].translation = {j == 2 || j == 4 ? 0.2 : 0.0, up[j], 0};
+  for (int j = 6; j < 12; ++j) sk.rest[j].translation = {j < 9 ? 0.03 : -0.03, 0.03, 0.09};
+  sk.rest[12].translation = {0, -0.05, 0.05};
+  sk.rest[13].translation = {0, 0, 0.012};
+  sk.inverse_bind.assign(sk.names.size(), Eigen::Matrix4d::Identity());
+  sk.root_parent.block<3, 3>(0, 0) = 0.9 * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  sk.root_parent.block<3, 1>(0, 3) = Eigen::Vector3d(0.5, 0, -1);
+  return sk;
+}
+
+// Every joint turned at 30 keys/s for 4 s, the hips moving and the head's scale changing.
+std::shared_ptr<Clip> Fidget(const Skeleton& sk) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto clip = std::make_shared<Clip>();
+  clip->name = "fidget";
+  clip->duration = 4;
+  clip->tracks.resize(sk.size());
+  for (int i = 0; i <= 120; ++i) {
+    const double t = i / 30.0;
+    for (int j = 0; j < sk.size(); ++j) {
+      const Eigen::Vector3d axis = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
+      clip->tracks[j].rotation.push_back({t, Eigen::Quaterniond(Eigen::AngleAxisd(0.3 * u(rng), axis))});
+    }
+    clip->tracks[0].translation.push_back({t, Eigen::Vector3d(0.05 * u(rng), 1.0, 0.05 * u(rng))});
+    clip->tracks[5].scale.push_back({t, Eigen::Vector3d::Constant(1.0 + 0.05 * u(rng))});
+  }
+  return clip;
+}
+
+TEST(LocalToModel, AJointChainGivesTheMatricesOfAFullPassBitForBit) {
+  const Skeleton sk = EyedBody();
+  const int head = sk.Find("Head");
+  const std::vector<int> chain = JointChain(sk, std::vector<int>{head, head});
+  EXPECT_EQ(chain, (std::vector<int>{0, 1, 3, 5}));
+  LocalPose pose(sk.size());
+  MustRun(SamplingJob{&sk, Fidget(sk).get(), 1.37, true, &pose}, "test");
+  std::vector<Eigen::Matrix4d> full(sk.size()), part(sk.size(), Eigen::Matrix4d::Constant(7.0));
+  MustRun(LocalToModelJob{&sk, &pose, full}, "test");
+  MustRun(JointsToModelJob{&sk, &pose, chain, part}, "test");
+  for (int j = 0; j < sk.size(); ++j) {
+    const bool listed = std::find(chain.begin(), chain.end(), j) != chain.end();
+    if (listed) EXPECT_TRUE(part[j] == full[j]) << sk.names[j];
+    else EXPECT_TRUE(part[j] == Eigen::Matrix4d::Constant(7.0)) << sk.names[j] << " was written";
+  }
+  // Out of order, repeated or out of range: refused, nothing written.
+  for (const std::vector<int>& bad : {std::vector<int>{3, 1}, std::vector<int>{1, 1}, std::vector<int>{-1}, std::vector<int>{14}}) {
+    std::vector<Eigen::Matrix4d> untouched(sk.size(), Eigen::Matrix4d::Zero());
+    EXPECT_FALSE((JointsToModelJob{&sk, &pose, bad, untouched}.Run()));
+    EXPECT_TRUE(untouched[0].isZero(0));
+  }
+  EXPECT_THROW(JointChain(sk, std::vector<int>{14}), Error);
+}
+
+// The Animator computes only the chain to the eyes' parents before gaze, then every joint once:
+// its frames equal, bit for bit, a full local-to-model pass before gaze and another after it.
+TEST(EyeGaze, TheAnimatorsFramesEqualFullPassesBeforeAndAfterGaze) {
+  const auto sk = std::make_shared<const Skeleton>(EyedBody());
+  const std::shared_ptr<Clip> clip = Fidget(*sk);
+  auto schedule = [&] {
+    auto s = std::make_shared<Schedule>(sk);
+    s->Add({std::make_shared<ClipSource>(sk, clip), {}, 0, true, "fidget"});
+    return s;
+  };
+  AnimatorOptions options;
+  options.view_action.clear();
+  options.gaze = GazeSetup{FindGazeRig(*sk), GazeOptions{}};
+  options.gaze->options.mode = GazeMode::kTalking;
+  Animator animator(sk, schedule(), options);
+  const std::shared_ptr<Schedule> reference_schedule = schedule();
+  Gaze reference_gaze(*sk, options.gaze->rig, options.gaze->options);
+  LocalPose local = LocalPose::Rest(*sk);
+  std::vector<Eigen::Matrix4d> model(sk->size());
+  std::vector<Eigen::Matrix4f> skin(sk->size());
+  std::vector<DualQuatf> skin_dq(sk->size());
+  int differing = 0, moved_eyes = 0;
+  for (int frame = 0; frame < 600; ++frame) {
+    const double t = frame / 60.0;
+    FrameInputs in;
+    in.viewer = Eigen::Vector3d(0.8 * std::sin(t), 1.8, 1.5);
+    const AnimatorFrame& f = animator.Update(t, in);
+    ASSERT_TRUE(reference_schedule->Sample(t, in, local));
+    const Eigen::Quaterniond eye_as_clipped = local.rigid[6].Rotation();
+    MustRun(LocalToModelJob{sk.get(), &local, model}, "test");
+    reference_gaze.Apply(t, in.viewer, model, local);
+    MustRun(LocalToModelJob{sk.get(), &local, model}, "test");
+    MustRun(SkinningMatricesJob{sk.get(), model, skin, skin_dq}, "test");
+    for (int j = 0; j < sk->size(); ++j) {
+      differing += !(f.model[j] == model[j]) || !(f.skinning_matrices[j] == skin[j]) ||
+                   f.skinning_dual_quats[j].real().coeffs() != skin_dq[j].real().coeffs() ||
+                   f.skinning_dual_quats[j].dual().coeffs() != skin_dq[j].dual().coeffs();
+    }
+    moved_eyes += f.local[0].rigid[6].Rotation().angularDistance(eye_as_clipped) > 1e-3;
+    EXPECT_EQ(f.gaze.eyes_on_viewer, reference_gaze.frame().eyes_on_viewer);
+  }
+  EXPECT_EQ(differing, 0) << "joint matrices in 600 frames unlike the two full passes'";
+  EXPECT_GT(moved_eyes, 500) << "gaze turned the eyes";
 }
 
 }  // namespace

@@ -18,8 +18,7 @@ const AnimatorFrame& PlacedCharacter::Update(const Eigen::Vector3d& viewpoint, d
   if (!parts_.blend->Sample(time_seconds, inputs, buffers_.local[0]))
     throw Error(parts_.where + ": view-adaptive blend: key clips and skeleton disagree");
   if (gaze_) {
-    MustRun(LocalToModelJob{&sk, &buffers_.local[0], buffers_.model}, "local to model before gaze");
-    gaze_->Apply(time_seconds, viewer, buffers_.model, buffers_.local[0]);
+    gaze_->PoseEyes(sk, time_seconds, viewer, buffers_.local[0], buffers_.model);
     frame_.gaze = gaze_->frame();
   }
   buffers_.Finish(sk, frame_, "local to model", "skinning matrices");

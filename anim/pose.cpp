@@ -137,6 +137,19 @@ bool BlendingJob::Run() const {
   return true;
 }
 
+namespace {
+
+// Joint j's model matrix from its parent's (already in `output`) and its local transform.
+void JointToModel(const Skeleton& skeleton, const LocalPose& input, int j, bool affine, std::span<Eigen::Matrix4d> output) {
+  Eigen::Matrix4d local = input.rigid[j].ToMatrix();
+  local.block<3, 3>(0, 0) *= input.scale[j].asDiagonal();
+  const int p = skeleton.parents[j];
+  const Eigen::Matrix4d& parent = p < 0 ? skeleton.root_parent : output[p];
+  output[j] = affine ? AffineProduct(parent, local) : Eigen::Matrix4d(parent * local);
+}
+
+}  // namespace
+
 bool LocalToModelJob::Validate() const {
   return skeleton && input && input->size() == skeleton->size() && output.size() == std::size_t(skeleton->size());
 }
@@ -145,14 +158,35 @@ bool LocalToModelJob::Run() const {
   if (!Validate()) return false;
   // Every local matrix is affine, and so is every model matrix when root_parent is.
   const bool affine = Affine(skeleton->root_parent);
-  for (int j = 0; j < skeleton->size(); ++j) {
-    Eigen::Matrix4d local = input->rigid[j].ToMatrix();
-    local.block<3, 3>(0, 0) *= input->scale[j].asDiagonal();
-    const int p = skeleton->parents[j];
-    const Eigen::Matrix4d& parent = p < 0 ? skeleton->root_parent : output[p];
-    output[j] = affine ? AffineProduct(parent, local) : Eigen::Matrix4d(parent * local);
-  }
+  for (int j = 0; j < skeleton->size(); ++j) JointToModel(*skeleton, *input, j, affine, output);
   return true;
+}
+
+bool JointsToModelJob::Validate() const {
+  if (!LocalToModelJob{skeleton, input, output}.Validate()) return false;
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (joints[i] < 0 || joints[i] >= skeleton->size() || (i > 0 && joints[i] <= joints[i - 1])) return false;
+  return true;
+}
+
+bool JointsToModelJob::Run() const {
+  if (!Validate()) return false;
+  const bool affine = Affine(skeleton->root_parent);
+  for (int j : joints) JointToModel(*skeleton, *input, j, affine, output);
+  return true;
+}
+
+std::vector<int> JointChain(const Skeleton& skeleton, std::span<const int> joints) {
+  std::vector<bool> wanted(skeleton.size(), false);
+  for (int j : joints) {
+    if (j < 0 || j >= skeleton.size())
+      throw Error("joint chain: joint " + std::to_string(j) + " out of range (" + std::to_string(skeleton.size()) + " joints)");
+    for (int a = j; a >= 0 && !wanted[a]; a = skeleton.parents[a]) wanted[a] = true;
+  }
+  std::vector<int> chain;
+  for (int j = 0; j < skeleton.size(); ++j)
+    if (wanted[j]) chain.push_back(j);
+  return chain;
 }
 
 bool SkinningMatricesJob::Validate() const {

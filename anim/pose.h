@@ -94,6 +94,24 @@ struct LocalToModelJob {
   [[nodiscard]] bool Run() const;
 };
 
+// LocalToModelJob for some joints only: `joints` increasing, each one's parent listed before it
+// or already holding its model matrix in `output` (JointChain gives a set closed under parents);
+// the other entries of `output` are left as they are. Each listed joint gets the matrix a full
+// LocalToModelJob gives it, bit for bit (the Animator poses the eyes from the chain to the head).
+struct JointsToModelJob {
+  const Skeleton* skeleton = nullptr;
+  const LocalPose* input = nullptr;
+  std::span<const int> joints;
+  std::span<Eigen::Matrix4d> output;
+
+  bool Validate() const;
+  [[nodiscard]] bool Run() const;
+};
+
+// `joints` and all their ancestors, increasing: what a JointsToModelJob must compute for the model
+// matrices of `joints` alone (allocates: build it once). Throws Error for a joint out of range.
+std::vector<int> JointChain(const Skeleton& skeleton, std::span<const int> joints);
+
 // Model-space joint matrices → skinning matrices (model · inverse_bind), as float matrices and,
 // when `dual_quats` is not empty, as dual quaternions of their rigid part (for DQ skinning; a
 // non-rigid skinning matrix loses its scale there: see RigidSkinning()).

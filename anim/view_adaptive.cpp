@@ -1,5 +1,8 @@
 #include "anim/view_adaptive.h"
 
+#include "anim/morph.h"
+
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <type_traits>
@@ -23,6 +26,20 @@ bool SameKeys(const std::vector<Key<V>>& a, const std::vector<Key<V>>& b) {
 
 bool SameTrack(const JointTrack& a, const JointTrack& b) {
   return SameKeys(a.rotation, b.rotation) && SameKeys(a.translation, b.translation) && SameKeys(a.scale, b.scale);
+}
+
+bool SameWeightTracks(const std::vector<WeightTrack>& a, const std::vector<WeightTrack>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].target != b[i].target || !SameKeys(a[i].weights, b[i].weights)) return false;
+  return true;
+}
+
+// A clip's time for `t` looped into [0, duration), as PreparedSamplingJob loops it.
+double Looped(double t, double duration) {
+  if (duration <= 0) return 0;
+  t = std::fmod(t, duration);
+  return t < 0 ? t + duration : t;
 }
 
 std::vector<Eigen::Vector3d> Directions(const std::vector<ViewAdaptiveKey>& keys) {
@@ -57,8 +74,20 @@ ViewAdaptiveBlend::ViewAdaptiveBlend(std::shared_ptr<const Skeleton> skeleton, s
     for (int k = 1; same && k < K; ++k) same = SameTrack(keys_[k].clip->tracks[j], keys_[0].clip->tracks[j]);
     (same ? shared_joints_ : varying_joints_).push_back(j);
   }
+  // The face (morph target weights) is blended apart from the joints (BlendFace): the prepared
+  // clips sample joints only.
+  const int targets = skeleton_->morph_target_count();
+  for (const ViewAdaptiveKey& k : keys_) {
+    face_keyed_ = face_keyed_ || (targets > 0 && !k.clip->weight_tracks.empty());
+    face_varies_ = face_varies_ || !same_length || !SameWeightTracks(k.clip->weight_tracks, keys_[0].clip->weight_tracks);
+    if (!WeightTracksFit(k.clip->weight_tracks, targets, 0))
+      throw Error("key clip '" + k.clip->name + "' keys a morph target the skeleton does not have");
+  }
+  face_.Resize(0, targets);
+  Clip joints_only = *keys_[0].clip;
+  joints_only.weight_tracks.clear();
   if (!shared_joints_.empty())
-    shared_ = std::make_unique<PreparedClip>(*skeleton_, *keys_[0].clip, options_.nlerp_sampling, shared_joints_);
+    shared_ = std::make_unique<PreparedClip>(*skeleton_, joints_only, options_.nlerp_sampling, shared_joints_);
   if (!varying_joints_.empty())
     for (const ViewAdaptiveKey& k : keys_) prepared_.emplace_back(*skeleton_, *k.clip, options_.nlerp_sampling, varying_joints_);
   weights_.assign(K, 0.0);
@@ -75,10 +104,40 @@ double ViewAdaptiveBlend::KeyTime(int key, double t) const {
   return phase * d;
 }
 
+void ViewAdaptiveBlend::BlendFace(double t, LocalPose& out) {
+  out.morph_keyed = false;
+  if (!face_keyed_ || out.morph.empty()) return;
+  if (!face_varies_) {  // every key keys the same weights: the blend is any key's
+    SampleWeightTracks(keys_[0].clip->weight_tracks, Looped(KeyTime(0, t), keys_[0].clip->duration), out);
+    return;
+  }
+  // As DLB blends the joints: each key's weights, by its view weight (normalised); a key without
+  // weight tracks is the rest (every weight 0), as a key without a joint's track is its rest.
+  double total = 0;
+  for (double w : weights_) total += w;
+  if (!(total > 0)) return;
+  std::fill(out.morph.begin(), out.morph.end(), 0.f);
+  for (int k = 0; k < key_count(); ++k) {
+    const std::vector<WeightTrack>& tracks = keys_[k].clip->weight_tracks;
+    if (weights_[k] <= 0 || tracks.empty()) continue;
+    SampleWeightTracks(tracks, Looped(KeyTime(k, t), keys_[k].clip->duration), face_);
+    const float f = static_cast<float>(weights_[k] / total);
+    for (std::size_t i = 0; i < out.morph.size(); ++i) out.morph[i] += f * face_.morph[i];
+  }
+  out.morph_keyed = true;
+}
+
 bool ViewAdaptiveBlend::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
   if (!std::isfinite(t)) t = 0;
   sphere_.Weights(inputs.viewpoint, weights_);
   if (out.size() != skeleton_->size()) return false;
+  if (!out.morph.empty() && static_cast<int>(out.morph.size()) != skeleton_->morph_target_count()) return false;
+  if (!SampleJoints(t, out)) return false;
+  BlendFace(t, out);  // after the joints: sampling them marks the weights unkeyed
+  return true;
+}
+
+bool ViewAdaptiveBlend::SampleJoints(double t, LocalPose& out) {
   converged_ = true;
   max_iterations_ = 0;
   if (shared_ && !PreparedSamplingJob{shared_.get(), KeyTime(0, t), true, &out}.Run()) return false;

@@ -43,7 +43,10 @@ class ViewAdaptiveBlend : public Blendable {
 
   double Duration() const override { return kUnbounded; }
   // Weights for inputs.viewpoint (a zero viewpoint: equal weights), every key with weight > 0
-  // sampled at t (the shared phase or its own loop) and blended.
+  // sampled at t (the shared phase or its own loop) and blended. The keys' morph target weights
+  // (their clips' weight tracks) are blended with the same weights, linearly; a key without
+  // weight tracks counts as every weight 0, and when no key has any the pose's weights are left
+  // unkeyed (morph_keyed false: the layers below keep the face).
   bool Sample(double t, const FrameInputs& inputs, LocalPose& out) override;
   int joint_count() const override { return skeleton_->size(); }
 
@@ -59,6 +62,8 @@ class ViewAdaptiveBlend : public Blendable {
 
  private:
   double KeyTime(int key, double t) const;
+  bool SampleJoints(double t, LocalPose& out);  // sampled and blended (DLB or DIB)
+  void BlendFace(double t, LocalPose& out);     // the morph target weights, when a key keys them
 
   std::shared_ptr<const Skeleton> skeleton_;
   std::vector<ViewAdaptiveKey> keys_;
@@ -74,6 +79,10 @@ class ViewAdaptiveBlend : public Blendable {
   double shared_period_ = 0;
   std::vector<double> weights_;
   std::vector<LocalPose> key_poses_;
+  // The face: whether a key clip has weight tracks, whether they differ between keys (or the
+  // keys' lengths do), and one key's weights as sampled (joints: none).
+  bool face_keyed_ = false, face_varies_ = false;
+  LocalPose face_;
   std::vector<const LocalPose*> active_ptrs_;
   std::vector<double> active_weights_;
   bool converged_ = true;

@@ -5,7 +5,10 @@
 // (__libc_malloc, ...), so every allocation is seen: operator new, Eigen's dynamic matrices,
 // std::vector. Sanitizer builds bring their own allocator; there the test is skipped.
 
+#include "anim/animator.h"
 #include "anim/balance_shift.h"
+#include "anim/placed_character.h"
+#include "anim/view_adaptive.h"
 #include "tests/support/face_schedule.h"
 #include "anim/gaze.h"
 #include "tests/support/eyed_head.h"
@@ -16,7 +19,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstddef>
+#include <memory>
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ARVIEW_SANITIZED_ALLOCATOR 1
@@ -168,6 +173,70 @@ TEST(NoAllocation, GazeOverTenMinutes) {
   const long allocations = g_allocations.load() - before;
   EXPECT_GT(blinks, 200);
   EXPECT_EQ(allocations, 0) << "allocations in 36000 Gaze::Apply calls";
+#endif
+}
+
+// The face through the whole runtime: an eyed head with three targets, view-adaptive keys that
+// key the targets differently (blended as the joints are), the same blend mirrored on a layer
+// above (left and right targets exchanged), gaze posing the eyes from the chain to the head
+// (Animator::Update); and PlacedCharacter::Update with gaze. 20 s at 60 Hz each.
+TEST(NoAllocation, GazeAndTheViewAdaptiveFaceThroughTheAnimator) {
+#ifndef ARVIEW_COUNTS_ALLOCATIONS
+  GTEST_SKIP() << "allocations are not counted in sanitizer builds (they replace malloc)";
+#else
+  auto character = std::make_shared<anim::Character>();
+  character->source = "eyed-head";
+  character->skeleton = testing::EyedHead();
+  character->skeleton.morph_targets = {"eyeBlinkLeft", "eyeBlinkRight", "jawOpen"};
+  const auto sk = std::shared_ptr<const anim::Skeleton>(character, &character->skeleton);
+  std::vector<anim::ViewAdaptiveKey> keys;
+  for (int k = 0; k < 4; ++k) {
+    auto clip = std::make_shared<anim::Clip>();
+    clip->name = "key" + std::to_string(k);
+    clip->duration = 2;
+    clip->tracks.resize(sk->size());
+    const double turn = (k - 1.5) * 0.3;
+    clip->tracks[0].rotation = {{0.0, Eigen::Quaterniond(Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitY()))},
+                                {2.0, Eigen::Quaterniond(Eigen::AngleAxisd(-turn, Eigen::Vector3d::UnitY()))}};
+    clip->weight_tracks = {{k % 3, {{0.0, 0.0}, {1.0, 0.25 * (k + 1)}, {2.0, 0.0}}}};
+    const double a = k * M_PI / 2;
+    keys.push_back({Eigen::Vector3d(std::sin(a), 0, std::cos(a)), clip});
+  }
+  auto blend = std::make_shared<anim::ViewAdaptiveBlend>(sk, keys);
+  auto schedule = std::make_shared<anim::Schedule>(sk);
+  schedule->Add({blend, {}, 0, true, "view"});
+  schedule->Add({std::make_shared<anim::Mirror>(blend, sk), {}, 0, true, "mirrored", 1});
+  schedule->SetLiveWeight(1, 0.4);
+  anim::AnimatorOptions options;
+  options.gaze = anim::GazeSetup{anim::FindGazeRig(*sk), anim::GazeOptions{}};
+  anim::Animator animator(sk, schedule, options, blend);
+  anim::PlacedCharacterParts parts;
+  parts.character = character;
+  parts.blend = std::make_shared<anim::ViewAdaptiveBlend>(sk, keys);
+  parts.gaze = options.gaze;
+  anim::PlacedCharacter placed(std::move(parts));
+  auto inputs = [](int frame) {
+    const double t = frame / 60.0;
+    anim::FrameInputs in;
+    in.viewpoint = Eigen::Vector3d(std::sin(t), 0.1, std::cos(t)).normalized();
+    in.viewer = Eigen::Vector3d(0.5 * std::sin(t), 1.7, 1.2);
+    return in;
+  };
+  animator.Update(0, inputs(0));
+  placed.Update(inputs(0).viewpoint, 0, inputs(0).viewer);
+  const long before = g_allocations.load();
+  float face = 0;
+  int on_viewer = 0;
+  for (int frame = 1; frame <= 1200; ++frame) {
+    const anim::AnimatorFrame& f = animator.Update(frame / 60.0, inputs(frame));
+    face += f.morph_weights[0] + f.morph_weights[1];
+    on_viewer += f.gaze.eyes_on_viewer;
+    on_viewer += placed.Update(inputs(frame).viewpoint, frame / 60.0, inputs(frame).viewer).gaze.eyes_on_viewer;
+  }
+  const long allocations = g_allocations.load() - before;
+  EXPECT_GT(face, 0) << "the keys key the face";
+  EXPECT_GT(on_viewer, 0) << "the eyes met the viewer";
+  EXPECT_EQ(allocations, 0) << "allocations in 1200 Animator::Update and 1200 PlacedCharacter::Update calls with gaze";
 #endif
 }
 

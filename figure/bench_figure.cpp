@@ -3,8 +3,11 @@
 //   BM_FigureFrame/weighted:<n>  anim update + GPU skinning (DQS) + draw with 4x MSAA + contact
 //                                shadow + background upload + resolve + read-back of the figure
 //                                from 1.2 m (the head about 100 px tall), with the first <n> of its
-//                                ARKit targets weighted at 0.3 to 0.9 (0: the program without morphing)
-// Compare weighted:8 with weighted:0 in one run: the difference is the face's cost. Render's own
+//                                ARKit targets weighted at 0.3 to 0.9 (0: the program without morphing);
+//                                gaze:1 poses the eyes and lids toward the camera every frame
+//                                (anim/gaze.h), gaze:0 leaves them at rest
+// Compare weighted:8/gaze:1 (the face on) with weighted:0/gaze:0 (off) in one run: the difference
+// is the face's cost a frame. Counter process_cpu_ms: the process's CPU a frame, all threads. Render's own
 // morph cases (BM_ArFrameMorph, BM_ArFrameFace) are in bench_render; this one is here because
 // render/ does not link figure/.
 
@@ -14,7 +17,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <memory>
+#include <string>
 
 #include "anim_authoring/character_builder.h"
 #include "anim_authoring/scene.h"
@@ -28,8 +33,10 @@ namespace {
 void BM_FigureFrame(benchmark::State& state) {
   RegisterBuiltinCharacters();
   static std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create();
-  const authoring::Scene scene = authoring::ParseScene(
-      "characters:\n  - asset: builtin:figure\n    gaze: {enabled: false}\n    keys: [{azimuth: 0, clip: Idle}]\n", "bench.yaml");
+  const bool gaze = state.range(1) != 0;
+  const authoring::Scene scene = authoring::ParseScene(std::string("characters:\n  - asset: builtin:figure\n    gaze: {enabled: ") +
+                                                           (gaze ? "true" : "false") + "}\n    keys: [{azimuth: 0, clip: Idle}]\n",
+                                                       "bench.yaml");
   authoring::AnimatedCharacter figure(scene.characters[0]);
   const anim::Placement placement = scene.characters[0].placement();
   // 1.2 m in front of the eyes, looking back along -Z (camera y down: 180° about X).
@@ -44,20 +51,30 @@ void BM_FigureFrame(benchmark::State& state) {
     weights[k] = 0.3f + 0.6f * (k % 7) / 6;
   double time = 0;
   auto frame = [&] {
-    anim::AnimatorFrame f = figure.Update(placement.ViewpointFromCamera(camera_at), time);
+    anim::AnimatorFrame f = figure.Update(placement.ViewpointFromCamera(camera_at), time, placement.MapToModel(camera_at));
     f.morph_weights = weights;
     const anim::AnimatorFrame* frames[] = {&f};
     return renderer.Render(background, pose, frames);
   };
   for (int i = 0; i < 3; ++i) frame();  // llvmpipe compiles each new pipeline state at its first draw
+  const std::clock_t cpu_start = std::clock();  // the process's CPU, llvmpipe's threads included
   for (auto _ : state) {
     const cv::Mat image = frame();
     benchmark::DoNotOptimize(image.data);
     time += 1.0 / 30;
   }
+  // Steadier than the real time on a loaded machine: what a frame costs the cores.
+  state.counters["process_cpu_ms"] =
+      1e3 * static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / std::max<double>(1.0, state.iterations());
 }
 
-BENCHMARK(BM_FigureFrame)->Arg(0)->Arg(8)->ArgName("weighted")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FigureFrame)
+    ->Args({0, 0})
+    ->Args({8, 0})
+    ->Args({8, 1})
+    ->ArgNames({"weighted", "gaze"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace arview::figure

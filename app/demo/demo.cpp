@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "anim/character_bounds.h"
+#include "anim_authoring/character_builder.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
 #include "app/demo/demo_figures.h"
@@ -24,6 +25,7 @@
 #include "base/stats.h"
 #include "mapping/colmap_pipeline.h"
 #include "recordings/accuracy.h"
+#include "render/ar_renderer.h"
 #include "render/prt_cache.h"
 #include "synth/synth_room.h"
 
@@ -272,6 +274,7 @@ struct DemoCharacter {
   anim::Character asset;
   ScenePlacement placed;
   fs::path scene;
+  double map_units_per_metre = 1;
 };
 
 DemoCharacter PlaceDemoCharacter(const DemoOptions& o, const map::Map& map, const recordings::Sim3& to_room,
@@ -285,6 +288,7 @@ DemoCharacter PlaceDemoCharacter(const DemoOptions& o, const map::Map& map, cons
   if (c.asset.FindClip("Idle")) place_options.base_clip = "Idle";
   else if (o.character.find("BCN_Epileptic") != std::string::npos) place_options.base_clip = "rest";
   const double map_units_per_metre = MapUnitsPerMetre(map, to_room);
+  c.map_units_per_metre = map_units_per_metre;
   place_options.anchor =
       AnchorInMap(to_room, orbit.Subject(), orbit.CloseApproachAzimuth(), o.height, asset_height, map_units_per_metre);
   c.placed = PlaceCharacter(map, o.character, place_options);
@@ -384,6 +388,84 @@ std::vector<std::string> Greetings(const PipelineReport& replayed, const recordi
   return greetings;
 }
 
+// The close-up of the contact sheet: the character's face from 0.6 m, on the line from its eyes
+// to where the viewer was at a moment of the replay when the eyes met the viewer's.
+struct FaceCloseUp {
+  cv::Mat image;  // the camera's size, the face at its centre
+  long long frame = -1;
+  double time = 0;        // seconds into the replay (the animation's time)
+  double viewer_m = 0;    // how far the viewer was from the eyes then
+  bool eyes_on_viewer = false, blinking = false;
+};
+
+constexpr double kCloseUpMetres = 0.6;
+
+// The midpoint of the eyes, in the map.
+Eigen::Vector3d EyesCentre(const anim::PlacedCharacter& c, const anim::AnimatorFrame& f) {
+  const anim::GazeRig& rig = c.gaze()->rig;
+  const Eigen::Vector3d model = 0.5 * (f.model[rig.eyes[0].eye].block<3, 1>(0, 3) + f.model[rig.eyes[1].eye].block<3, 1>(0, 3));
+  return (c.placement().ModelToMap() * model.homogeneous()).head<3>();
+}
+
+// A camera at `centre` looking at `target`, `up` (map) up in its picture.
+calib::Pose LookingAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, const Eigen::Vector3d& up) {
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d x = (-up).cross(z).normalized();  // the camera's y points down
+  Eigen::Matrix3d camera_to_map;
+  camera_to_map << x, z.cross(x), z;
+  return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(camera_to_map), centre);
+}
+
+// The replayed frames in which the eyes met the viewer's, not blinking, nearest viewer first.
+std::vector<const FrameLog*> EyeContactFrames(const PipelineReport& report, const Eigen::Vector3d& character_map) {
+  std::vector<const FrameLog*> frames;
+  for (const FrameLog& f : report.frames)
+    if (f.eyes.eyes_on_viewer && !f.eyes.blinking && f.track.status != tracker::TrackStatus::kLost) frames.push_back(&f);
+  std::stable_sort(frames.begin(), frames.end(), [&](const FrameLog* a, const FrameLog* b) {
+    return (a->track.center - character_map).norm() < (b->track.center - character_map).norm();
+  });
+  return frames;
+}
+
+// The scene's character (its view-adaptive keys and gaze, without the demo's idle layer: the body
+// is the keys' pose, the eyes the demo's, the same seed at the same time) at the nearest moment
+// of eye contact where it keeps the eyes on a camera 0.6 m from them, rendered in the scene's
+// light on grey. None for a character without eyes, or no such moment.
+std::optional<FaceCloseUp> RenderFaceCloseUp(const DemoCharacter& character, const PipelineReport& report,
+                                             const calib::Camera& camera, const render::OffscreenOptions& gl) {
+  const authoring::Scene scene = authoring::LoadScene(character.scene);
+  authoring::AnimatedCharacter c(scene.characters.at(0));
+  if (!c.gaze() || report.frames.empty()) return std::nullopt;
+  const anim::Placement& placement = c.placement();
+  const Eigen::Vector3d up = placement.UpInMap().normalized();
+  const double first_time = report.frames.front().timestamp;
+  const std::vector<const FrameLog*> candidates = EyeContactFrames(report, placement.ModelToMap().block<3, 1>(0, 3));
+  for (std::size_t i = 0; i < std::min<std::size_t>(candidates.size(), 100); ++i) {
+    const FrameLog& f = *candidates[i];
+    const double t = f.timestamp - first_time;
+    const Eigen::Vector3d viewer = f.track.center;
+    const Eigen::Vector3d eyes = EyesCentre(c, c.Update(placement.ViewpointFromCamera(viewer), t, placement.MapToModel(viewer)));
+    const Eigen::Vector3d camera_centre = eyes + kCloseUpMetres * character.map_units_per_metre * (viewer - eyes).normalized();
+    const anim::AnimatorFrame& frame =
+        c.Update(placement.ViewpointFromCamera(camera_centre), t, placement.MapToModel(camera_centre));
+    if (!frame.gaze.eyes_on_viewer || frame.gaze.blinking) continue;
+    FaceCloseUp close{{}, f.index, t, (viewer - eyes).norm() / character.map_units_per_metre, true, false};
+    auto context = render::OffscreenContext::Create(gl);
+    const SceneLighting lighting = ResolveSceneLighting(character.scene, "auto", {});
+    render::ArOptions options;
+    options.lighting = lighting.mode;
+    options.prt_cache_folder = render::DefaultPrtCacheFolder();
+    options.exposure_smoothing = 1.0;  // one frame: its own exposure
+    render::ArRenderer renderer(*context, camera, options);
+    if (lighting.light) renderer.SetRoomLight(*lighting.light);
+    renderer.AddCharacter(c.character(), placement);
+    const anim::AnimatorFrame* frames[] = {&frame};
+    close.image = renderer.Render(cv::Mat(), LookingAt(camera_centre, EyesCentre(c, frame), up), frames);
+    return close;
+  }
+  return std::nullopt;
+}
+
 // Step 7: what a viewer sees. The character drawn where tracking placed it: its rest pose placed
 // in the room by the scene's anchor and the map-to-room alignment, seen from the ground-truth
 // camera of every replayed frame that was localized (a lost frame shows the video alone).
@@ -406,7 +488,21 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
   std::vector<double> distances;
   for (const auto& g : second_lap) distances.push_back((g.pose.Center() - orbit.Subject()).head<2>().norm());
   const fs::path sheet_file = out.parent_path() / "contact_sheet.png";
-  WriteImageAtomically(sheet_file, ContactSheet(out, 12, 4, 320));
+  const double seconds = result.report.frames.empty() ? 0.0 : result.report.frames.back().timestamp - result.report.frames.front().timestamp;
+  cv::Mat sheet = ContactSheet(out, 12, 4, 320);
+  const std::optional<FaceCloseUp> close_up = RenderFaceCloseUp(character, result.report, walk.camera, o.gl);
+  if (close_up) {
+    char lines[4][96];
+    std::snprintf(lines[0], sizeof lines[0], "the face from %.1f m, eyes on the viewer", kCloseUpMetres);
+    std::snprintf(lines[1], sizeof lines[1], "frame %lld (%.2f s), the viewer %.2f m away", close_up->frame, close_up->time,
+                  close_up->viewer_m);
+    std::snprintf(lines[2], sizeof lines[2], "eye contact in %.0f%% of the lap's frames,",
+                  100.0 * result.report.eye_contact_frames / std::max<std::size_t>(1, result.report.eye_frames));
+    std::snprintf(lines[3], sizeof lines[3], "%ld blinks (%.1f a minute)", result.report.blinks,
+                  seconds > 0 ? 60.0 * result.report.blinks / seconds : 0.0);
+    sheet = WithCloseUp(sheet, close_up->image, 320, 240, {lines[0], lines[1], lines[2], lines[3]});
+  }
+  WriteImageAtomically(sheet_file, sheet);
 
   char buffer[64];
   const double latency = result.report.stages.count("latency") ? result.report.stages.at("latency").median : 0.0;
@@ -416,6 +512,16 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
               100 * view.median_height_fraction, 100 * view.min_height_fraction,
               Percent(view.at_least_a_fifth, view.in_view, buffer, sizeof buffer));
   std::printf("  head within 20 deg of the camera, frames in view: %s\n", Percent(gaze_within, gaze_frames, buffer, sizeof buffer));
+  if (result.report.eye_frames > 0) {
+    std::printf("  eyes on the viewer's (mutual gaze), frames with eyes: %s; blinks: %ld (%.1f a minute)\n",
+                Percent(result.report.eye_contact_frames, result.report.eye_frames, buffer, sizeof buffer), result.report.blinks,
+                seconds > 0 ? 60.0 * result.report.blinks / seconds : 0.0);
+    if (close_up)
+      std::printf("  close-up for the contact sheet: frame %lld (%.2f s), the face from %.1f m, eyes on the camera\n",
+                  close_up->frame, close_up->time, kCloseUpMetres);
+    else
+      std::printf("  close-up for the contact sheet: none (no frame kept the eyes on a camera at %.1f m)\n", kCloseUpMetres);
+  }
   std::printf("  the viewer's distance to the character: median %.2f m, %.2f to %.2f m\n", Median(distances),
               *std::min_element(distances.begin(), distances.end()), *std::max_element(distances.begin(), distances.end()));
   const ScenePlacement& placed = character.placed;
@@ -428,7 +534,8 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
   std::printf("  tracking: %zu/%zu localized, centre error median %.1f mm, latency median %.1f ms\n",
               result.report.frames_localized, result.report.frames_processed, 1000 * report.ate.median, latency);
   std::printf("  end to end: %.1f frames per second at %dx%d\n", result.report.fps, walk.camera.width, walk.camera.height);
-  std::printf("\nwrote %s\n      %s (12 frames), %s (plot), %s, %s, %s\n", out.c_str(), sheet_file.c_str(),
+  std::printf("\nwrote %s\n      %s (12 frames%s), %s (plot), %s, %s, %s\n", out.c_str(), sheet_file.c_str(),
+              close_up ? " and the face's close-up" : "",
               (work / "trajectory.png").c_str(), (work / "trajectory.txt").c_str(), (work / "stats.json").c_str(),
               character.scene.c_str());
 }

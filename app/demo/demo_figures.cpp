@@ -104,4 +104,21 @@ cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns,
   return sheet;
 }
 
+cv::Mat WithCloseUp(const cv::Mat& sheet, const cv::Mat& close_up, int tile_width, int tile_height,
+                    const std::vector<std::string>& lines) {
+  if (close_up.cols < tile_width || close_up.rows < tile_height || sheet.cols < 2 * tile_width || sheet.type() != CV_8UC3 ||
+      close_up.type() != CV_8UC3)
+    throw std::invalid_argument("contact sheet: a close-up of " + std::to_string(close_up.cols) + "x" + std::to_string(close_up.rows) +
+                                " does not fill a tile of " + std::to_string(tile_width) + "x" + std::to_string(tile_height) +
+                                " on a sheet " + std::to_string(sheet.cols) + " wide");
+  cv::Mat out(sheet.rows + tile_height, sheet.cols, CV_8UC3, cv::Scalar::all(0));
+  sheet.copyTo(out(cv::Rect(0, 0, sheet.cols, sheet.rows)));
+  const cv::Rect centre((close_up.cols - tile_width) / 2, (close_up.rows - tile_height) / 2, tile_width, tile_height);
+  close_up(centre).copyTo(out(cv::Rect(0, sheet.rows, tile_width, tile_height)));
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    cv::putText(out, lines[i], {tile_width + 16, sheet.rows + 36 + 28 * static_cast<int>(i)}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
+                cv::Scalar::all(255), 1, cv::LINE_AA);
+  return out;
+}
+
 }  // namespace arview::app

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "anim/character.h"
@@ -45,5 +46,12 @@ InViewSummary MeasureInView(const calib::Camera& camera, const std::vector<std::
 // tiled `columns` wide, each labelled with its frame number. Throws std::runtime_error naming
 // the video when it cannot be read.
 cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width);
+
+// `sheet` with a row of `tile_height` added below: `close_up` cropped about its centre to one
+// tile of tile_width x tile_height at its own scale (a still of the face, centred on it), and
+// `lines` of text beside it. Throws std::invalid_argument when the close-up is smaller than a
+// tile or the sheet is narrower than two.
+cv::Mat WithCloseUp(const cv::Mat& sheet, const cv::Mat& close_up, int tile_width, int tile_height,
+                    const std::vector<std::string>& lines);
 
 }  // namespace arview::app

@@ -67,5 +67,19 @@ TEST(DemoFigures, ContactSheetSpreadsFramesOverTheVideo) {
   EXPECT_THROW(ContactSheet(video, 12, 4, 80), std::runtime_error);
 }
 
+TEST(DemoFigures, TheCloseUpIsARowBelowTheSheetCroppedAboutItsCentre) {
+  const cv::Mat sheet(3 * 60, 4 * 80, CV_8UC3, cv::Scalar::all(40));
+  cv::Mat close_up(120, 160, CV_8UC3, cv::Scalar::all(0));
+  close_up(cv::Rect(40, 30, 80, 60)).setTo(cv::Scalar(200, 100, 50));  // the centre tile's area
+  const cv::Mat out = WithCloseUp(sheet, close_up, 80, 60, {"the face from 0.6 m"});
+  ASSERT_EQ(out.cols, sheet.cols);
+  ASSERT_EQ(out.rows, sheet.rows + 60);
+  EXPECT_EQ(out.at<cv::Vec3b>(10, 10), cv::Vec3b(40, 40, 40)) << "the sheet is kept";
+  EXPECT_EQ(out.at<cv::Vec3b>(180, 0), cv::Vec3b(200, 100, 50)) << "the crop's corner is the close-up's centre tile";
+  EXPECT_EQ(out.at<cv::Vec3b>(239, 79), cv::Vec3b(200, 100, 50));
+  EXPECT_GT(cv::countNonZero(out(cv::Rect(80, 180, 240, 60)).reshape(1)), 0) << "the text beside it";
+  EXPECT_THROW(WithCloseUp(sheet, close_up(cv::Rect(0, 0, 60, 60)), 80, 60, {}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace arview::app
