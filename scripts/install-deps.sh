@@ -21,6 +21,7 @@ PACKAGES=(
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
+  python3
 )
 
 missing=()
