@@ -25,6 +25,7 @@ PACKAGES=(
   xdotool
   libmetis-dev
   slurmctld slurmd slurm-client munge
+  python3
 )
 
 missing=()

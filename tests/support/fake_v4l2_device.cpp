@@ -95,10 +95,20 @@ constexpr int kJpegQuality = 80;
 // frames would not fit; those are encoded again each time).
 constexpr size_t kCacheBytes = 256u << 20;
 
-// The C library's own functions, found once.
+// The C library's own function `name`, found at its first use and kept in `slot`: a
+// constant-initialised atomic, where a function-local static with a dynamic initialiser would
+// take a guard (__cxa_guard_acquire/release). ThreadSanitizer intercepts those guards, and its
+// runtime's own start-up calls mmap before the runtime exists: a tsan build of arview with this
+// library preloaded died with SEGV in TSan's guard_release before main (docs/reliability.md,
+// "The live crash"). Two threads finding it at once store the same address.
 template <class Function>
-Function Real(const char* name) {
-  return reinterpret_cast<Function>(::dlsym(RTLD_NEXT, name));
+Function Real(std::atomic<void*>& slot, const char* name) {
+  void* function = slot.load(std::memory_order_acquire);
+  if (function == nullptr) {
+    function = ::dlsym(RTLD_NEXT, name);
+    slot.store(function, std::memory_order_release);
+  }
+  return reinterpret_cast<Function>(function);
 }
 
 // The listed node (ARVIEW_FAKE_CAMERA_NODE), "" when none.
@@ -810,7 +820,8 @@ Entry* NodeEntryAfter(DIR* dir, Entry* real_entry, Entry Listing::*entry) {
 extern "C" {
 
 DIR* opendir(const char* name) {
-  static const auto real = Real<DIR* (*)(const char*)>("opendir");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<DIR* (*)(const char*)>(real_slot, "opendir");
   DIR* dir = real(name);
   WatchIfNodesFolder(dir, name);
   return dir;
@@ -818,7 +829,8 @@ DIR* opendir(const char* name) {
 
 // libstdc++'s directory_iterator opens with openat and reads through fdopendir.
 DIR* fdopendir(int fd) {
-  static const auto real = Real<DIR* (*)(int)>("fdopendir");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<DIR* (*)(int)>(real_slot, "fdopendir");
   DIR* dir = real(fd);
   if (dir != nullptr && !ListedNode().empty()) {
     char target[4096];
@@ -830,12 +842,14 @@ DIR* fdopendir(int fd) {
 }
 
 dirent* readdir(DIR* dir) {
-  static const auto real = Real<dirent* (*)(DIR*)>("readdir");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<dirent* (*)(DIR*)>(real_slot, "readdir");
   return NodeEntryAfter(dir, real(dir), &Listing::entry);
 }
 
 dirent64* readdir64(DIR* dir) {
-  static const auto real = Real<dirent64* (*)(DIR*)>("readdir64");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<dirent64* (*)(DIR*)>(real_slot, "readdir64");
   return NodeEntryAfter(dir, real(dir), &Listing::entry64);
 }
 
@@ -844,7 +858,8 @@ int closedir(DIR* dir) {
     std::lock_guard<std::mutex> lock(g_listings_mutex);
     Listings().erase(dir);
   }
-  static const auto real = Real<int (*)(DIR*)>("closedir");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(DIR*)>(real_slot, "closedir");
   return real(dir);
 }
 
@@ -854,7 +869,8 @@ int stat(const char* path, struct stat* st) noexcept {
     st->st_mode = S_IFCHR | 0660;
     return 0;
   }
-  static const auto real = Real<int (*)(const char*, struct stat*)>("stat");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(const char*, struct stat*)>(real_slot, "stat");
   return real(path, st);
 }
 
@@ -866,7 +882,8 @@ int open(const char* path, int flags, ...) {
     mode = static_cast<mode_t>(va_arg(args, int));
     va_end(args);
   }
-  static const auto real = Real<int (*)(const char*, int, ...)>("open");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(const char*, int, ...)>(real_slot, "open");
   if (!IsFakePath(path)) return real(path, flags, mode);
   std::lock_guard<std::mutex> lock(g_open);
   if (g_fd.load() >= 0) return Fail(EBUSY);
@@ -879,7 +896,8 @@ int open(const char* path, int flags, ...) {
 }
 
 int close(int fd) {
-  static const auto real = Real<int (*)(int)>("close");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(int)>(real_slot, "close");
   if (IsFake(fd)) {
     std::lock_guard<std::mutex> lock(g_open);
     g_camera.load()->Close();
@@ -894,7 +912,8 @@ int ioctl(int fd, unsigned long request, ...) noexcept {
   void* arg = va_arg(args, void*);
   va_end(args);
   if (IsFake(fd)) return g_camera.load()->Ioctl(request, arg);
-  static const auto real = Real<int (*)(int, unsigned long, ...)>("ioctl");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(int, unsigned long, ...)>(real_slot, "ioctl");
   return real(fd, request, arg);
 }
 
@@ -904,14 +923,16 @@ int ioctl(int fd, unsigned long request, ...) noexcept {
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 int poll(pollfd* fds, nfds_t count, int timeout_ms) {
   if (count == 1 && IsFake(fds[0].fd)) return g_camera.load()->Poll(fds[0], timeout_ms);
-  static const auto real = Real<int (*)(pollfd*, nfds_t, int)>("poll");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(pollfd*, nfds_t, int)>(real_slot, "poll");
   return real(fds, count, timeout_ms);
 }
 #pragma GCC diagnostic pop
 
 void* mmap(void* address, size_t length, int protection, int flags, int fd, off_t offset) noexcept {
   if (IsFake(fd)) return g_camera.load()->Map(length, offset);
-  static const auto real = Real<void* (*)(void*, size_t, int, int, int, off_t)>("mmap");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<void* (*)(void*, size_t, int, int, int, off_t)>(real_slot, "mmap");
   return real(address, length, protection, flags, fd, offset);
 }
 
@@ -919,7 +940,8 @@ void* mmap(void* address, size_t length, int protection, int flags, int fd, off_
 // the buffer addresses.
 int munmap(void* address, size_t length) noexcept {
   if (Camera* camera = g_camera.load(); camera != nullptr && camera->Owns(address)) return 0;
-  static const auto real = Real<int (*)(void*, size_t)>("munmap");
+  static std::atomic<void*> real_slot;
+  const auto real = Real<int (*)(void*, size_t)>(real_slot, "munmap");
   return real(address, length);
 }
 
