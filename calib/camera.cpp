@@ -248,13 +248,14 @@ void PrecheckCameraText(const std::string& text, const std::string& source) {
 // Every top-level key is either used or known to be informational; anything else (a typo, a
 // field of another camera model) is refused rather than ignored.
 void RefuseUnknownKeys(const cv::FileStorage& fs, const std::string& source) {
-  static const std::set<std::string> used{"image_width", "image_height", "camera_matrix", "distortion_coefficients",
-                                          "focus_absolute"};
+  static const std::set<std::string> used{"image_width",    "image_height",     "camera_matrix",
+                                          "distortion_coefficients", "focus_absolute", "calibrated",
+                                          "intrinsics_source"};
   const cv::FileNode root = fs.root();
   for (const std::string& key : root.keys()) {
     if (used.count(key) == 0 && InformationalKeys().count(key) == 0) {
       throw CameraError(source + ": unknown key '" + key + "' (a camera file holds image_width, image_height, " +
-                        "camera_matrix, distortion_coefficients, focus_absolute)");
+                        "camera_matrix, distortion_coefficients, focus_absolute, calibrated, intrinsics_source)");
     }
   }
   const cv::FileNode fisheye = fs["fisheye_model"];
@@ -316,12 +317,41 @@ Camera LoadCameraFile(const std::filesystem::path& path) {
     for (int i = 0; i < n; ++i) c.dist[i] = d.at<double>(i);
   }
   if (!fs["focus_absolute"].empty()) c.focus = ReadInt(fs, source, "focus_absolute");
+  if (!fs["calibrated"].empty()) {
+    const int calibrated = ReadInt(fs, source, "calibrated");
+    if (calibrated != 0 && calibrated != 1) throw CameraError(source + ": calibrated must be 0 or 1 (is " + std::to_string(calibrated) + ")");
+    c.calibrated = calibrated == 1;
+  }
+  if (!fs["intrinsics_source"].empty()) {
+    const cv::FileNode node = fs["intrinsics_source"];
+    if (!node.isString()) throw CameraError(source + ": intrinsics_source must be a text");
+    c.intrinsics_source = static_cast<std::string>(node);
+  }
   RefuseUnknownKeys(fs, source);
   c.Validate(source);
   return c;
 }
 
 }  // namespace
+
+Camera EstimatedCamera(int width, int height, double focal_px, const std::string& source) {
+  Camera c = Camera::Pinhole(width, height, focal_px, focal_px, width / 2.0 - 0.5, height / 2.0 - 0.5);
+  c.calibrated = false;
+  c.intrinsics_source = source;
+  c.Validate("the estimated camera (" + source + ")");
+  return c;
+}
+
+double FocalFromHorizontalFov(int width, double fov_deg, const std::string& what) {
+  if (!(std::isfinite(fov_deg) && fov_deg > 0 && fov_deg < 180)) {
+    std::ostringstream s;
+    s << what << ": the horizontal field of view must be between 0 and 180 degrees (is " << fov_deg << ")";
+    throw CameraError(s.str());
+  }
+  return width / 2.0 / std::tan(fov_deg * M_PI / 360.0);
+}
+
+double GuessedFocal(int width, int height) { return 0.6 * std::hypot(width, height); }
 
 Camera LoadCamera(const std::filesystem::path& path) {
   // A library's own exception (std::bad_alloc, filesystem_error, ...) leaves naming the input.
@@ -338,6 +368,8 @@ void SaveCamera(const Camera& camera, const std::filesystem::path& path) {
   fs << "distortion_coefficients" << camera.DistCoeffs();
   // FileStorage writes 32-bit integers: a V4L2 control's value is one.
   if (camera.focus) fs << "focus_absolute" << static_cast<int>(*camera.focus);
+  if (!camera.calibrated) fs << "calibrated" << 0;
+  if (!camera.intrinsics_source.empty()) fs << "intrinsics_source" << camera.intrinsics_source;
   WriteFileAtomically(path, fs.releaseAndGetString());
 }
 

@@ -45,6 +45,13 @@ struct Camera {
   // (V4L2_CID_FOCUS_ABSOLUTE, in the camera's units; camera.yaml's focus_absolute). A camera that
   // focuses elsewhere has another focal length. Unset: not known.
   std::optional<std::int64_t> focus;
+  // False when the intrinsics were not measured but estimated (a focal length from the file's
+  // metadata, a stated field of view, or a guess: `arview import` without --camera); `arview
+  // map` then refines them in COLMAP's adjustment. camera.yaml's `calibrated: 0`.
+  bool calibrated = true;
+  // Where estimated intrinsics came from, in words (camera.yaml's `intrinsics_source`), e.g.
+  // "a guess: focal length 0.6 x the diagonal"; empty for a calibration.
+  std::string intrinsics_source;
 
   static Camera Pinhole(int width, int height, double fx, double fy, double cx, double cy);
 
@@ -71,6 +78,19 @@ struct Camera {
   // Throws CameraError naming `source` and the offending field.
   void Validate(const std::string& source) const;
 };
+
+// An uncalibrated camera of the given size: principal point at the image's centre, no
+// distortion, fx = fy = focal_px; `source` says where the focal length came from.
+Camera EstimatedCamera(int width, int height, double focal_px, const std::string& source);
+
+// The focal length in pixels of a camera whose horizontal field of view is `fov_deg` degrees
+// (0 < fov < 180, else CameraError naming `what`).
+double FocalFromHorizontalFov(int width, double fov_deg, const std::string& what);
+
+// The focal length of a camera nothing is known of: 0.6 x the image's diagonal, a diagonal field
+// of view of 80°, what phones' main cameras (24-28 mm equivalent) and webcams have. (COLMAP's
+// own guess, 1.2 x the longer side, is a 45° lens: 67% long for phone-fox, whose maps then folded.)
+double GuessedFocal(int width, int height);
 
 // OpenCV FileStorage YAML with the names of OpenCV's calibration sample.
 Camera LoadCamera(const std::filesystem::path& path);

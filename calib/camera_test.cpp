@@ -131,6 +131,29 @@ TEST(Camera, LoadRejectsBadFilesNamingTheField) {
   EXPECT_THROW(LoadCamera("/nonexistent/camera.yaml"), CameraError);
 }
 
+// Issue 56: a camera estimated without a calibration keeps saying so through its file.
+TEST(Camera, AnEstimatedCameraIsMarkedUncalibratedAndKeepsItsSource) {
+  const Camera guessed = EstimatedCamera(1080, 1920, GuessedFocal(1080, 1920), "a guess: 0.6 x the diagonal");
+  EXPECT_FALSE(guessed.calibrated);
+  EXPECT_NEAR(guessed.fx, 0.6 * 2202.9, 0.1);
+  EXPECT_DOUBLE_EQ(guessed.cx, 539.5);
+  EXPECT_DOUBLE_EQ(guessed.cy, 959.5);
+  const auto path = ProcessTempDir() / "arview_camera_estimated.yaml";
+  SaveCamera(guessed, path);
+  const Camera loaded = LoadCamera(path);
+  EXPECT_FALSE(loaded.calibrated);
+  EXPECT_EQ(loaded.intrinsics_source, "a guess: 0.6 x the diagonal");
+  SaveCamera(DistortedCamera(), path);  // a calibration writes neither key and loads as calibrated
+  EXPECT_TRUE(LoadCamera(path).calibrated);
+  EXPECT_TRUE(LoadCamera(path).intrinsics_source.empty());
+  std::filesystem::remove(path);
+  std::error_code ignored;
+  std::filesystem::remove(path.parent_path(), ignored);
+  EXPECT_NEAR(FocalFromHorizontalFov(640, 90, "--fov"), 320, 1e-9);
+  EXPECT_THROW(FocalFromHorizontalFov(640, 0, "--fov"), CameraError);
+  EXPECT_NE(LoadError(std::string(kGood) + "calibrated: 2\n").find("calibrated must be 0 or 1"), std::string::npos);
+}
+
 // Issue 17's fuzzer reproducers: each was a crash, a huge allocation or a silently wrong camera.
 TEST(Camera, MatrixHeadersThatMadeOpenCvAllocateGigabytesAreRefused) {
   for (const std::string rows : {"+", "\xd9\xa3" /* ARABIC-INDIC DIGIT THREE */, "99999999", "0", "-3"}) {

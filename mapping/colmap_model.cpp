@@ -322,11 +322,12 @@ class Database {
     int inliers = 0;
     int config = 0;  // COLMAP's TwoViewGeometry::ConfigurationType
     Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d fundamental = Eigen::Matrix3d::Zero();  // zero where COLMAP stored none
   };
   std::vector<PairGeometry> PairGeometries() {
     std::vector<PairGeometry> pairs;
     sqlite3_stmt* raw = nullptr;
-    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config FROM two_view_geometries WHERE rows > 0", -1, &raw,
+    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F FROM two_view_geometries WHERE rows > 0", -1, &raw,
                            nullptr) != SQLITE_OK) {
       sqlite3_finalize(raw);
       return pairs;
@@ -345,6 +346,11 @@ class Database {
       Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rows_first;
       std::memcpy(rows_first.data(), blob, 9 * sizeof(double));
       g.essential = rows_first;
+      const void* f_blob = sqlite3_column_blob(st.get(), 4);
+      if (f_blob && sqlite3_column_bytes(st.get(), 4) == 9 * sizeof(double)) {
+        std::memcpy(rows_first.data(), f_blob, 9 * sizeof(double));
+        g.fundamental = rows_first;
+      }
       pairs.push_back(g);
     }
     return pairs;
@@ -681,6 +687,33 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
 DatabaseMatchGraph ReadMatchGraph(const fs::path& database) {
   Database db(database);
   return {db.Images(), db.VerifiedPairs()};
+}
+
+std::vector<FundamentalPair> ReadFundamentalMatrices(const fs::path& database) {
+  Database db(database);
+  std::vector<FundamentalPair> result;
+  for (const auto& pair : db.PairGeometries()) {
+    // CALIBRATED (2) and UNCALIBRATED (3) pairs: a general motion, whose F is defined (a
+    // homography's pairs, planar or a pure turn, leave it free).
+    if ((pair.config != 2 && pair.config != 3) || pair.fundamental.isZero()) continue;
+    result.push_back({pair.image_a, pair.image_b, pair.inliers, pair.fundamental});
+  }
+  return result;
+}
+
+void SetSingleCameraParams(const fs::path& database, const std::vector<double>& params) {
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(database.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
+  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> db(raw, sqlite3_close);
+  sqlite3_stmt* st = nullptr;
+  const bool ok = rc == SQLITE_OK &&
+                  sqlite3_prepare_v2(raw, "UPDATE cameras SET params = ?", -1, &st, nullptr) == SQLITE_OK &&
+                  sqlite3_bind_blob(st, 1, params.data(), static_cast<int>(params.size() * sizeof(double)),
+                                    SQLITE_TRANSIENT) == SQLITE_OK &&
+                  sqlite3_step(st) == SQLITE_DONE && sqlite3_changes(raw) == 1;
+  const std::string why = raw ? sqlite3_errmsg(raw) : "out of memory";
+  sqlite3_finalize(st);
+  if (!ok) throw map::MapError(database.string() + ": cannot set its camera's parameters (" + why + "; one camera expected)");
 }
 
 namespace {

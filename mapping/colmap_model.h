@@ -84,6 +84,20 @@ struct DatabaseMatchGraph {
 };
 DatabaseMatchGraph ReadMatchGraph(const std::filesystem::path& database);
 
+// A verified pair's fundamental matrix, in COLMAP's pixels (centres at +0.5): x_b^T F x_a = 0.
+struct FundamentalPair {
+  std::uint32_t image_a = 0, image_b = 0;  // COLMAP's image ids
+  int inliers = 0;
+  Eigen::Matrix3d fundamental;
+};
+// Every pair of a general motion (COLMAP's CALIBRATED and UNCALIBRATED configurations) with its
+// F; the planar and pure-turn pairs, whose F is not defined, are left out.
+std::vector<FundamentalPair> ReadFundamentalMatrices(const std::filesystem::path& database);
+
+// Replaces the parameters of the database's one camera (arview maps with a single camera), in
+// COLMAP's order for its model. MapError naming the database when it cannot.
+void SetSingleCameraParams(const std::filesystem::path& database, const std::vector<double>& params);
+
 // Throws MapError naming the file of `sparse_dir` (images.bin, points3D.bin) that holds the first
 // value a map may not hold.
 void RequireModelValuesInRange(const map::Map& map, const std::filesystem::path& sparse_dir);

@@ -22,6 +22,7 @@
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
 #include "mapping/leaf_mapping.h"
+#include "mapping/self_calibration.h"
 #include "mapping/map_extend.h"
 #include "mapping/pair_matching.h"
 #include "recordings/trajectory.h"
@@ -808,9 +809,10 @@ std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const Ma
                                            const fs::path& database, const fs::path& image_root,
                                            const fs::path& image_list) {
   bool full_opencv = false;
-  const std::vector<double> params = ColmapCameraParams(camera, &full_opencv);
+  const std::vector<double> params = camera.calibrated ? ColmapCameraParams(camera, &full_opencv) : ColmapRadialParams(camera);
+  const char* model = !camera.calibrated ? "RADIAL" : full_opencv ? "FULL_OPENCV" : "OPENCV";
   return {"feature_extractor", "--database_path", database.string(), "--image_path", image_root.string(),
-          "--image_list_path", image_list.string(), "--ImageReader.camera_model", full_opencv ? "FULL_OPENCV" : "OPENCV",
+          "--image_list_path", image_list.string(), "--ImageReader.camera_model", model,
           "--ImageReader.single_camera", "1", "--ImageReader.camera_params", FormatParams(params),
           "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", std::to_string(options.threads),
           "--SiftExtraction.max_num_features", std::to_string(options.max_num_features),
@@ -819,8 +821,11 @@ std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const Ma
 }
 
 std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const fs::path& database,
-                                          const fs::path& image_root, const fs::path& sparse) {
+                                          const fs::path& image_root, const fs::path& sparse, bool self_calibrate) {
   const std::string refine = options.refine_intrinsics ? "1" : "0";
+  // Self-calibration refines the focal length and the radial terms, never the principal point
+  // (which the frames of one walk cannot pin down: COLMAP's own advice).
+  const std::string refine_lens = options.refine_intrinsics || self_calibrate ? "1" : "0";
   std::vector<std::string> args{"mapper", "--database_path", database.string(), "--image_path",
                                 image_root.string(), "--output_path", sparse.string(),
                                 "--Mapper.num_threads", std::to_string(options.threads),
@@ -829,9 +834,9 @@ std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const 
                                 // 96-frame room (20,000-45,000) there: 27 s of its 66 s mapper.
                                 // The demo room's mapper at 5,000: 46 s, the same map.
                                 "--Mapper.ba_min_num_residuals_for_multi_threading", "5000",
-                                "--Mapper.ba_refine_focal_length", refine,
+                                "--Mapper.ba_refine_focal_length", refine_lens,
                                 "--Mapper.ba_refine_principal_point", refine,
-                                "--Mapper.ba_refine_extra_params", refine,
+                                "--Mapper.ba_refine_extra_params", refine_lens,
                                 "--Mapper.ba_global_images_ratio", FormatParams({options.ba_global_ratio}),
                                 "--Mapper.ba_global_points_ratio", FormatParams({options.ba_global_ratio}),
                                 "--Mapper.ba_global_max_num_iterations",
@@ -873,7 +878,12 @@ MapCheck RecheckMap(const fs::path& map_dir) {
   for (const map::Keyframe& k : built.keyframes) frames[k.name] = {k.frame_index, k.timestamp};
   std::vector<std::vector<Eigen::Vector2f>> keypoints;
   const map::Map model = ReadColmapMap(model_dir, database, frames, {}, &keypoints, false);
-  const MapCheck check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
+  MapCheck check = CheckMap(model, keypoints, ReadTwoViewGeometries(database, model));
+  // A map made without a calibration keeps the warning on its refined intrinsics.
+  std::error_code ec;
+  if (fs::exists(map_dir / "camera.yaml", ec) && !calib::LoadCamera(map_dir / "camera.yaml").calibrated) {
+    for (const std::string& problem : ImplausibleIntrinsics(built.camera)) check.warnings.push_back(problem);
+  }
   WriteMapCheck(check, map_dir / kMapCheckFileName);
   return check;
 }
@@ -979,11 +989,16 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   // Half-written matches stay until the next run clears them (clearing needs room to write).
   const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
 
-  const std::vector<std::string> mapper_args = ColmapMapperArgs(options, database, images.root, sparse);
+  const bool self_calibrate = !recording.camera.calibrated;
+  if (self_calibrate && cb.note) {
+    cb.note("the recording's camera is not calibrated (" + recording.camera.intrinsics_source +
+            "): COLMAP refines its focal length and radial distortion");
+  }
+  const std::vector<std::string> mapper_args = ColmapMapperArgs(options, database, images.root, sparse, self_calibrate);
   const bool in_leaves = options.leaf_size > 0 && n > options.leaf_size;  // mapping/leaf_mapping.h
   inputs += "--\n" + Joined(mapper_args) +
             (in_leaves ? "leaves " + std::to_string(options.leaf_size) + " " + std::to_string(options.leaf_overlap) + "\n" : "");
-  const std::string mapper_inputs = inputs;
+  std::string mapper_inputs = inputs;  // + the focal length self-calibration starts from
   // `extra_args`: a retry's start (RetryFoldedMap), appended to the command and its inputs.
   const auto mapper = [&](const std::vector<std::string>& extra_args) {
     if (in_leaves) {  // sparse/ is replaced only once the leaves are merged
@@ -1017,6 +1032,13 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
     result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
   };
   match();
+  calib::Camera start_camera = recording.camera;  // what COLMAP's adjustment starts from
+  if (self_calibrate) {
+    std::string note;
+    start_camera = StartSelfCalibration(database, recording.camera, &note);
+    if (cb.note) cb.note(note);
+    mapper_inputs += "--\nself-calibration " + FormatParams(ColmapRadialParams(start_camera));
+  }
   // The board is looked for while COLMAP maps, on the CPU time its mapper leaves (a third of two
   // cores); not when the mapper's stage will be skipped, as its model is then likely made metric.
   std::optional<BoardSearchInBackground> board_search;
@@ -1048,6 +1070,11 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   };
   MakeMetric(KeyframeImagesIn(result.map, {images.root}), board_search ? &*board_search : nullptr, options, cb,
              read_moved_model, &result);
+  if (self_calibrate) {
+    if (cb.note) cb.note(RefinedCameraNote(start_camera, result.map.camera));
+    for (const std::string& problem : ImplausibleIntrinsics(result.map.camera)) result.check.warnings.push_back(problem);
+    WriteRefinedCamera(start_camera, result.map.camera, out_dir);
+  }
   WriteMapFiles(result, out_dir, options, cb);
   result.timings.push_back({"write", Seconds(t0), false});
   return result;

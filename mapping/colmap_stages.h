@@ -31,14 +31,16 @@ ImageSet SelectImages(const recordings::Recording& recording, const std::filesys
 void RunColmap(const MapBuildOptions& options, const std::filesystem::path& out_dir, const std::string& stage,
                const std::vector<std::string>& args, int total, const MapBuildCallbacks& cb);
 
-// COLMAP's feature_extractor and mapper command lines as `arview map` runs them.
+// COLMAP's feature_extractor and mapper command lines as `arview map` runs them. An uncalibrated
+// camera (calib::Camera::calibrated false) starts as COLMAP's RADIAL model, and `self_calibrate`
+// lets the mapper refine its focal length and radial terms (mapping/self_calibration.h).
 std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const MapBuildOptions& options,
                                            const std::filesystem::path& database,
                                            const std::filesystem::path& image_root,
                                            const std::filesystem::path& image_list);
 std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const std::filesystem::path& database,
                                           const std::filesystem::path& image_root,
-                                          const std::filesystem::path& sparse);
+                                          const std::filesystem::path& sparse, bool self_calibrate = false);
 
 // Whether `arview map` matches this many frames exhaustively (--matcher), else sequentially.
 bool ExhaustiveMatchingWanted(const MapBuildOptions& options, int frames);

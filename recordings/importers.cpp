@@ -1,5 +1,7 @@
 #include "recordings/importers.h"
 
+#include "recordings/image_metadata.h"
+
 #include "base/image_file.h"
 #include "base/input_guard.h"
 
@@ -405,11 +407,37 @@ ImportResult ImportStrecha(const fs::path& source_dir, const fs::path& out_dir, 
 
 namespace {
 
-calib::Camera RequireCamera(const ImportOptions& options, const std::string& kind) {
-  if (!options.camera) {
-    throw RecordingError("import " + kind + ": needs the camera's intrinsics (--camera camera.yaml)");
+// The camera of an import without a calibration (ImportOptions::horizontal_fov_deg), with a
+// note saying what it is.
+calib::Camera EstimatedCamera(int width, int height, const ImportOptions& options, const fs::path* exif_image,
+                              std::vector<std::string>* notes) {
+  double focal = 0;
+  std::string source;
+  std::string exif_ignored;
+  std::optional<FocalFromMetadata> from_exif;
+  if (options.horizontal_fov_deg) {
+    try {
+      focal = calib::FocalFromHorizontalFov(width, *options.horizontal_fov_deg, "--fov");
+    } catch (const calib::CameraError& e) {
+      throw RecordingError(e.what());
+    }
+    std::ostringstream s;
+    s << "--fov " << *options.horizontal_fov_deg << " degrees across the width";
+    source = s.str();
+  } else if (exif_image && (from_exif = ReadFocalFromExif(*exif_image, width, height, &exif_ignored))) {
+    focal = from_exif->focal_px;
+    source = from_exif->description;
+  } else {
+    focal = calib::GuessedFocal(width, height);
+    source = "a guess: focal length 0.6 x the diagonal, a phone's or a webcam's (no --camera, no --fov, no focal length in the file)";
   }
-  return *options.camera;
+  if (!exif_ignored.empty()) notes->push_back(exif_ignored);
+  calib::Camera camera = calib::EstimatedCamera(width, height, focal, source);
+  std::ostringstream s;
+  s << "no --camera: the camera is not calibrated; focal length " << std::lround(focal) << " px from " << source
+    << ". `arview map` refines it (a calibration, `arview calibrate`, is more accurate)";
+  notes->push_back(s.str());
+  return camera;
 }
 
 }  // namespace
@@ -459,11 +487,21 @@ ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, cons
 
 ImportResult ImportImages(const fs::path& source_dir, const fs::path& out_dir, const ImportOptions& options) {
   RequireDirectory(source_dir, "image folder");
-  const calib::Camera camera = RequireCamera(options, "images");
   const std::vector<fs::path> images = ImagesInFolder(source_dir);
+  std::vector<std::string> notes;
+  calib::Camera camera;
+  std::string camera_source = "--camera";
+  if (options.camera) {
+    camera = *options.camera;
+    if (options.horizontal_fov_deg) notes.push_back("--fov ignored: --camera gives the intrinsics");
+  } else {
+    const cv::Mat first = ReadSourceImage(images.front());
+    camera = EstimatedCamera(first.cols, first.rows, options, &images.front(), &notes);
+    camera_source = "the first image " + images.front().string();
+  }
   PreparedOutput prepared(out_dir, options.overwrite);
-  const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, "--camera");
-  ImportResult result = Finish(out_dir, camera, frames, nullptr, {});
+  const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, camera_source);
+  ImportResult result = Finish(out_dir, camera, frames, nullptr, std::move(notes));
   prepared.Commit();
   return result;
 }
@@ -474,23 +512,31 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
   } catch (const InputError& e) {
     throw RecordingError(std::string(e.what()) + " (the video to import)");
   }
-  const calib::Camera camera = RequireCamera(options, "video");
   cv::VideoCapture cap;
   if (!cap.open(video_file.string(), cv::CAP_FFMPEG)) {
     throw RecordingError(video_file.string() + ": cannot be opened as a video (OpenCV FFmpeg backend)");
   }
   const double fps = cap.get(cv::CAP_PROP_FPS);
   std::vector<double> stamps;
+  std::vector<std::string> notes;
+  calib::Camera camera;
   cv::Mat image;
   while (cap.read(image)) {
-    if (stamps.empty()) CheckSize(image, video_file, camera, "--camera");
+    if (stamps.empty()) {
+      if (options.camera) {
+        camera = *options.camera;
+        if (options.horizontal_fov_deg) notes.push_back("--fov ignored: --camera gives the intrinsics");
+      } else {
+        camera = EstimatedCamera(image.cols, image.rows, options, nullptr, &notes);
+      }
+      CheckSize(image, video_file, camera, "--camera");
+    }
     stamps.push_back(cap.get(cv::CAP_PROP_POS_MSEC) / 1000.0);
   }
   if (stamps.empty()) throw RecordingError(video_file.string() + ": holds no decodable frames");
   // Container timestamps are used when they increase strictly; otherwise index / fps.
   bool increasing = true;
   for (size_t i = 1; i < stamps.size(); ++i) increasing = increasing && stamps[i] > stamps[i - 1];
-  std::vector<std::string> notes;
   if (!increasing) {
     const double rate = (std::isfinite(fps) && fps > 0) ? fps : 30.0;
     if (!(std::isfinite(fps) && fps > 0)) notes.push_back("the video declares no frame rate; assumed 30 fps");

@@ -23,6 +23,10 @@ struct ImportOptions {
   bool overwrite = false;
   // Intrinsics for sources that carry none (images, video, tum); optional for the others.
   std::optional<calib::Camera> camera;
+  // images and video without `camera`: the horizontal field of view in degrees (`--fov`), else
+  // the focal length from the first image's EXIF, else a guess (calib::GuessedFocal: 0.6 x the diagonal). The
+  // recording's camera is then marked uncalibrated (`calibrated: 0`) and `arview map` refines it.
+  std::optional<double> horizontal_fov_deg;
 };
 
 struct ImportResult {
@@ -52,13 +56,14 @@ ImportResult ImportStrecha(const std::filesystem::path& source_dir, const std::f
 ImportResult ImportTum(const std::filesystem::path& source_dir, const std::filesystem::path& out_dir,
                        const ImportOptions& options = {});
 
-// A folder of images (png, jpg, jpeg, bmp, tif, tiff, ppm, pgm) in name order; needs
-// options.camera, whose size must match every image.
+// A folder of images (png, jpg, jpeg, bmp, tif, tiff, ppm, pgm) in name order; every image the
+// size of options.camera, or without it of the first image (an estimated camera, above).
 ImportResult ImportImages(const std::filesystem::path& source_dir, const std::filesystem::path& out_dir,
                           const ImportOptions& options = {});
 
 // One video file, copied into frames/ and decoded once (OpenCV FFmpeg backend) to count its
-// frames and read their timestamps; needs options.camera, whose size must match the video.
+// frames and read their timestamps; options.camera's size must match the video (without it, an
+// estimated camera from --fov or a guess: a video's container carries no focal length).
 ImportResult ImportVideo(const std::filesystem::path& video_file, const std::filesystem::path& out_dir,
                          const ImportOptions& options = {});
 

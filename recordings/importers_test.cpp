@@ -281,7 +281,6 @@ TEST(ImportImages, TakesImagesInNameOrderWithTheGivenCamera) {
   WriteImage(dir.path() / "src/a.png", 64, 48, 1);
   WriteImage(dir.path() / "src/c.bmp", 64, 48, 3);
   WriteFile(dir.path() / "src/notes.txt", "not an image");
-  EXPECT_THROW(ImportImages(dir.path() / "src", dir.path() / "out"), RecordingError);  // no --camera
   ImportOptions options;
   options.camera = SmallCamera();
   EXPECT_EQ(ImportImages(dir.path() / "src", dir.path() / "out", options).frame_count, 3);
@@ -334,7 +333,11 @@ using test::WriteTestVideo;
 TEST(ImportVideo, CountsFramesAndKeepsTheirTimestamps) {
   TempDir dir("video");
   ASSERT_TRUE(WriteTestVideo(dir.path() / "clip.avi", 12, 10.0));
-  EXPECT_THROW(ImportVideo(dir.path() / "clip.avi", dir.path() / "out"), RecordingError);  // no --camera
+  // No --camera: an estimated camera of the video's size, marked uncalibrated.
+  ImportVideo(dir.path() / "clip.avi", dir.path() / "guessed");
+  const Recording guessed = LoadRecording(dir.path() / "guessed");
+  EXPECT_FALSE(guessed.camera.calibrated);
+  EXPECT_DOUBLE_EQ(guessed.camera.fx, 0.6 * std::hypot(guessed.camera.width, guessed.camera.height));
   ImportOptions options;
   options.camera = SmallCamera();
   EXPECT_EQ(ImportVideo(dir.path() / "clip.avi", dir.path() / "out", options).frame_count, 12);

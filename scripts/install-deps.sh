@@ -9,6 +9,7 @@ PACKAGES=(
   colmap
   libceres-dev libopengv-dev libflann-dev libeigen3-dev
   libv4l-dev
+  libexif-dev
   libosmesa6-dev libegl-dev libgl-dev libgles-dev
   libassimp-dev assimp-testmodels
   libsqlite3-dev zlib1g-dev libjpeg62-turbo-dev libpng-dev

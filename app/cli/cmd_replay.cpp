@@ -94,10 +94,11 @@ void AddReplayCommand(CLI::App& app) {
     } else {
       o.sink = a->out;
     }
-    o.frame_camera = recording.camera;
     o.recording = &recording;
     recordings::RecordingSource source(recording, replay);
     const map::Map map = map::LoadMap(a->map_dir);
+    // An uncalibrated recording's camera is a guess; its map holds the refined one.
+    o.frame_camera = recording.camera.calibrated ? recording.camera : map.camera;
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();

@@ -155,7 +155,8 @@ void RunTrack(const TrackArgs& args) {
   }
   tracker->WarmUp();  // the first frame's timing is then a relocalization's, not a process start's
 
-  const tracker::LossDiagnoser diagnoser(map.camera, rec.camera, KeyframeAppearance(map, MapFolder(args.map), &rec));
+  // An uncalibrated recording's camera is a guess; its map holds the refined one.
+  const tracker::LossDiagnoser diagnoser(map.camera, rec.camera.calibrated ? rec.camera : map.camera, KeyframeAppearance(map, MapFolder(args.map), &rec));
   tracker::LossSummary losses;
   recordings::RecordingSource source(std::move(rec), replay);
   std::vector<FrameRecord> frames;
