@@ -33,7 +33,8 @@ void RunColmap(const MapBuildOptions& options, const std::filesystem::path& out_
 
 // COLMAP's feature_extractor and mapper command lines as `arview map` runs them. An uncalibrated
 // camera (calib::Camera::calibrated false) starts as COLMAP's RADIAL model, and `self_calibrate`
-// lets the mapper refine its focal length and radial terms (mapping/self_calibration.h).
+// lets the mapper refine its focal length, principal point and radial terms
+// (mapping/self_calibration.h).
 std::vector<std::string> ColmapExtractArgs(const calib::Camera& camera, const MapBuildOptions& options,
                                            const std::filesystem::path& database,
                                            const std::filesystem::path& image_root,

@@ -144,8 +144,9 @@ std::vector<std::string> ImplausibleIntrinsics(const calib::Camera& c) {
 
 std::string RefinedCameraNote(const calib::Camera& estimated, const calib::Camera& refined) {
   return "the camera was not calibrated (" + estimated.intrinsics_source + "); COLMAP refined it: focal length " +
-         Fixed(estimated.fx, 0) + " -> " + Fixed(refined.fx, 1) + " px, k1 " + Fixed(refined.dist[0], 4) + ", k2 " +
-         Fixed(refined.dist[1], 4) + " (written to the map and to its camera.yaml)";
+         Fixed(estimated.fx, 0) + " -> " + Fixed(refined.fx, 1) + " px, principal point (" + Fixed(refined.cx, 1) + ", " +
+         Fixed(refined.cy, 1) + "), k1 " + Fixed(refined.dist[0], 4) + ", k2 " + Fixed(refined.dist[1], 4) +
+         " (written to the map and to its camera.yaml)";
 }
 
 void WriteRefinedCamera(const calib::Camera& estimated, const calib::Camera& refined,

@@ -1,9 +1,9 @@
 #pragma once
 // Maps from recordings whose camera is not calibrated (`arview import` without --camera): COLMAP
-// refines the focal length and two radial terms in its bundle adjustment (its RADIAL model; the
-// principal point stays at the image's centre, which self-calibration cannot pin down), the map
-// keeps the refined camera, and a camera whose refined values no lens has is flagged by the
-// map's self-check (docs/mapping.md, "Maps without a calibration").
+// refines the focal length, the principal point and two radial terms in its bundle adjustment
+// (its RADIAL model, from the image's centre and the estimated focal length), the map keeps the
+// refined camera, and a camera whose refined values no lens has is flagged by the map's
+// self-check (docs/mapping.md, "Maps without a calibration").
 
 #include <filesystem>
 #include <optional>
