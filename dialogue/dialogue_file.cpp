@@ -71,7 +71,11 @@ class NoAliases : public YAML::EventHandler {
 };
 
 YAML::Node ParseYaml(std::string_view text, const std::string& file) {
-  RequireYamlDepthAtMost(text, kMaxYamlDepth, file);
+  try {
+    RequireYamlDepthAtMost(text, kMaxYamlDepth, file);
+  } catch (const InputError& e) {  // a refusal of the file, as every other: the loader's own type
+    throw DialogueError(e.what());
+  }
   const std::string copy(text);
   try {
     std::istringstream events(copy);

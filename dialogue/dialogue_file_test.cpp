@@ -205,3 +205,22 @@ TEST(DialogueCheck, NamesUnreachableStatesAndUnusedVariables) {
 
 }  // namespace
 }  // namespace arview::dialogue
+
+// fuzz_dialogue's finding (CI, 2026-12-06): a flow mapping nested 70 deep was refused by the YAML
+// depth guard with base's InputError, which escaped callers that catch the loader's DialogueError.
+namespace arview::dialogue {
+namespace {
+
+TEST(DialogueFile, ATooDeeplyNestedFileIsTheLoadersOwnError) {
+  const std::string deep = "dialogue: 1\nmachines: " + std::string(70, '[') + std::string(70, ']') + "\n";
+  try {
+    ParseDialogue(deep, "deep.yaml");
+    FAIL() << "expected a DialogueError";
+  } catch (const DialogueError& e) {
+    EXPECT_NE(std::string(e.what()).find("deep.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nested"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace arview::dialogue
