@@ -4,8 +4,9 @@
 #include <limits>
 
 #include <Eigen/SVD>
+
+#include "base/stats.h"
 #include <cmath>
-#include <sstream>
 
 namespace arview::mapping {
 namespace {
@@ -26,16 +27,24 @@ bool RadialFoldsInside(const calib::Camera& c, double corner_radius) {
   return false;
 }
 
-// The pairs' robust cost at one focal length: the mean of (σ1 − σ2) / σ1 over the pairs, each
-// capped at 0.5 so that a few pairs with a wrong F cannot pull the minimum.
-double EssentialCost(const std::vector<Eigen::Matrix3d>& fundamentals, double focal, double cx, double cy) {
+Eigen::Matrix3d SquarePixelK(double focal, double cx, double cy) {
   Eigen::Matrix3d K;
   K << focal, 0, cx, 0, focal, cy, 0, 0, 1;
+  return K;
+}
+
+// How far E = Kᵀ F K is from an essential matrix: (σ1 − σ2) / σ1, 0 for one; 1 for a zero matrix.
+double EssentialDefect(const Eigen::Matrix3d& K, const Eigen::Matrix3d& F) {
+  const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3d>(K.transpose() * F * K).singularValues();
+  return sv[0] > 0 ? (sv[0] - sv[1]) / sv[0] : 1.0;
+}
+
+// The pairs' robust cost at one focal length: the mean defect over the pairs, each capped at 0.5
+// so that a few pairs with a wrong F cannot pull the minimum.
+double EssentialCost(const std::vector<Eigen::Matrix3d>& fundamentals, double focal, double cx, double cy) {
+  const Eigen::Matrix3d K = SquarePixelK(focal, cx, cy);
   double sum = 0;
-  for (const Eigen::Matrix3d& F : fundamentals) {
-    const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3d>(K.transpose() * F * K).singularValues();
-    sum += sv[0] > 0 ? std::min((sv[0] - sv[1]) / sv[0], 0.5) : 0.5;
-  }
+  for (const Eigen::Matrix3d& F : fundamentals) sum += std::min(EssentialDefect(K, F), 0.5);
   return sum / static_cast<double>(fundamentals.size());
 }
 
@@ -72,15 +81,10 @@ std::optional<FocalEstimate> FocalFromFundamentalMatrices(const std::vector<Fund
   FocalEstimate estimate;
   estimate.focal_px = std::exp((a + b) / 2);
   estimate.pairs = static_cast<int>(fundamentals.size());
-  Eigen::Matrix3d K;
-  K << estimate.focal_px, 0, cx, 0, estimate.focal_px, cy, 0, 0, 1;
-  std::vector<double> costs;
-  for (const Eigen::Matrix3d& F : fundamentals) {
-    const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3d>(K.transpose() * F * K).singularValues();
-    costs.push_back((sv[0] - sv[1]) / sv[0]);
-  }
-  std::nth_element(costs.begin(), costs.begin() + costs.size() / 2, costs.end());
-  estimate.median_cost = costs[costs.size() / 2];
+  const Eigen::Matrix3d K = SquarePixelK(estimate.focal_px, cx, cy);
+  std::vector<double> defects;
+  for (const Eigen::Matrix3d& F : fundamentals) defects.push_back(EssentialDefect(K, F));
+  estimate.median_cost = Median(defects);
   return estimate;
 }
 
