@@ -3,6 +3,9 @@
 // lives in $TMPDIR/arview_temple_map_test_<uid>/map under a file lock; the first process builds
 // it, every other one re-uses it through BuildMap's stage records (COLMAP skipped, the model
 // still read and checked). TempleMapTest checks it; ExtendTempleMapTest extends copies of it.
+// Tests that map with other options (tracker/'s TempleRingTest) keep theirs in another folder
+// beside it, built once the same way: ctest runs every test in a process of its own, and the
+// three templeRing tracker tests built the same map three times (40 s each).
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -21,10 +24,13 @@ inline std::filesystem::path TempleMapRoot() {
   return std::filesystem::temp_directory_path() / ("arview_temple_map_test_" + std::to_string(::getuid()));
 }
 
-// The map in TempleMapRoot()/map of the recording imported from `source` (templeRing) into
-// TempleMapRoot()/recording, which `recording` receives. Throws what BuildMap throws.
+// The map in TempleMapRoot()/<map_folder> made with `options` of the recording imported from
+// `source` (templeRing) into TempleMapRoot()/recording, which `recording` receives. Each folder
+// holds one set of options: a test that maps with other options names another folder. Throws
+// what BuildMap throws.
 inline mapping::MapBuildResult BuildSharedTempleMap(const std::filesystem::path& source, recordings::Recording* recording,
-                                           const mapping::MapBuildCallbacks& cb = {}) {
+                                                    const std::string& map_folder, const mapping::MapBuildOptions& options,
+                                                    const mapping::MapBuildCallbacks& cb = {}) {
   const std::filesystem::path root = TempleMapRoot();
   std::filesystem::create_directories(root);
   const int lock = ::open((root / "lock").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
@@ -40,11 +46,17 @@ inline mapping::MapBuildResult BuildSharedTempleMap(const std::filesystem::path&
     recordings::ImportMiddlebury(source, root / "recording", io);
   }
   *recording = recordings::LoadRecording(root / "recording");
+  return mapping::BuildMap(*recording, root / map_folder, options, cb);
+}
+
+// The suite's default: templeRing's even frames, arview's matching on small frames (kAuto would
+// take COLMAP's: the suite covers it whole), in TempleMapRoot()/map.
+inline mapping::MapBuildResult BuildSharedTempleMap(const std::filesystem::path& source, recordings::Recording* recording,
+                                                    const mapping::MapBuildCallbacks& cb = {}) {
   mapping::MapBuildOptions options;
   options.frames_spec = "0-46:2";
-  // arview's matching on small frames (kAuto would take COLMAP's): the suite covers it whole.
   options.match_engine = mapping::MatchEngine::kArview;
-  return mapping::BuildMap(*recording, root / "map", options, cb);
+  return BuildSharedTempleMap(source, recording, "map", options, cb);
 }
 
 }  // namespace arview::testing

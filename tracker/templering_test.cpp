@@ -1,9 +1,9 @@
 // The tracker on real photographs against a real COLMAP map: templeRing (Middlebury), a map
 // from the 24 even frames, the 23 odd frames localised and judged against the ground truth
 // with the alignment fitted on the map's keyframes (never on the judged frames). The map is
-// built once for the whole suite, with 2048 features per image to keep COLMAP's exhaustive
-// matching short (a partial arc of the ring splits into several small models, so the whole
-// ring is mapped).
+// built once for every test process of the user (mapping/test_temple_map.h), with 2048
+// features per image to keep COLMAP's exhaustive matching short (a partial arc of the ring
+// splits into several small models, so the whole ring is mapped).
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "mapping/colmap_pipeline.h"
+#include "mapping/test_temple_map.h"
 #include "recordings/accuracy.h"
 #include "recordings/importers.h"
 #include "recordings/recording.h"
@@ -34,20 +35,17 @@ class TempleRingTest : public ::testing::Test {
   static void SetUpTestSuite() {
     const fs::path source = arview::testing::SharedData("templeRing");
     if (!fs::exists(source) || !ColmapOnPath()) return;
-    dir_ = fs::temp_directory_path() / ("arview_tracker_temple_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    recordings::ImportMiddlebury(source, dir_ / "recording");
-    recording_ = std::make_unique<recordings::Recording>(recordings::LoadRecording(dir_ / "recording"));
+    recording_ = std::make_unique<recordings::Recording>();
     mapping::MapBuildOptions options;
     options.frames_spec = "0-46:2";
     options.matcher = mapping::MatcherKind::kExhaustive;
     options.max_num_features = 2048;
-    map_ = std::make_unique<map::Map>(mapping::BuildMap(*recording_, dir_ / "map", options).map);
+    map_ = std::make_unique<map::Map>(
+        arview::testing::BuildSharedTempleMap(source, recording_.get(), "tracker_map", options).map);
   }
   static void TearDownTestSuite() {
     map_.reset();
     recording_.reset();
-    if (!dir_.empty()) fs::remove_all(dir_);
   }
   void SetUp() override {
     ARVIEW_REQUIRE_DATA_PATH(arview::testing::SharedData("templeRing"), "../shared/data");
@@ -61,11 +59,9 @@ class TempleRingTest : public ::testing::Test {
     return t;
   }
 
-  static fs::path dir_;
   static std::unique_ptr<recordings::Recording> recording_;
   static std::unique_ptr<map::Map> map_;
 };
-fs::path TempleRingTest::dir_;
 std::unique_ptr<recordings::Recording> TempleRingTest::recording_;
 std::unique_ptr<map::Map> TempleRingTest::map_;
 
