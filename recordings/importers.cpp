@@ -440,6 +440,15 @@ calib::Camera EstimatedCamera(int width, int height, const ImportOptions& option
   return camera;
 }
 
+// The camera of an import from images or a video whose first frame is cols x rows: --camera's
+// when given (a --fov beside it is noted as ignored), else the estimate above.
+calib::Camera ChooseImportCamera(int cols, int rows, const ImportOptions& options, const fs::path* exif_file,
+                                 std::vector<std::string>* notes) {
+  if (!options.camera) return EstimatedCamera(cols, rows, options, exif_file, notes);
+  if (options.horizontal_fov_deg) notes->push_back("--fov ignored: --camera gives the intrinsics");
+  return *options.camera;
+}
+
 }  // namespace
 
 ImportResult ImportTum(const fs::path& source_dir, const fs::path& out_dir, const ImportOptions& options) {
@@ -489,16 +498,10 @@ ImportResult ImportImages(const fs::path& source_dir, const fs::path& out_dir, c
   RequireDirectory(source_dir, "image folder");
   const std::vector<fs::path> images = ImagesInFolder(source_dir);
   std::vector<std::string> notes;
-  calib::Camera camera;
-  std::string camera_source = "--camera";
-  if (options.camera) {
-    camera = *options.camera;
-    if (options.horizontal_fov_deg) notes.push_back("--fov ignored: --camera gives the intrinsics");
-  } else {
-    const cv::Mat first = ReadSourceImage(images.front());
-    camera = EstimatedCamera(first.cols, first.rows, options, &images.front(), &notes);
-    camera_source = "the first image " + images.front().string();
-  }
+  const bool estimated = !options.camera;
+  const cv::Size first = estimated ? ReadSourceImage(images.front()).size() : cv::Size();
+  const calib::Camera camera = ChooseImportCamera(first.width, first.height, options, &images.front(), &notes);
+  const std::string camera_source = estimated ? "the first image " + images.front().string() : "--camera";
   PreparedOutput prepared(out_dir, options.overwrite);
   const std::vector<FrameEntry> frames = StoreStills(images, out_dir, camera, camera_source);
   ImportResult result = Finish(out_dir, camera, frames, nullptr, std::move(notes));
@@ -523,12 +526,7 @@ ImportResult ImportVideo(const fs::path& video_file, const fs::path& out_dir, co
   cv::Mat image;
   while (cap.read(image)) {
     if (stamps.empty()) {
-      if (options.camera) {
-        camera = *options.camera;
-        if (options.horizontal_fov_deg) notes.push_back("--fov ignored: --camera gives the intrinsics");
-      } else {
-        camera = EstimatedCamera(image.cols, image.rows, options, nullptr, &notes);
-      }
+      camera = ChooseImportCamera(image.cols, image.rows, options, nullptr, &notes);
       CheckSize(image, video_file, camera, "--camera");
     }
     stamps.push_back(cap.get(cv::CAP_PROP_POS_MSEC) / 1000.0);
