@@ -15,6 +15,7 @@ extern "C" {
 #include <numbers>
 #include <vector>
 
+#include "tests/support/test_data.h"
 #include "video/video_error.h"
 
 namespace arview::video {
@@ -26,9 +27,8 @@ constexpr int kRate = 16000;
 constexpr double kFps = 25.0;
 
 fs::path Scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("arview_h264_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  static const testing::ScratchFolder folder("arview_h264_test");
+  return folder.path() / name;
 }
 
 std::vector<std::int16_t> Tone(double seconds, double hz = 1000.0) {

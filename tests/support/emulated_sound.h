@@ -42,6 +42,15 @@ class EmulatedSound {
     ::setenv("ALSA_CONFIG_PATH", path.c_str(), 1);
   }
 
+  // The folder goes with the object (ALSA_CONFIG_PATH still names its configuration until the
+  // next EmulatedSound: a device opened after this is gone fails to open, as a missing one does).
+  ~EmulatedSound() {
+    std::error_code ec;
+    std::filesystem::remove_all(folder_, ec);
+  }
+  EmulatedSound(const EmulatedSound&) = delete;
+  EmulatedSound& operator=(const EmulatedSound&) = delete;
+
   // Where the speaker's samples land; what the microphone reads.
   std::filesystem::path played() const { return folder_ / "played.raw"; }
   std::filesystem::path spoken() const { return folder_ / "spoken.raw"; }

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 namespace arview::testing {
 
 inline std::filesystem::path SourceDir() {
@@ -33,6 +35,28 @@ inline bool DataRequired() {
   const char* env = std::getenv("ARVIEW_REQUIRE_DATA");
   return env && std::string(env) == "1";
 }
+
+// A folder of the test process's own, <temp>/<prefix>_<pid>, made on construction and removed
+// with what it holds on destruction: a function-local static one is removed when the process
+// exits, whether its tests passed or failed (a failed ASSERT skips the cleanup written after it,
+// and /tmp kept hundreds of such folders).
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const std::string& prefix)
+      : path_(std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace arview::testing
 
