@@ -32,6 +32,7 @@ struct LineActionTiming {
   double face_fade_in = 0.3, face_fade_out = 0.6;
   double face_hold_after_line = 1.0;  // the expression stays this long after the line ends
   int gesture_layer = 8;              // over the idle and the view-adaptive layers
+  double gesture_min_turn_deg = 5.0;  // a gesture's upper-body joints that turn less stay below
   int face_layer = 9;
 };
 

@@ -183,6 +183,30 @@ TEST(SceneLines, TheGestureStartsOnItsWordAndTheUtteranceOnTheFrameClock) {
   EXPECT_EQ(s.animator->saying(), "Oh, hello there! Nice to see you.");
 }
 
+// A gesture on a word takes the upper-body joints its clip moves and leaves the rest to the
+// layers below: the wave's arm, not the head the look-at keeps on the viewer (with the whole
+// torso masked in, the demo's head turned up to 43 deg off the camera while it said hello); a
+// nod's neck and head.
+TEST(SceneLines, AGestureMovesTheJointsOfItsClipAndLeavesTheHeadToTheLookAt) {
+  Speaker s(FigureSpec({{"start", "<gesture name=\"Wave\"/>Hello. <gesture name=\"Nod\"/>Yes."}}));
+  const anim::Skeleton& skeleton = s.character.character().skeleton;
+  const std::vector<anim::Action>& actions = s.animator->speech()->lines().at(0).actions;
+  ASSERT_EQ(actions.size(), 2u);
+  auto weight = [&](const anim::Action& a, const char* joint) {
+    return a.params.masks.at(0).rotation.at(static_cast<std::size_t>(skeleton.Find(joint)));
+  };
+  const anim::Action& wave = actions[0];
+  const anim::Action& nod = actions[1];
+  EXPECT_EQ(weight(wave, "RightArm"), 1.0);
+  EXPECT_EQ(weight(wave, "RightForeArm"), 1.0);
+  EXPECT_EQ(weight(wave, "Head"), 0.0);
+  EXPECT_EQ(weight(wave, "Neck"), 0.0);
+  EXPECT_EQ(weight(wave, "LeftUpLeg"), 0.0);
+  EXPECT_EQ(weight(nod, "Head"), 1.0);
+  EXPECT_EQ(weight(nod, "Neck"), 1.0);
+  EXPECT_EQ(weight(nod, "RightArm"), 0.0);
+}
+
 // The cues: near (with hysteresis), lost after half a second, found; one line at a time.
 TEST(SceneLines, CuesStartTheirLines) {
   Speaker s(FigureSpec({{"near", "You came close."}, {"lost", "Where did you go?"}, {"found", "There you are."}}));
