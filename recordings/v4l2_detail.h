@@ -35,3 +35,22 @@ bool ParseInteger(const std::string& text, int64_t& value);
 int64_t AutoExposureMode(const CameraControl& control);
 
 }  // namespace arview::recordings::v4l2_detail
+
+// Only the two files above include this header: they use the helpers unqualified.
+namespace arview::recordings {
+using v4l2_detail::DeviceIdentity;
+using v4l2_detail::ErrnoText;
+using v4l2_detail::DeviceFail;
+using v4l2_detail::RetryIoctl;
+using v4l2_detail::FpsText;
+using v4l2_detail::SizeText;
+using v4l2_detail::IntervalFps;
+using v4l2_detail::OpenDevice;
+using v4l2_detail::QueryIdentity;
+using v4l2_detail::CheckCaptureNode;
+using v4l2_detail::EnumerateCapabilities;
+using v4l2_detail::EnumerateControls;
+using v4l2_detail::MjpegOffered;
+using v4l2_detail::ParseInteger;
+using v4l2_detail::AutoExposureMode;
+}  // namespace arview::recordings

@@ -277,17 +277,6 @@ int64_t AutoExposureMode(const CameraControl& control) {
 
 }  // namespace v4l2_detail
 
-using v4l2_detail::DeviceIdentity;
-using v4l2_detail::ErrnoText;
-using v4l2_detail::RetryIoctl;
-using v4l2_detail::IntervalFps;
-using v4l2_detail::OpenDevice;
-using v4l2_detail::QueryIdentity;
-using v4l2_detail::CheckCaptureNode;
-using v4l2_detail::EnumerateCapabilities;
-using v4l2_detail::EnumerateControls;
-using v4l2_detail::ParseInteger;
-
 V4l2Io& SystemV4l2Io() {
   static SystemIo io;
   return io;

@@ -29,22 +29,6 @@
 
 namespace arview::recordings {
 
-using v4l2_detail::DeviceIdentity;
-using v4l2_detail::ErrnoText;
-using v4l2_detail::DeviceFail;
-using v4l2_detail::RetryIoctl;
-using v4l2_detail::FpsText;
-using v4l2_detail::SizeText;
-using v4l2_detail::IntervalFps;
-using v4l2_detail::OpenDevice;
-using v4l2_detail::QueryIdentity;
-using v4l2_detail::CheckCaptureNode;
-using v4l2_detail::EnumerateCapabilities;
-using v4l2_detail::EnumerateControls;
-using v4l2_detail::MjpegOffered;
-using v4l2_detail::ParseInteger;
-using v4l2_detail::AutoExposureMode;
-
 // ---- V4l2Source: set-up ----
 
 int V4l2Source::Ioctl(unsigned long request, void* arg) { return RetryIoctl(io_, fd_, request, arg); }
