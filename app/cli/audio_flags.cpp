@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "anim_authoring/scene.h"
+#include "app/session/ar_session.h"
 #include "audio/audio_error.h"
 
 namespace arview::app {
@@ -27,6 +29,11 @@ audio::OpenedAudioOut OpenAudioOutOrSilent(const std::string& value, const audio
   audio::OpenedAudioOut out = audio::OpenAudioOut(audio::ParseAudioOut(value), timing);
   if (!out.note.empty()) std::fprintf(stderr, "note: %s\n", out.note.c_str());
   return out;
+}
+
+audio::OpenedAudioOut OpenAudioOutForScene(const std::string& value, const std::filesystem::path& scene) {
+  if (scene.empty() || !audio::ParseAudioOut(value).enabled || !SceneHasLines(authoring::LoadScene(scene))) return {};
+  return OpenAudioOutOrSilent(value);
 }
 
 }  // namespace arview::app

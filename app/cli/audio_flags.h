@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
 #include <string>
 
 #include "audio/audio_out.h"
@@ -18,5 +19,10 @@ void AddAudioOutFlag(CLI::App* cmd, std::string& value);
 // The player `value` asks for (none for "none"), or none and the note "note: no sound: ..." on
 // stderr when the device cannot be opened.
 audio::OpenedAudioOut OpenAudioOutOrSilent(const std::string& value, const audio::PlayerOptions& timing = {});
+
+// The player for a session on `scene` (SessionOptions::sound_out): as OpenAudioOutOrSilent when
+// the scene's characters have lines; none, and nothing said, when there is no scene or nothing in
+// it is said (a device is not opened for nothing).
+audio::OpenedAudioOut OpenAudioOutForScene(const std::string& value, const std::filesystem::path& scene);
 
 }  // namespace arview::app

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/session/ar_session.h"
+#include "app/cli/audio_flags.h"
 #include "app/cli/commands.h"
 #include "app/cli/output_flags.h"
 #include "app/cli/first_run_figure.h"
@@ -23,6 +24,7 @@ namespace {
 
 struct ReplayArgs {
   std::string recording, map_dir, out, frames;
+  std::string audio_out = "default";  // played only with --paced
   bool paced = false;
   long loop = 1;
   int read_ahead = recordings::ReplayOptions{}.read_ahead;
@@ -50,6 +52,7 @@ void AddReplayCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
   AddSessionFlags(cmd, a->session);
+  AddAudioOutFlag(cmd, a->audio_out);
   cmd->callback([a, read_ahead] {
     // An unpaced replay reads each frame when the tracker takes it: there is no ahead.
     if (read_ahead->count() > 0 && !a->paced)
@@ -100,9 +103,15 @@ void AddReplayCommand(CLI::App& app) {
     // An uncalibrated recording's camera is a guess; its map holds the refined one.
     o.frame_camera = recording.camera.calibrated ? recording.camera : map.camera;
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
+    // The scene's lines into a video file's audio track, and played live (--audio-out) when the
+    // frames keep real time: --paced.
+    o.audio_track = true;
+    const audio::OpenedAudioOut sound = a->paced ? OpenAudioOutForScene(a->audio_out, o.scene_file) : audio::OpenedAudioOut{};
+    o.sound_out = sound.player.get();
     const SessionResult result = RunSession(source, recording.camera.Size(), map, a->map_dir, o);
     if (pending) pending->Commit();
-    std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
+    std::printf("%s%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str(),
+                SoundSummaryText(result.sound).c_str());
     std::printf("%s %s\n", to_window ? "shown in" : "wrote",
                 to_window ? result.output.c_str() : a->out.c_str());
   });

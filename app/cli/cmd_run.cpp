@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "app/session/ar_session.h"
+#include "app/cli/audio_flags.h"
 #include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
 #include "app/cli/output_flags.h"
@@ -23,6 +24,7 @@ namespace {
 
 struct RunArgs {
   std::string device = "/dev/video0", map_dir, out = "window";
+  std::string audio_out = "default";
   CameraFlags camera;
   SessionFlags session;
 };
@@ -48,6 +50,7 @@ void AddRunCommand(CLI::App& app) {
   cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
   AddCameraFlags(cmd, a->camera, "default: the map's camera size; another of the same aspect scales the map's camera exactly");
   AddSessionFlags(cmd, a->session);
+  AddAudioOutFlag(cmd, a->audio_out);
   cmd->callback([a] {
     const bool to_file = !video::IsWindowTarget(a->out) && a->out != "null";
     RequireDistinctOutputs(
@@ -97,8 +100,13 @@ void AddRunCommand(CLI::App& app) {
                    SizeText(calibrated.Size()).c_str(), SizeText(source.size()).c_str(), calibrated.fx, map.camera.fx);
     }
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
+    // The scene's lines played live (--audio-out), and written into a video file.
+    const audio::OpenedAudioOut sound = OpenAudioOutForScene(a->audio_out, o.scene_file);
+    o.sound_out = sound.player.get();
+    o.audio_track = true;
     const SessionResult result = RunSession(source, source.size(), map, a->map_dir, o);
-    std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
+    std::printf("%s%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str(),
+                SoundSummaryText(result.sound).c_str());
     std::printf("output: %s\n", result.output.c_str());
     if (result.seconds_to_first_output >= 0) {
       std::printf("first frame shown %.2f s after the command started (start-up: the tracker %.2f s beside the "

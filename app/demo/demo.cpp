@@ -329,6 +329,7 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   session.expected_frames = o.frames - half;
   session.cancel = cancel;
   session.output_name = out.string();
+  session.audio_track = true;  // the greeting spoken in the video
   recordings::ReplayOptions replay;
   for (int i = half; i < o.frames; ++i) replay.frames.push_back(i);
   const recordings::Recording replayed = WithUncompressedFrames(walk, half, work / "replay-frames", cancel);
@@ -337,7 +338,8 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   recordings::RecordingSource source(replayed, replay);
   SessionResult result = RunSession(source, walk.camera.Size(), map, (work / "map").string(), session);
   video.Commit();
-  std::printf("%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str());
+  std::printf("%s%s%s", PipelineReportText(result.report).c_str(), result.loss_advice.c_str(),
+              SoundSummaryText(result.sound).c_str());
   return result;
 }
 

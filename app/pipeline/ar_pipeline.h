@@ -111,6 +111,9 @@ struct FrameLog {
   int64_t index = 0;        // a recording's frame index; a camera's sequence number
   double timestamp = 0;
   double captured_s = 0;    // capture time, seconds since the pipeline started (< 0: before)
+  // The characters' animation time (the frame clock of speech::Utterance: 0 at the first frame
+  // composed); < 0: no characters.
+  double animation_s = -1;
   FrameTimeline timeline;
   tracker::FrameResult track;
   std::optional<tracker::LossDiagnosis> loss;  // lost, with PipelineOptions::diagnoser: why

@@ -98,6 +98,7 @@ int CharacterSpeech::Cued(double time, const SpeechCues& cues) {
   return due;
 }
 
+// `time`: the line's start, its cue's frame or a later one (DelayedStart).
 void CharacterSpeech::Start(std::size_t index, double time, anim::Animator& animator) {
   const ReadyLine& line = lines_[index];
   current_ = static_cast<int>(index);
@@ -124,14 +125,24 @@ void CharacterSpeech::Start(std::size_t index, double time, anim::Animator& anim
   if (options_.on_utterance) options_.on_utterance(utterances_.back());
 }
 
+double CharacterSpeech::DelayedStart(double time) const {
+  if (options_.start_delay_s <= 0) return time;
+  if (frame_interval_ <= 0) return time + options_.start_delay_s;
+  return time + std::ceil(options_.start_delay_s / frame_interval_ - 1e-9) * frame_interval_;
+}
+
 const anim::FaceTrack& CharacterSpeech::Update(double time, const SpeechCues& cues, anim::Animator& animator) {
+  if (last_time_ >= 0 && time > last_time_) frame_interval_ = time - last_time_;
+  last_time_ = time;
   const int due = Cued(time, cues);
   if (current_ >= 0 && time - current_start_ > lines_[current_].duration_s() + options_.ramp_s) current_ = -1;
-  if (current_ < 0 && due >= 0) Start(static_cast<std::size_t>(due), time, animator);  // a cue while talking is let go
+  // A cue while talking is let go.
+  if (current_ < 0 && due >= 0) Start(static_cast<std::size_t>(due), DelayedStart(time), animator);
   track_ = anim::FaceTrack{};
   if (current_ < 0) return track_;
   const ReadyLine& line = lines_[current_];
   const double local = time - current_start_;
+  if (local < 0) return track_;  // a delayed line: the mouth waits for its start
   const double ramp = std::max(options_.ramp_s, 1e-3);
   track_.talking = static_cast<float>(std::clamp(std::min(local / ramp, (line.duration_s() + ramp - local) / ramp), 0.0, 1.0));
   speech::VisemeWeights weights;

@@ -56,6 +56,10 @@ struct SpeechOptions {
   double lost_after_s = 0.5;      // a loss says its line once it has lasted this long (not a one-frame blip)
   double ramp_s = 0.08;           // speech takes the mouth over and gives it back over this
   std::string character;          // for the utterances
+  // A cued line starts this long after its cue (0: on the cue's frame), rounded up to whole frame
+  // intervals (the last one seen), so that it starts on a frame: a live session's sound must reach
+  // the player its lead ahead of the frame it plays with (app/session/session_sound.h).
+  double start_delay_s = 0;
   // Called on arview-render when a line starts (the audio's sinks take it from there; must not block).
   std::function<void(const speech::Utterance&)> on_utterance;
 };
@@ -79,6 +83,7 @@ class CharacterSpeech {
   int Cued(double time, const SpeechCues& cues);
   int NextLineFor(SpeechCue cue);  // the cue's lines take turns; −1: it has none
   void Start(std::size_t line, double time, anim::Animator& animator);
+  double DelayedStart(double cue_time) const;  // SpeechOptions::start_delay_s on whole frames
 
   std::vector<ReadyLine> lines_;
   SpeechOptions options_;
@@ -90,6 +95,7 @@ class CharacterSpeech {
   double lost_since_ = 0;
   int current_ = -1;  // the line being said
   double current_start_ = 0;
+  double last_time_ = -1, frame_interval_ = 0;  // the previous frame's time and the interval to it
   anim::FaceTrack track_;
   std::vector<speech::Utterance> utterances_;
 };

@@ -96,6 +96,7 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
                                   {"rms_px", f.track.rms_px},
                                   {"track_ms", f.track.times.total_ms},
                                   {"idle_weight", f.idle_weight}};
+  if (f.animation_s >= 0) frame["animation_s"] = f.animation_s;
   if (f.track.status != tracker::TrackStatus::kLost) {
     // The raw centre places the character in the image, the smoothed one drives its animation:
     // `arview eval --smoothed` measures the smoothing's lag from both.
@@ -149,9 +150,12 @@ void StatsFileWriter::Add(const FrameLog& frame) {
 }
 
 void StatsFileWriter::Finish(const PipelineReport& report, const std::string& gl_description,
-                             const render::RendererInfo& gl) {
+                             const render::RendererInfo& gl, const nlohmann::ordered_json& more) {
+  nlohmann::ordered_json summary_json = PipelineSummaryJson(report, gl_description, gl);
+  if (more.is_object())
+    for (const auto& [key, value] : more.items()) summary_json[key] = value;
   // The summary's own braces dropped: its keys follow "frames" in the one object.
-  const std::string summary = PipelineSummaryJson(report, gl_description, gl).dump(2);
+  const std::string summary = summary_json.dump(2);
   Write("\n  ]," + summary.substr(1) + "\n");
   // On disk before the rename makes it the file (as WriteFileAtomically).
   const bool synced = ::fsync(::fileno(file_)) == 0;

@@ -68,7 +68,9 @@ class StatsFileWriter {
   void Add(const FrameLog& frame);
   // The summary after the frames; then the file is renamed into place. Throws arview::Error
   // naming the file when a write fails.
-  void Finish(const PipelineReport& report, const std::string& gl_description, const render::RendererInfo& gl = {});
+  // `more`: keys of the session's own added after the summary's (the sound's, app/session).
+  void Finish(const PipelineReport& report, const std::string& gl_description, const render::RendererInfo& gl = {},
+              const nlohmann::ordered_json& more = {});
   std::size_t frames() const { return frames_; }
 
  private:

@@ -178,6 +178,7 @@ void RenderStage::AnimateAndCompose(InFlight& item) {
     if (localized) centre = item.track.smoothed_center;
     if (!first_timestamp_) first_timestamp_ = item.frame.timestamp;
     const double animation_time = item.frame.timestamp - *first_timestamp_;
+    log.animation_s = animation_time;
     for (LayeredAnimator* animator : animators_) {
       compose.animations.push_back(&animator->Update(centre, animation_time));
     }

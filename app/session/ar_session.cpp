@@ -62,6 +62,11 @@ std::optional<std::string> CameraNote(const tracker::LossDiagnoser& diagnoser, c
 
 }  // namespace
 
+bool SceneHasLines(const authoring::Scene& scene) {
+  return std::any_of(scene.characters.begin(), scene.characters.end(),
+                     [](const authoring::CharacterSpec& c) { return !c.lines.empty(); });
+}
+
 void SessionOptions::Check(const OptionNames& names) const {
   RequireOption(sink_fps > 0, names("sink_fps"), "above 0", sink_fps);
   compositor.Check(names.Nested("compositor"));
@@ -86,16 +91,29 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                          "is wrong ('arview map scale' makes the map metric)\n",
                  map_name.c_str(), o.compositor.ipd_m);
   }
-  // The output first: a window without a display, or an unwritable file, is said before anything
-  // loads.
+  // The scene (its lines decide whether a video gets an audio track), then the output: a window
+  // without a display, or an unwritable file, is said before anything else loads.
+  const bool first_view = o.scene_file.empty() && o.first_view;
+  std::optional<authoring::Scene> scene;
+  if (!o.scene_file.empty()) scene = authoring::LoadScene(o.scene_file);
+  if (first_view) scene = o.first_view->scene;
   std::unique_ptr<video::FrameSink> sink =
-      video::OpenSink(o.sink, ArCompositor::OutputSizeFor(map.camera, o.compositor), o.sink_fps, o.window);
+      video::OpenSink(o.sink, ArCompositor::OutputSizeFor(map.camera, o.compositor), o.sink_fps, o.window,
+                      o.audio_track && scene && SceneHasLines(*scene) ? std::optional(video::AudioTrackOptions{}) : std::nullopt);
+  SessionSound sound(o.sound_out, *sink, o.sink_fps);
   // --stats: each frame's record goes to disk as it comes (pipeline_report.h), none is kept.
   std::optional<StatsFileWriter> stats;
   PipelineOptions pipeline = o.pipeline;
   if (!o.stats_out.empty()) {
     stats.emplace(o.stats_out);
     pipeline.on_frame_log = [&stats](const FrameLog& frame) { stats->Add(frame); };
+  }
+  if (sound.active()) {
+    pipeline.on_frame_log = [stats_log = std::move(pipeline.on_frame_log), &sound](const FrameLog& frame) {
+      const Clock::time_point shown = Clock::now();  // the sink has just written (shown) the frame
+      if (stats_log) stats_log(frame);
+      sound.OnFrameShown(frame, shown);
+    };
   }
   Clock::time_point step = Clock::now();
   const auto seconds_of_step = [&step] {
@@ -133,14 +151,17 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::vector<std::unique_ptr<LayeredAnimator>> animators;
   std::vector<LayeredAnimator*> animator_ptrs;
   std::vector<const anim::PlacedCharacter*> character_ptrs;
-  const bool first_view = o.scene_file.empty() && o.first_view;
-  if (!o.scene_file.empty() || first_view) {
-    const authoring::Scene scene = first_view ? o.first_view->scene : authoring::LoadScene(o.scene_file);
-    for (const authoring::CharacterSpec& spec : scene.characters) {
+  const std::function<void(const speech::Utterance&)> on_utterance = [&o, &sound](const speech::Utterance& u) {
+    sound.OnUtterance(u);
+    if (o.on_utterance) o.on_utterance(u);
+  };
+  if (scene) {
+    for (const authoring::CharacterSpec& spec : scene->characters) {
       characters.push_back(std::make_unique<authoring::AnimatedCharacter>(spec));
       animators.push_back(MakeLayeredAnimator(*characters.back(), "", o.fade));
       // The lines are synthesized here, at load, on the speech queue's thread: the frames only say them.
-      if (std::unique_ptr<CharacterSpeech> speech = MakeCharacterSpeech(*characters.back(), o.on_utterance))
+      if (std::unique_ptr<CharacterSpeech> speech = MakeCharacterSpeech(*characters.back(), on_utterance,
+                                                                            o.sound_out ? kLiveSpeechDelay : 0.0))
         animators.back()->SetSpeech(std::move(speech));
       for (const std::string& note : animators.back()->notes()) std::cerr << "note: " << note << "\n";
       animator_ptrs.push_back(animators.back().get());
@@ -229,7 +250,11 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.trajectory_out.empty()) {
     recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
   }
-  if (stats) stats->Finish(result.report, result.renderer, result.renderer_info);
+  result.sound = sound.Finish();
+  if (stats) {
+    stats->Finish(result.report, result.renderer, result.renderer_info,
+                  sound.active() ? nlohmann::ordered_json{{"sound", SoundJson(result.sound)}} : nlohmann::ordered_json());
+  }
   result.loss_advice = LossAdviceText(result.report, map_name);
   return result;
 }

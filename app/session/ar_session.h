@@ -13,6 +13,7 @@
 #include "base/cancellation.h"
 #include "app/pipeline/ar_pipeline.h"
 #include "app/pipeline/layered_animator.h"
+#include "app/session/session_sound.h"
 #include "anim_authoring/scene.h"
 #include "base/geometry.h"
 #include "map/map.h"
@@ -65,6 +66,12 @@ struct SessionOptions {
   // Called on arview-render when a character starts a line (its 16 kHz samples and its start on
   // the frame clock, speech/utterance.h): for live sound output. Must not block.
   std::function<void(const speech::Utterance&)> on_utterance;
+  // Issue 53's sound (app/session/session_sound.h). `sound_out`: the player the lines are played
+  // on live (the caller's, kept until RunSession returns; null: no live sound). With one, lines
+  // start kLiveSpeechDelay after their cues, so that the sound reaches the player its lead ahead.
+  // `audio_track`: a video file sink gets an AAC track with the lines, when the scene has lines.
+  audio::ClipPlayer* sound_out = nullptr;
+  bool audio_track = false;
   // When the command started, for "first frame shown after ..." (default: RunSession's start).
   std::optional<Clock::time_point> command_start;
 
@@ -89,11 +96,16 @@ struct SessionResult {
   // Every line the characters started, in the order they started (speech/utterance.h): for the
   // audio track of a written video.
   std::vector<speech::Utterance> utterances{};
+  // Where the lines' sound went (played, heard when, underruns; the video's track).
+  SoundReport sound{};
 };
 
 // Frames per second of a recording from its median frame interval: 30 for a single frame, 10
 // for still-photo datasets (stamped a second apart), so that their videos are watchable.
 double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
+
+// Whether any of the scene's characters has `lines:` (its session then has sound to play or write).
+bool SceneHasLines(const authoring::Scene& scene);
 
 // `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
 // names the map in messages. Throws CancelledError when options.cancel was cancelled.

@@ -115,7 +115,10 @@ SayResult RenderSpokenLine(const SayOptions& o) {
 
   PendingOutput pending(o.out);
   const bool folder = !o.out.has_extension();
-  std::unique_ptr<video::FrameSink> sink = video::OpenSink(folder ? pending.sink_target() : pending.partial().string(), o.size, o.fps);
+  // A video file gets the line's sound, from its first frame (the line starts there).
+  std::unique_ptr<video::FrameSink> sink =
+      video::OpenSink(folder ? pending.sink_target() : pending.partial().string(), o.size, o.fps, {},
+                      folder ? std::nullopt : std::optional(video::AudioTrackOptions{}));
   nlohmann::ordered_json curves = nlohmann::ordered_json::array();
   const double duration = animator->speech()->lines().front().duration_s() + o.tail_seconds;
   SayResult result;
@@ -125,6 +128,7 @@ SayResult RenderSpokenLine(const SayOptions& o) {
     const anim::AnimatorFrame& frame = animator->Update(pose.Center(), t);
     const anim::AnimatorFrame* frames[] = {&frame};
     sink->Write(renderer.Render(background, pose, frames));
+    if (i == 0 && sink->HasAudio()) sink->WriteAudio(0, animator->speech()->utterances().at(0).line->samples);
     if (!o.curves.empty()) curves.push_back(FrameCurves(t, frame, character.character().skeleton));
   }
   sink->Close();

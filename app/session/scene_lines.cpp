@@ -196,7 +196,8 @@ int PlayedActionRoom(const authoring::CharacterSpec& spec) {
 }
 
 std::unique_ptr<CharacterSpeech> MakeCharacterSpeech(const authoring::AnimatedCharacter& character,
-                                                     std::function<void(const speech::Utterance&)> on_utterance) {
+                                                     std::function<void(const speech::Utterance&)> on_utterance,
+                                                     double start_delay_s) {
   const authoring::CharacterSpec& spec = character.spec();
   if (spec.lines.empty()) return nullptr;
   const std::string voice_origin = spec.voice_line ? spec.where.substr(0, spec.where.rfind(':')) + ":" + std::to_string(spec.voice_line)
@@ -206,6 +207,7 @@ std::unique_ptr<CharacterSpeech> MakeCharacterSpeech(const authoring::AnimatedCh
   options.up = spec.up;
   options.character = spec.name;
   options.on_utterance = std::move(on_utterance);
+  options.start_delay_s = start_delay_s;
   return std::make_unique<CharacterSpeech>(PrepareLines(character, SceneLineRequests(spec), spec.voice, voice_origin),
                                            std::move(options));
 }

@@ -54,8 +54,10 @@ std::optional<anim::FaceRig> SpeakingFace(const authoring::AnimatedCharacter& ch
 // The schedule room a character's lines need for what they play (anim::Animator::Play).
 int PlayedActionRoom(const authoring::CharacterSpec& spec);
 
-// The character's CharacterSpeech from its scene lines, or nullptr when it has none.
+// The character's CharacterSpeech from its scene lines, or nullptr when it has none. Its lines
+// start `start_delay_s` after their cues (SpeechOptions::start_delay_s).
 std::unique_ptr<CharacterSpeech> MakeCharacterSpeech(const authoring::AnimatedCharacter& character,
-                                                     std::function<void(const speech::Utterance&)> on_utterance);
+                                                     std::function<void(const speech::Utterance&)> on_utterance,
+                                                     double start_delay_s = 0);
 
 }  // namespace arview::app

@@ -38,9 +38,9 @@ authoring::CharacterSpec FigureSpec(const std::vector<std::pair<std::string, std
 }
 
 struct Speaker {
-  explicit Speaker(const authoring::CharacterSpec& spec) : character(spec) {
+  explicit Speaker(const authoring::CharacterSpec& spec, double start_delay_s = 0) : character(spec) {
     animator = MakeLayeredAnimator(character);
-    auto speech = MakeCharacterSpeech(character, [this](const speech::Utterance& u) { started.push_back(u); });
+    auto speech = MakeCharacterSpeech(character, [this](const speech::Utterance& u) { started.push_back(u); }, start_delay_s);
     if (speech) animator->SetSpeech(std::move(speech));
   }
   authoring::AnimatedCharacter character;
@@ -205,6 +205,36 @@ TEST(SceneLines, AGestureMovesTheJointsOfItsClipAndLeavesTheHeadToTheLookAt) {
   EXPECT_EQ(weight(nod, "Head"), 1.0);
   EXPECT_EQ(weight(nod, "Neck"), 1.0);
   EXPECT_EQ(weight(nod, "RightArm"), 0.0);
+}
+
+// A live session's delay (app/session/session_sound.h): the cue's frame hands the utterance over
+// at once, its start a whole number of frame intervals later; the mouth and the gesture wait for it.
+TEST(SceneLines, ADelayedLineStartsOnAWholeFrameAfterItsCueAndTheMouthWaitsForIt) {
+  Speaker s(FigureSpec({{"start", "<gesture name=\"Wave\"/>Oh, hello there!"}}), 0.2);
+  const double frame = 1.0 / 25;  // 0.2 s is five frames
+  double t = 1.0;
+  s.animator->Update(std::nullopt, t);  // the frame interval is known from here on
+  t += frame;
+  s.animator->Update(kInFront, t);
+  ASSERT_EQ(s.started.size(), 1u) << "handed over on the cue's frame";
+  const double start = s.started[0].start_s;
+  EXPECT_NEAR(start, t + 5 * frame, 1e-9);
+  const anim::Schedule& schedule = s.animator->animator().schedule();
+  const int wave = schedule.FindByName("say:gesture:Wave");
+  ASSERT_GE(wave, 0);
+  EXPECT_GE(schedule.Find(wave)->start, start);
+  for (int i = 1; i < 5; ++i) {
+    EXPECT_EQ(s.animator->Update(kInFront, t + i * frame).face.talking, 0.0f) << "frame " << i << " before the start";
+  }
+  float talking = 0;
+  for (int i = 5; i < 12; ++i) talking = std::max(talking, s.animator->Update(kInFront, t + i * frame).face.talking);
+  EXPECT_GT(talking, 0.5f) << "the mouth moves from the line's start on";
+  // With 0.25 s and frames of 0.1 s the line starts three frames (0.3 s) after its cue.
+  Speaker late(FigureSpec({{"start", "Hello."}}), 0.25);
+  late.animator->Update(std::nullopt, 0.0);
+  late.animator->Update(kInFront, 0.1);
+  ASSERT_EQ(late.started.size(), 1u);
+  EXPECT_NEAR(late.started[0].start_s, 0.4, 1e-9);
 }
 
 // The cues: near (with hysteresis), lost after half a second, found; one line at a time.
