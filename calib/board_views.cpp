@@ -42,7 +42,7 @@ BoardPlacement PlaceBoard(const std::vector<cv::Point2f>& corners, cv::Size boar
 }
 
 void ViewSelectionOptions::Check(const OptionNames& names) const {
-  RequireOption(still_px > 0, names("still_px"), "positive", still_px);
+  RequireOption(still_px_per_s > 0, names("still_px_per_s"), "positive", still_px_per_s);
   RequireOption(min_novelty >= 0, names("min_novelty"), "0 or more", min_novelty);
   for (const auto& [field, value] : {std::pair{"needed_x", needed_x}, std::pair{"needed_y", needed_y},
                                      std::pair{"needed_size", needed_size}, std::pair{"needed_skew", needed_skew}}) {
@@ -58,20 +58,21 @@ ViewSelector::ViewSelector(cv::Size board, cv::Size image_size, ViewSelectionOpt
   options_.Check();
 }
 
-ViewSelector::Decision ViewSelector::Offer(const std::vector<cv::Point2f>& corners) {
+ViewSelector::Decision ViewSelector::Offer(const std::vector<cv::Point2f>& corners, double timestamp) {
+  last_speed_ = -1;
   if (corners.size() != static_cast<size_t>(board_.area())) {
     previous_.clear();
-    last_motion_px_ = -1;
     return Decision::kNoBoard;
   }
-  last_motion_px_ = -1;
-  if (previous_.size() == corners.size()) {
+  const double interval = timestamp - previous_time_;
+  if (previous_.size() == corners.size() && interval > 0) {
     double motion = 0;
     for (size_t i = 0; i < corners.size(); ++i) motion += cv::norm(corners[i] - previous_[i]);
-    last_motion_px_ = motion / corners.size();
+    last_speed_ = motion / corners.size() / interval;
   }
   previous_ = corners;
-  if (last_motion_px_ < 0 || last_motion_px_ >= options_.still_px) return Decision::kMoving;
+  previous_time_ = timestamp;
+  if (last_speed_ < 0 || last_speed_ >= options_.still_px_per_s) return Decision::kMoving;
   const BoardPlacement placement = PlaceBoard(corners, board_, image_size_);
   for (const BoardPlacement& known : taken_) {
     if (placement.Distance(known) < options_.min_novelty) return Decision::kKnown;

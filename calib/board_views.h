@@ -2,7 +2,7 @@
 // Choosing the views of a live calibration, as ROS camera_calibration does: each board seen is
 // described by four numbers in [0, 1] (X and Y: where it sits across the image; size: how much of
 // the image it fills; skew: how far it is tilted), a view is taken when the board is held still
-// (its corners moved less than a threshold since the previous frame, so that the view is not
+// (its corners moved slower than a threshold since the previous frame, so that the view is not
 // blurred) and when it differs from every view taken so far (the L1 distance of the four numbers),
 // and the coverage of each number (the range the taken views span, against the range a good
 // calibration needs) says when there are enough. Pure logic: corners in, decisions out.
@@ -39,10 +39,11 @@ struct CoverageBar {
 };
 
 struct ViewSelectionOptions {
-  // A board is still when its corners moved on average less than this since the previous frame
-  // (pixels at the camera's size): at 30 fps, 1 px a frame is 30 px/s, a few pixels of smear
-  // within a webcam's exposure of 1/30 s at most.
-  double still_px = 1.0;
+  // A board is still when its corners moved on average slower than this since the previous
+  // frame (pixels a second at the camera's size): the smear within an exposure of 1/30 s (a
+  // webcam's longest at 30 fps) stays under a pixel. A speed, not a distance between frames, so
+  // that frames dropped by a reader that falls behind do not make a still board look moving.
+  double still_px_per_s = 30;
   // A view is new when its placement is at least this far (L1) from every view taken (ROS's 0.2).
   double min_novelty = 0.2;
   // The spans a calibration needs of X, Y, size and skew (ROS's 0.7, 0.7, 0.4, 0.5).
@@ -67,22 +68,23 @@ class ViewSelector {
 
   ViewSelector(cv::Size board, cv::Size image_size, ViewSelectionOptions options = {});
 
-  // The next frame's corners (empty: no board found). A frame without a board forgets the last
-  // corners, so that a board seen again is never still at once.
-  Decision Offer(const std::vector<cv::Point2f>& corners);
+  // The next frame's corners (empty: no board found) and its time (seconds, increasing). A frame
+  // without a board forgets the last corners, so that a board seen again is never still at once.
+  Decision Offer(const std::vector<cv::Point2f>& corners, double timestamp);
 
   const std::vector<std::vector<cv::Point2f>>& taken_corners() const { return taken_corners_; }
   const std::vector<BoardPlacement>& taken() const { return taken_; }
   std::vector<CoverageBar> Bars() const;  // X, Y, size, skew
   bool Sufficient() const;
-  // The average corner motion at the last offer (pixels; negative when not known).
-  double last_motion_px() const { return last_motion_px_; }
+  // The corners' average speed at the last offer (pixels a second; negative when not known).
+  double last_speed_px_per_s() const { return last_speed_; }
 
  private:
   cv::Size board_, image_size_;
   ViewSelectionOptions options_;
   std::vector<cv::Point2f> previous_;
-  double last_motion_px_ = -1;
+  double previous_time_ = 0;
+  double last_speed_ = -1;
   std::vector<BoardPlacement> taken_;
   std::vector<std::vector<cv::Point2f>> taken_corners_;
 };

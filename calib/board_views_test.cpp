@@ -57,47 +57,62 @@ TEST(PlaceBoard, BoardAtTheLeftEdgeIsNearZeroAndATiltedBoardIsSkewed) {
   EXPECT_LT(facing.skew, 0.01);
 }
 
+constexpr double kFrame = 1.0 / 30;
+
 TEST(ViewSelector, TakesAStillBoardOnceAndNotAMovingOne) {
   ViewSelector selector(kBoard, kImage);
   const auto still = FlatBoard({100, 100}, 30);
-  EXPECT_EQ(selector.Offer(still), ViewSelector::Decision::kMoving);  // no motion known yet
-  EXPECT_EQ(selector.Offer(still), ViewSelector::Decision::kTaken);
-  EXPECT_EQ(selector.Offer(still), ViewSelector::Decision::kKnown);
+  EXPECT_EQ(selector.Offer(still, 0), ViewSelector::Decision::kMoving);  // no motion known yet
+  EXPECT_EQ(selector.Offer(still, kFrame), ViewSelector::Decision::kTaken);
+  EXPECT_EQ(selector.Offer(still, 2 * kFrame), ViewSelector::Decision::kKnown);
   EXPECT_EQ(selector.taken().size(), 1u);
-  // 3 px a frame across the image: moving, even where it would be a new view.
+  // 3 px a frame at 30 fps across the image: moving, even where it would be a new view.
   ViewSelector moving(kBoard, kImage);
   for (int i = 0; i < 20; ++i) {
-    EXPECT_NE(moving.Offer(FlatBoard({50.f + 3 * i, 100}, 30)), ViewSelector::Decision::kTaken) << i;
+    EXPECT_NE(moving.Offer(FlatBoard({50.f + 3 * i, 100}, 30), i * kFrame), ViewSelector::Decision::kTaken) << i;
   }
   EXPECT_TRUE(moving.taken().empty());
+}
+
+TEST(ViewSelector, StillnessIsASpeedSoDroppedFramesDoNotMakeABoardMove) {
+  ViewSelector selector(kBoard, kImage);
+  selector.Offer(FlatBoard({100, 100}, 30), 0);
+  // 2 px over four frame times (three dropped): 15 px/s, still.
+  EXPECT_EQ(selector.Offer(FlatBoard({102, 100}, 30), 4 * kFrame), ViewSelector::Decision::kTaken);
+  EXPECT_NEAR(selector.last_speed_px_per_s(), 15, 1e-3);
+  // A frame with the same time as the one before says nothing of the speed.
+  EXPECT_EQ(selector.Offer(FlatBoard({300, 100}, 30), 4 * kFrame), ViewSelector::Decision::kMoving);
+  EXPECT_LT(selector.last_speed_px_per_s(), 0);
 }
 
 TEST(ViewSelector, ABoardLostInBetweenIsNotStillWhenSeenAgain) {
   ViewSelector selector(kBoard, kImage);
   const auto a = FlatBoard({100, 100}, 30);
-  selector.Offer(a);
-  EXPECT_EQ(selector.Offer({}), ViewSelector::Decision::kNoBoard);
-  EXPECT_EQ(selector.Offer(a), ViewSelector::Decision::kMoving);
+  selector.Offer(a, 0);
+  EXPECT_EQ(selector.Offer({}, kFrame), ViewSelector::Decision::kNoBoard);
+  EXPECT_EQ(selector.Offer(a, 2 * kFrame), ViewSelector::Decision::kMoving);
   // A detection with too few corners is no board either.
-  EXPECT_EQ(selector.Offer(std::vector<cv::Point2f>(a.begin(), a.begin() + 10)), ViewSelector::Decision::kNoBoard);
+  EXPECT_EQ(selector.Offer(std::vector<cv::Point2f>(a.begin(), a.begin() + 10), 3 * kFrame),
+            ViewSelector::Decision::kNoBoard);
 }
 
 TEST(ViewSelector, SmallMotionBelowTheThresholdIsStill) {
   ViewSelectionOptions options;
-  options.still_px = 1.0;
+  options.still_px_per_s = 30;
   ViewSelector selector(kBoard, kImage, options);
-  selector.Offer(FlatBoard({100, 100}, 30));
-  EXPECT_EQ(selector.Offer(FlatBoard({100.6f, 100}, 30)), ViewSelector::Decision::kTaken);
-  EXPECT_NEAR(selector.last_motion_px(), 0.6, 1e-4);
-  selector.Offer(FlatBoard({300, 200}, 30));
-  EXPECT_EQ(selector.Offer(FlatBoard({301.5f, 200}, 30)), ViewSelector::Decision::kMoving);
+  selector.Offer(FlatBoard({100, 100}, 30), 0);
+  EXPECT_EQ(selector.Offer(FlatBoard({100.6f, 100}, 30), kFrame), ViewSelector::Decision::kTaken);
+  EXPECT_NEAR(selector.last_speed_px_per_s(), 18, 1e-2);
+  selector.Offer(FlatBoard({300, 200}, 30), 2 * kFrame);
+  EXPECT_EQ(selector.Offer(FlatBoard({301.5f, 200}, 30), 3 * kFrame), ViewSelector::Decision::kMoving);
 }
 
 // Holds each board still for two frames, as a person pauses.
 void Show(ViewSelector& selector, const std::vector<cv::Point2f>& corners) {
-  selector.Offer({});
-  selector.Offer(corners);
-  selector.Offer(corners);
+  static double time = 0;
+  selector.Offer({}, time += kFrame);
+  selector.Offer(corners, time += kFrame);
+  selector.Offer(corners, time += kFrame);
 }
 
 TEST(ViewSelector, BoardsOnlyInTheMiddleNeverSuffice) {
@@ -139,9 +154,9 @@ TEST(ViewSelector, EnoughViewsSufficeWhateverTheBars) {
 
 TEST(ViewSelectionOptions, ChecksNameTheField) {
   ViewSelectionOptions options;
-  options.still_px = 0;
+  options.still_px_per_s = 0;
   try {
-    options.Check(OptionNames({{"still_px", "--still"}, {"max_views", "--max-views"}}));
+    options.Check(OptionNames({{"still_px_per_s", "--still"}, {"max_views", "--max-views"}}));
     FAIL() << "no error";
   } catch (const OptionError& e) {
     EXPECT_STREQ(e.what(), "--still must be positive (got 0)");

@@ -109,19 +109,12 @@ PassResult CalibratePass(const std::vector<const BoardDetection*>& views, cv::Si
 
 }  // namespace
 
-std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners) {
-  std::vector<cv::Point2f> corners;
-  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
-  if (!cv::findChessboardCorners(gray, inner_corners, corners, flags)) {
-    // A board seen small or at a slant (a map's keyframes: squares of 6-10 px) that the classic
-    // detector misses: OpenCV's sector-based detector, whose corners are already sub-pixel.
-    corners.clear();
-    if (!cv::findChessboardCornersSB(gray, inner_corners, corners, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) return {};
-    return corners;
-  }
-  // The refinement window must stay inside the corner's four squares: 11 px each way (OpenCV's
-  // sample) on a board seen small or at a slant, whose squares are 6-8 px tall, pulled corners
-  // 2-3 px onto their neighbours' edges. Close-up calibration photos keep the full window.
+namespace {
+
+// The refinement window must stay inside the corner's four squares: 11 px each way (OpenCV's
+// sample) on a board seen small or at a slant, whose squares are 6-8 px tall, pulled corners
+// 2-3 px onto their neighbours' edges. Close-up calibration photos keep the full window.
+void RefineCorners(const cv::Mat& gray, cv::Size inner_corners, std::vector<cv::Point2f>& corners) {
   double nearest = 1e9;
   for (int row = 0; row < inner_corners.height; ++row) {
     for (int column = 0; column < inner_corners.width; ++column) {
@@ -133,6 +126,29 @@ std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inn
   const int half_window = std::clamp(static_cast<int>(0.45 * nearest), 2, 11);
   cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+}
+
+constexpr int kClassicFlags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+
+}  // namespace
+
+std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners) {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCorners(gray, inner_corners, corners, kClassicFlags)) {
+    // A board seen small or at a slant (a map's keyframes: squares of 6-10 px) that the classic
+    // detector misses: OpenCV's sector-based detector, whose corners are already sub-pixel.
+    corners.clear();
+    if (!cv::findChessboardCornersSB(gray, inner_corners, corners, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) return {};
+    return corners;
+  }
+  RefineCorners(gray, inner_corners, corners);
+  return corners;
+}
+
+std::vector<cv::Point2f> FindChessboardCornersQuickly(const cv::Mat& gray, cv::Size inner_corners) {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCorners(gray, inner_corners, corners, kClassicFlags | cv::CALIB_CB_FAST_CHECK)) return {};
+  RefineCorners(gray, inner_corners, corners);
   return corners;
 }
 

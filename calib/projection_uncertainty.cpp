@@ -208,9 +208,8 @@ cv::Mat DrawProjectionUncertainty(const ProjectionUncertainty& u, const std::vec
     cv::putText(picture, line, {10, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
   };
   text(cv::format("projection uncertainty at %.2g m (px, 1 sigma, worst direction)", u.options.distance_m), 22);
-  text(cv::format("centre %.3f  median %.3f  worst %.3f; white line: %.2g px; red: %.2g px and above", u.centre_px,
-                  u.median_px, u.worst_px, u.options.poor_px, top),
-       42);
+  text(cv::format("centre %.3f  median %.3f  worst %.3f", u.centre_px, u.median_px, u.worst_px), 42);
+  text(cv::format("white line: %.2g px; red: %.2g px and above", u.options.poor_px, top), 62);
   return picture;
 }
 

@@ -74,7 +74,7 @@ TEST(Cli, CalibrateBadInputsAreOneClearLine) {
       {{"calibrate", "--images", "/tmp/*.jpg", "--board", "nine", "--out", out}, "must look like 9x6"},
       {{"calibrate", "--images", "/tmp/*.jpg", "--square", "-1", "--out", out}, "--square"},
       {{"calibrate", "--images", "/tmp/*.jpg", "--out", "/nonexistent/dir/cam.yaml"}, "does not exist"},
-      {{"calibrate", "--out", out}, "--images is required"},
+      {{"calibrate", "--out", out}, "calibrate needs one of --images, --device or --recording"},
   };
   for (const Case& c : cases) {
     const auto r = RunArview(c.args);
