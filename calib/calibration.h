@@ -95,8 +95,9 @@ cv::Mat DrawCalibrationReport(const CalibrationResult& result);
 std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners);
 
 // The same for frames of a live camera, many without a board: the classic detector alone, with
-// its quick check that a board is there first, without the exhaustive sector-based fallback
-// meant for still photos, and with the same sub-pixel refinement.
+// its quick check that a board is there first and without its adaptive threshold, without the
+// exhaustive sector-based fallback meant for still photos, and with the same sub-pixel
+// refinement.
 std::vector<cv::Point2f> FindChessboardCornersQuickly(const cv::Mat& gray, cv::Size inner_corners);
 
 // Renders a ChArUco board image for printing or for tests.

@@ -159,7 +159,12 @@ void CalibrateFromFrames(const CalibrateArgs& args, const calib::CalibrationOpti
   options.calibration = calibration;
   options.max_seconds = args.seconds;
   const CollectedViews collected = CollectCalibrationViews(
-      *source, options, open_window, [](const std::string& line) { std::printf("%s\n", line.c_str()); },
+      *source, options, open_window,
+      [](const std::string& line) {
+        // At once, as the views are taken: the console is the headless user's window.
+        std::printf("%s\n", line.c_str());
+        std::fflush(stdout);
+      },
       signals.token());
   std::printf("%s\n", EndingText(collected).c_str());
   const std::string where = args.device.empty() ? "--recording " + args.recording : args.device;

@@ -6,6 +6,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "app/cli/commands.h"
 
@@ -199,6 +200,18 @@ std::unique_ptr<recordings::FrameSource> OpenCalibrationRecording(const std::fil
   recordings::Recording recording;
   recording.root = folder;
   recording.frames = recordings::ReadFrameList(list);
+  if (recording.frames.empty()) throw recordings::RecordingError(list.string() + ": lists no frames");
+  // The replay holds every frame to its camera's size; with no camera yet, the first frame's.
+  cv::Size size;
+  if (recording.IsVideo()) {
+    cv::VideoCapture video(recording.FramePath(0).string());
+    if (!video.isOpened()) throw recordings::RecordingError(recording.FramePath(0).string() + ": cannot be opened as a video");
+    size = {static_cast<int>(video.get(cv::CAP_PROP_FRAME_WIDTH)), static_cast<int>(video.get(cv::CAP_PROP_FRAME_HEIGHT))};
+  } else {
+    size = recording.ReadImage(0).size();
+  }
+  recording.camera = calib::Camera::Pinhole(size.width, size.height, size.width, size.width, (size.width - 1) / 2.0,
+                                            (size.height - 1) / 2.0);
   return std::make_unique<recordings::RecordingSource>(std::move(recording));
 }
 
