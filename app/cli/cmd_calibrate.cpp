@@ -124,6 +124,32 @@ std::string EndingText(const CollectedViews& c) {
   return views;
 }
 
+// The camera set up as `record` sets it up: auto-focus off (the default) where the focus stands,
+// since the calibration holds at this focus only.
+std::unique_ptr<recordings::V4l2Source> OpenCamera(const CalibrateArgs& args, const CancellationToken& cancel) {
+  recordings::V4l2Options options;
+  const cv::Size size = *ParseFrameSize(args.camera_flags.size.empty() ? "640x480" : args.camera_flags.size);
+  options.width = size.width;
+  options.height = size.height;
+  ApplyCameraFlags(args.camera_flags, options);
+  options.cancel = cancel;
+  auto camera = std::make_unique<recordings::V4l2Source>(args.device, options);
+  std::cerr << camera->GrantedLine() << "\n";
+  for (const std::string& note : camera->notes()) std::cerr << "note: " << note << "\n";
+  return camera;
+}
+
+// Flags that mean something for some sources only: given with another they are a mistake, not
+// ignored.
+void RequireFlagsFitTheSource(const CLI::App& cmd, bool images, bool device) {
+  for (const char* flag : {"--no-window", "--seconds"}) {
+    if (images && cmd.get_option(flag)->count() > 0) throw CommandError(std::string(flag) + " is for --device or --recording", 2);
+  }
+  for (const char* flag : {"--size", "--fps", "--format", "--focus", "--exposure"}) {
+    if (!device && cmd.get_option(flag)->count() > 0) throw CommandError(std::string(flag) + " is for --device (the camera's set-up)", 2);
+  }
+}
+
 // --device or --recording: views picked from the frames, then calibrated.
 void CalibrateFromFrames(const CalibrateArgs& args, const calib::CalibrationOptions& calibration) {
   if (calibration.kind == calib::BoardKind::kCharuco) {
@@ -133,16 +159,7 @@ void CalibrateFromFrames(const CalibrateArgs& args, const calib::CalibrationOpti
   std::unique_ptr<recordings::FrameSource> source;
   recordings::V4l2Source* camera = nullptr;
   if (!args.device.empty()) {
-    recordings::V4l2Options options;
-    const cv::Size size = *ParseFrameSize(args.camera_flags.size.empty() ? "640x480" : args.camera_flags.size);
-    options.width = size.width;
-    options.height = size.height;
-    // Focus locked (the default) as `record` locks it: the calibration holds at this focus only.
-    ApplyCameraFlags(args.camera_flags, options);
-    options.cancel = signals.token();
-    auto v4l2 = std::make_unique<recordings::V4l2Source>(args.device, options);
-    std::cerr << v4l2->GrantedLine() << "\n";
-    for (const std::string& note : v4l2->notes()) std::cerr << "note: " << note << "\n";
+    auto v4l2 = OpenCamera(args, signals.token());
     camera = v4l2.get();
     source = std::move(v4l2);
   } else {
@@ -229,10 +246,11 @@ void AddCalibrateCommand(CLI::App& app) {
                   "coverage does not suffice yet (0: no limit)")
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
-  cmd->callback([args, images, device, recording] {
+  cmd->callback([cmd, args, images, device, recording] {
     if (images->count() + device->count() + recording->count() == 0) {
       throw CommandError("calibrate needs one of --images, --device or --recording", 2);
     }
+    RequireFlagsFitTheSource(*cmd, images->count() > 0, device->count() > 0);
     calib::CalibrationOptions options;
     options.board = ParseBoard(args->board);
     options.square_size = args->square;
