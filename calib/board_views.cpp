@@ -112,14 +112,4 @@ bool ViewSelector::Sufficient() const {
   return true;
 }
 
-const char* DecisionName(ViewSelector::Decision decision) {
-  switch (decision) {
-    case ViewSelector::Decision::kNoBoard: return "no board";
-    case ViewSelector::Decision::kMoving: return "moving";
-    case ViewSelector::Decision::kKnown: return "still, like a view taken";
-    case ViewSelector::Decision::kTaken: return "taken";
-  }
-  return "?";
-}
-
 }  // namespace arview::calib

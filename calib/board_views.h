@@ -89,6 +89,4 @@ class ViewSelector {
   std::vector<std::vector<cv::Point2f>> taken_corners_;
 };
 
-const char* DecisionName(ViewSelector::Decision decision);
-
 }  // namespace arview::calib
