@@ -32,11 +32,6 @@ std::vector<std::string> ExpandImageGlob(const std::string& pattern) {
 
 namespace {
 
-struct Detection {
-  std::vector<cv::Point2f> image_points;
-  std::vector<cv::Point3f> object_points;
-};
-
 cv::Ptr<cv::aruco::Dictionary> CharucoDictionary(const std::string& name) {
   static const std::map<std::string, int> kNames = {
       {"DICT_4X4_50", cv::aruco::DICT_4X4_50},     {"DICT_4X4_100", cv::aruco::DICT_4X4_100},
@@ -56,19 +51,15 @@ cv::Ptr<cv::aruco::CharucoBoard> MakeCharucoBoard(const CalibrationOptions& o) {
                                          static_cast<float>(marker), CharucoDictionary(o.charuco_dictionary));
 }
 
-bool DetectChessboard(const cv::Mat& gray, const CalibrationOptions& o, Detection* d) {
+bool DetectChessboard(const cv::Mat& gray, const CalibrationOptions& o, BoardDetection* d) {
   std::vector<cv::Point2f> corners = FindChessboardCorners(gray, o.board);
   if (corners.empty()) return false;
   d->image_points = corners;
-  for (int y = 0; y < o.board.height; ++y) {
-    for (int x = 0; x < o.board.width; ++x) {
-      d->object_points.emplace_back(static_cast<float>(x * o.square_size), static_cast<float>(y * o.square_size), 0.f);
-    }
-  }
+  d->object_points = ChessboardObjectPoints(o);
   return true;
 }
 
-bool DetectCharuco(const cv::Mat& gray, const cv::Ptr<cv::aruco::CharucoBoard>& board, Detection* d) {
+bool DetectCharuco(const cv::Mat& gray, const cv::Ptr<cv::aruco::CharucoBoard>& board, BoardDetection* d) {
   std::vector<std::vector<cv::Point2f>> marker_corners;
   std::vector<int> marker_ids;
   cv::aruco::detectMarkers(gray, board->dictionary, marker_corners, marker_ids);
@@ -85,7 +76,7 @@ bool DetectCharuco(const cv::Mat& gray, const cv::Ptr<cv::aruco::CharucoBoard>& 
   return true;
 }
 
-double ViewRms(const Detection& d, const cv::Mat& K, const cv::Mat& dist, const cv::Mat& rvec, const cv::Mat& tvec) {
+double ViewRms(const BoardDetection& d, const cv::Mat& K, const cv::Mat& dist, const cv::Mat& rvec, const cv::Mat& tvec) {
   std::vector<cv::Point2f> projected;
   cv::projectPoints(d.object_points, rvec, tvec, K, dist, projected);
   double sum = 0;
@@ -100,37 +91,30 @@ struct PassResult {
   double rms = 0;
   cv::Mat K, dist;
   std::vector<double> view_rms;
+  std::vector<cv::Mat> rvecs, tvecs;
 };
 
-PassResult CalibratePass(const std::vector<const Detection*>& views, cv::Size image_size) {
+PassResult CalibratePass(const std::vector<const BoardDetection*>& views, cv::Size image_size) {
   std::vector<std::vector<cv::Point3f>> object;
   std::vector<std::vector<cv::Point2f>> image;
-  for (const Detection* d : views) {
+  for (const BoardDetection* d : views) {
     object.push_back(d->object_points);
     image.push_back(d->image_points);
   }
   PassResult r;
-  std::vector<cv::Mat> rvecs, tvecs;
-  r.rms = cv::calibrateCamera(object, image, image_size, r.K, r.dist, rvecs, tvecs);
-  for (size_t i = 0; i < views.size(); ++i) r.view_rms.push_back(ViewRms(*views[i], r.K, r.dist, rvecs[i], tvecs[i]));
+  r.rms = cv::calibrateCamera(object, image, image_size, r.K, r.dist, r.rvecs, r.tvecs);
+  for (size_t i = 0; i < views.size(); ++i) r.view_rms.push_back(ViewRms(*views[i], r.K, r.dist, r.rvecs[i], r.tvecs[i]));
   return r;
 }
 
 }  // namespace
 
-std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners) {
-  std::vector<cv::Point2f> corners;
-  const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
-  if (!cv::findChessboardCorners(gray, inner_corners, corners, flags)) {
-    // A board seen small or at a slant (a map's keyframes: squares of 6-10 px) that the classic
-    // detector misses: OpenCV's sector-based detector, whose corners are already sub-pixel.
-    corners.clear();
-    if (!cv::findChessboardCornersSB(gray, inner_corners, corners, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) return {};
-    return corners;
-  }
-  // The refinement window must stay inside the corner's four squares: 11 px each way (OpenCV's
-  // sample) on a board seen small or at a slant, whose squares are 6-8 px tall, pulled corners
-  // 2-3 px onto their neighbours' edges. Close-up calibration photos keep the full window.
+namespace {
+
+// The refinement window must stay inside the corner's four squares: 11 px each way (OpenCV's
+// sample) on a board seen small or at a slant, whose squares are 6-8 px tall, pulled corners
+// 2-3 px onto their neighbours' edges. Close-up calibration photos keep the full window.
+void RefineCorners(const cv::Mat& gray, cv::Size inner_corners, std::vector<cv::Point2f>& corners) {
   double nearest = 1e9;
   for (int row = 0; row < inner_corners.height; ++row) {
     for (int column = 0; column < inner_corners.width; ++column) {
@@ -142,24 +126,72 @@ std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inn
   const int half_window = std::clamp(static_cast<int>(0.45 * nearest), 2, 11);
   cv::cornerSubPix(gray, corners, cv::Size(half_window, half_window), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+}
+
+constexpr int kClassicFlags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+
+}  // namespace
+
+std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners) {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCorners(gray, inner_corners, corners, kClassicFlags)) {
+    // A board seen small or at a slant (a map's keyframes: squares of 6-10 px) that the classic
+    // detector misses: OpenCV's sector-based detector, whose corners are already sub-pixel.
+    corners.clear();
+    if (!cv::findChessboardCornersSB(gray, inner_corners, corners, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) return {};
+    return corners;
+  }
+  RefineCorners(gray, inner_corners, corners);
   return corners;
 }
 
-CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const CalibrationOptions& o,
-                            const std::function<void(int, int)>& progress) {
+std::vector<cv::Point2f> FindChessboardCornersQuickly(const cv::Mat& gray, cv::Size inner_corners) {
+  std::vector<cv::Point2f> corners;
+  // Without the adaptive threshold: on the rendered board walk it found as many boards at a
+  // sixtieth of the time (docs/calibration.md, "Live calibration").
+  const int flags = cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
+  if (!cv::findChessboardCorners(gray, inner_corners, corners, flags)) return {};
+  RefineCorners(gray, inner_corners, corners);
+  return corners;
+}
+
+std::vector<cv::Point3f> ChessboardObjectPoints(const CalibrationOptions& o) {
+  std::vector<cv::Point3f> points;
+  for (int y = 0; y < o.board.height; ++y) {
+    for (int x = 0; x < o.board.width; ++x) {
+      points.emplace_back(static_cast<float>(x * o.square_size), static_cast<float>(y * o.square_size), 0.f);
+    }
+  }
+  return points;
+}
+
+bool DetectBoard(const cv::Mat& gray, const CalibrationOptions& o, BoardDetection* detection) {
+  if (o.kind == BoardKind::kCharuco) return DetectCharuco(gray, MakeCharucoBoard(o), detection);
+  return DetectChessboard(gray, o, detection);
+}
+
+namespace {
+
+void CheckBoardOptions(const CalibrationOptions& o) {
   if (o.board.width < 2 || o.board.height < 2) throw CalibrationError("board must have at least 2x2 corners");
   if (!(o.square_size > 0)) throw CalibrationError("square size must be positive");
+}
+
+}  // namespace
+
+CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const CalibrationOptions& o,
+                            const std::function<void(int, int)>& progress) {
+  CheckBoardOptions(o);
   cv::Ptr<cv::aruco::CharucoBoard> charuco;
   if (o.kind == BoardKind::kCharuco) charuco = MakeCharucoBoard(o);
 
-  CalibrationResult result;
-  std::vector<Detection> detections(image_paths.size());
+  std::vector<BoardDetection> found;
+  std::vector<std::string> labels;
+  int without_board = 0;
   cv::Size image_size;
   std::string size_source;
   for (size_t i = 0; i < image_paths.size(); ++i) {
     if (progress) progress(static_cast<int>(i) + 1, static_cast<int>(image_paths.size()));
-    ViewReport view;
-    view.path = image_paths[i];
     // ReadImageFile: a cut or damaged photo is one error naming it (cv::imread let libjpeg print
     // "Premature end of JPEG file" and gave the photo with its missing part grey).
     cv::Mat gray;
@@ -177,27 +209,58 @@ CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const C
                              std::to_string(image_size.width) + "x" + std::to_string(image_size.height) +
                              "; all calibration images must come from one camera at one size");
     }
-    view.board_found = charuco ? DetectCharuco(gray, charuco, &detections[i]) : DetectChessboard(gray, o, &detections[i]);
+    BoardDetection detection;
+    const bool board_found = charuco ? DetectCharuco(gray, charuco, &detection) : DetectChessboard(gray, o, &detection);
+    if (board_found) {
+      found.push_back(std::move(detection));
+      labels.push_back(image_paths[i]);
+    } else {
+      ++without_board;
+    }
+  }
+  CalibrationResult result = CalibrateDetections(found, labels, image_size, o, without_board);
+  // The report lists every image in the order given, the ones without a board too.
+  std::vector<ViewReport> in_order;
+  size_t next_found = 0;
+  for (const std::string& path : image_paths) {
+    if (next_found < result.views.size() && result.views[next_found].path == path) {
+      in_order.push_back(result.views[next_found++]);
+    } else {
+      ViewReport none;
+      none.path = path;
+      in_order.push_back(none);
+    }
+  }
+  result.views = std::move(in_order);
+  return result;
+}
+
+CalibrationResult CalibrateDetections(const std::vector<BoardDetection>& detections,
+                                      const std::vector<std::string>& labels, cv::Size image_size,
+                                      const CalibrationOptions& o, int images_without_board) {
+  CheckBoardOptions(o);
+  CalibrationResult result;
+  result.views_without_board = images_without_board;
+  for (size_t i = 0; i < detections.size(); ++i) {
+    ViewReport view;
+    view.path = i < labels.size() ? labels[i] : "view " + std::to_string(i + 1);
+    view.board_found = true;
     view.corners = static_cast<int>(detections[i].image_points.size());
-    if (!view.board_found) ++result.views_without_board;
     result.views.push_back(view);
   }
-
-  std::vector<size_t> used;
-  for (size_t i = 0; i < detections.size(); ++i) {
-    if (result.views[i].board_found) used.push_back(i);
-  }
+  std::vector<size_t> used(detections.size());
+  for (size_t i = 0; i < used.size(); ++i) used[i] = i;
+  const int images = static_cast<int>(detections.size()) + images_without_board;
   auto too_few = [&](const std::string& why) {
-    return CalibrationError("only " + std::to_string(used.size()) + " usable view(s) of " +
-                            std::to_string(image_paths.size()) + " image(s) " + why + "; at least " +
-                            std::to_string(o.min_views) + " are needed");
+    return CalibrationError("only " + std::to_string(used.size()) + " usable view(s) of " + std::to_string(images) +
+                            " image(s) " + why + "; at least " + std::to_string(o.min_views) + " are needed");
   };
   if (static_cast<int>(used.size()) < o.min_views) {
     throw too_few(used.empty() ? "(no board found: check --board, which counts inner corners)" : "");
   }
 
   auto run = [&](const std::vector<size_t>& indices) {
-    std::vector<const Detection*> views;
+    std::vector<const BoardDetection*> views;
     for (size_t i : indices) views.push_back(&detections[i]);
     return CalibratePass(views, image_size);
   };
@@ -231,6 +294,11 @@ CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const C
   c.Validate("calibration result");
   result.rms = pass.rms;
   result.views_used = static_cast<int>(used.size());
+  for (size_t k = 0; k < used.size(); ++k) {
+    result.used_views.push_back(detections[used[k]]);
+    result.rvecs.emplace_back(pass.rvecs[k]);
+    result.tvecs.emplace_back(pass.tvecs[k]);
+  }
 
   const int gx = o.coverage_grid, gy = std::max(1, o.coverage_grid * 3 / 4);
   std::vector<char> cells(gx * gy, 0);

@@ -41,6 +41,13 @@ struct ViewReport {
   bool rejected = false;
 };
 
+// A board found in one image: its corners' pixels and the same corners on the board (metres,
+// z = 0), in the same order.
+struct BoardDetection {
+  std::vector<cv::Point2f> image_points;
+  std::vector<cv::Point3f> object_points;
+};
+
 struct CalibrationResult {
   Camera camera;
   double rms = 0;  // over the views used, pixels
@@ -50,6 +57,10 @@ struct CalibrationResult {
   int views_without_board = 0;
   double coverage = 0;  // fraction of coverage cells holding at least one used corner
   std::vector<std::vector<cv::Point2f>> used_corners;  // for the report picture
+  // The views of the final pass and each board's pose in the camera (rvec, tvec as
+  // cv::calibrateCamera gives them), for the projection uncertainty (calib/projection_uncertainty.h).
+  std::vector<BoardDetection> used_views;
+  std::vector<cv::Vec3d> rvecs, tvecs;
 };
 
 // Expands a shell glob to the sorted list of matching files; throws CalibrationError when
@@ -60,6 +71,21 @@ std::vector<std::string> ExpandImageGlob(const std::string& pattern);
 CalibrationResult Calibrate(const std::vector<std::string>& image_paths, const CalibrationOptions& options,
                             const std::function<void(int, int)>& progress = {});
 
+// Calibration from boards already found (`labels[i]` names view i in the report: a file, a
+// frame); `images_without_board` of the images looked at held none. Rejects outlier views and
+// calibrates again without them, as Calibrate does.
+CalibrationResult CalibrateDetections(const std::vector<BoardDetection>& views, const std::vector<std::string>& labels,
+                                      cv::Size image_size, const CalibrationOptions& options,
+                                      int images_without_board = 0);
+
+// The board of `options` in a grey image; false when it is not found whole (a chessboard) or
+// with fewer than 6 corners (ChArUco).
+bool DetectBoard(const cv::Mat& gray, const CalibrationOptions& options, BoardDetection* detection);
+
+// The board's corners on the board (metres, z = 0), row after row: what a chessboard's
+// detection pairs with its image corners.
+std::vector<cv::Point3f> ChessboardObjectPoints(const CalibrationOptions& options);
+
 // A picture of the corner coverage (left) and the per-view errors (right).
 cv::Mat DrawCalibrationReport(const CalibrationResult& result);
 
@@ -67,6 +93,12 @@ cv::Mat DrawCalibrationReport(const CalibrationResult& result);
 // after row, refined to sub-pixel as calibration refines them; empty when the board is not found
 // whole.
 std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inner_corners);
+
+// The same for frames of a live camera, many without a board: the classic detector alone, with
+// its quick check that a board is there first and without its adaptive threshold, without the
+// exhaustive sector-based fallback meant for still photos, and with the same sub-pixel
+// refinement.
+std::vector<cv::Point2f> FindChessboardCornersQuickly(const cv::Mat& gray, cv::Size inner_corners);
 
 // Renders a ChArUco board image for printing or for tests.
 cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square);

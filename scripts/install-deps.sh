@@ -24,6 +24,8 @@ PACKAGES=(
   libx11-dev libxext-dev libxrandr-dev
   xvfb
   xdotool
+  x11-apps imagemagick
+  mrcal libmrcal-dev python3-mrcal python3-opencv
   libmetis-dev
   slurmctld slurmd slurm-client munge
   python3

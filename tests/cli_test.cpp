@@ -74,7 +74,10 @@ TEST(Cli, CalibrateBadInputsAreOneClearLine) {
       {{"calibrate", "--images", "/tmp/*.jpg", "--board", "nine", "--out", out}, "must look like 9x6"},
       {{"calibrate", "--images", "/tmp/*.jpg", "--square", "-1", "--out", out}, "--square"},
       {{"calibrate", "--images", "/tmp/*.jpg", "--out", "/nonexistent/dir/cam.yaml"}, "does not exist"},
-      {{"calibrate", "--out", out}, "--images is required"},
+      {{"calibrate", "--out", out}, "calibrate needs one of --images, --device or --recording"},
+      {{"calibrate", "--images", "/tmp/*.jpg", "--device", "/dev/video0", "--out", out}, "--images excludes --device"},
+      {{"calibrate", "--images", "/tmp/*.jpg", "--no-window", "--out", out}, "--no-window is for --device or --recording"},
+      {{"calibrate", "--recording", "/tmp", "--focus", "lock", "--out", out}, "--focus is for --device (the camera's set-up)"},
   };
   for (const Case& c : cases) {
     const auto r = RunArview(c.args);
