@@ -281,12 +281,18 @@ void MapInLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, 
   } else {
     RunLocally(options, paths, plan, cb, steps);
   }
-  // Only now is the map folder's model replaced.
-  const fs::path sparse = paths.out_dir / "sparse";
+  // Only now is the map folder's model replaced: the new sparse/ is made whole beside it, then the
+  // old one renamed aside and the new one into its place (a crash between the renames leaves both
+  // whole, as sparse.old/ and sparse.new/).
+  const fs::path sparse = paths.out_dir / "sparse", fresh = paths.out_dir / "sparse.new", old = paths.out_dir / "sparse.old";
   std::error_code ec;
-  fs::remove_all(sparse, ec);
-  fs::create_directories(sparse);
-  fs::rename(plan.adjusted, sparse / "0");
+  fs::remove_all(fresh, ec);
+  fs::remove_all(old, ec);
+  fs::create_directories(fresh);
+  fs::rename(plan.adjusted, fresh / "0");
+  if (fs::exists(sparse)) fs::rename(sparse, old);
+  fs::rename(fresh, sparse);
+  fs::remove_all(old, ec);
 }
 
 }  // namespace arview::mapping

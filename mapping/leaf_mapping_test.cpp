@@ -333,6 +333,33 @@ TEST(TempleLeavesOnSlurm, TwoLeavesMergeIntoTheSingleMapperMapAndAFailedLeafChan
   EXPECT_TRUE(queued.empty()) << "still queued: " << queued.front();
   EXPECT_EQ(FileBytes(out / "map.arvmap"), map_file);
   EXPECT_EQ(FileBytes(out / "sparse" / "0" / "images.bin"), model);
+
+  // Leaf 1's mapper "succeeds" with a damaged model: read as its job completes, refused, mapped
+  // once more, refused again; one line, the map folder as it was.
+  const fs::path damaging = scratch / "damaging_colmap.sh";
+  {
+    std::ofstream script(damaging);
+    script << "#!/bin/bash\nif [ \"$1\" = mapper ] && [[ \"$*\" == */leaves/1/sparse* ]]; then\n"
+           << "  out=\"$(printf '%s\\n' \"$@\" | grep '/leaves/1/sparse$')/0\"; mkdir -p \"$out\"\n"
+           << "  printf 'junk' > \"$out/cameras.bin\"; printf 'junk' > \"$out/images.bin\"; : > \"$out/points3D.bin\"; exit 0\nfi\n"
+           << "exec '" << colmap.string() << "' \"$@\"\n";
+  }
+  ::chmod(damaging.c_str(), 0755);
+  options.colmap = damaging.string();
+  options.leaf_overlap = 4;  // a new map stage
+  try {
+    BuildMap(recording, out, options, cb);
+    FAIL() << "a damaged leaf model went unnoticed";
+  } catch (const SlurmError& e) {
+    const std::string what = e.what();
+    std::cout << "the damaged leaf: " << what << "\n";
+    EXPECT_NE(what.find(" frames) failed on Slurm twice (job "), std::string::npos) << what;
+    EXPECT_NE(what.find("COMPLETED: its model is damaged: "), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+  EXPECT_TRUE(QueuedAfterCancelling("arview-map-leaves").empty());
+  EXPECT_EQ(FileBytes(out / "map.arvmap"), map_file);
+  EXPECT_EQ(FileBytes(out / "sparse" / "0" / "images.bin"), model);
   if (!HasFailure()) fs::remove_all(scratch);  // kept to look at otherwise
 }
 
