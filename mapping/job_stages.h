@@ -16,9 +16,10 @@
 //             pairs to <out>/database.db (MergeVerifiedPairs).
 //
 // A job is retried once (mapping/slurm_engine.h); a chunk whose database lacks one of its frames'
-// descriptors counts as failed. On any failure the map's database is not changed by extraction
-// (matching's half-added pairs are cleared by the next run's match stage, as for the local
-// matcher); the jobs' logs stay in <work>.
+// descriptors counts as failed. A failed extraction never leaves a half-merged database.db (the
+// extract stage then removes the old one, as when the local extractor fails); matching's
+// half-added pairs are cleared by the next run's match stage, as for the local matcher. The
+// jobs' logs stay in <work>.
 
 #include <filesystem>
 #include <string>

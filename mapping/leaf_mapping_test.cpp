@@ -151,9 +151,10 @@ TEST_F(SlurmJobs, ATaskWhoseResultIsRefusedFailsAfterItsRetryNamingBothJobs) {
     EXPECT_NE(what.find("COMPLETED: its model is damaged; before, job "), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
   }
+  // (The final job may have run: Slurm starts it once the tasks completed, before arview has read
+  // their results; what it wrote is the work folder's, and nothing of it is used.)
   const std::vector<std::string> queued = QueuedAfterCancelling(plan.job_name);
   EXPECT_TRUE(queued.empty()) << "still queued: " << queued.front();
-  EXPECT_FALSE(fs::exists(dir / "never"));
 }
 
 // The local cluster's slurmd killed while task 0 runs (and the task with it, as a node's death

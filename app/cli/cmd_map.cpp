@@ -146,7 +146,12 @@ void RunMap(const MapArgs& args) {
             ? recordings::LoadRecording(args.recordings.front())
             : mapping::VenueRecording({args.recordings.begin(), args.recordings.end()}, args.out, &rooms);
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
-    if (!rooms.empty()) mapping::WriteVenueFile(rooms, result.map, args.out);
+    if (!rooms.empty()) {
+      mapping::WriteVenueFile(rooms, result.map, args.out);
+    } else {
+      std::error_code ec;  // a folder that held a venue's map holds one recording's now
+      fs::remove(fs::path(args.out) / mapping::kVenueFileName, ec);
+    }
     bar.Finish();
     const auto stats = map::ComputeStats(result.map);
     std::cout << "registered " << result.map.keyframes.size() << " of " << result.selected_frames.size()
