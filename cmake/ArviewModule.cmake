@@ -3,6 +3,7 @@
 # Labels the tests that the last gtest_discover_tests call of <test target> found, once ctest
 # has read them: <labels> (a list: gtest_discover_tests (CMake 3.25) splits a list-valued
 # property) on each, and `tsan` besides on those whose name matches <tsan regex> (empty: none).
+# Tests labelled `slurm` also share the RESOURCE_LOCK arview_slurm_cluster.
 function(_arview_label_discovered target labels tsan_regex)
   get_property(counter TARGET ${target} PROPERTY CTEST_DISCOVERED_TEST_COUNTER)
   set(tests_file "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_tests.cmake")
@@ -21,6 +22,11 @@ if(EXISTS \"${tests_file}\")
     endif()
     if(labels)
       set_tests_properties(\"\${name}\" PROPERTIES LABELS \"\${labels}\")
+    endif()
+    # The Slurm tests share one cluster, and one of them kills its node: never two at once.
+    list(FIND labels slurm slurm_index)
+    if(NOT slurm_index EQUAL -1)
+      set_tests_properties(\"\${name}\" PROPERTIES RESOURCE_LOCK arview_slurm_cluster)
     endif()
   endforeach()
 endif()

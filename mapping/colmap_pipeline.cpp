@@ -21,6 +21,7 @@
 #include "map/map_file.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
+#include "mapping/job_stages.h"
 #include "mapping/leaf_mapping.h"
 #include "mapping/self_calibration.h"
 #include "mapping/map_extend.h"
@@ -475,17 +476,26 @@ int VerifyingProcesses(const MapBuildOptions& options) {
   return std::max(1, options.threads <= 0 ? cores : options.threads);
 }
 
+// "exhaustive" or "sequential 10 quadratic": which pairs are matched, for the stage records.
+std::string PairsWanted(const MapBuildOptions& options, int frames) {
+  return ExhaustiveMatchingWanted(options, frames)
+             ? "exhaustive"
+             : "sequential " + std::to_string(options.sequential_overlap) + (options.quadratic_overlap ? " quadratic" : "");
+}
+
 // What decides arview's matches, for the stage record.
 std::string ArviewMatchInputs(const MapBuildOptions& options, int frames) {
   const PairMatchingOptions& m = options.pair_matching;
   std::ostringstream ss;
-  ss << "arview pair matching\n"
-     << (ExhaustiveMatchingWanted(options, frames)
-             ? "exhaustive"
-             : "sequential " + std::to_string(options.sequential_overlap) + (options.quadratic_overlap ? " quadratic" : ""))
-     << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
+  ss << "arview pair matching\n" << PairsWanted(options, frames) << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
      << m.trees << " checks " << m.checks << " at least " << m.min_matches << "\nmatches_importer raw\n";
   return ss.str();
+}
+
+// What decides the matches of the Slurm jobs (matches_importer on pairs), for the stage record.
+std::string SlurmMatchInputs(const MapBuildOptions& options, int frames) {
+  return "COLMAP pair matching in Slurm jobs\n" + PairsWanted(options, frames) + "\nthreads " +
+         std::to_string(options.threads) + "\n";
 }
 
 // The candidate matches in `lists` verified by COLMAP (matches_importer --match_type raw), one
@@ -971,22 +981,37 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   };
 
   const auto remove_database = [&] { RemoveColmapDatabase(database); };
-  stage("extract", inputs, remove_database, colmap_stage("extract", extract_args), fs::exists(database),
-        remove_database);
+  // --engine slurm --slurm-chunk N: extraction and matching as jobs (mapping/job_stages.h). The
+  // same database either way, so the stage records do not say where it was made.
+  const bool stages_as_jobs = options.engine == MapEngine::kSlurm && options.slurm_chunk > 0;
+  const JobStageFiles job_files{database, images.root, out_dir / "jobs"};
+  const std::function<void(std::vector<StageTiming>*)> run_extract =
+      stages_as_jobs ? std::function<void(std::vector<StageTiming>*)>([&](std::vector<StageTiming>*) {
+        ExtractOnSlurm(recording.camera, options, job_files, images.names, cb);
+      })
+                     : colmap_stage("extract", extract_args);
+  stage("extract", inputs, remove_database, run_extract, fs::exists(database), remove_database);
 
   const bool arview_wanted = options.match_engine == MatchEngine::kArview ||
                              (options.match_engine == MatchEngine::kAuto && !FramesDoubled(recording.camera, options));
-  const bool arview_matches = arview_wanted && NamesFitAMatchList(images.names);
+  const bool arview_matches = !stages_as_jobs && arview_wanted && NamesFitAMatchList(images.names);
   if (arview_wanted && !arview_matches && cb.note)
     cb.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
   const std::vector<std::string> match_args = MatchArgs(options, database, n);
-  inputs += "--\n" + (arview_matches ? ArviewMatchInputs(options, n) : Joined(match_args));
+  inputs += "--\n" + (stages_as_jobs   ? SlurmMatchInputs(options, n)
+                      : arview_matches ? ArviewMatchInputs(options, n)
+                                       : Joined(match_args));
   const std::string match_inputs = inputs;
-  const std::function<void(std::vector<StageTiming>*)> run_match =
-      arview_matches ? std::function<void(std::vector<StageTiming>*)>([&](std::vector<StageTiming>* steps) {
-        MatchWithArview(colmap, database, out_dir, images.names, options, cb, steps);
-      })
-                     : colmap_stage("match", match_args);
+  std::function<void(std::vector<StageTiming>*)> run_match = colmap_stage("match", match_args);
+  if (arview_matches) {
+    run_match = [&](std::vector<StageTiming>* steps) {
+      MatchWithArview(colmap, database, out_dir, images.names, options, cb, steps);
+    };
+  } else if (stages_as_jobs) {
+    run_match = [&](std::vector<StageTiming>*) {
+      MatchOnSlurm(options, job_files, images.names, PairsToMatch(options, n), cb);
+    };
+  }
   // Half-written matches stay until the next run clears them (clearing needs room to write).
   const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
 

@@ -115,6 +115,9 @@ struct MapBuildOptions {
   int leaf_overlap = 10;
   MapEngine engine = MapEngine::kLocal;
   SlurmOptions slurm;
+  // With engine kSlurm: feature extraction and matching as Slurm jobs of about this many frames
+  // each (mapping/job_stages.h); 0: they run here, as with kLocal.
+  int slurm_chunk = 0;
   // The map made metric and upright before it is written (the COLMAP model too). A board that
   // cannot be used falls back to the camera-height estimate, and MapBuildResult::scale_failure
   // says why; with kCameraHeight, a map without a floor stays in COLMAP's frame (a note says so).

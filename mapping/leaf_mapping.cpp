@@ -159,6 +159,19 @@ void CheckAdjusted(const LeafPlan& plan, const fs::path& log) {
   }
 }
 
+// Why a leaf's model cannot be merged (missing, empty, a file damaged), or empty when it can.
+std::string LeafModelProblem(const fs::path& model) {
+  if (!fs::exists(model / "images.bin"))
+    return "COLMAP mapper registered no images (no model in " + model.string() + "): too few matches between its frames?";
+  try {
+    RequireReadableModel(model);
+  } catch (const Error& e) {
+    return std::string("its model is damaged: ") + e.what();
+  }
+  if (CountRegisteredImages(model) == 0) return "its model in " + model.string() + " holds no registered image";
+  return "";
+}
+
 Command WithExecutable(const std::string& colmap, Command args) {
   args.insert(args.begin(), colmap);
   return args;
@@ -201,22 +214,30 @@ void RunOnSlurm(const MapBuildOptions& options, const LeafPlan& plan, const MapB
   for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) {
     jobs.tasks.push_back(WithExecutable(colmap, plan.leaf_commands[i]));
     jobs.task_names.push_back(plan.LeafName(static_cast<int>(i)));
+    jobs.task_outputs.push_back(plan.LeafModel(static_cast<int>(i)));
   }
   for (const auto& command : plan.merge_commands) jobs.final_commands.push_back(WithExecutable(colmap, command));
   jobs.final_name = "the merge of the leaves";
   jobs.final_failure_marker = kMergeFailed;
   const int cpus = options.slurm.cpus_per_task > 0 ? options.slurm.cpus_per_task : std::max(1, options.threads);
+  // Each leaf's model is read as soon as its job completes: one that is missing or damaged fails
+  // the leaf (and is mapped once more) before the merge takes it.
+  jobs.check_task = [&plan](int leaf) { return LeafModelProblem(plan.LeafModel(leaf)); };
   const auto t0 = std::chrono::steady_clock::now();
-  const auto progress = [&](int done, int total) {
-    if (cb.progress) cb.progress("map", done, total);
+  SlurmCallbacks slurm;
+  slurm.progress = [&](const SlurmProgress& p) {
+    if (cb.progress) cb.progress("map", p.done, p.total);
+    if (cb.note && p.done < p.total) cb.note("leaves on Slurm: " + p.Describe());
   };
+  slurm.note = cb.note;
   std::vector<fs::path> leaf_logs;
   for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) leaf_logs.push_back(TaskLog(jobs, static_cast<int>(i)));
   try {
-    RunSlurmJobs(jobs, options.slurm, cpus, options.cancel, progress);
-  } catch (const SlurmError&) {
-    // The merge job fails when a leaf registered nothing or could not be merged: say which.
-    if (fs::exists(FinalLog(jobs))) CheckMerges(plan, leaf_logs, static_cast<int>(plan.merge_order.size()) - 1, FinalLog(jobs));
+    RunSlurmJobs(jobs, options.slurm, cpus, options.cancel, slurm);
+  } catch (const SlurmError& e) {
+    // The merge job fails when a leaf could not be merged: say which.
+    if (std::string(e.what()).rfind(jobs.final_name, 0) == 0 && fs::exists(FinalLog(jobs)))
+      CheckMerges(plan, leaf_logs, static_cast<int>(plan.merge_order.size()) - 1, FinalLog(jobs));
     throw;
   }
   CheckMerges(plan, leaf_logs, static_cast<int>(plan.merge_order.size()) - 1, FinalLog(jobs));
@@ -260,12 +281,18 @@ void MapInLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, 
   } else {
     RunLocally(options, paths, plan, cb, steps);
   }
-  // Only now is the map folder's model replaced.
-  const fs::path sparse = paths.out_dir / "sparse";
+  // Only now is the map folder's model replaced: the new sparse/ is made whole beside it, then the
+  // old one renamed aside and the new one into its place (a crash between the renames leaves both
+  // whole, as sparse.old/ and sparse.new/).
+  const fs::path sparse = paths.out_dir / "sparse", fresh = paths.out_dir / "sparse.new", old = paths.out_dir / "sparse.old";
   std::error_code ec;
-  fs::remove_all(sparse, ec);
-  fs::create_directories(sparse);
-  fs::rename(plan.adjusted, sparse / "0");
+  fs::remove_all(fresh, ec);
+  fs::remove_all(old, ec);
+  fs::create_directories(fresh);
+  fs::rename(plan.adjusted, fresh / "0");
+  if (fs::exists(sparse)) fs::rename(sparse, old);
+  fs::rename(fresh, sparse);
+  fs::remove_all(old, ec);
 }
 
 }  // namespace arview::mapping

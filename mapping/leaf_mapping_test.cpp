@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <chrono>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "base/process.h"
 #include "mapping/leaf_mapping.h"
 #include "mapping/slurm_engine.h"
+#include "mapping/test_slurm.h"
 #include "mapping/test_temple_map.h"
 #include "recordings/accuracy.h"
 #include "recordings/trajectory.h"
@@ -53,52 +55,6 @@ TEST(LeafMapping, MergesEachNextTheLeafSharingTheMostImages) {
   p.leaves = {{{0, 1}, {2}}, {{6, 7}, {5}}, {{2, 3}, {1, 4}}, {{4, 5}, {3, 6}}};
   // 0 shares 1 and 2 with leaf 2; then 3 shares 3, 4 with {0..4}; then leaf 1.
   EXPECT_EQ(MergeOrder(p), (std::vector<int>{0, 2, 3, 1}));
-}
-
-// Whether the cluster of scripts/slurm-local.sh (or another that SLURM_CONF names) answers.
-bool SlurmAnswers() {
-  const fs::path log = fs::temp_directory_path() / ("arview_sinfo_" + std::to_string(::getpid()) + ".log");
-  bool idle = false;
-  try {
-    const ProcessResult r = RunProcess({"sinfo", "-h", "-o", "%T"}, log, [&](const std::string& line) {
-      idle = idle || line.find("idle") != std::string::npos || line.find("mixed") != std::string::npos;
-    });
-    idle = idle && r.ok();
-  } catch (const Error&) {
-    idle = false;  // sinfo not installed
-  }
-  fs::remove(log);
-  return idle;
-}
-
-#define ARVIEW_REQUIRE_SLURM()                                                                          \
-  do {                                                                                                  \
-    if (!SlurmAnswers()) {                                                                              \
-      const char* why = "needs a running Slurm cluster: bash scripts/slurm-local.sh start, then "      \
-                        "export SLURM_CONF=$(bash scripts/slurm-local.sh conf) (scripts/test.sh does both)"; \
-      if (testing::DataRequired()) FAIL() << why << "; ARVIEW_REQUIRE_DATA=1 makes this a failure";   \
-      GTEST_SKIP() << why;                                                                              \
-    }                                                                                                   \
-  } while (0)
-
-// The jobs of `name` still pending or running.
-std::vector<std::string> QueuedJobs(const std::string& name) {
-  std::vector<std::string> lines;
-  const fs::path log = fs::temp_directory_path() / ("arview_squeue_" + std::to_string(::getpid()) + ".log");
-  RunProcess({"squeue", "-h", "-t", "PENDING,RUNNING,COMPLETING", "-n", name + "," + name + "-final", "-o", "%i %T"}, log,
-             [&](const std::string& line) { lines.push_back(line); });
-  fs::remove(log);
-  return lines;
-}
-
-// The jobs of `name` still queued once scancel had up to 10 s to take them off.
-std::vector<std::string> QueuedAfterCancelling(const std::string& name) {
-  std::vector<std::string> queued = QueuedJobs(name);
-  for (int i = 0; i < 50 && !queued.empty(); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    queued = QueuedJobs(name);
-  }
-  return queued;
 }
 
 std::string FileBytes(const fs::path& file) {
@@ -151,14 +107,99 @@ class SlurmJobs : public ::testing::Test {
 TEST_F(SlurmJobs, TheFinalJobRunsAfterEveryTask) {
   const SlurmJobPlan plan = ShellPlan(dir, {"sleep 1; touch done_0", "touch done_1"},
                                       "test -e done_0 && test -e done_1 && touch all_done");
-  std::vector<int> progress;
-  RunSlurmJobs(plan, QuickPolls(), 1, {}, [&](int done, int total) {
-    EXPECT_EQ(total, 3);
-    progress.push_back(done);
-  });
+  std::vector<SlurmProgress> progress;
+  SlurmCallbacks callbacks;
+  callbacks.progress = [&](const SlurmProgress& p) {
+    EXPECT_EQ(p.total, 3);
+    progress.push_back(p);
+  };
+  RunSlurmJobs(plan, QuickPolls(), 1, {}, callbacks);
   EXPECT_TRUE(fs::exists(dir / "all_done"));
   ASSERT_FALSE(progress.empty());
-  EXPECT_EQ(progress.back(), 3);
+  EXPECT_EQ(progress.back().done, 3);
+  // Task 0 sleeps a second: it was seen queued or running before everything was done.
+  EXPECT_TRUE(std::any_of(progress.begin(), progress.end(), [](const SlurmProgress& p) { return p.queued + p.running > 0; }));
+  EXPECT_EQ(progress.back().Describe(), "0 queued, 0 running, 3 of 3 done");
+}
+
+TEST_F(SlurmJobs, AFailedTaskIsSubmittedOnceMoreAndTheFinalJobWaitsForIt) {
+  // Task 1 fails on its first try only; its second try appends to the same log.
+  const SlurmJobPlan plan =
+      ShellPlan(dir, {"sleep 1; touch done_0", "if [ ! -e tried_1 ]; then touch tried_1; echo 'first try'; exit 4; fi; touch done_1"},
+                "test -e done_0 && test -e done_1 && touch all_done");
+  std::vector<std::string> notes;
+  SlurmCallbacks callbacks;
+  callbacks.note = [&](const std::string& note) { notes.push_back(note); };
+  RunSlurmJobs(plan, QuickPolls(), 1, {}, callbacks);
+  EXPECT_TRUE(fs::exists(dir / "all_done"));
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("task 1 failed on Slurm"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("FAILED: first try"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("submitting it once more"), std::string::npos) << notes[0];
+  EXPECT_NE(FileBytes(TaskLog(plan, 1)).find("first try"), std::string::npos) << "the retry appends to the log";
+}
+
+TEST_F(SlurmJobs, ATaskWhoseResultIsRefusedFailsAfterItsRetryNamingBothJobs) {
+  SlurmJobPlan plan = ShellPlan(dir, {"true", "sleep 1"}, "touch never");
+  plan.check_task = [](int task) { return task == 1 ? std::string("its model is damaged") : std::string(); };
+  try {
+    RunSlurmJobs(plan, QuickPolls(), 1, {}, {});
+    FAIL() << "the refused result went unnoticed";
+  } catch (const SlurmError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("task 1 failed on Slurm twice (job "), std::string::npos) << what;
+    EXPECT_NE(what.find("COMPLETED: its model is damaged; before, job "), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+  // (The final job may have run: Slurm starts it once the tasks completed, before arview has read
+  // their results; what it wrote is the work folder's, and nothing of it is used.)
+  const std::vector<std::string> queued = QueuedAfterCancelling(plan.job_name);
+  EXPECT_TRUE(queued.empty()) << "still queued: " << queued.front();
+}
+
+// The local cluster's slurmd killed while task 0 runs (and the task with it, as a node's death
+// takes its processes): slurmctld marks the node down after SlurmdTimeout (10 s; about 30 s in
+// all), the job ends, arview submits it once more, and it runs once the node is back.
+TEST_F(SlurmJobs, AJobOnANodeThatDiedRunsAgainWhenTheNodeIsBack) {
+  const SlurmJobPlan plan = ShellPlan(
+      dir, {"if [ ! -e tried_0 ]; then touch tried_0; echo $$ > task_0.pid; exec sleep 120; fi; touch done_0"},
+      "test -e done_0 && touch all_done");
+  const std::string script = (testing::SourceDir() / "scripts" / "slurm-local.sh").string();
+  std::vector<std::string> notes;
+  std::atomic<bool> retried{false};
+  SlurmCallbacks callbacks;
+  callbacks.note = [&](const std::string& note) {
+    notes.push_back(note);
+    retried = true;
+  };
+  std::jthread node([&](std::stop_token stop) {
+    const fs::path pid = dir / "task_0.pid";
+    for (int i = 0; i < 600 && !fs::exists(pid) && !stop.stop_requested(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the pid written whole
+    RunProcess({"bash", script, "kill-node"}, dir / "node.log", {});
+    std::ifstream in(pid);
+    int task = 0;
+    if (in >> task && task > 0) ::kill(task, SIGKILL);
+    // Back once the job has ended and its retry waits for a node.
+    for (int i = 0; i < 1200 && !retried && !stop.stop_requested(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    RunProcess({"bash", script, "start-node"}, dir / "node.log", {});
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    RunSlurmJobs(plan, QuickPolls(), 1, {}, callbacks);
+  } catch (...) {
+    node.request_stop();  // the node is started again before the test ends
+    throw;
+  }
+  std::cout << "finished " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()
+            << " s after submitting\n";
+  node.join();
+  EXPECT_TRUE(fs::exists(dir / "all_done"));
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("task 0 failed on Slurm (job "), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("submitting it once more"), std::string::npos) << notes[0];
 }
 
 TEST_F(SlurmJobs, AFailedTaskCancelsTheRestAndSaysWhy) {
@@ -168,9 +209,9 @@ TEST_F(SlurmJobs, AFailedTaskCancelsTheRestAndSaysWhy) {
     FAIL() << "the failed task went unnoticed";
   } catch (const SlurmError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("task 1 failed on Slurm"), std::string::npos) << what;
-    EXPECT_NE(what.find("FAILED"), std::string::npos) << what;
-    EXPECT_NE(what.find("no images here"), std::string::npos) << what;
+    EXPECT_NE(what.find("task 1 failed on Slurm twice"), std::string::npos) << what;
+    EXPECT_NE(what.find("FAILED: no images here; before, job "), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
   }
   const std::vector<std::string> queued = QueuedAfterCancelling(plan.job_name);
   EXPECT_TRUE(queued.empty()) << "still queued: " << queued.front();
@@ -183,7 +224,8 @@ TEST_F(SlurmJobs, AFinalCommandPrintingTheFailureMarkerFailsTheJob) {
     RunSlurmJobs(plan, QuickPolls(), 1, {}, {});
     FAIL() << "model_merger's failure went unnoticed";
   } catch (const SlurmError& e) {
-    EXPECT_NE(std::string(e.what()).find("the final job failed on Slurm"), std::string::npos) << e.what();
+    // Not retried: a merge that failed fails again.
+    EXPECT_NE(std::string(e.what()).find("the final job failed on Slurm (job "), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("printed '=> Merge failed'"), std::string::npos) << e.what();
   }
 }
@@ -281,13 +323,42 @@ TEST(TempleLeavesOnSlurm, TwoLeavesMergeIntoTheSingleMapperMapAndAFailedLeafChan
     FAIL() << "a failed leaf went unnoticed";
   } catch (const SlurmError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("leaf 1"), std::string::npos) << what;
+    std::cout << "the failed leaf: " << what << "\n";
+    EXPECT_NE(what.find("leaf 1 ("), std::string::npos) << what;
+    EXPECT_NE(what.find(" frames) failed on Slurm twice (job "), std::string::npos) << what;
     EXPECT_NE(what.find("FAILED"), std::string::npos) << what;
     EXPECT_NE(what.find("forced failure of leaf 1"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
   }
   const std::vector<std::string> queued = QueuedAfterCancelling("arview-map-leaves");
   EXPECT_TRUE(queued.empty()) << "still queued: " << queued.front();
+  EXPECT_EQ(FileBytes(out / "map.arvmap"), map_file);
+  EXPECT_EQ(FileBytes(out / "sparse" / "0" / "images.bin"), model);
+
+  // Leaf 1's mapper "succeeds" with a damaged model: read as its job completes, refused, mapped
+  // once more, refused again; one line, the map folder as it was.
+  const fs::path damaging = scratch / "damaging_colmap.sh";
+  {
+    std::ofstream script(damaging);
+    script << "#!/bin/bash\nif [ \"$1\" = mapper ] && [[ \"$*\" == */leaves/1/sparse* ]]; then\n"
+           << "  out=\"$(printf '%s\\n' \"$@\" | grep '/leaves/1/sparse$')/0\"; mkdir -p \"$out\"\n"
+           << "  printf 'junk' > \"$out/cameras.bin\"; printf 'junk' > \"$out/images.bin\"; : > \"$out/points3D.bin\"; exit 0\nfi\n"
+           << "exec '" << colmap.string() << "' \"$@\"\n";
+  }
+  ::chmod(damaging.c_str(), 0755);
+  options.colmap = damaging.string();
+  options.leaf_overlap = 4;  // a new map stage
+  try {
+    BuildMap(recording, out, options, cb);
+    FAIL() << "a damaged leaf model went unnoticed";
+  } catch (const SlurmError& e) {
+    const std::string what = e.what();
+    std::cout << "the damaged leaf: " << what << "\n";
+    EXPECT_NE(what.find(" frames) failed on Slurm twice (job "), std::string::npos) << what;
+    EXPECT_NE(what.find("COMPLETED: its model is damaged: "), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+  EXPECT_TRUE(QueuedAfterCancelling("arview-map-leaves").empty());
   EXPECT_EQ(FileBytes(out / "map.arvmap"), map_file);
   EXPECT_EQ(FileBytes(out / "sparse" / "0" / "images.bin"), model);
   if (!HasFailure()) fs::remove_all(scratch);  // kept to look at otherwise

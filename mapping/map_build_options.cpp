@@ -19,6 +19,7 @@ void MapBuildOptions::Check(const OptionNames& names) const {
   RequireOption(ba_local_max_iterations >= 0, names("ba_local_max_iterations"), "0 or more", ba_local_max_iterations);
   RequireOption(sequential_overlap >= 1, names("sequential_overlap"), "at least 1", sequential_overlap);
   RequireOption(fold_retries >= 0, names("fold_retries"), "0 or more", fold_retries);
+  RequireOption(slurm_chunk >= 0, names("slurm_chunk"), "0 (extraction and matching here) or more", slurm_chunk);
   if (colmap.empty()) throw OptionError(names("colmap") + ": an empty name: give the COLMAP executable");
   if (scale.from == ScaleFrom::kBoard) {
     RequireOption(scale.board.square > 0, names("scale.board.square"), "above 0 (metres)", scale.board.square);

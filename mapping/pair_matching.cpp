@@ -225,13 +225,19 @@ void WriteMatchLists(const std::vector<std::string>& names, const std::vector<Pa
   }
 }
 
-void MergeVerifiedPairs(const fs::path& database, const fs::path& part) {
+namespace {
+
+// Runs `sql` (one transaction) on `database` with the database `part` attached as "part";
+// `what` names the step for the error ("add the verified pairs of <part>"). `precondition`, when
+// given, is a query run first whose one value must be 1, else `refusal` is the error's reason.
+void RunWithPartAttached(const fs::path& database, const fs::path& part, const char* sql, const std::string& what,
+                         const char* precondition = nullptr, const std::string& refusal = "") {
   sqlite3* db = nullptr;
   const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr);
   const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
   if (rc != SQLITE_OK) {
-    throw map::MapError(database.string() + ": cannot open to add the verified pairs of " + part.string() + " (" +
-                        (db ? sqlite3_errmsg(db) : "out of memory") + ")");
+    throw map::MapError(database.string() + ": cannot open to " + what + " (" + (db ? sqlite3_errmsg(db) : "out of memory") +
+                        ")");
   }
   sqlite3_busy_timeout(db, 5000);
   // The part's path is bound, not spliced into the SQL: any file name works.
@@ -240,18 +246,56 @@ void MergeVerifiedPairs(const fs::path& database, const fs::path& part) {
                   sqlite3_bind_text(attach, 1, part.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
                   sqlite3_step(attach) == SQLITE_DONE;
   sqlite3_finalize(attach);
+  if (attached && precondition) {
+    sqlite3_stmt* check = nullptr;
+    const bool holds = sqlite3_prepare_v2(db, precondition, -1, &check, nullptr) == SQLITE_OK &&
+                       sqlite3_step(check) == SQLITE_ROW && sqlite3_column_int(check, 0) == 1;
+    sqlite3_finalize(check);
+    if (!holds) throw map::MapError(database.string() + ": cannot " + what + " (" + refusal + ")");
+  }
   char* error = nullptr;
-  if (!attached ||
-      sqlite3_exec(db,
-                   "BEGIN; INSERT OR REPLACE INTO main.matches SELECT * FROM part.matches; "
-                   "INSERT OR REPLACE INTO main.two_view_geometries SELECT * FROM part.two_view_geometries; COMMIT;",
-                   nullptr, nullptr, &error) != SQLITE_OK) {
+  if (!attached || sqlite3_exec(db, sql, nullptr, nullptr, &error) != SQLITE_OK) {
     const std::string why = error ? error : sqlite3_errmsg(db);
     sqlite3_free(error);
     sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw map::MapError(database.string() + ": cannot add the verified pairs of " + part.string() + " (" + why + ")");
+    throw map::MapError(database.string() + ": cannot " + what + " (" + why + ")");
   }
   sqlite3_exec(db, "DETACH DATABASE part", nullptr, nullptr, nullptr);
+}
+
+}  // namespace
+
+void MergeVerifiedPairs(const fs::path& database, const fs::path& part) {
+  RunWithPartAttached(database, part,
+                      "BEGIN; INSERT OR REPLACE INTO main.matches SELECT * FROM part.matches; "
+                      "INSERT OR REPLACE INTO main.two_view_geometries SELECT * FROM part.two_view_geometries; COMMIT;",
+                      "add the verified pairs of " + part.string());
+}
+
+void MergeExtractedImages(const fs::path& database, const fs::path& part) {
+  // The part's ids are moved past the database's, through ids from 2^30 up (COLMAP's image ids are
+  // checked to lie in 0 .. 2^31 - 2), so that no two rows of the part ever share one; then its
+  // rows are copied. Its camera must be the database's one camera (the same feature_extractor
+  // command line).
+  RunWithPartAttached(
+      database, part,
+      "BEGIN;"
+      "UPDATE part.images SET image_id = image_id + 1073741824, camera_id = (SELECT camera_id FROM main.cameras);"
+      "UPDATE part.keypoints SET image_id = image_id + 1073741824;"
+      "UPDATE part.descriptors SET image_id = image_id + 1073741824;"
+      "CREATE TEMP TABLE merge_offset AS SELECT IFNULL(MAX(image_id), 0) - 1073741824 AS value FROM main.images;"
+      "UPDATE part.images SET image_id = image_id + (SELECT value FROM merge_offset);"
+      "UPDATE part.keypoints SET image_id = image_id + (SELECT value FROM merge_offset);"
+      "UPDATE part.descriptors SET image_id = image_id + (SELECT value FROM merge_offset);"
+      "INSERT INTO main.images SELECT * FROM part.images;"
+      "INSERT INTO main.keypoints SELECT * FROM part.keypoints;"
+      "INSERT INTO main.descriptors SELECT * FROM part.descriptors;"
+      "DROP TABLE temp.merge_offset; COMMIT;",
+      "add the images extracted in " + part.string(),
+      "SELECT (SELECT COUNT(*) FROM part.cameras) = 1 AND (SELECT COUNT(*) FROM main.cameras) = 1 AND"
+      " (SELECT model || ' ' || width || ' ' || height || ' ' || hex(params) FROM part.cameras) ="
+      " (SELECT model || ' ' || width || ' ' || height || ' ' || hex(params) FROM main.cameras)",
+      "its camera is not the database's one camera");
 }
 
 }  // namespace arview::mapping

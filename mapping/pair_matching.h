@@ -81,4 +81,10 @@ void WriteMatchLists(const std::vector<std::string>& names, const std::vector<Pa
 // (the pairs verified in a copy of it). Throws MapError naming the database that fails.
 void MergeVerifiedPairs(const std::filesystem::path& database, const std::filesystem::path& part);
 
+// Copies the images, keypoints and descriptors of the COLMAP database `part` (feature_extractor
+// run on other images with the same camera) into `database`, the part's image ids moved past the
+// database's; the part is changed too (it is a job's, removed after). Throws MapError when the
+// part's camera is not the database's one camera, an image name is in both, or a file fails.
+void MergeExtractedImages(const std::filesystem::path& database, const std::filesystem::path& part);
+
 }  // namespace arview::mapping

@@ -198,15 +198,29 @@ void MakeDatabase(const fs::path& file, const std::vector<int>& pair_ids) {
   sqlite3_close(db);
 }
 
-int Count(const fs::path& file, const std::string& table) {
+// Each row of a query, its columns joined by ':'.
+std::vector<std::string> Rows(const fs::path& file, const std::string& sql) {
   sqlite3* db = nullptr;
   sqlite3_open(file.c_str(), &db);
   sqlite3_stmt* st = nullptr;
-  sqlite3_prepare_v2(db, ("SELECT count(*) FROM " + table).c_str(), -1, &st, nullptr);
-  const int n = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int(st, 0) : -1;
+  sqlite3_prepare_v2(db, sql.c_str(), -1, &st, nullptr);
+  std::vector<std::string> rows;
+  while (sqlite3_step(st) == SQLITE_ROW) {
+    std::string row;
+    for (int c = 0; c < sqlite3_column_count(st); ++c) {
+      const unsigned char* text = sqlite3_column_text(st, c);
+      row += (c ? ":" : "") + std::string(text ? reinterpret_cast<const char*>(text) : "NULL");
+    }
+    rows.push_back(row);
+  }
   sqlite3_finalize(st);
   sqlite3_close(db);
-  return n;
+  return rows;
+}
+
+int Count(const fs::path& file, const std::string& table) {
+  const std::vector<std::string> rows = Rows(file, "SELECT count(*) FROM " + table);
+  return rows.empty() ? -1 : std::stoi(rows[0]);
 }
 
 TEST(PairMatching, VerifiedPairsOfACopyAreAddedToTheDatabase) {
@@ -226,6 +240,73 @@ TEST(PairMatching, VerifiedPairsOfACopyAreAddedToTheDatabase) {
     EXPECT_NE(std::string(e.what()).find("junk.db"), std::string::npos) << e.what();
   }
   EXPECT_EQ(Count(dir / "main db.db", "matches"), 5);
+  fs::remove_all(dir);
+}
+
+// A database of feature_extractor's tables (the columns arview reads) holding `names` with
+// image ids 1, 2, ..., each with keypoints and descriptors whose rows are its id times 10, and
+// one camera whose width is `width`.
+void MakeExtractedDatabase(const fs::path& file, const std::vector<std::string>& names, int width = 640) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  Exec(db,
+       "CREATE TABLE cameras(camera_id INTEGER PRIMARY KEY NOT NULL, model INTEGER NOT NULL, width INTEGER NOT NULL, "
+       "height INTEGER NOT NULL, params BLOB, prior_focal_length INTEGER NOT NULL);"
+       "CREATE TABLE images(image_id INTEGER PRIMARY KEY NOT NULL, name TEXT NOT NULL UNIQUE, camera_id INTEGER NOT "
+       "NULL, prior_qw REAL, CONSTRAINT image_id_check CHECK(image_id >= 0 and image_id < 2147483647));"
+       "CREATE TABLE keypoints(image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT NULL, "
+       "data BLOB);"
+       "CREATE TABLE descriptors(image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT NULL, "
+       "data BLOB);"
+       "INSERT INTO cameras VALUES(1, 4, " + std::to_string(width) + ", 480, x'0102', 1);");
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const std::string id = std::to_string(i + 1), rows = std::to_string(10 * (i + 1));
+    Exec(db, "INSERT INTO images VALUES(" + id + ", '" + names[i] + "', 1, NULL);");
+    Exec(db, "INSERT INTO keypoints VALUES(" + id + ", " + rows + ", 6, NULL);");
+    Exec(db, "INSERT INTO descriptors VALUES(" + id + ", " + rows + ", 128, NULL);");
+  }
+  sqlite3_close(db);
+}
+
+// "id:name:keypoint rows:descriptor rows " of every image, by id.
+std::string ImagesOf(const fs::path& file) {
+  std::string text;
+  for (const std::string& row : Rows(file,
+                                     "SELECT images.image_id, name, keypoints.rows, descriptors.rows FROM images JOIN "
+                                     "keypoints USING (image_id) JOIN descriptors USING (image_id) ORDER BY images.image_id"))
+    text += row + " ";
+  return text;
+}
+
+TEST(PairMatching, ImagesExtractedInAnotherDatabaseAreAddedAfterTheDatabasesOwn) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_extract_merge_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  MakeExtractedDatabase(dir / "main.db", {"f/0.png", "f/1.png"});
+  MakeExtractedDatabase(dir / "chunk 1.db", {"f/2.png", "f/3.png", "f/4.png"});
+  MergeExtractedImages(dir / "main.db", dir / "chunk 1.db");
+  // Each image keeps its own keypoints and descriptors under its new id.
+  EXPECT_EQ(ImagesOf(dir / "main.db"), "1:f/0.png:10:10 2:f/1.png:20:20 3:f/2.png:10:10 4:f/3.png:20:20 5:f/4.png:30:30 ");
+  EXPECT_EQ(Count(dir / "main.db", "cameras"), 1);
+  const std::string merged = ImagesOf(dir / "main.db");
+
+  // Another camera, or an image the database holds already: refused, the database as it was.
+  MakeExtractedDatabase(dir / "other camera.db", {"f/5.png"}, 1280);
+  try {
+    MergeExtractedImages(dir / "main.db", dir / "other camera.db");
+    ADD_FAILURE() << "merged another camera's images";
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("its camera is not the database's one camera"), std::string::npos) << e.what();
+  }
+  MakeExtractedDatabase(dir / "again.db", {"f/6.png", "f/1.png"});
+  try {
+    MergeExtractedImages(dir / "main.db", dir / "again.db");
+    ADD_FAILURE() << "merged an image twice";
+  } catch (const map::MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("again.db"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("UNIQUE"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ImagesOf(dir / "main.db"), merged);
   fs::remove_all(dir);
 }
 

@@ -9,6 +9,9 @@
 #   scripts/slurm-local.sh stop
 #   scripts/slurm-local.sh status   # exit status 0 when both daemons run
 #   scripts/slurm-local.sh conf     # prints the slurm.conf path (for SLURM_CONF)
+#   scripts/slurm-local.sh kill-node   # the node dies: slurmd killed (SIGKILL); slurmctld marks
+#                                      # it down after SlurmdTimeout (10 s here)
+#   scripts/slurm-local.sh start-node  # the node back: slurmd started again (ReturnToService=2)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir="${ARVIEW_SLURM_DIR:-/tmp/arview-slurm-$(id -u)}"
@@ -79,10 +82,26 @@ start() {
   echo "slurm-local: running, one node '$(hostname -s)' with $(nproc) CPUs; export SLURM_CONF=$conf"
 }
 
+kill_node() {
+  pid_alive "$dir/slurmd.pid" || die "slurmd is not running"
+  kill -9 "$(cat "$dir/slurmd.pid")"
+  echo "slurm-local: slurmd killed"
+}
+
+start_node() {
+  pid_alive "$dir/slurmctld.pid" || die "slurmctld is not running: scripts/slurm-local.sh start"
+  if pid_alive "$dir/slurmd.pid"; then echo "slurm-local: slurmd already running"; return 0; fi
+  PATH="/usr/sbin:$PATH"
+  slurmd -f "$conf" || die "slurmd did not start: see $dir/slurmd.log"
+  echo "slurm-local: slurmd started"
+}
+
 case "${1:-}" in
   start) start ;;
+  kill-node) kill_node ;;
+  start-node) start_node ;;
   stop) stop ;;
   status) pid_alive "$dir/slurmctld.pid" && pid_alive "$dir/slurmd.pid" && echo "slurm-local: running ($conf)" ;;
   conf) echo "$conf" ;;
-  *) echo "usage: scripts/slurm-local.sh start|stop|status|conf" >&2; exit 2 ;;
+  *) echo "usage: scripts/slurm-local.sh start|stop|status|conf|kill-node|start-node" >&2; exit 2 ;;
 esac

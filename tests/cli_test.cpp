@@ -648,7 +648,12 @@ TEST_F(Round4BadInputs, MapScaleRefusesOneRayAndAnotherMapsModelAndChangesNothin
 // Issue 55: the venue flags of `arview map` refused before anything is written.
 TEST_F(Round4BadInputs, MapEngineFlagsThatDoNotGoTogetherAreRefused) {
   ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "slurm"},
-                "map: --engine slurm maps leaves as jobs: it needs --leaf-size", 2);
+                "map: --engine slurm runs stages as jobs: give --leaf-size (the mapping in leaves) or --slurm-chunk "
+                "(extraction and matching), or both",
+                2);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--slurm-chunk", "8"},
+                "map: --slurm-chunk makes Slurm jobs: it needs --engine slurm", 2);
+  ExpectRefused({"map", At("rec"), At("rec"), "--out", At("venue")}, At("rec") + ": the same recording given twice", 1);
   ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "cloud", "--leaf-size", "10"},
                 "--engine: cloud not in {local,slurm}", kFlagCheck);
   ExpectRefused({"map", At("rec"), "--out", At("venue"), "--leaf-size", "-1"}, "--leaf-size", kFlagCheck);

@@ -1,7 +1,7 @@
-// arview map <recording> --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
+// arview map <recording> [<recording> ...] --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
 //            [--fold-retries N] [--keep-folded] [--board CxR --square M [--board-off-floor] | --no-metric]
-//            [--leaf-size N [--leaf-overlap N] [--engine local|slurm [--slurm-partition P] [--slurm-cpus N]]]
+//            [--leaf-size N [--leaf-overlap N]] [--engine local|slurm [--slurm-chunk N] [--slurm-partition P] [--slurm-cpus N]]
 // arview map info <map-dir>
 // arview map scale <map-dir> [<recording>] (--board CxR --square M [--board-off-floor] | --distance M --from .. --to ..)
 
@@ -23,6 +23,7 @@
 #include "map/map_file.h"
 #include "mapping/colmap_pipeline.h"
 #include "mapping/map_check.h"
+#include "mapping/venue.h"
 
 namespace arview::app {
 
@@ -33,7 +34,7 @@ namespace fs = std::filesystem;
 using mapping::Fixed;
 
 struct MapArgs {
-  std::string recording;
+  std::vector<std::string> recordings;  // two or more: a venue (mapping/venue.h)
   std::string out;
   std::string frames;
   // The defaults are MapBuildOptions' own.
@@ -53,6 +54,7 @@ struct MapArgs {
   std::string engine = "local";
   std::string slurm_partition;
   int slurm_cpus = 0;
+  int slurm_chunk = 0;
   std::string info_dir;
   bool info_recheck = false;
   // Metres and up (mapping/metric_frame.h).
@@ -101,7 +103,7 @@ std::string DescribeFrame(const map::MapFrame& f) {
 
 
 void RunMap(const MapArgs& args) {
-  if (args.recording.empty()) throw CommandError("map: the recording folder is required (arview map <recording> --out <map-dir>)", 2);
+  if (args.recordings.empty()) throw CommandError("map: the recording folder is required (arview map <recording> --out <map-dir>)", 2);
   if (args.out.empty()) throw CommandError("map: --out <map-dir> is required", 2);
   mapping::MapBuildOptions options;
   options.frames_spec = args.frames;
@@ -117,8 +119,12 @@ void RunMap(const MapArgs& args) {
   options.leaf_overlap = args.leaf_overlap;
   options.slurm.partition = args.slurm_partition;
   options.slurm.cpus_per_task = args.slurm_cpus;
-  if (args.engine == "slurm" && args.leaf_size == 0)
-    throw CommandError("map: --engine slurm maps leaves as jobs: it needs --leaf-size", 2);
+  options.slurm_chunk = args.slurm_chunk;
+  if (args.engine == "slurm" && args.leaf_size == 0 && args.slurm_chunk == 0)
+    throw CommandError("map: --engine slurm runs stages as jobs: give --leaf-size (the mapping in leaves) or "
+                       "--slurm-chunk (extraction and matching), or both", 2);
+  if (args.slurm_chunk > 0 && args.engine != "slurm")
+    throw CommandError("map: --slurm-chunk makes Slurm jobs: it needs --engine slurm", 2);
   if (!args.board.empty()) {
     if (args.no_metric) throw CommandError("map: --board and --no-metric exclude each other", 2);
     options.scale.from = mapping::ScaleFrom::kBoard;
@@ -134,8 +140,18 @@ void RunMap(const MapArgs& args) {
     options.matcher = mapping::ParseMatcherKind(args.matcher);
     options.match_engine = mapping::ParseMatchEngine(args.match_engine);
     options.engine = mapping::ParseMapEngine(args.engine);
-    const recordings::Recording recording = recordings::LoadRecording(args.recording);
+    std::vector<mapping::VenueRoom> rooms;
+    const recordings::Recording recording =
+        args.recordings.size() == 1
+            ? recordings::LoadRecording(args.recordings.front())
+            : mapping::VenueRecording({args.recordings.begin(), args.recordings.end()}, args.out, &rooms);
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
+    if (!rooms.empty()) {
+      mapping::WriteVenueFile(rooms, result.map, args.out);
+    } else {
+      std::error_code ec;  // a folder that held a venue's map holds one recording's now
+      fs::remove(fs::path(args.out) / mapping::kVenueFileName, ec);
+    }
     bar.Finish();
     const auto stats = map::ComputeStats(result.map);
     std::cout << "registered " << result.map.keyframes.size() << " of " << result.selected_frames.size()
@@ -148,6 +164,8 @@ void RunMap(const MapArgs& args) {
       total += t.seconds;
     }
     std::cout << " (total " << Fixed(total, 1) << " s)\n";
+    if (const auto venue = mapping::ReadVenueFile(args.out))
+      for (const auto& room : *venue) std::cout << "room " << mapping::DescribeRoom(room) << "\n";
     std::cout << "check: " << mapping::DescribeMapCheck(result.check) << "\n";
     std::cout << "frame: " << DescribeFrame(result.map.frame) << "\n";
     std::cout << "wrote " << args.out << "/{" << map::kMapFileName << ", " << mapping::kMapCheckFileName
@@ -255,6 +273,10 @@ void RunInfo(const std::string& dir, bool recheck) {
     std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
               << " is written by arview map since issue 17)\n";
   }
+  if (const auto venue = mapping::ReadVenueFile(folder)) {
+    std::cout << "rooms:               " << venue->size() << " (" << mapping::kVenueFileName << ")\n";
+    for (const auto& room : *venue) std::cout << "                     " << mapping::DescribeRoom(room) << "\n";
+  }
   if (const auto why = map::DegeneratePoints(map)) {
     std::cout << "warning:             the map's points cannot hold a floor ('arview place' refuses the map): " << *why
               << "\n";
@@ -266,7 +288,9 @@ void RunInfo(const std::string& dir, bool recheck) {
 void AddMapCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("map", "Build the map of a scene from a recording with COLMAP ('map info' describes one)");
   auto args = std::make_shared<MapArgs>();
-  cmd->add_option("recording", args->recording, "Recording folder (see 'arview import')");
+  cmd->add_option("recording", args->recordings,
+                  "Recording folder (see 'arview import'); several: a venue, its recordings (rooms) mapped as one, "
+                  "named in the map (venue.json, 'arview map info')");
   cmd->add_option("--out", args->out, "Map directory to write (created; a re-run skips unchanged stages)");
   cmd->add_option("--frames", args->frames, "Frames to use, e.g. 0-46:2 or 1,5,9-12 (default: all)");
   cmd->add_option("--matcher", args->matcher, "auto (exhaustive up to 100 frames, else sequential), sequential or exhaustive")
@@ -311,10 +335,16 @@ void AddMapCommand(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
   cmd->add_option("--engine", args->engine,
-                  "Where the leaves are mapped: local (one after another here) or slurm (a job array and a merge job "
-                  "through sbatch; the map folder must be on a filesystem every node sees)")
+                  "Where the leaves are mapped (and with --slurm-chunk, extraction and matching run): local (one after "
+                  "another here) or slurm (job arrays and a merge job through sbatch, a failed job submitted once "
+                  "more; the map folder must be on a filesystem every node sees)")
       ->capture_default_str()
       ->check(CLI::IsMember({"local", "slurm"}));
+  cmd->add_option("--slurm-chunk", args->slurm_chunk,
+                  "With --engine slurm: feature extraction and matching as Slurm jobs of about this many frames each, "
+                  "their databases merged here (0: both run here)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
   cmd->add_option("--slurm-partition", args->slurm_partition, "The Slurm partition of the jobs (default: the cluster's)");
   cmd->add_option("--slurm-cpus", args->slurm_cpus, "CPUs each Slurm job asks for (0: --threads)")
       ->capture_default_str()
