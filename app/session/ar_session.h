@@ -13,6 +13,7 @@
 #include "base/cancellation.h"
 #include "app/pipeline/ar_pipeline.h"
 #include "app/pipeline/layered_animator.h"
+#include "app/session/session_dialogue.h"
 #include "anim_authoring/scene.h"
 #include "base/geometry.h"
 #include "map/map.h"
@@ -65,6 +66,8 @@ struct SessionOptions {
   // Called on arview-render when a character starts a line (its 16 kHz samples and its start on
   // the frame clock, speech/utterance.h): for live sound output. Must not block.
   std::function<void(const speech::Utterance&)> on_utterance;
+  // The first character listens and answers (issue 54): --dialogue, --mic, --audio-in.
+  DialogueSessionOptions dialogue;
   // When the command started, for "first frame shown after ..." (default: RunSession's start).
   std::optional<Clock::time_point> command_start;
 
