@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -156,7 +157,8 @@ class CharacterDialogue {
   // One line per problem met while running (a reply that could not be made, a grammar the
   // recognizer refused), for the session's end; never thrown on the frame path.
   const std::vector<std::string>& problems() const { return problems_; }
-  // Stop feeding the recognizer (its input is gone): the session goes on without listening.
+  // The recognizer's input is gone (a microphone unplugged): the session goes on without
+  // listening, and the HUD says so. Any thread (the audio source's).
   void StopListening() { listening_ = false; }
 
  private:
@@ -172,7 +174,7 @@ class CharacterDialogue {
   std::unique_ptr<ReplyVoice> voice_;
   ExpressionTargets expressions_;
   DialogueOptions options_;
-  bool listening_ = true;
+  std::atomic<bool> listening_{true};
   bool broken_ = false;                    // a DialogueError at run time: no more turns
   double heard_confidence_ = 0, heard_end_s_ = -1;  // of the phrase taken this frame
   std::optional<double> last_time_;

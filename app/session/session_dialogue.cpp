@@ -214,6 +214,7 @@ void SessionDialogue::Start() {
           std::lock_guard lock(mutex_);
           audio_error_ = end.error;
         }
+        dialogue_->StopListening();
         if (on_line_) on_line_(end.error);  // the session goes on without listening
       });
 }

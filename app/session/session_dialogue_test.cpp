@@ -11,6 +11,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "app/pipeline/ar_compositor.h"
 #include "app/session/test_dialogue_exchange.h"
 #include "figure/face_targets.h"
 
@@ -92,6 +93,12 @@ TEST(SessionDialogue, TheViewersDistanceSideGazeAndLossReachTheDialogueAndEachRe
   EXPECT_EQ(happy_before_near, 0.0f);
   EXPECT_GT(happy_after_near, 0.1f);
   EXPECT_EQ(d.frame().expression, "happy");
+  // The HUD: nothing to listen to here, the machine chosen last, the emotion and the face.
+  const std::vector<std::string> hud = DialogueHudLines(d);
+  ASSERT_EQ(hud.size(), 2u);
+  EXPECT_EQ(hud[0], "heard: not listening");
+  EXPECT_EQ(hud[1].rfind("machine: lost   emotion: joy 0.", 0), 0u) << hud[1];
+  EXPECT_NE(hud[1].find("face: happy 0."), std::string::npos) << hud[1];
   fs::remove(file);
 }
 
