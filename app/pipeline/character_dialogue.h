@@ -113,7 +113,6 @@ struct ExpressionTargets {
 };
 
 struct DialogueOptions {
-  std::uint64_t seed = 0;
   std::string origin;            // the dialogue file, for the replies' origins
   // The character's front and up in its frame (the viewer's side), as SpeechOptions's.
   Eigen::Vector3d forward = Eigen::Vector3d::UnitZ(), up = Eigen::Vector3d::UnitY();

@@ -154,7 +154,6 @@ SessionDialogue::SessionDialogue(const DialogueSessionOptions& o, const authorin
   }
 
   DialogueOptions options;
-  options.seed = o.seed;
   options.origin = file;
   options.forward = character.spec().forward;
   options.up = character.spec().up;
