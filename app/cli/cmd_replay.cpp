@@ -11,6 +11,7 @@
 #include "app/cli/first_run_figure.h"
 #include "base/atomic_file.h"
 #include "app/cli/session_flags.h"
+#include "app/cli/dialogue_flags.h"
 #include "base/cancellation.h"
 #include "app/pipeline/pipeline_report.h"
 #include "map/map_file.h"
@@ -29,6 +30,7 @@ struct ReplayArgs {
   long loop = 1;
   int read_ahead = recordings::ReplayOptions{}.read_ahead;
   SessionFlags session;
+  DialogueFlags dialogue;
 };
 
 }  // namespace
@@ -53,6 +55,7 @@ void AddReplayCommand(CLI::App& app) {
       ->check(CLI::Range(0, 1000));
   AddSessionFlags(cmd, a->session);
   AddAudioOutFlag(cmd, a->audio_out);
+  AddDialogueFlags(cmd, a->dialogue, DialogueInput::kWavFile);
   cmd->callback([a, read_ahead] {
     // An unpaced replay reads each frame when the tracker takes it: there is no ahead.
     if (read_ahead->count() > 0 && !a->paced)
@@ -73,6 +76,7 @@ void AddReplayCommand(CLI::App& app) {
 
     SessionOptions o;
     ApplySessionFlags(a->session, /*live_source=*/a->paced, o);
+    ApplyDialogueFlags(a->dialogue, o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

@@ -11,6 +11,7 @@
 #include "app/pipeline/pipeline_report.h"
 #include "app/cli/numeric_flags.h"
 #include "app/cli/session_flags.h"
+#include "app/cli/dialogue_flags.h"
 #include "base/cancellation.h"
 #include "map/map_file.h"
 #include "recordings/v4l2_source.h"
@@ -27,6 +28,7 @@ struct RunArgs {
   std::string audio_out = "default";
   CameraFlags camera;
   SessionFlags session;
+  DialogueFlags dialogue;
 };
 
 std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
@@ -51,6 +53,7 @@ void AddRunCommand(CLI::App& app) {
   AddCameraFlags(cmd, a->camera, "default: the map's camera size; another of the same aspect scales the map's camera exactly");
   AddSessionFlags(cmd, a->session);
   AddAudioOutFlag(cmd, a->audio_out);
+  AddDialogueFlags(cmd, a->dialogue, DialogueInput::kMicrophone);
   cmd->callback([a] {
     const bool to_file = !video::IsWindowTarget(a->out) && a->out != "null";
     RequireDistinctOutputs(
@@ -58,6 +61,7 @@ void AddRunCommand(CLI::App& app) {
     SessionOptions o;
     o.command_start = Clock::now();
     ApplySessionFlags(a->session, /*live_source=*/true, o);
+    ApplyDialogueFlags(a->dialogue, o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

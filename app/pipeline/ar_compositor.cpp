@@ -42,6 +42,26 @@ ArCompositor::ArCompositor(const calib::Camera& camera, std::vector<const anim::
   context_->ReleaseCurrent();  // for the render thread (BindToThread)
 }
 
+std::vector<std::string> DialogueHudLines(const CharacterDialogue& dialogue) {
+  const DialogueFrame& d = dialogue.frame();
+  std::vector<std::string> lines;
+  char line[192];
+  if (!dialogue.last_heard().empty()) {
+    std::snprintf(line, sizeof line, "heard: \"%.80s\" (confidence %.2f%s)", dialogue.last_heard().c_str(),
+                  d.heard_confidence, d.heard_accepted ? "" : ", not taken");
+    lines.push_back(line);
+  } else {
+    lines.push_back(d.listening ? "heard: nothing yet" : "heard: not listening");
+  }
+  std::snprintf(line, sizeof line, "machine: %.*s   emotion: %.*s %.2f   face: %.*s %.2f",
+                static_cast<int>(d.machine.empty() ? 1 : d.machine.size()), d.machine.empty() ? "-" : d.machine.data(),
+                static_cast<int>(d.emotion.empty() ? 7 : d.emotion.size()), d.emotion.empty() ? "neutral" : d.emotion.data(),
+                d.emotion_intensity, static_cast<int>(d.expression.empty() ? 7 : d.expression.size()),
+                d.expression.empty() ? "neutral" : d.expression.data(), d.expression_weight);
+  lines.push_back(line);
+  return lines;
+}
+
 std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) const {
   char line[128];
   std::snprintf(line, sizeof line, "frame %lld   %s   %.0f frames/s", static_cast<long long>(input.frame->index),
@@ -55,6 +75,9 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
     std::snprintf(line, sizeof line, "idle weight %.2f", input.animations.front()->idle_weight());
     status.push_back(line);
     if (std::string eyes = render::EyeContactLine(input.animations.front()->gaze); !eyes.empty()) status.push_back(eyes);
+  }
+  if (input.dialogue) {
+    for (std::string& l : DialogueHudLines(*input.dialogue)) status.push_back(std::move(l));
   }
   return status;
 }

@@ -19,6 +19,10 @@
 
 namespace arview::app {
 
+// The HUD's lines for a character's dialogue: what was heard (with its confidence), the machine
+// chosen last, the dominant emotion and the face's expression with its weight.
+std::vector<std::string> DialogueHudLines(const CharacterDialogue& dialogue);
+
 struct CompositorOptions {
   render::OffscreenOptions gl;
   render::ArOptions ar;

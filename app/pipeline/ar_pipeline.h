@@ -35,6 +35,7 @@ struct FrameToCompose {
   const tracker::FrameResult* track = nullptr;
   std::vector<const anim::AnimatorFrame*> animations;  // one per character (none: no character)
   const tracker::LossDiagnosis* loss = nullptr;  // a lost frame's cause (PipelineOptions::diagnoser)
+  const CharacterDialogue* dialogue = nullptr;    // the first character's, for the HUD (render thread)
 };
 
 class FrameCompositor {
@@ -123,6 +124,7 @@ struct FrameLog {
   anim::GazeFrame eyes;       // first character: its eyes on the viewer, blinks (anim/gaze.h; inactive: none)
   anim::FaceFrame face;       // first character: speech on its face (anim/face.h; inactive: none)
   std::string_view saying;    // first character: the line being said (its LayeredAnimator keeps the text), or empty
+  std::optional<DialogueFrame> dialogue;  // first character with a dialogue: heard, machine, emotion, expression
 };
 
 struct PipelineReport {
@@ -163,6 +165,8 @@ struct PipelineReport {
   long blinks = 0;
   tracker::LossSummary losses;                  // the lost frames' causes (PipelineOptions::diagnoser)
   recordings::Trajectory trajectory;            // raw poses of localized frames
+  // The first character's dialogue turns (app/session fills them in after the run, for --stats).
+  std::vector<DialogueTurnRecord> dialogue_turns;
 };
 
 // Runs until the source ends (or `stop()` returns true, or the sink asks to stop: checked by the

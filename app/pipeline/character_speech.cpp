@@ -32,11 +32,21 @@ double AngleFromFront(const Eigen::Vector3d& viewpoint, const SpeechOptions& o) 
 }  // namespace
 
 CharacterSpeech::CharacterSpeech(std::vector<ReadyLine> lines, SpeechOptions options)
-    : lines_(std::move(lines)), options_(std::move(options)), next_by_cue_(5, 0), near_armed_(lines_.size(), true) {
+    : lines_(std::make_move_iterator(lines.begin()), std::make_move_iterator(lines.end())),
+      scene_lines_(lines_.size()),
+      options_(std::move(options)),
+      next_by_cue_(5, 0),
+      near_armed_(lines_.size(), true) {
   if (!SlotsMatchSpeech()) throw Error("speech: anim's viseme slots are not speech's visemes (anim/face.cpp, speech/visemes.h)");
   for (const ReadyLine& l : lines_)
     if (!l.spoken || !l.visemes) throw Error(l.origin + ": the line was not synthesized");
   utterances_.reserve(64);
+}
+
+void CharacterSpeech::Say(ReadyLine line) {
+  if (!line.spoken || !line.visemes) throw Error(line.origin + ": the line was not synthesized");
+  lines_.push_back(std::move(line));
+  replies_waiting_.push_back(lines_.size() - 1);
 }
 
 std::string_view CharacterSpeech::saying() const {
@@ -45,8 +55,8 @@ std::string_view CharacterSpeech::saying() const {
 
 int CharacterSpeech::NextLineFor(SpeechCue cue) {
   const std::size_t c = static_cast<std::size_t>(cue);
-  for (std::size_t k = 0; k < lines_.size(); ++k) {
-    const std::size_t i = (next_by_cue_[c] + k) % lines_.size();
+  for (std::size_t k = 0; k < scene_lines_; ++k) {
+    const std::size_t i = (next_by_cue_[c] + k) % scene_lines_;
     if (lines_[i].cue == cue) {
       next_by_cue_[c] = i + 1;  // the cue's lines take turns
       return static_cast<int>(i);
@@ -68,7 +78,7 @@ int CharacterSpeech::Cued(double time, const SpeechCues& cues) {
     if (lost_said_) fire(SpeechCue::kFound);
     lost_said_ = false;
     has_lost_since_ = false;
-    for (std::size_t i = 0; i < lines_.size(); ++i) {
+    for (std::size_t i = 0; i < scene_lines_; ++i) {
       const ReadyLine& l = lines_[i];
       if (l.cue != SpeechCue::kNear || !(cues.distance >= 0)) continue;
       if (near_armed_[i] && cues.distance <= l.near) {
@@ -136,8 +146,14 @@ const anim::FaceTrack& CharacterSpeech::Update(double time, const SpeechCues& cu
   last_time_ = time;
   const int due = Cued(time, cues);
   if (current_ >= 0 && time - current_start_ > lines_[current_].duration_s() + options_.ramp_s) current_ = -1;
-  // A cue while talking is let go.
-  if (current_ < 0 && due >= 0) Start(static_cast<std::size_t>(due), DelayedStart(time), animator);
+  if (current_ < 0 && !replies_waiting_.empty()) {
+    const double start = DelayedStart(time);
+    Start(replies_waiting_.front(), start, animator);  // a reply before a cue, which is let go
+    replies_waiting_.pop_front();
+    replies_started_.push_back(start);
+  } else if (current_ < 0 && due >= 0) {
+    Start(static_cast<std::size_t>(due), DelayedStart(time), animator);  // a cue while talking is let go
+  }
   track_ = anim::FaceTrack{};
   if (current_ < 0) return track_;
   const ReadyLine& line = lines_[current_];

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -72,11 +73,18 @@ class CharacterSpeech {
   // `animator`); returns the frame's face track. `time`: the animation time (seconds, monotonic).
   const anim::FaceTrack& Update(double time, const SpeechCues& cues, anim::Animator& animator);
 
+  // A line said as soon as no line is being said, before any cued line: the dialogue's replies
+  // (app/pipeline/character_dialogue.h). Lines given here wait in order.
+  void Say(ReadyLine line);
+  // The frame times at which Say's lines started, in the order given.
+  const std::vector<double>& replies_started() const { return replies_started_; }
+
   // The line being said (its text), empty when silent.
   std::string_view saying() const;
   // Every line started so far, in order.
   const std::vector<speech::Utterance>& utterances() const { return utterances_; }
-  const std::vector<ReadyLine>& lines() const { return lines_; }
+  // A deque: Say appends while the sink's thread may still read an earlier line's text (saying()).
+  const std::deque<ReadyLine>& lines() const { return lines_; }
 
  private:
   // Advances the cues' states; the line a cue calls for this frame, or −1.
@@ -85,7 +93,8 @@ class CharacterSpeech {
   void Start(std::size_t line, double time, anim::Animator& animator);
   double DelayedStart(double cue_time) const;  // SpeechOptions::start_delay_s on whole frames
 
-  std::vector<ReadyLine> lines_;
+  std::deque<ReadyLine> lines_;  // the scene's lines first (scene_lines_ of them), then Say's
+  std::size_t scene_lines_ = 0;
   SpeechOptions options_;
   std::vector<std::size_t> next_by_cue_;  // per cue: where to look for its next line
   std::vector<bool> near_armed_;          // per line (kNear lines: their own distances)
@@ -98,6 +107,8 @@ class CharacterSpeech {
   double last_time_ = -1, frame_interval_ = 0;  // the previous frame's time and the interval to it
   anim::FaceTrack track_;
   std::vector<speech::Utterance> utterances_;
+  std::deque<std::size_t> replies_waiting_;  // Say's lines not yet started
+  std::vector<double> replies_started_;
 };
 
 }  // namespace arview::app

@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "base/error.h"
+
 namespace arview::app {
 
 void FadeOptions::Check(const OptionNames& names) const {
@@ -13,7 +15,13 @@ LayeredAnimator::LayeredAnimator(const anim::PlacedCharacter& character, std::un
                                  const anim::Clip* idle_clip, std::vector<std::string> notes)
     : character_(character), idle_(idle_clip), animator_(std::move(animator)), notes_(std::move(notes)) {}
 
-const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d>& camera_center, double time) {
+void LayeredAnimator::SetDialogue(std::unique_ptr<CharacterDialogue> dialogue) {
+  if (dialogue && !speech_) throw Error("dialogue: the character has no speech to answer with (SetSpeech first)");
+  dialogue_ = std::move(dialogue);
+}
+
+const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Vector3d>& camera_center, double time,
+                                                   const std::optional<Eigen::Vector3d>& optical_axis) {
   const anim::Placement& placement = character_.placement();
   anim::FrameInputs inputs;
   inputs.tracking = camera_center.has_value();
@@ -31,8 +39,11 @@ const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Ve
     cues.distance = inputs.distance;
     cues.viewpoint = inputs.viewpoint;
   }
+  if (dialogue_) dialogue_->Update(time, placement, camera_center, optical_axis, *speech_, *animator_);
   const anim::FaceTrack& face = speech_->Update(time, cues, *animator_);
-  return animator_->Update(time, inputs, &face);
+  const anim::AnimatorFrame& frame = animator_->Update(time, inputs, &face);
+  if (dialogue_) dialogue_->ShowExpression(*animator_, frame);
+  return frame;
 }
 
 }  // namespace arview::app

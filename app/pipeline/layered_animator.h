@@ -23,6 +23,7 @@
 
 #include "anim/animator.h"
 #include "anim/placed_character.h"
+#include "app/pipeline/character_dialogue.h"
 #include "app/pipeline/character_speech.h"
 #include "base/option_check.h"
 
@@ -45,13 +46,19 @@ class LayeredAnimator {
                   const anim::Clip* idle_clip = nullptr, std::vector<std::string> notes = {});
 
   // `camera_center` is the (smoothed) camera centre in map coordinates, or nothing when the
-  // tracker lost the frame. `time` is the video time in seconds (monotonic).
-  const anim::AnimatorFrame& Update(const std::optional<Eigen::Vector3d>& camera_center, double time);
+  // tracker lost the frame. `time` is the video time in seconds (monotonic). `optical_axis`: the
+  // camera's viewing direction in the map (for the dialogue's gaze condition), when known.
+  const anim::AnimatorFrame& Update(const std::optional<Eigen::Vector3d>& camera_center, double time,
+                                    const std::optional<Eigen::Vector3d>& optical_axis = std::nullopt);
 
   // The character's lines (app/pipeline/character_speech.h), set before the pipeline starts:
   // each Update then lets them start a line and drive the face.
   void SetSpeech(std::unique_ptr<CharacterSpeech> speech) { speech_ = std::move(speech); }
   const CharacterSpeech* speech() const { return speech_.get(); }
+  // The character's dialogue (issue 54), set before the pipeline starts, after SetSpeech (its
+  // replies are said by the speech): each Update ticks it first and shows its expression after.
+  void SetDialogue(std::unique_ptr<CharacterDialogue> dialogue);
+  const CharacterDialogue* dialogue() const { return dialogue_.get(); }
   // The line being said, empty when silent or without lines.
   std::string_view saying() const { return speech_ ? speech_->saying() : std::string_view(); }
 
@@ -70,6 +77,7 @@ class LayeredAnimator {
   std::unique_ptr<anim::Animator> animator_;
   std::vector<std::string> notes_;
   std::unique_ptr<CharacterSpeech> speech_;
+  std::unique_ptr<CharacterDialogue> dialogue_;
 };
 
 }  // namespace arview::app

@@ -36,6 +36,24 @@ nlohmann::ordered_json TimingJson(const TimingSummary& s) {
   return {{"count", s.count}, {"median_ms", s.median}, {"p95_ms", s.p95}, {"p99_ms", s.p99}, {"mean_ms", s.mean}, {"max_ms", s.max}};
 }
 
+namespace {
+
+// --stats's "dialogue_turns": one record per reply (docs/app.md, "--stats").
+nlohmann::ordered_json DialogueTurnsJson(const std::vector<DialogueTurnRecord>& turns) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const DialogueTurnRecord& t : turns) {
+    nlohmann::ordered_json turn = {{"time_s", t.time_s}, {"heard", t.heard}, {"confidence", t.confidence},
+                                   {"machine", t.machine}, {"said", t.said}};
+    if (t.heard_end_s >= 0) turn["heard_end_s"] = t.heard_end_s;
+    if (t.reply_start_s >= 0) turn["reply_start_s"] = t.reply_start_s;
+    if (t.LatencyS() >= 0) turn["latency_ms"] = 1000 * t.LatencyS();
+    out.push_back(std::move(turn));
+  }
+  return out;
+}
+
+}  // namespace
+
 nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& r, const std::string& gl_description,
                                            const render::RendererInfo& gl) {
   nlohmann::ordered_json j;
@@ -72,6 +90,7 @@ nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& r, const std::s
   for (const auto& [cause, name] : EnumNames(tracker::LossCause{})) {
     if (r.losses.count(cause) > 0) lost_by_cause[std::string(name)] = r.losses.count(cause);
   }
+  if (!r.dialogue_turns.empty()) j["dialogue_turns"] = DialogueTurnsJson(r.dialogue_turns);
   return j;
 }
 
@@ -117,6 +136,19 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
     if (f.face.viseme >= 0) frame["viseme"] = std::string(ToString(static_cast<speech::Viseme>(f.face.viseme)));
   }
   if (!f.saying.empty()) frame["saying"] = std::string(f.saying);
+  if (f.dialogue) {
+    const DialogueFrame& d = *f.dialogue;
+    nlohmann::ordered_json dialogue = {{"machine", std::string(d.machine)},
+                                       {"emotion", std::string(d.emotion)},
+                                       {"emotion_intensity", d.emotion_intensity},
+                                       {"expression", std::string(d.expression)},
+                                       {"expression_weight", d.expression_weight},
+                                       {"activation", d.activation},
+                                       {"listening", d.listening}};
+    if (d.heard_this_frame)
+      dialogue["heard"] = {{"text", d.heard_now}, {"confidence", d.heard_confidence}, {"accepted", d.heard_accepted}};
+    frame["dialogue"] = std::move(dialogue);
+  }
   if (!f.track.reason.empty()) frame["reason"] = f.track.reason;
   if (f.loss) frame["cause"] = {{"kind", ToString(f.loss->cause)}, {"numbers", f.loss->detail}};
   return frame;

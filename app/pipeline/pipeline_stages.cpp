@@ -174,19 +174,26 @@ void RenderStage::AnimateAndCompose(InFlight& item) {
       localized_before_ = true;
       if (on_first_localized_) on_first_localized_(item.track);
     }
-    std::optional<Eigen::Vector3d> centre;
-    if (localized) centre = item.track.smoothed_center;
+    std::optional<Eigen::Vector3d> centre, axis;
+    if (localized) {
+      centre = item.track.smoothed_center;
+      axis = item.track.pose.CameraToWorldRotation() * Eigen::Vector3d::UnitZ();  // the camera looks along +z
+    }
     if (!first_timestamp_) first_timestamp_ = item.frame.timestamp;
     const double animation_time = item.frame.timestamp - *first_timestamp_;
     log.animation_s = animation_time;
     for (LayeredAnimator* animator : animators_) {
-      compose.animations.push_back(&animator->Update(centre, animation_time));
+      compose.animations.push_back(&animator->Update(centre, animation_time, axis));
     }
     log.idle_weight = compose.animations.front()->idle_weight();
     log.actions_triggered = compose.animations.front()->triggered;
     log.eyes = compose.animations.front()->gaze;
     log.face = compose.animations.front()->face;
     log.saying = animators_.front()->saying();
+    if (const CharacterDialogue* dialogue = animators_.front()->dialogue()) {
+      log.dialogue = dialogue->frame();
+      compose.dialogue = dialogue;
+    }
     if (localized) {
       log.gaze_error_deg = GazeErrorDeg(animators_.front()->character(), compose.animations.front()->model,
                                         item.track.center);

@@ -169,6 +169,16 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     }
   }
 
+  // The dialogue after the characters: it answers through the first one's speech.
+  std::unique_ptr<SessionDialogue> dialogue;
+  if (o.dialogue.enabled()) {
+    if (characters.empty())
+      throw Error(o.dialogue.dialogue_file.string() + ": a dialogue needs a character to answer (not with --no-figure)");
+    dialogue = std::make_unique<SessionDialogue>(o.dialogue, *characters.front(), *animators.front(), o.on_utterance,
+                                                 [](const std::string& line) { std::cerr << "note: " << line << "\n"; });
+    for (const std::string& note : dialogue->load_notes()) std::cerr << "note: " << note << "\n";
+  }
+
   const double characters_seconds = seconds_of_step();
   ArCompositor compositor(map.camera, character_ptrs, o.compositor, std::move(context));
   const double renderer_seconds = context_seconds + seconds_of_step();
@@ -198,6 +208,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
     if (key == "h") compositor.ToggleHud();
   });
 
+  if (dialogue) dialogue->Start();
   Progress progress("augmenting frames");
   double rss_mib = -1;
   std::size_t rss_read_at = 0;
@@ -222,6 +233,12 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
       },
       [&o] { return o.cancel.IsCancelled(); });
   progress.Finish();
+  if (dialogue) {
+    dialogue->Stop();
+    const CharacterDialogue& answered = *animators.front()->dialogue();
+    report.dialogue_turns = answered.turns();
+    for (const std::string& problem : answered.problems()) std::cerr << "note: " << problem << "\n";
+  }
   if (o.cancel.IsCancelled() && !o.cancel_ends_normally) {
     std::string unwritten = o.output_name.empty() ? std::string() : o.output_name;
     for (const auto& file : {o.trajectory_out, o.stats_out}) {

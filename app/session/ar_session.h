@@ -14,6 +14,7 @@
 #include "app/pipeline/ar_pipeline.h"
 #include "app/pipeline/layered_animator.h"
 #include "app/session/session_sound.h"
+#include "app/session/session_dialogue.h"
 #include "anim_authoring/scene.h"
 #include "base/geometry.h"
 #include "map/map.h"
@@ -72,6 +73,8 @@ struct SessionOptions {
   // `audio_track`: a video file sink gets an AAC track with the lines, when the scene has lines.
   audio::ClipPlayer* sound_out = nullptr;
   bool audio_track = false;
+  // The first character listens and answers (issue 54): --dialogue, --mic, --audio-in.
+  DialogueSessionOptions dialogue;
   // When the command started, for "first frame shown after ..." (default: RunSession's start).
   std::optional<Clock::time_point> command_start;
 

@@ -47,29 +47,14 @@ std::vector<int> UpperBodyJointsMoved(const anim::Skeleton& skeleton, const anim
   return moved;
 }
 
-// <gesture name="Wave"/>: the character's clip of that name, over the idle and the view layer on
-// the upper-body joints it moves (UpperBodyJointsMoved; the legs stay on the layers below), faded
-// in and out.
+// <gesture name="Wave"/>: the character's clip of that name (GestureClipAction).
 anim::Action GestureAction(const authoring::AnimatedCharacter& ch, const speech::TimedTag& t, const std::string& origin,
                            const LineActionTiming& timing) {
-  const anim::Character& c = ch.character();
-  const anim::Clip* clip = c.FindClip(t.tag.target);
-  if (!clip)
+  std::optional<anim::Action> a = GestureClipAction(ch, t.tag.target, t.time_s, timing);
+  if (!a)
     throw anim::Error(Where(origin, t.tag) + "the character '" + ch.spec().name + "' has no gesture '" + t.tag.target +
-                      "' (its clips: " + authoring::ClipList(c) + ")");
-  anim::Action a;
-  a.object = std::make_shared<anim::ClipSource>(ch.shared_skeleton(), std::shared_ptr<const anim::Clip>(ch.shared_character(), clip));
-  a.start = t.time_s;
-  a.name = "say:gesture:" + t.tag.target;
-  a.layer = timing.gesture_layer;
-  anim::Curve fade = anim::Curve::CosineFade(std::min(timing.gesture_fade_in, clip->duration / 2),
-                                             std::min(timing.gesture_fade_out, clip->duration / 2));
-  fade.in_seconds = true;
-  a.params.curves = {fade};
-  anim::JointMask mask = anim::JointMask::Uniform(c.skeleton.size(), 0.0);
-  mask.Set(UpperBodyJointsMoved(c.skeleton, *clip, timing.gesture_min_turn_deg), 1.0);
-  a.params.masks = {mask};
-  return a;
+                      "' (its clips: " + authoring::ClipList(ch.character()) + ")");
+  return std::move(*a);
 }
 
 // <face expr="happy" intensity="0.6"/>: the expression's target weights held from its word to a
@@ -126,6 +111,48 @@ std::vector<speech::SpokenLine> SynthesizeAll(const std::vector<speech::MarkedLi
 
 }  // namespace
 
+std::optional<anim::Action> GestureClipAction(const authoring::AnimatedCharacter& ch, const std::string& name, double start,
+                                             const LineActionTiming& timing) {
+  const anim::Character& c = ch.character();
+  const anim::Clip* clip = c.FindClip(name);
+  if (!clip) return std::nullopt;
+  anim::Action a;
+  a.object = std::make_shared<anim::ClipSource>(ch.shared_skeleton(), std::shared_ptr<const anim::Clip>(ch.shared_character(), clip));
+  a.start = start;
+  a.name = "say:gesture:" + name;
+  a.layer = timing.gesture_layer;
+  anim::Curve fade = anim::Curve::CosineFade(std::min(timing.gesture_fade_in, clip->duration / 2),
+                                             std::min(timing.gesture_fade_out, clip->duration / 2));
+  fade.in_seconds = true;
+  a.params.curves = {fade};
+  anim::JointMask mask = anim::JointMask::Uniform(c.skeleton.size(), 0.0);
+  mask.Set(UpperBodyJointsMoved(c.skeleton, *clip, timing.gesture_min_turn_deg), 1.0);
+  a.params.masks = {mask};
+  return a;
+}
+
+ReadyLine MakeReadyLine(const authoring::AnimatedCharacter& character, const LineRequest& request,
+                        const speech::MarkedLine& marked, speech::SpokenLine spoken, const LineActionTiming& timing) {
+  ReadyLine line;
+  line.origin = request.origin;
+  line.text = marked.text;
+  line.cue = request.cue;
+  line.near = request.near;
+  line.far = request.far;
+  auto sp = std::make_shared<const speech::SpokenLine>(std::move(spoken));
+  line.visemes = std::make_shared<const speech::VisemeTrack>(sp->phones);
+  const double end = sp->DurationSeconds();
+  for (const speech::TimedTag& t : speech::TimeTags(marked, *sp, line.origin)) {
+    switch (t.tag.kind) {
+      case speech::TagKind::kGesture: line.actions.push_back(GestureAction(character, t, line.origin, timing)); break;
+      case speech::TagKind::kFace: line.actions.push_back(FaceAction(character, t, end, line.origin, timing)); break;
+      case speech::TagKind::kGaze: line.gaze_at_viewer.push_back(t.time_s); break;
+    }
+  }
+  line.spoken = std::move(sp);
+  return line;
+}
+
 std::vector<LineRequest> SceneLineRequests(const authoring::CharacterSpec& spec) {
   const std::string file = spec.where.substr(0, spec.where.rfind(':'));
   std::vector<LineRequest> out;
@@ -150,28 +177,10 @@ std::vector<ReadyLine> PrepareLines(const authoring::AnimatedCharacter& characte
       if (tag.kind == speech::TagKind::kGaze && tag.target != "viewer")
         throw speech::SpeechError(Where(r.origin, tag) + "the character can look at 'viewer' only, not '" + tag.target + "'");
   }
-  const std::vector<speech::SpokenLine> spoken = SynthesizeAll(marked, requests, voice);
+  std::vector<speech::SpokenLine> spoken = SynthesizeAll(marked, requests, voice);
   std::vector<ReadyLine> lines;
-  for (std::size_t i = 0; i < requests.size(); ++i) {
-    ReadyLine line;
-    line.origin = requests[i].origin;
-    line.text = marked[i].text;
-    line.cue = requests[i].cue;
-    line.near = requests[i].near;
-    line.far = requests[i].far;
-    auto sp = std::make_shared<const speech::SpokenLine>(spoken[i]);
-    line.visemes = std::make_shared<const speech::VisemeTrack>(sp->phones);
-    const double end = sp->DurationSeconds();
-    for (const speech::TimedTag& t : speech::TimeTags(marked[i], *sp, line.origin)) {
-      switch (t.tag.kind) {
-        case speech::TagKind::kGesture: line.actions.push_back(GestureAction(character, t, line.origin, timing)); break;
-        case speech::TagKind::kFace: line.actions.push_back(FaceAction(character, t, end, line.origin, timing)); break;
-        case speech::TagKind::kGaze: line.gaze_at_viewer.push_back(t.time_s); break;
-      }
-    }
-    line.spoken = std::move(sp);
-    lines.push_back(std::move(line));
-  }
+  for (std::size_t i = 0; i < requests.size(); ++i)
+    lines.push_back(MakeReadyLine(character, requests[i], marked[i], std::move(spoken[i]), timing));
   return lines;
 }
 

@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,18 @@ struct LineActionTiming {
 std::vector<ReadyLine> PrepareLines(const authoring::AnimatedCharacter& character, const std::vector<LineRequest>& requests,
                                     const std::string& voice_name, const std::string& voice_origin,
                                     const LineActionTiming& timing = {});
+// One line made ready from its parsed markup and its synthesized sound (what PrepareLines does for
+// each line; the dialogue's replies are made one at a time): its viseme track, its tags timed at
+// their words as schedule actions. Throws anim::Error for a gesture or expression the character
+// cannot play.
+ReadyLine MakeReadyLine(const authoring::AnimatedCharacter& character, const LineRequest& request,
+                        const speech::MarkedLine& marked, speech::SpokenLine spoken, const LineActionTiming& timing = {});
+// The character's clip `name` as a gesture starting at `start`: over the idle and the view layer
+// on the upper-body joints the clip moves (the legs, and the head the look-at turns to the viewer
+// when the clip leaves it still, stay on the layers below), faded in and out. Nothing when the
+// character has no such clip.
+std::optional<anim::Action> GestureClipAction(const authoring::AnimatedCharacter& character, const std::string& name,
+                                              double start, const LineActionTiming& timing = {});
 // The scene's `lines:` of the character as requests.
 std::vector<LineRequest> SceneLineRequests(const authoring::CharacterSpec& spec);
 

@@ -1,0 +1,31 @@
+#include "app/cli/dialogue_flags.h"
+
+namespace arview::app {
+
+void AddDialogueFlags(CLI::App* cmd, DialogueFlags& flags, DialogueInput input) {
+  cmd->add_option("--dialogue", flags.dialogue,
+                  "A dialogue file (docs/dialogue.md): the character answers what it hears and what the viewer does; "
+                  "the HUD shows what was heard, the machine and the emotion, --stats records each turn")
+      ->check(CLI::ExistingFile);
+  if (input == DialogueInput::kMicrophone) {
+    cmd->add_option("--mic", flags.mic,
+                    "With --dialogue: listen on this ALSA capture device ('default', 'hw:1', a name from ~/.asoundrc); "
+                    "without it the character answers only what the viewer does");
+  } else {
+    cmd->add_option("--audio-in", flags.audio_in,
+                    "With --dialogue: a WAV file the character hears as the replay's clock reaches each sample "
+                    "(16-bit PCM; another rate or stereo is converted to 16 kHz mono)")
+        ->check(CLI::ExistingFile);
+  }
+}
+
+void ApplyDialogueFlags(const DialogueFlags& flags, SessionOptions& options) {
+  if (flags.dialogue.empty() && !flags.mic.empty()) throw CommandError("--mic needs --dialogue: what would it answer?", 2);
+  if (flags.dialogue.empty() && !flags.audio_in.empty())
+    throw CommandError("--audio-in needs --dialogue: what would it answer?", 2);
+  options.dialogue.dialogue_file = flags.dialogue;
+  options.dialogue.mic_device = flags.mic;
+  options.dialogue.audio_in = flags.audio_in;
+}
+
+}  // namespace arview::app

@@ -1,0 +1,197 @@
+// The character listens and answers end to end (issue 54): the user's side of a scripted exchange
+// spoken by three Flite voices into a WAV, heard through the session's dialogue as `replay
+// --dialogue --audio-in` hears it (the WAV paced by the frame clock, recognition on its own
+// thread, the replies synthesized on the speech queue's and said on the frame path), the
+// dialogue's expected path followed every time, each reply's audio written.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/session/test_dialogue_exchange.h"
+#include "tests/support/graffiti_map.h"
+#include "tests/support/run_command.h"
+#include "tests/support/test_data.h"
+#include "tracker/test_planar_scene.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace arview;
+using app::testing::kAnsweringMachines;
+using app::testing::kUserLines;
+
+fs::path GuideDialogue() { return app::testing::SpokenDialogue(arview::testing::SourceDir()); }
+
+fs::path TempFolder(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("arview_dialogue_session_" + std::to_string(::getpid()) + "_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+bool ModelMissing() {
+  if (fs::exists(app::testing::kPocketsphinxModel)) return false;
+  if (std::getenv("ARVIEW_REQUIRE_DATA")) ADD_FAILURE() << "no " << app::testing::kPocketsphinxModel;
+  return true;
+}
+
+TEST(DialogueSession, AScriptedSpokenExchangeFollowsTheGuidesPathInThreeVoices) {
+  if (ModelMissing()) GTEST_SKIP() << "needs the Debian package pocketsphinx-en-us";
+  for (const char* voice : {"slt", "rms", "awb"}) {
+    SCOPED_TRACE(voice);
+    const fs::path dir = TempFolder(voice);
+    const app::testing::UserSide user = app::testing::SynthesizeUserSide(kUserLines, speech::VoiceFromName(voice));
+    app::testing::WriteSpeechWav(dir / "talk.wav", user.samples);
+    // Three times faster than real time: recognition and synthesis keep up on the loaded machine,
+    // and the path does not depend on timing (the viewer stands still in front).
+    const app::testing::ExchangeRun run = app::testing::RunExchange(GuideDialogue(), dir / "talk.wav", "slt", 3.0, 90);
+    EXPECT_TRUE(run.problems.empty()) << run.problems.front();
+    EXPECT_TRUE(run.ended);
+    std::vector<std::string> machines, heard;
+    for (const app::DialogueTurnRecord& t : run.turns) {
+      machines.push_back(t.machine);
+      if (!t.heard.empty()) heard.push_back(t.heard);
+    }
+    std::string results;
+    for (const std::string& r : run.results) results += "\n  " + r;
+    EXPECT_EQ(machines, kAnsweringMachines) << "recognitions:" << results;
+    EXPECT_EQ(heard, kUserLines) << "recognitions:" << results;
+    ASSERT_EQ(run.utterances.size(), kAnsweringMachines.size());
+    for (std::size_t i = 0; i < run.turns.size(); ++i) {
+      const app::DialogueTurnRecord& t = run.turns[i];
+      EXPECT_GE(t.reply_start_s, t.time_s) << t.said;
+      if (t.heard.empty()) continue;
+      EXPECT_GT(t.confidence, 0.06) << t.heard;
+      // The heard words end where the WAV's line ends, within the speech's own trailing silence.
+      const std::size_t line = std::find(kUserLines.begin(), kUserLines.end(), t.heard) - kUserLines.begin();
+      ASSERT_LT(line, user.line_end_s.size());
+      EXPECT_NEAR(t.heard_end_s, user.line_end_s[line], 0.5) << t.heard;
+      EXPECT_GT(t.LatencyS(), 0) << t.heard;
+    }
+    for (const speech::Utterance& u : run.utterances) {
+      const fs::path file = dir / ("reply_" + std::to_string(u.sequence) + ".wav");
+      app::testing::WriteSpeechWav(file, u.line->samples);
+      EXPECT_GT(u.line->samples.size(), 8000u) << u.origin;  // at least half a second said
+      EXPECT_GT(fs::file_size(file), 16000u);
+    }
+    fs::remove_all(dir);
+  }
+}
+
+// Praise raises joy, and the face shows it: the expression's weight in the per-frame stats
+// (DialogueFrame::expression_weight) rises after "you are very kind".
+TEST(DialogueSession, PraiseRaisesJoyAndTheExpressionWeightInASeededRun) {
+  if (ModelMissing()) GTEST_SKIP() << "needs the Debian package pocketsphinx-en-us";
+  const fs::path dir = TempFolder("praise");
+  const app::testing::UserSide user = app::testing::SynthesizeUserSide({"you are very kind"}, speech::Voice::kSlt, 1.0, 3.0);
+  app::testing::WriteSpeechWav(dir / "talk.wav", user.samples);
+  const app::testing::ExchangeRun run = app::testing::RunExchange(GuideDialogue(), dir / "talk.wav", "slt", 3.0, 6.0, 7);
+  const std::size_t praised = static_cast<std::size_t>(user.line_end_s[0] * 30);
+  ASSERT_GT(run.joy.size(), praised + 30);
+  const auto before_joy = run.joy[praised - 1];
+  const auto before_weight = run.expression_weight[praised - 1];
+  EXPECT_GT(run.joy.back(), before_joy + 0.2);
+  EXPECT_GT(run.expression_weight.back(), before_weight + 0.15);
+  fs::remove_all(dir);
+}
+
+// `arview replay --dialogue --audio-in --stats` as the user runs it: the graffiti map's views
+// (tests/support/graffiti_map.h) replayed four times over, the figure standing in front of the
+// first localized view, a WAV saying "what is this place". The greeting and the answer are the
+// stats' dialogue_turns, the frame the phrase was heard says so, and every frame has the dialogue.
+class DialogueReplay : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ARVIEW_REQUIRE_DATA_PATH(tracker::testing::kGraffitiTexture, "Debian package opencv-doc");
+    dir_ = TempFolder("replay");
+    ::setenv("ARVIEW_CACHE_DIR", (dir_ / "cache").c_str(), 1);
+    arview::testing::WriteGraffitiMapFolder(dir_ / "map");
+    arview::testing::WriteGraffitiViews(dir_ / "views");
+    std::ofstream(dir_ / "d.yaml") << "dialogue: 1\n"
+                                      "personality: {openness: 0.5, conscientiousness: 0.5, extraversion: 0.5, "
+                                      "agreeableness: 0.5, neuroticism: 0.5}\n"
+                                      "decay: 0.01\n"
+                                      "machines:\n"
+                                      "  - name: host\n"
+                                      "    states: [waiting, greeted, answered]\n"
+                                      "    final: [answered]\n"
+                                      "    transitions:\n"
+                                      "      - {from: waiting, to: greeted, when: [{viewer_tracked: true}], do: [{say: Hello.}]}\n"
+                                      "      - from: greeted\n"
+                                      "        to: answered\n"
+                                      "        when: [{heard: what is this place}]\n"
+                                      "        do: [{say: This is the graffiti wall.}, {emotional_influence: {emotion: joy, value: 0.5}}]\n";
+  }
+  void TearDown() override {
+    ::unsetenv("ARVIEW_CACHE_DIR");
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  arview::testing::CommandResult Replay(std::vector<std::string> extra) {
+    std::vector<std::string> args = {"replay", (dir_ / "views").string(), "--map", (dir_ / "map").string(), "--out", "null"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return arview::testing::RunArview(args);
+  }
+  fs::path dir_;
+};
+
+TEST_F(DialogueReplay, TheCharacterAnswersWhatTheWavSaysAndTheStatsRecordTheTurns) {
+  if (ModelMissing()) GTEST_SKIP() << "needs the Debian package pocketsphinx-en-us";
+  const app::testing::UserSide user = app::testing::SynthesizeUserSide({"what is this place"}, speech::Voice::kSlt, 0.5, 2.0);
+  app::testing::WriteSpeechWav(dir_ / "talk.wav", user.samples);
+  const auto r = Replay({"--loop", "4", "--hud", "--dialogue", (dir_ / "d.yaml").string(), "--audio-in",
+                         (dir_ / "talk.wav").string(), "--stats", (dir_ / "s.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir_ / "s.json"));
+  ASSERT_TRUE(stats.contains("dialogue_turns")) << r.err;
+  const nlohmann::json& turns = stats["dialogue_turns"];
+  ASSERT_EQ(turns.size(), 2u) << turns.dump(1);
+  EXPECT_EQ(turns[0]["said"], "Hello.");
+  EXPECT_EQ(turns[0]["heard"], "");
+  EXPECT_EQ(turns[1]["heard"], "what is this place");
+  EXPECT_EQ(turns[1]["machine"], "host");
+  EXPECT_GT(turns[1]["confidence"].get<double>(), 0.06);
+  EXPECT_NEAR(turns[1]["heard_end_s"].get<double>(), user.line_end_s[0], 0.5);
+  EXPECT_GT(turns[1]["latency_ms"].get<double>(), 0);
+  int heard_frames = 0;
+  for (const nlohmann::json& f : stats["frames"]) {
+    ASSERT_TRUE(f.contains("dialogue"));
+    if (f["dialogue"].contains("heard")) heard_frames += f["dialogue"]["heard"]["text"] == "what is this place";
+  }
+  EXPECT_EQ(heard_frames, 1);
+  EXPECT_EQ(stats["frames"].back()["dialogue"]["emotion"], "joy");
+  EXPECT_GT(stats["frames"].back()["dialogue"]["expression_weight"].get<double>(), 0.0);
+}
+
+TEST_F(DialogueReplay, BadInputsAreOneLineEach) {
+  auto r = Replay({"--audio-in", (dir_ / "d.yaml").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--audio-in needs --dialogue"), std::string::npos) << r.err;
+  // Not a WAV: the audio module's line, before any frame.
+  r = Replay({"--dialogue", (dir_ / "d.yaml").string(), "--audio-in", (dir_ / "d.yaml").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(arview::testing::LineCount(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("d.yaml"), std::string::npos) << r.err;
+  // A phrase the recognizer cannot hear (a word not in its dictionary): named before any frame.
+  std::ofstream(dir_ / "bad.yaml") << "dialogue: 1\n"
+                                      "personality: {openness: 0.5, conscientiousness: 0.5, extraversion: 0.5, "
+                                      "agreeableness: 0.5, neuroticism: 0.5}\n"
+                                      "decay: 0.1\n"
+                                      "machines:\n"
+                                      "  - {name: m, states: [s, t], transitions: [{from: s, to: t, when: [{heard: hello xyzzyq}]}]}\n";
+  const app::testing::UserSide user = app::testing::SynthesizeUserSide({"hello"}, speech::Voice::kSlt, 0.5, 0.5);
+  app::testing::WriteSpeechWav(dir_ / "talk.wav", user.samples);
+  r = Replay({"--dialogue", (dir_ / "bad.yaml").string(), "--audio-in", (dir_ / "talk.wav").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("'xyzzyq'"), std::string::npos) << r.err;
+}
+
+}  // namespace
