@@ -1,5 +1,6 @@
 #include "synth/room_walkers.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "figure/humanoid.h"
@@ -15,12 +16,14 @@ WalkerCircle WalkerPath(int i) {
   return kCircles[i];
 }
 
-WalkerState WalkerAt(const WalkersOptions& options, int i, double t) {
+WalkerState WalkerAt(const WalkersOptions& options, int i, double t, const Eigen::Vector3d& camera_centre) {
   const WalkerCircle circle = WalkerPath(i);
   const double walked = std::max(0.0, t - options.from_s);
   const double angle = circle.start_angle + circle.direction * figure::kWalkSpeed * walked / circle.radius;
+  const double camera_to_spot = (camera_centre.head<2>() - options.spot).norm();
+  const double radius = std::clamp(camera_to_spot - kKeepAwayFromCamera, 0.2, circle.radius);
   WalkerState state;
-  state.position = {options.spot.x() + circle.radius * std::cos(angle), options.spot.y() + circle.radius * std::sin(angle), 0};
+  state.position = {options.spot.x() + radius * std::cos(angle), options.spot.y() + radius * std::sin(angle), 0};
   state.heading = Eigen::Vector3d(-std::sin(angle), std::cos(angle), 0) * circle.direction;
   state.clip_time = walked;
   return state;
@@ -53,8 +56,9 @@ WalkersRenderer::WalkersRenderer(const render::GlApi& gl, const WalkersOptions& 
 
 void WalkersRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Matrix4d& view, double t) {
   if (t < options_.from_s) return;
+  const Eigen::Vector3d camera_centre = -view.block<3, 3>(0, 0).transpose() * view.block<3, 1>(0, 3);
   for (int i = 0; i < options_.count; ++i) {
-    const WalkerState state = WalkerAt(options_, i, t);
+    const WalkerState state = WalkerAt(options_, i, t, camera_centre);
     const bool posed = anim::SamplingJob{&figure_.skeleton, &walk_, state.clip_time, true, &local_}.Run() &&
                        anim::LocalToModelJob{&figure_.skeleton, &local_, model_}.Run() &&
                        anim::SkinningMatricesJob{&figure_.skeleton, model_, matrices_, dual_quats_}.Run();
