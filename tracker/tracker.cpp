@@ -132,43 +132,6 @@ int Tracker::FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std
   return added;
 }
 
-MovingTrackVerdict Tracker::DropMovingTracks(const std::vector<Eigen::Vector2d>& predicted, const std::vector<float>& lk_errors,
-                                             Correspondences* c, FrameResult* result) {
-  const std::size_t n = predicted.size();
-  MovingTrackVerdict verdict = moving_filter_.Judge(
-      {std::span(c->point_ids).first(n), std::span(c->pixels).first(n), predicted, lk_errors}, static_cast<std::uint32_t>(frames_tracked_));
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < c->pixels.size(); ++i) {
-    if (i < n && !verdict.keep[i]) continue;
-    c->pixels[kept] = c->pixels[i];
-    c->points[kept] = c->points[i];
-    c->point_ids[kept] = c->point_ids[i];
-    ++kept;
-  }
-  result->moving_rejected += static_cast<int>(c->pixels.size() - kept);
-  c->pixels.resize(kept);
-  c->points.resize(kept);
-  c->point_ids.resize(kept);
-  return verdict;
-}
-
-void Tracker::DropNearMoving(const MovingTrackVerdict& verdict, std::size_t from, Correspondences* c, FrameResult* result) const {
-  if (verdict.rejected.empty()) return;
-  const double region = options_.tracking.moving.region_px;
-  std::size_t kept = from;
-  for (std::size_t i = from; i < c->pixels.size(); ++i) {
-    if (MovingTrackFilter::NearRejected(verdict, c->pixels[i], region)) continue;
-    c->pixels[kept] = c->pixels[i];
-    c->points[kept] = c->points[i];
-    c->point_ids[kept] = c->point_ids[i];
-    ++kept;
-  }
-  result->moving_rejected += static_cast<int>(c->pixels.size() - kept);
-  c->pixels.resize(kept);
-  c->points.resize(kept);
-  c->point_ids.resize(kept);
-}
-
 Tracker::PriorPose Tracker::PoseFromPrior(const Correspondences& c, AbsolutePoseOptions options,
                                           FrameResult* result) const {
   const calib::Camera& camera = resolution_.work();
