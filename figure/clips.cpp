@@ -1,5 +1,7 @@
 #include "figure/rig.h"
 
+#include "figure/humanoid.h"
+
 #include <functional>
 #include <set>
 
@@ -219,6 +221,27 @@ void Point(const Rig& r, double t, PoseWriter& p) {
   RaiseRightArm(r, p, e, {-0.10, 0.06, 1.0}, {-0.05, 0.04, 1.0}, {1, -1, 0}, 0);
 }
 
+// The walk cycle in place (the root stays put; whoever plays it moves the figure along its path
+// at kWalkSpeed): the feet swing ±kStride / 2 about the hips in antiphase, the swinging foot
+// lifted, the hips a little lower and bobbing twice a cycle, the arms swinging against the legs.
+// The stance foot slides back at the same speed only on average (a sinusoid, not a plant).
+void Walk(const Rig& r, double t, PoseWriter& p) {
+  Relaxed(p, Period(t, kWalkCycle));
+  const double phase = Period(t, kWalkCycle);
+  p.MoveHips({0, -0.045 + 0.012 * std::cos(2 * phase), 0});
+  p.Set("Hips", Ry(4 * std::sin(phase)));
+  p.Set("Spine", Ry(-5 * std::sin(phase)));
+  for (int side : {1, -1}) {
+    const double own = phase + (side > 0 ? 0 : kPi);
+    const double forward = 0.5 * kStride * std::sin(own);
+    const double lift = 0.07 * std::max(0.0, std::cos(own));  // while the foot swings forward
+    const Vector3d ankle = r.At(Sided(side, "Foot")) + Vector3d(0, lift, forward);
+    PlaceLeg(r, p, side, ankle, Rx(-12 * std::sin(own)));
+    p.Turn(Sided(side, "Arm"), Rx(22 * std::sin(own)));  // + turns the arm back: against its leg
+    p.Turn(Sided(side, "ForeArm"), Flex(ArmDirection(side), 8 + 8 * std::max(0.0, -std::sin(own))));
+  }
+}
+
 void Nod(double t, PoseWriter& p) {
   Relaxed(p, Period(t, 2));
   const double nod = std::pow(std::sin(kPi * std::clamp(t / 1.4, 0.0, 1.0)), 2);
@@ -237,6 +260,10 @@ std::vector<anim::Clip> MakeClips(const Rig& rig) {
   clips.push_back(SampleClip(rig, "Point", 3.0, [&](double t, PoseWriter& p) { Point(rig, t, p); }));
   clips.push_back(SampleClip(rig, "Nod", 2.0, Nod));
   return clips;
+}
+
+anim::Clip MakeWalkClip(const Rig& rig) {
+  return SampleClip(rig, "Walk", kWalkCycle, [&](double t, PoseWriter& p) { Walk(rig, t, p); });
 }
 
 }  // namespace arview::figure

@@ -143,6 +143,23 @@ TEST(Figure, ClipsLoopOrReturnToTheStartPosture) {
   }
 }
 
+TEST(Figure, TheWalkLoopsItsFeetSwingInAntiphaseAndItIsNotAmongTheBlendedClips) {
+  const anim::Character& c = Figure();
+  EXPECT_EQ(c.FindClip("Walk"), nullptr) << "a scene blends the character's clips; the walk is for walkers";
+  const anim::Clip walk = MakeHumanoidWalk();
+  EXPECT_NEAR(walk.duration, kWalkCycle, 1e-9);
+  const std::vector<Eigen::Matrix4d> start = ModelPose(c, &walk, 0), end = ModelPose(c, &walk, walk.duration);
+  for (int j = 0; j < c.skeleton.size(); ++j) EXPECT_LT((start[j] - end[j]).cwiseAbs().maxCoeff(), 2e-3) << c.skeleton.names[j];
+  double most_apart = 0;
+  for (double t = 0; t < kWalkCycle; t += kWalkCycle / 20) {
+    const std::vector<Eigen::Matrix4d> m = ModelPose(c, &walk, t);
+    const double left = JointAt(c, m, "LeftFoot").z(), right = JointAt(c, m, "RightFoot").z();
+    EXPECT_LT(left * right, 1e-4) << "one foot ahead of the hips, the other behind, at " << t;
+    most_apart = std::max(most_apart, std::abs(left - right));
+  }
+  EXPECT_GT(most_apart, 0.8 * kStride) << "the feet swing about a stride apart";
+}
+
 TEST(Figure, WeightShiftKeepsTheFeetPlantedAndMovesTheHips) {
   const anim::Character& c = Figure();
   const anim::Clip* shift = c.FindClip("WeightShift");

@@ -21,6 +21,8 @@ anim::Character MakeHumanoid() {
   return c;
 }
 
+anim::Clip MakeHumanoidWalk() { return MakeWalkClip(BuildRig()); }
+
 std::vector<std::string> BuiltinCharacterNames() { return {"figure"}; }
 
 anim::Character MakeBuiltinCharacter(const std::string& name) {

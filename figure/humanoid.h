@@ -44,6 +44,15 @@ namespace arview::figure {
 // The humanoid above. Deterministic: the same character every call.
 anim::Character MakeHumanoid();
 
+// The figure walking, one cycle of two steps in place (the root stays put), looping: not one of
+// the character's clips (a scene blends those, and all start in Idle's posture), but for figures
+// moved along a path at kWalkSpeed, so that the feet keep pace with the ground on average
+// (`arview synth room --walkers`).
+inline constexpr double kWalkCycle = 1.1;   // seconds
+inline constexpr double kStride = 0.6;      // metres each foot swings about the hips, front to back
+inline constexpr double kWalkSpeed = kStride / (kWalkCycle / 2);  // m/s: the stance foot's mean speed back
+anim::Clip MakeHumanoidWalk();
+
 // Names accepted after "builtin:" (today: "figure").
 std::vector<std::string> BuiltinCharacterNames();
 

@@ -84,5 +84,7 @@ void AddSkin(const Rig& rig, anim::Character& character);
 void AddFaceTargets(const Rig& rig, anim::Character& character);
 // Idle, WeightShift, Wave, Point and Nod, sampled at kKeysPerSecond.
 std::vector<anim::Clip> MakeClips(const Rig& rig);
+// The walk cycle in place (humanoid.h, MakeHumanoidWalk), kWalkCycle seconds, looping.
+anim::Clip MakeWalkClip(const Rig& rig);
 
 }  // namespace arview::figure

@@ -1,5 +1,6 @@
 #include "synth/synth_room.h"
 
+#include "base/atomic_file.h"
 #include "base/image_file.h"
 
 #include <Eigen/Geometry>
@@ -151,6 +152,10 @@ class SceneBuilder {
 // The window of SynthLighting::kWindow takes this photo's place on its wall.
 constexpr const char* kWindowReplaces = "graf1.png";
 
+constexpr double kWindowWidth = 1.4, kWindowHeight = 1.6, kWindowCentreZ = 1.7, kWindowBar = 0.06;
+// The transom lies this share of the half-height above the window's centre.
+constexpr double kTransomAt = 0.25;
+
 // A window seen from inside: panes clipped white by the daylight behind them, in a dark frame
 // with a mullion and a transom (their corners give the tracker something to hold on to).
 void AddWindow(SceneBuilder& builder, const Eigen::Vector3d& center, const Eigen::Vector3d& right,
@@ -161,7 +166,7 @@ void AddWindow(SceneBuilder& builder, const Eigen::Vector3d& center, const Eigen
                                         o + right * hi.x() + up * lo.y(), o + right * lo.x() + up * lo.y()};
     builder.Paint(corners, colour);
   };
-  const double w = width / 2, h = height / 2, bar = 0.06;
+  const double w = width / 2, h = height / 2, bar = kWindowBar;
   const Eigen::Vector3f pane(1.f, 1.f, 1.f), frame(0.3f, 0.27f, 0.24f);
   rectangle({-w, -h}, {w, h}, kPanelOffset, pane);
   const double in_front = 2 * kPanelOffset;
@@ -170,7 +175,7 @@ void AddWindow(SceneBuilder& builder, const Eigen::Vector3d& center, const Eigen
   rectangle({-w, h - bar}, {w, h}, in_front, frame);
   rectangle({-w, -h}, {w, -h + bar}, in_front, frame);
   rectangle({-bar / 2, -h}, {bar / 2, h}, in_front, frame);              // mullion
-  rectangle({-w, 0.25 * h - bar / 2}, {w, 0.25 * h + bar / 2}, in_front, frame);  // transom
+  rectangle({-w, kTransomAt * h - bar / 2}, {w, kTransomAt * h + bar / 2}, in_front, frame);  // transom
 }
 
 void AddWalls(SceneBuilder& builder, SynthLighting light) {
@@ -187,7 +192,7 @@ void AddWalls(SceneBuilder& builder, SynthLighting light) {
     for (int i = 0; i < n; ++i) {
       const double along = -wall.length / 2 + spacing * (i + 0.5);
       if (light == SynthLighting::kWindow && std::string_view(wall.images[i]) == kWindowReplaces) {
-        AddWindow(builder, base + right * along + up * 1.7, right, up, -wall.facing, 1.4, 1.6);
+        AddWindow(builder, base + right * along + up * kWindowCentreZ, right, up, -wall.facing, kWindowWidth, kWindowHeight);
         continue;
       }
       const double height = 1.6;
@@ -305,6 +310,49 @@ RoomScene MakeRoomScene(const fs::path& data_dir, SynthLighting light, const Flo
   return builder.Finish();
 }
 
+WindowGeometry RoomWindow() {
+  for (const Wall& wall : Walls()) {
+    for (size_t i = 0; i < wall.images.size(); ++i) {
+      if (std::string_view(wall.images[i]) != kWindowReplaces) continue;
+      const double spacing = wall.length / static_cast<double>(wall.images.size());
+      const double along = -wall.length / 2 + spacing * (static_cast<double>(i) + 0.5);
+      const Eigen::Vector3d right = wall.facing.cross(Eigen::Vector3d::UnitZ());
+      const double x = (wall.facing * wall.distance + right * along).x();
+      return {wall.distance, x - kWindowWidth / 2, x + kWindowWidth / 2, kWindowCentreZ - kWindowHeight / 2,
+              kWindowCentreZ + kWindowHeight / 2, kWindowBar, kWindowCentreZ + kTransomAt * kWindowHeight / 2};
+    }
+  }
+  throw render::RenderError("synth room: internal error: no wall holds the window");
+}
+
+double RoomRayDepth(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
+  const Eigen::Vector3d lo(-kHalfX, -kHalfY, 0), hi(kHalfX, kHalfY, kHeight);
+  if ((origin.array() < lo.array()).any() || (origin.array() > hi.array()).any()) return INFINITY;
+  double nearest = INFINITY;
+  for (int axis = 0; axis < 3; ++axis) {  // leaving the room's box
+    if (direction[axis] > 1e-12) nearest = std::min(nearest, (hi[axis] - origin[axis]) / direction[axis]);
+    if (direction[axis] < -1e-12) nearest = std::min(nearest, (lo[axis] - origin[axis]) / direction[axis]);
+  }
+  for (const BoxSpec& box : Boxes()) {  // entering a box: slabs in the box's frame
+    const Eigen::Matrix3d to_box = Eigen::AngleAxisd(-box.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d o = to_box * (origin - Eigen::Vector3d(box.center.x(), box.center.y(), box.size.z() / 2));
+    const Eigen::Vector3d d = to_box * direction;
+    double enter = 0, leave = INFINITY;
+    for (int axis = 0; axis < 3 && enter <= leave; ++axis) {
+      const double half = box.size[axis] / 2;
+      if (std::abs(d[axis]) < 1e-12) {
+        if (std::abs(o[axis]) > half) leave = -1;
+        continue;
+      }
+      const double a = (-half - o[axis]) / d[axis], b = (half - o[axis]) / d[axis];
+      enter = std::max(enter, std::min(a, b));
+      leave = std::min(leave, std::max(a, b));
+    }
+    if (enter <= leave && enter > 0) nearest = std::min(nearest, enter);
+  }
+  return nearest;
+}
+
 calib::Camera RoomCamera(int width, int height) {
   const double s = width / 640.0;
   // The 640x480 camera's principal point offset from the image centre, scaled (pixel centres:
@@ -354,12 +402,22 @@ RoomRenderer::RoomRenderer(render::OffscreenContext& context, const RoomScene& s
       scene_(context.gl(), scene.textures, scene.batches, render::TextureOptions{true, kRoomAnisotropy, false}),
       target_(context.gl(), camera.width, camera.height, samples) {}
 
-cv::Mat RoomRenderer::Render(const calib::Pose& pose) {
+RoomRenderer::~RoomRenderer() = default;
+
+void RoomRenderer::SetWalkers(const WalkersOptions& walkers) {
+  walkers_ = walkers.count > 0 ? std::make_unique<WalkersRenderer>(context_->gl(), walkers) : nullptr;
+}
+
+cv::Mat RoomRenderer::Render(const calib::Pose& pose) { return Render(pose, -INFINITY); }
+
+cv::Mat RoomRenderer::Render(const calib::Pose& pose, double t) {
   const render::GlApi& gl = context_->gl();
   target_.Bind();
   gl.ClearColor(0, 0, 0, 1);
   gl.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  scene_.Draw(render::ProjectionMatrix(camera_, {0.05, 20.0}), render::ViewMatrix(pose));
+  const Eigen::Matrix4d projection = render::ProjectionMatrix(camera_, {0.05, 20.0}), view = render::ViewMatrix(pose);
+  scene_.Draw(projection, view);
+  if (walkers_ && std::isfinite(t)) walkers_->Draw(projection, view, t);
   return target_.ReadBgr();
 }
 
@@ -383,6 +441,19 @@ void ValidateOptions(const SynthRoomOptions& o) {
   if (!(o.still_at_s >= 0 && o.still_at_s <= o.frames / o.fps)) {
     fail("--still-at must be within the walk, [0, " + std::to_string(o.frames / o.fps) + "] seconds");
   }
+  const double duration = RecordingFrames(o) / o.fps;
+  if (o.walkers.count < 0 || o.walkers.count > kMaxWalkers) {
+    fail("--walkers must be in 0.." + std::to_string(kMaxWalkers) + ", got " + std::to_string(o.walkers.count));
+  }
+  if (!(o.walkers.from_s >= 0 && o.walkers.from_s <= duration)) {
+    fail("--walkers-from must be within the recording, [0, " + std::to_string(duration) + "] seconds");
+  }
+  const LightChanges& l = o.lights;
+  if (l.lamp_off_s > duration) fail("--lamp-off must be within the recording, [0, " + std::to_string(duration) + "] seconds");
+  if (l.lamp_on_s >= 0 && !(l.lamp_off_s >= 0 && l.lamp_on_s > l.lamp_off_s)) {
+    fail("--lamp-on needs an earlier --lamp-off (the lamp is on until then)");
+  }
+  if (l.sun && o.light != SynthLighting::kWindow) fail("--sun needs --light window (the sun comes through its window)");
   if (!o.board.empty()) {
     if (!(o.board.square > 0 && o.board.square <= 1)) fail("--square must be in (0, 1] metres");
     const double reach = 0.5 * o.board.square * std::hypot(o.board.inner_corners.width + 3, o.board.inner_corners.height + 3);
@@ -415,7 +486,7 @@ void PrepareFolder(const SynthRoomOptions& o) {
     if (!o.overwrite) throw render::RenderError(o.out.string() + ": folder exists and is not empty (--force replaces the recording)");
     // Only what a recording consists of, never anything else the user keeps there.
     fs::remove_all(o.out / "frames", ec);
-    for (const char* file : {"frames.txt", "groundtruth.txt", "camera.yaml"}) fs::remove(o.out / file, ec);
+    for (const char* file : {"frames.txt", "groundtruth.txt", "camera.yaml", "walkers.txt"}) fs::remove(o.out / file, ec);
   }
   fs::create_directories(o.out / "frames", ec);
   if (ec) throw render::RenderError(o.out.string() + ": cannot create the recording folder (" + ec.message() + ")");
@@ -424,12 +495,12 @@ void PrepareFolder(const SynthRoomOptions& o) {
 using PoseAt = std::function<calib::Pose(double)>;
 
 cv::Mat RenderGlobalExposure(RoomRenderer& renderer, const PoseAt& path, double t, const SynthRoomOptions& o) {
-  if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path(t));
+  if (o.motion_blur_samples <= 1 || o.exposure_s == 0) return renderer.Render(path(t), t);
   cv::Mat sum;
   for (int k = 0; k < o.motion_blur_samples; ++k) {
     const double offset = o.exposure_s * (static_cast<double>(k) / (o.motion_blur_samples - 1) - 0.5);
     cv::Mat frame;
-    renderer.Render(path(t + offset)).convertTo(frame, CV_32FC3);
+    renderer.Render(path(t + offset), t + offset).convertTo(frame, CV_32FC3);
     if (sum.empty()) sum = frame;
     else sum += frame;
   }
@@ -467,6 +538,52 @@ void AddNoise(cv::Mat& image, double sigma, uint64_t seed, int frame) {
   noisy.convertTo(image, CV_8UC3);  // saturating
 }
 
+// The pixels the walkers cover at time t (8-bit, 255 there): where the frame with them differs
+// from the room alone; `with_walkers` is that frame when the exposure was a single render.
+cv::Mat WalkerPixels(RoomRenderer& renderer, const calib::Pose& pose, double t, const SynthRoomOptions& o,
+                     const cv::Mat& with_walkers) {
+  const bool single_render = (o.motion_blur_samples <= 1 || o.exposure_s == 0) && o.rolling_shutter_s <= 0;
+  const cv::Mat with = single_render ? with_walkers : renderer.Render(pose, t);
+  cv::Mat difference, mask;
+  cv::absdiff(with, renderer.Render(pose), difference);
+  cv::cvtColor(difference, difference, cv::COLOR_BGR2GRAY);
+  cv::threshold(difference, mask, 0, 255, cv::THRESH_BINARY);
+  return mask;
+}
+
+void WriteWalkersTxt(const fs::path& file, const std::vector<std::pair<double, double>>& covered) {
+  std::string text = "# arview synth room: the share of each frame's pixels that people walking through cover\n"
+                     "# timestamp share\n";
+  for (const auto& [t, share] : covered) {
+    char line[64];
+    std::snprintf(line, sizeof line, "%.9f %.4f\n", t, share);
+    text += line;
+  }
+  WriteFileAtomically(file, text);
+}
+
+// The people and light changes in the ground truth's header.
+std::string ConditionsText(const SynthRoomOptions& o) {
+  std::string text;
+  char part[160];
+  if (o.walkers.count > 0) {
+    std::snprintf(part, sizeof part, ", %d walker%s from %.4g s round (%.3f, %.3f)", o.walkers.count,
+                  o.walkers.count > 1 ? "s" : "", o.walkers.from_s, o.walkers.spot.x(), o.walkers.spot.y());
+    text += part;
+  }
+  if (o.lights.lamp_off_s >= 0) {
+    std::snprintf(part, sizeof part, ", lamp off at %.4g s", o.lights.lamp_off_s);
+    text += part;
+  }
+  if (o.lights.lamp_on_s >= 0) {
+    std::snprintf(part, sizeof part, ", on at %.4g s", o.lights.lamp_on_s);
+    text += part;
+  }
+  if (o.lights.sun) text += ", sun through the window moving";
+  if (o.lights.auto_exposure) text += ", auto-exposure";
+  return text;
+}
+
 // The board in the ground truth's header: whoever reads the recording learns its size and place.
 std::string BoardText(const FloorBoard& board) {
   if (board.empty()) return "";
@@ -494,14 +611,18 @@ double WalkTime(const SynthRoomOptions& o, double t) {
   return std::max(o.still_at_s, t - o.still_s);
 }
 
-SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<void(int, int)>& progress) {
-  ValidateOptions(o);
+SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options, const std::function<void(int, int)>& progress) {
+  ValidateOptions(options);
+  SynthRoomOptions o = options;
+  o.walkers.spot = o.walk == RoomWalk::kOrbit ? o.orbit.subject : Eigen::Vector2d::Zero();
+  o.lights.duration_s = RecordingFrames(o) / o.fps;
   const std::vector<int> indices = FramesToRender(o);
   const RoomScene scene = MakeRoomScene(o.data_dir, o.light, o.board);
   std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.gl);
   PrepareFolder(o);
   const calib::Camera camera = RoomCamera(o.width, o.height);
   RoomRenderer renderer(*context, scene, camera, o.samples);
+  renderer.SetWalkers(o.walkers);
   const RoomPath room_path(o.frames / o.fps, o.seed);
   const OrbitWalk orbit_walk(o.frames / o.fps, o.seed, o.orbit);
   const PoseAt path = [&](double t) {
@@ -511,6 +632,7 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
 
   std::vector<recordings::FrameEntry> entries;
   recordings::Trajectory groundtruth;
+  std::vector<std::pair<double, double>> covered;  // by the walkers: time, share of the frame
   // PNG encoding of frame i overlaps the rendering of frame i + 1.
   std::future<bool> pending_write;
   std::string pending_name;
@@ -523,6 +645,12 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
     const int i = indices[n];
     const double t = i / o.fps;
     cv::Mat image = RenderExposure(renderer, path, t, o);
+    cv::Mat walkers;
+    if (o.walkers.count > 0) {
+      walkers = WalkerPixels(renderer, path(t), t, o, image);
+      covered.emplace_back(t, static_cast<double>(cv::countNonZero(walkers)) / static_cast<double>(walkers.total()));
+    }
+    ApplyLightChanges(image, o.lights, camera, path(t), o.fps, i, walkers);
     ApplyGain(image, o.gain_drift, t);
     AddNoise(image, o.noise_sigma, o.seed, i);
     char name[32];
@@ -546,9 +674,10 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& o, const std::function<vo
   finish_write();
   calib::SaveCamera(camera, o.out / "camera.yaml");
   recordings::WriteFramesTxt(o.out, entries);
+  if (o.walkers.count > 0) WriteWalkersTxt(o.out / "walkers.txt", covered);
   recordings::WriteTum(groundtruth, o.out / "groundtruth.txt",
                        "arview synth room, seed " + std::to_string(o.seed) + (o.light == SynthLighting::kWindow ? ", window light" : "") +
-                           BoardText(o.board) + StillText(o) + ", world: metres, z up, floor z = 0");
+                           BoardText(o.board) + StillText(o) + ConditionsText(o) + ", world: metres, z up, floor z = 0");
   return {context->Description(), static_cast<int>(indices.size())};
 }
 

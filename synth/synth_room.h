@@ -13,14 +13,17 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "calib/camera.h"
 #include "calib/pose.h"
 #include "render/offscreen.h"
-#include "synth/orbit_walk.h"
 #include "render/textured_scene.h"
+#include "synth/orbit_walk.h"
+#include "synth/room_lights.h"
+#include "synth/room_walkers.h"
 
 namespace arview::synth {
 
@@ -69,6 +72,17 @@ struct FloorBoard {
 // Loads the photos from `data_dir`; throws RenderError naming a missing or unreadable file.
 RoomScene MakeRoomScene(const std::filesystem::path& data_dir = kOpenCvDocData, SynthLighting light = SynthLighting::kEven,
                         const FloorBoard& board = {});
+
+// The window of SynthLighting::kWindow: its outer frame on the +y wall (world metres), the bars'
+// width and the transom's height (a mullion halves it at its middle).
+struct WindowGeometry {
+  double wall_y, x_min, x_max, z_min, z_max, bar, transom_z;
+};
+WindowGeometry RoomWindow();
+
+// The distance along a ray from a point inside the room (`direction` unit) to the first of its
+// walls, floor, ceiling and boxes (the photos lie on them); infinity when it starts outside.
+double RoomRayDepth(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction);
 
 // The synthetic camera: 640x480, fx = fy = 525, principal point slightly off centre, no distortion.
 // Other sizes keep the horizontal field of view (f and the principal point offset scale with
@@ -125,6 +139,12 @@ struct SynthRoomOptions {
   // camera's jitter is measured there: `arview eval`). 0: no still segment.
   double still_s = 0.0;
   double still_at_s = 0.0;
+  // People walking through (room_walkers.h): their circles go round `walkers.spot`, which
+  // SynthesizeRoom sets to the orbit's subject on the orbit walk (the room's centre otherwise).
+  WalkersOptions walkers;
+  // The lamp, the sun through the window, the camera's auto-exposure (room_lights.h); times in the
+  // recording's seconds (SynthesizeRoom sets `duration_s`).
+  LightChanges lights;
   bool overwrite = false;        // replace an existing recording in `out`
   std::filesystem::path data_dir = kOpenCvDocData;
   render::OffscreenOptions gl;
@@ -143,7 +163,8 @@ struct SynthRoomReport {
 
 // Renders and writes the recording: frames/NNNNNN.png (or .jpg), frames.txt, camera.yaml and
 // groundtruth.txt (TUM, camera-to-world, pose at the middle of each exposure; with a rolling
-// shutter, of the middle row's exposure).
+// shutter, of the middle row's exposure); with walkers, walkers.txt: each frame's time and the
+// share of its pixels the walkers cover.
 // `progress(done, total)` is called after every frame when given.
 SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options,
                                const std::function<void(int, int)>& progress = nullptr);
@@ -152,13 +173,18 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options,
 class RoomRenderer {
  public:
   RoomRenderer(render::OffscreenContext& context, const RoomScene& scene, const calib::Camera& camera, int samples);
-  cv::Mat Render(const calib::Pose& pose);
+  ~RoomRenderer();
+  // People walking through, drawn by Render(pose, t) from now on.
+  void SetWalkers(const WalkersOptions& walkers);
+  cv::Mat Render(const calib::Pose& pose);            // the room alone
+  cv::Mat Render(const calib::Pose& pose, double t);  // with the walkers where they are at time t
 
  private:
   render::OffscreenContext* context_;
   calib::Camera camera_;
   render::TexturedScene scene_;
   render::RenderTarget target_;
+  std::unique_ptr<WalkersRenderer> walkers_;
 };
 
 }  // namespace arview::synth

@@ -2,6 +2,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -9,6 +10,7 @@
 #include "recordings/recording.h"
 #include "room/ray_caster.h"
 #include "room/room_light.h"
+#include "figure/humanoid.h"
 #include "synth/synth_room.h"
 #include "render/test_scene.h"
 #include "tests/support/test_data.h"
@@ -385,6 +387,68 @@ TEST(SynthRoom, NamesADamagedPhotoAndLibjpegSaysNothing) {
     EXPECT_EQ(std::string(e.what()).rfind(damaged.string() + ": the JPEG is cut short", 0), 0u) << e.what();
   }
   EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+}
+
+}  // namespace
+}  // namespace arview::synth
+
+namespace arview::synth {
+namespace {
+
+TEST(SynthLights, TheLampDropsTwoStopsInOneFrameAndTheExposureStepsBackInThirds) {
+  LightChanges lights;
+  lights.lamp_off_s = 1.0;
+  lights.lamp_on_s = 5.0;
+  EXPECT_EQ(LampGain(lights, 0.99), 1.0);
+  EXPECT_EQ(LampGain(lights, 1.0), kLampOffGain);
+  EXPECT_EQ(LampGain(lights, 5.0), 1.0);
+  EXPECT_EQ(ExposureGain(lights, 30, 100), 1.0) << "no auto-exposure: the exposure stays";
+  lights.auto_exposure = true;
+  EXPECT_EQ(ExposureGain(lights, 30, 38), 1.0) << "0.3 s before the camera reacts";
+  double previous = 1.0;
+  for (int frame = 39; frame < 100; ++frame) {
+    const double gain = ExposureGain(lights, 30, frame);
+    const double step_ev = std::log2(gain / previous);  // none, or a third (floating point's last bit aside)
+    EXPECT_TRUE(std::abs(step_ev) < 1e-9 || std::abs(step_ev - 1.0 / 3) < 1e-9) << frame << ": " << step_ev;
+    previous = gain;
+  }
+  EXPECT_NEAR(ExposureGain(lights, 30, 100), 4.0, 1e-9) << "the two stops made up";
+}
+
+TEST(SynthWalkers, WalkersKeepTheirDistanceFromTheCameraAndWalkAtTheClipsPace) {
+  WalkersOptions walkers;
+  walkers.count = 3;
+  walkers.spot = {-0.2, 0.25};
+  // 1.3 m from the spot the circles shrink to keep 1 m; at the demo's close approach, 1.15 m, to
+  // their smallest, 0.2 m, which leaves 0.95 m.
+  const Eigen::Vector3d near_camera(-0.2 + 1.3, 0.25, 1.5), close_camera(-0.2 + 1.15, 0.25, 1.5);
+  for (int i = 0; i < 3; ++i) {
+    for (double t = 0; t < 10; t += 0.1) {
+      EXPECT_GE((WalkerAt(walkers, i, t, near_camera).position - near_camera).head<2>().norm(), kKeepAwayFromCamera - 1e-9);
+      const WalkerState s = WalkerAt(walkers, i, t, close_camera);
+      EXPECT_GE((s.position - close_camera).head<2>().norm(), 0.95 - 1e-9);
+      EXPECT_NEAR(s.heading.norm(), 1.0, 1e-12);
+      EXPECT_NEAR(s.heading.dot((s.position - Eigen::Vector3d(-0.2, 0.25, 0)).normalized()), 0.0, 1e-9) << "along its circle";
+    }
+    const Eigen::Vector3d far_camera(3, 2, 1.5);
+    const double step = (WalkerAt(walkers, i, 1.0, far_camera).position - WalkerAt(walkers, i, 1.01, far_camera).position).norm();
+    EXPECT_NEAR(step / 0.01, figure::kWalkSpeed, 0.01);
+  }
+}
+
+TEST(SynthWalkers, SunWithoutTheWindowAndALampOnBeforeItIsOffAreRefused) {
+  TempDir dir;
+  SynthRoomOptions options;
+  options.out = dir.path / "r";
+  options.frames = 2;
+  options.lights.sun = true;
+  EXPECT_THROW(SynthesizeRoom(options), render::RenderError);
+  options.lights.sun = false;
+  options.lights.lamp_on_s = 0.01;
+  EXPECT_THROW(SynthesizeRoom(options), render::RenderError);
+  options.lights.lamp_on_s = -1;
+  options.walkers.count = 4;
+  EXPECT_THROW(SynthesizeRoom(options), render::RenderError);
 }
 
 }  // namespace

@@ -1,4 +1,6 @@
 #include "tracker/tracker.h"
+
+#include "tracker/brightness_match.h"
 #include "tracker/tracker_internal.h"
 
 #include <opencv2/video/tracking.hpp>
@@ -38,7 +40,8 @@ Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
       options_(Checked(options)),  // before any member is built from them
       resolution_(map.camera, options.working_long_side),
       rms_gate_(options.tracking.rms_gate),
-      smoother_(options.smoothing) {
+      smoother_(options.smoothing),
+      moving_filter_(options.tracking.moving, map.points.size()) {
   CheckTrackable(map, options.min_map_points);
   index_ = options.index_cache_folder.empty()
                ? map::DescriptorIndex(map.descriptors, options.index)
@@ -93,10 +96,12 @@ std::vector<cv::Mat> Tracker::FlowPyramid(const cv::Mat& gray) const {
 
 std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_pyramid,
                                                const std::vector<cv::Mat>& to_pyramid,
-                                               const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const {
+                                               const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+                                               std::vector<float>* errors) const {
   const TrackingOptions& opt = options_.tracking;
   std::vector<unsigned char> status;
-  std::vector<float> error;
+  std::vector<float> own_errors;
+  std::vector<float>& error = errors ? *errors : own_errors;
   cv::calcOpticalFlowPyrLK(
       from_pyramid, to_pyramid, from, *to, status, error, cv::Size(opt.lk_window_px, opt.lk_window_px),
       opt.lk_pyramid_levels,
@@ -108,10 +113,12 @@ std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_
 int Tracker::FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
                              const std::vector<cv::Point2f>& from, const std::vector<std::uint32_t>& point_ids,
                              std::vector<cv::Point2f> guesses, Correspondences* out,
-                             const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep) const {
+                             const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep,
+                             std::vector<float>* appended_errors) const {
   if (from.empty()) return 0;
   const calib::Camera& camera = resolution_.work();
-  const std::vector<unsigned char> status = FollowByLk(from_pyramid, to_pyramid, from, &guesses);
+  std::vector<float> errors;
+  const std::vector<unsigned char> status = FollowByLk(from_pyramid, to_pyramid, from, &guesses, &errors);
   int added = 0;
   for (std::size_t i = 0; i < guesses.size(); ++i) {
     const Eigen::Vector2d px(guesses[i].x, guesses[i].y);
@@ -119,6 +126,7 @@ int Tracker::FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std
     out->pixels.push_back(px);
     out->points.push_back(map_.points[point_ids[i]].xyz);
     out->point_ids.push_back(point_ids[i]);
+    if (appended_errors) appended_errors->push_back(errors[i]);
     ++added;
   }
   return added;
@@ -241,9 +249,11 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
 
   // 1. Pyramidal LK from last frame's inliers, started where the prediction puts them.
   const auto flow_start = std::chrono::steady_clock::now();
-  std::vector<cv::Mat> pyramid = FlowPyramid(gray);
+  std::vector<cv::Mat> pyramid = FlowPyramid(
+      MatchMeanBrightness(gray, last_pyramid_.empty() ? cv::Mat() : last_pyramid_[0], opt.flow_brightness_tolerance));
   Correspondences c;
   ++frame_counter_;
+  MovingTrackVerdict moving;
   if (!last_inliers_.pixels.empty() && !last_pyramid_.empty()) {
     std::vector<cv::Point2f> guess;
     guess.reserve(last_inliers_.pixels.size());
@@ -253,11 +263,16 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       guess.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : last_inliers_.pixels[i]);
     }
     std::vector<double> motion_px;  // each surviving track's move from the last frame
-    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, std::move(guess), &c,
+    std::vector<Eigen::Vector2d> predicted_px;  // where the prediction puts each surviving track
+    std::vector<float> lk_errors;
+    FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, guess, &c,
                     [&](std::size_t i, const Eigen::Vector2d& px) {
                       motion_px.push_back((px - Eigen::Vector2d(last_inliers_.pixels[i].x, last_inliers_.pixels[i].y)).norm());
+                      predicted_px.emplace_back(guess[i].x, guess[i].y);
                       return true;
-                    });
+                    },
+                    &lk_errors);
+    moving = DropMovingTracks(predicted_px, lk_errors, &c, result);
     for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
     if (!motion_px.empty()) {
       std::nth_element(motion_px.begin(), motion_px.begin() + motion_px.size() / 2, motion_px.end());
@@ -322,6 +337,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
       result->times.match_ms = MillisecondsSince(match_start);
     }
   }
+
+  DropNearMoving(moving, static_cast<std::size_t>(result->flow_tracks), &c, result);
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short
   // RANSAC, whose pose must stay near the prediction.

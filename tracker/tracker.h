@@ -20,6 +20,7 @@
 #include "map/descriptor_index.h"
 #include "map/map.h"
 #include "tracker/centre_fitter.h"
+#include "tracker/moving_tracks.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
 #include "tracker/residual_gate.h"
@@ -135,6 +136,12 @@ struct TrackingOptions {
   // `background` (a live session).
   double fresh_features_after_s = 0.25;
   double fresh_max_rotation_deg = 3;
+  // The frame LK follows into is scaled to the previous flow image's mean grey when the two
+  // differ by more than this share (a light change; tracker/brightness_match.h).
+  double flow_brightness_tolerance = 0.05;
+  // Flow tracks and guided matches on things that move in front of the map, rejected before the
+  // pose (tracker/moving_tracks.h; docs/tracker.md, "People walking through").
+  MovingTrackOptions moving;
 
   // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
   void Check(const OptionNames& names = {}) const;
@@ -192,6 +199,7 @@ struct FrameResult {
   int flow_tracks = 0;     // LK tracks that survived into this frame
   double flow_motion_px = 0;  // their median move from the last frame, pixels of the working frame
   int guided_matches = 0;  // added by guided matching
+  int moving_rejected = 0; // flow tracks and guided matches rejected as on something moving
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
   // > 0: the tracked pose was replaced by the pose of the frame's own SIFT matched globally, on
@@ -300,8 +308,10 @@ class Tracker {
   // A frame's image pyramid for LK, with the tracking options' window and levels.
   std::vector<cv::Mat> FlowPyramid(const cv::Mat& gray) const;
   // Pyramidal LK with the tracking options, `to` holding the starting guesses; the status per point.
+  // `errors`, when given, gets LK's patch error per point.
   std::vector<unsigned char> FollowByLk(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
-                                        const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to) const;
+                                        const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
+                                        std::vector<float>* errors = nullptr) const;
   // A frame's 2D-3D correspondences: pixels (working camera), the map points' positions and ids.
   struct Correspondences {
     std::vector<Eigen::Vector2d> pixels;
@@ -314,7 +324,14 @@ class Tracker {
   int FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
                       const std::vector<cv::Point2f>& from, const std::vector<std::uint32_t>& point_ids,
                       std::vector<cv::Point2f> guesses, Correspondences* out,
-                      const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep = {}) const;
+                      const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep = {},
+                      std::vector<float>* appended_errors = nullptr) const;
+  // The flow tracks c[0, n) judged by the moving-track filter against where `predicted` puts
+  // them: the rejected ones removed from `c` (the rest keep their order); the verdict.
+  MovingTrackVerdict DropMovingTracks(const std::vector<Eigen::Vector2d>& predicted, const std::vector<float>& lk_errors,
+                                      Correspondences* c, FrameResult* result);
+  // Correspondences c[from, end) that lie where the verdict rejected tracks, removed.
+  void DropNearMoving(const MovingTrackVerdict& verdict, std::size_t from, Correspondences* c, FrameResult* result) const;
   // The pose from a prior: refined from it, and when that explains fewer than
   // prior_min_inlier_ratio of the correspondences, RANSAC without it (`prior_dropped`). The
   // solver's statistics of each attempt go into `result`.
@@ -366,6 +383,7 @@ class Tracker {
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
+  MovingTrackFilter moving_filter_;
   // Background work (TrackingOptions::background, prefetch_below): its own relocalizer and SIFT,
   // so that no object here but the map and the index is touched by two threads
   // (tracker/tracking_worker.h). Last: destroyed first, so that a running job finishes while

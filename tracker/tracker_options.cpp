@@ -90,6 +90,8 @@ void TrackingOptions::Check(const OptionNames& names) const {
   RequireOption(align_max_seconds >= 0, names("align_max_seconds"), "0 (off) or more", align_max_seconds);
   RequireOption(!std::isnan(fresh_features_after_s), names("fresh_features_after_s"), "a number (negative: never)",
                 fresh_features_after_s);
+  RequireOption(flow_brightness_tolerance >= 0, names("flow_brightness_tolerance"), "0 or more", flow_brightness_tolerance);
+  moving.Check(names.Nested("moving"));
 }
 
 void TrackerOptions::Check(const OptionNames& names) const {

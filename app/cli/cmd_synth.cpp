@@ -101,6 +101,26 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--still-at", o.still_at_s, "Where the walk stops for --still: the walk's time, seconds")
       ->default_val(o.still_at_s)
       ->check(CLI::Range(0.0, 1e6));
+  room->add_option("--walkers", o.walkers.count,
+                   "People walking through: 1 to 3 of the built-in figure pacing circles round the orbit's character "
+                   "spot (the room's centre on --path room), between the camera and the walls, in front of the "
+                   "character; walkers.txt gives the share of each frame they cover (0 = none)")
+      ->default_val(o.walkers.count)
+      ->check(CLI::Range(0, synth::kMaxWalkers));
+  room->add_option("--walkers-from", o.walkers.from_s,
+                   "When the walkers appear, seconds into the recording (e.g. the second lap, so the mapped first lap has none)")
+      ->default_val(o.walkers.from_s)
+      ->check(CLI::Range(0.0, 1e6));
+  room->add_option("--lamp-off", o.lights.lamp_off_s,
+                   "Switch the room's lamp off at this time, seconds: every surface at a quarter of its light (-2 EV in one frame)")
+      ->check(CLI::Range(0.0, 1e6));
+  room->add_option("--lamp-on", o.lights.lamp_on_s, "Switch the lamp back on at this time, seconds (after --lamp-off)")
+      ->check(CLI::Range(0.0, 1e6));
+  room->add_flag("--sun", o.lights.sun,
+                 "Sunlight through the window (--light window) falls on the floor, walls and boxes (+1 EV), moving as the "
+                 "sun's azimuth sweeps 60 degrees over the recording");
+  room->add_flag("--auto-exposure", o.lights.auto_exposure,
+                 "The camera re-exposes after the lamp changes: 1/3 EV steps every 4 frames, from 0.3 s after the change");
   AddGlFlags(room, args->gl);
   room->add_option("--data", args->data_dir, "Folder with the photos (Debian package opencv-doc)")->default_val(args->data_dir);
   room->add_option("--path", o.walk,
