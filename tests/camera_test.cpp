@@ -251,6 +251,35 @@ TEST_F(Camera, RunScalesTheMapsCameraToASizeOfTheSameAspect) {
   EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(frames: \d+ read, [1-9]\d* processed)"))) << r.out;
 }
 
+// Any camera on any map (issue 56): --camera gives the device's own calibration, of another
+// size, aspect and focal length than the map's camera; the frames are tracked with it.
+TEST_F(Camera, RunTracksWithTheCalibrationGivenByCamera) {
+  const fs::path map = dir_ / "map";
+  testing::WriteRandomMap(calib::Camera::Pinhole(1280, 720, 700, 700, 639.5, 359.5), map);
+  const fs::path webcam = dir_ / "webcam.yaml";
+  calib::SaveCamera(calib::Camera::Pinhole(640, 480, 520, 520, 319.5, 239.5), webcam);
+  const CommandResult r = RunWithCamera(
+      {"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--camera", webcam.string()}, {}, {0, 0},
+      3 * testing::kSanitizerSlowdown);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("640x480"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("note: the frames' camera differs from the map's (frames 640x480, the map's camera 1280x720): "
+                       "they are tracked with their own camera"),
+            std::string::npos)
+      << r.err;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(frames: \d+ read, [1-9]\d* processed)"))) << r.out;
+
+  const CommandResult refused = RunWithCamera(
+      {"run", "--device", kDevice, "--map", map.string(), "--out", "null", "--camera", webcam.string(), "--size", "1280x720"},
+      {});
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_EQ(testing::LineCount(refused.err), 1) << refused.err;
+  EXPECT_NE(refused.err.find("arview: --size 1280x720: another aspect than --camera's calibration (640x480, " +
+                             webcam.string() + ")"),
+            std::string::npos)
+      << refused.err;
+}
+
 TEST_F(Camera, RecordPlaysARealRecordingAt640x480InMjpegAndYuyv) {
   ARVIEW_REQUIRE_DATA_PATH(testing::SharedData("templeRing"), "../shared/data");
   const fs::path temple = TempleRecording();

@@ -80,7 +80,9 @@ struct LossThresholds {
 class LossDiagnoser {
  public:
   // `frame_camera`: the camera the frames come from (a recording's camera.yaml; for a live
-  // camera, the map's camera scaled to its size).
+  // camera, the map's camera scaled to its size). A caller that tracks the frames with their own
+  // camera (Tracker(map, camera, options): app's sessions and `track`) passes that camera as
+  // both, since then the camera is no cause of a lost frame.
   LossDiagnoser(const calib::Camera& map_camera, const calib::Camera& frame_camera, const AppearanceReference& reference,
                 const LossThresholds& thresholds = {});
   // The cause of a lost frame, from its image and the tracker's result.

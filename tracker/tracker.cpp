@@ -35,10 +35,12 @@ const TrackerOptions& Checked(const TrackerOptions& options) {
 
 }  // namespace
 
-Tracker::Tracker(const map::Map& map, const TrackerOptions& options)
+Tracker::Tracker(const map::Map& map, const TrackerOptions& options) : Tracker(map, map.camera, options) {}
+
+Tracker::Tracker(const map::Map& map, const calib::Camera& camera, const TrackerOptions& options)
     : map_(map),
       options_(Checked(options)),  // before any member is built from them
-      resolution_(map.camera, options.working_long_side),
+      resolution_(camera, options.working_long_side),
       rms_gate_(options.tracking.rms_gate),
       smoother_(options.smoothing),
       moving_filter_(options.tracking.moving, map.points.size()) {
@@ -672,10 +674,11 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   ++frames_tracked_;
   FrameResult result;
   const cv::Mat full_gray = image.empty() ? cv::Mat() : ToGray8(image);
-  if (full_gray.empty() || full_gray.size() != map_.camera.Size()) {
+  const calib::Camera& camera = resolution_.full();
+  if (full_gray.empty() || full_gray.size() != camera.Size()) {
     std::ostringstream msg;
-    msg << "frame is " << full_gray.cols << "x" << full_gray.rows << ", the map camera is "
-        << map_.camera.width << "x" << map_.camera.height;
+    msg << "frame is " << full_gray.cols << "x" << full_gray.rows << ", the tracking camera is "
+        << camera.width << "x" << camera.height;
     result.reason = msg.str();
     Reset();
     result.times.total_ms = MillisecondsSince(start);

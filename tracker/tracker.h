@@ -231,9 +231,15 @@ class Tracker {
   // builds its descriptor index. `map` must outlive the tracker. Throws TrackerError when the map
   // has too few points or inconsistent descriptors.
   Tracker(const map::Map& map, const TrackerOptions& options = {});
+  // The same for frames from `camera`, which need not be the map's: the map's points are in
+  // world metres and its SIFT descriptors do not depend on the camera that saw them, so frames
+  // of another size, focal length and distortion are projected with their own camera; the
+  // working resolution is taken from it (`--working-size` applies to its size).
+  Tracker(const map::Map& map, const calib::Camera& camera, const TrackerOptions& options = {});
   ~Tracker();
 
-  // image: 8-bit grey or BGR at the map camera's resolution; timestamp in seconds.
+  // image: 8-bit grey or BGR at the tracking camera's resolution (the map camera's unless
+  // another was given); timestamp in seconds.
   FrameResult Track(const cv::Mat& image, double timestamp);
   // Forgets the prior: the next frame is relocalised.
   void Reset();

@@ -104,8 +104,7 @@ void AddReplayCommand(CLI::App& app) {
     o.recording = &recording;
     recordings::RecordingSource source(recording, replay);
     const map::Map map = map::LoadMap(a->map_dir);
-    // An uncalibrated recording's camera is a guess; its map holds the refined one.
-    o.frame_camera = recording.camera.calibrated ? recording.camera : map.camera;
+    o.frame_camera = RecordingTrackingCamera(map.camera, recording.camera);
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     // The scene's lines into a video file's audio track, and played live (--audio-out) when the
     // frames keep real time: --paced.

@@ -25,6 +25,7 @@ namespace {
 
 struct RunArgs {
   std::string device = "/dev/video0", map_dir, out = "window";
+  std::string camera_file;  // --camera: the device's calibration when it is not the map's camera
   std::string audio_out = "default";
   CameraFlags camera;
   SessionFlags session;
@@ -35,11 +36,14 @@ std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::t
 
 // A camera calibrated at one size works at another of the same aspect (its intrinsics scale
 // exactly); across aspects the sensor is cropped differently and the calibration does not hold.
-void RequireSameAspect(cv::Size calibrated, cv::Size used, const std::string& what, const std::string& map_dir) {
+// `whose`: the calibration's owner, "the map's camera" or "--camera's calibration".
+void RequireSameAspect(cv::Size calibrated, cv::Size used, const std::string& what, const std::string& whose,
+                       const std::string& file) {
   const double cross = static_cast<double>(used.width) * calibrated.height - static_cast<double>(used.height) * calibrated.width;
   if (std::abs(cross) <= 0.005 * static_cast<double>(used.width) * calibrated.height) return;
-  throw CommandError(what + ": another aspect than the map's camera (" + SizeText(calibrated) + ", " + map_dir +
-                     "); a camera calibrated at one aspect cannot be scaled to another (calibrate and map at this size)");
+  throw CommandError(what + ": another aspect than " + whose + " (" + SizeText(calibrated) + ", " + file +
+                     "); a camera calibrated at one aspect cannot be scaled to another (calibrate this camera at this "
+                     "size and give it with --camera)");
 }
 
 }  // namespace
@@ -48,9 +52,15 @@ void AddRunCommand(CLI::App& app) {
   auto a = std::make_shared<RunArgs>();
   auto* cmd = app.add_subcommand("run", "Run the whole pipeline live on a V4L2 camera or HMD");
   cmd->add_option("--device", a->device, "V4L2 capture device")->capture_default_str();
-  cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (made with this camera)")->required();
+  cmd->add_option("--map", a->map_dir, "Map folder written by 'arview map' (with any camera)")->required();
+  cmd->add_option("--camera", a->camera_file,
+                  "The device's calibration (camera.yaml from 'arview calibrate') when it is not the camera the map "
+                  "was made with: frames are tracked with it (default: the map's camera)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--out", a->out, "Output: 'window' (Esc or q stops), a video file, or a PNG folder")->capture_default_str();
-  AddCameraFlags(cmd, a->camera, "default: the map's camera size; another of the same aspect scales the map's camera exactly");
+  AddCameraFlags(cmd, a->camera,
+                 "default: the size of --camera's calibration, else of the map's camera; another of the same aspect "
+                 "scales the calibration exactly");
   AddSessionFlags(cmd, a->session);
   AddAudioOutFlag(cmd, a->audio_out);
   AddDialogueFlags(cmd, a->dialogue, DialogueInput::kMicrophone);
@@ -76,32 +86,40 @@ void AddRunCommand(CLI::App& app) {
     o.cancel = signals.token();
     o.cancel_ends_normally = true;  // Ctrl-C is how a live session ends
 
-    // The camera delivers the map camera's size, or --size where its aspect is the map's (the
-    // map's camera is then scaled exactly); the map is read first to know it.
+    // The camera delivers its calibration's size (--camera's, else the map's camera's), or --size
+    // where its aspect is the calibration's (which is then scaled exactly); the map is read first
+    // to know it. The frames are tracked with that calibration, in the map's world.
     recordings::V4l2Options v4l2;
     ApplyCameraFlags(a->camera, v4l2);
     v4l2.cancel = signals.token();
-    map::Map map = map::LoadMap(a->map_dir);
-    v4l2.focus = SessionFocus(a->camera, map.camera);
-    const cv::Size wanted = a->camera.size.empty() ? map.camera.Size() : *ParseFrameSize(a->camera.size);
-    RequireSameAspect(map.camera.Size(), wanted, "--size " + a->camera.size, a->map_dir);
+    const map::Map map = map::LoadMap(a->map_dir);
+    const bool own_camera = !a->camera_file.empty();
+    const calib::Camera calibration = own_camera ? calib::LoadCamera(a->camera_file) : map.camera;
+    const std::string whose = own_camera ? "--camera's calibration" : "the map's camera";
+    const std::string calibration_file = own_camera ? a->camera_file : a->map_dir;
+    v4l2.focus = SessionFocus(a->camera, calibration);
+    const cv::Size wanted = a->camera.size.empty() ? calibration.Size() : *ParseFrameSize(a->camera.size);
+    RequireSameAspect(calibration.Size(), wanted, "--size " + a->camera.size, whose, calibration_file);
     v4l2.width = wanted.width;
     v4l2.height = wanted.height;
     recordings::V4l2Source source(a->device, v4l2);
     std::fprintf(stderr, "%s (Ctrl-C stops)\n", source.GrantedLine().c_str());
     for (const std::string& note : source.notes()) std::fprintf(stderr, "note: %s\n", note.c_str());
-    if (const std::string mismatch = FocusMismatch(source, map.camera, "the map " + a->map_dir); !mismatch.empty()) {
+    const std::string calibrated_where = own_camera ? a->camera_file : "the map " + a->map_dir;
+    if (const std::string mismatch = FocusMismatch(source, calibration, calibrated_where); !mismatch.empty()) {
       std::fprintf(stderr, "warning: %s\n", mismatch.c_str());
-    } else if (map.camera.focus && a->camera.focus.empty()) {
-      std::fprintf(stderr, "note: focus held at %lld, where the map's camera was calibrated\n",
-                   static_cast<long long>(*map.camera.focus));
+    } else if (calibration.focus && a->camera.focus.empty()) {
+      std::fprintf(stderr, "note: focus held at %lld, where %s was calibrated\n", static_cast<long long>(*calibration.focus),
+                   whose.c_str());
     }
-    if (source.size() != map.camera.Size()) {
-      RequireSameAspect(map.camera.Size(), source.size(), a->device + " delivers " + SizeText(source.size()), a->map_dir);
-      const calib::Camera calibrated = map.camera;
-      map.camera = tracker::ScaleCamera(calibrated, source.size().width, source.size().height);
-      std::fprintf(stderr, "note: the map's camera, calibrated at %s, is scaled exactly to %s (fx %.1f -> %.1f)\n",
-                   SizeText(calibrated.Size()).c_str(), SizeText(source.size()).c_str(), calibrated.fx, map.camera.fx);
+    o.frame_camera = calibration;
+    if (source.size() != calibration.Size()) {
+      RequireSameAspect(calibration.Size(), source.size(), a->device + " delivers " + SizeText(source.size()), whose,
+                        calibration_file);
+      o.frame_camera = tracker::ScaleCamera(calibration, source.size().width, source.size().height);
+      std::fprintf(stderr, "note: %s, calibrated at %s, is scaled exactly to %s (fx %.1f -> %.1f)\n", whose.c_str(),
+                   SizeText(calibration.Size()).c_str(), SizeText(source.size()).c_str(), calibration.fx,
+                   o.frame_camera->fx);
     }
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     // The scene's lines played live (--audio-out), and written into a video file.

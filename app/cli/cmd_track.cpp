@@ -11,6 +11,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "app/cli/commands.h"
@@ -20,6 +21,7 @@
 #include "base/progress.h"
 #include "app/cli/session_flags.h"
 #include "app/pipeline/stage_stats.h"
+#include "app/session/ar_session.h"
 #include "app/session/keyframe_appearance.h"
 #include "base/cancellation.h"
 #include "base/atomic_file.h"
@@ -139,15 +141,24 @@ void RunTrack(const TrackArgs& args) {
   const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
   map::Map map;
   map = map::LoadMap(args.map);
-  if (map.camera.Size() != rec.camera.Size()) {
+  const std::optional<calib::Camera> own_camera = RecordingTrackingCamera(map.camera, rec.camera);
+  const calib::Camera camera = own_camera.value_or(map.camera);
+  if (camera.Size() != rec.camera.Size()) {
     std::ostringstream msg;
     msg << args.recording << " has " << rec.camera.width << "x" << rec.camera.height << " frames but the map "
-        << args.map << " was built for " << map.camera.width << "x" << map.camera.height;
+        << args.map << " was built for " << map.camera.width << "x" << map.camera.height
+        << ", and the recording's camera.yaml is not calibrated (give the recording its camera's calibration: "
+           "'arview import ... --camera camera.yaml')";
     throw CommandError(msg.str());
+  }
+  if (own_camera) {
+    std::cerr << "note: the recording's camera (" << camera.width << "x" << camera.height << ", fx " << camera.fx
+              << ") differs from the map's (" << map.camera.width << "x" << map.camera.height << ", fx " << map.camera.fx
+              << "): its frames are tracked with their own camera\n";
   }
   std::unique_ptr<tracker::Tracker> tracker;
   try {
-    tracker = std::make_unique<tracker::Tracker>(map, options);
+    tracker = std::make_unique<tracker::Tracker>(map, camera, options);
   } catch (const tracker::TrackerError& e) {
     throw CommandError(args.map + ": " + e.what());
   } catch (const map::DescriptorIndexError& e) {
@@ -155,8 +166,8 @@ void RunTrack(const TrackArgs& args) {
   }
   tracker->WarmUp();  // the first frame's timing is then a relocalization's, not a process start's
 
-  // An uncalibrated recording's camera is a guess; its map holds the refined one.
-  const tracker::LossDiagnoser diagnoser(map.camera, rec.camera.calibrated ? rec.camera : map.camera, KeyframeAppearance(map, MapFolder(args.map), &rec));
+  // The frames are tracked with `camera`, so the cause of a lost frame is never its difference from the map's.
+  const tracker::LossDiagnoser diagnoser(camera, camera, KeyframeAppearance(map, MapFolder(args.map), &rec));
   tracker::LossSummary losses;
   recordings::RecordingSource source(std::move(rec), replay);
   std::vector<FrameRecord> frames;

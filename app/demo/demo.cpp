@@ -333,7 +333,7 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   recordings::ReplayOptions replay;
   for (int i = half; i < o.frames; ++i) replay.frames.push_back(i);
   const recordings::Recording replayed = WithUncompressedFrames(walk, half, work / "replay-frames", cancel);
-  session.frame_camera = walk.camera;
+  session.frame_camera = RecordingTrackingCamera(map.camera, walk.camera);
   session.recording = &walk;  // the walk the map was built from: its keyframes' images
   recordings::RecordingSource source(replayed, replay);
   SessionResult result = RunSession(source, walk.camera.Size(), map, (work / "map").string(), session);

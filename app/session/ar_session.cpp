@@ -50,17 +50,25 @@ std::string WindowStatus(const PipelineReport& r) {
   return status;
 }
 
-// Said before the first frame: a camera that differs from the map's loses frames whatever they
-// show. (Missing keyframe images are not said: the fixed floors then used show in the numbers of
-// each lost frame's cause.)
-std::optional<std::string> CameraNote(const tracker::LossDiagnoser& diagnoser, cv::Size frame_size) {
-  const auto difference = diagnoser.CameraDifference(frame_size);
+// Said before the first frame: frames from a camera other than the map's are tracked with their
+// own camera, which the user should know was taken. (Missing keyframe images are not said: the
+// fixed floors then used show in the numbers of each lost frame's cause.)
+std::optional<std::string> CameraNote(const calib::Camera& map_camera, const calib::Camera& frame_camera) {
+  const tracker::LossDiagnoser compare(map_camera, frame_camera, tracker::AppearanceReference{});
+  const auto difference = compare.CameraDifference(frame_camera.Size());
   if (!difference) return std::nullopt;
   return "the frames' camera differs from the map's (" + *difference +
-         "): they are tracked with the map's camera, and few will localize";
+         "): they are tracked with their own camera, the scene stays in the map's units";
 }
 
 }  // namespace
+
+std::optional<calib::Camera> RecordingTrackingCamera(const calib::Camera& map_camera, const calib::Camera& recording) {
+  if (!recording.calibrated) return std::nullopt;
+  const tracker::LossDiagnoser compare(map_camera, recording, tracker::AppearanceReference{});
+  if (!compare.CameraDifference(recording.Size())) return std::nullopt;
+  return recording;
+}
 
 bool SceneHasLines(const authoring::Scene& scene) {
   return std::any_of(scene.characters.begin(), scene.characters.end(),
@@ -79,11 +87,13 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                          const std::string& map_name, const SessionOptions& o) {
   const Clock::time_point command_start = o.command_start.value_or(Clock::now());
   o.Check();
-  if (source_size != map.camera.Size()) {
+  // The frames are tracked and drawn over with their own camera; the map gives only the world.
+  const calib::Camera& camera = o.frame_camera ? *o.frame_camera : map.camera;
+  if (source_size != camera.Size()) {
     throw Error(source.Name() + ": frames are " + std::to_string(source_size.width) + "x" +
-                             std::to_string(source_size.height) + " but the map " + map_name +
-                             " was built for a " + std::to_string(map.camera.width) + "x" +
-                             std::to_string(map.camera.height) + " camera");
+                std::to_string(source_size.height) + " but their camera " +
+                (o.frame_camera ? std::string("is calibrated") : "(the map " + map_name + "'s) is calibrated") +
+                " for " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
   // The eyes' disparity is --ipd in map units: metres only on a metric map.
   if (o.compositor.hmd && o.compositor.stereo_character && !map.frame.metric()) {
@@ -98,7 +108,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.scene_file.empty()) scene = authoring::LoadScene(o.scene_file);
   if (first_view) scene = o.first_view->scene;
   std::unique_ptr<video::FrameSink> sink =
-      video::OpenSink(o.sink, ArCompositor::OutputSizeFor(map.camera, o.compositor), o.sink_fps, o.window,
+      video::OpenSink(o.sink, ArCompositor::OutputSizeFor(camera, o.compositor), o.sink_fps, o.window,
                       o.audio_track && scene && SceneHasLines(*scene) ? std::optional(video::AudioTrackOptions{}) : std::nullopt);
   SessionSound sound(o.sound_out, *sink, o.sink_fps);
   // --stats: each frame's record goes to disk as it comes (pipeline_report.h), none is kept.
@@ -137,9 +147,10 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   std::jthread tracker_start([&] {
     try {
       const Clock::time_point t0 = Clock::now();
-      tracker.emplace(map, o.tracker);
-      diagnoser.emplace(map.camera, o.frame_camera.value_or(map.camera),
-                        KeyframeAppearance(map, MapFolder(map_name), o.recording));
+      tracker.emplace(map, camera, o.tracker);
+      // The tracker projects with the frames' camera, so the cause of a lost frame is never that
+      // camera's difference from the map's.
+      diagnoser.emplace(camera, camera, KeyframeAppearance(map, MapFolder(map_name), o.recording));
       tracker->WarmUp();  // before the first frame, so that its latency is a relocalization's only
       tracker_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     } catch (...) {
@@ -180,7 +191,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   }
 
   const double characters_seconds = seconds_of_step();
-  ArCompositor compositor(map.camera, character_ptrs, o.compositor, std::move(context));
+  ArCompositor compositor(camera, character_ptrs, o.compositor, std::move(context));
   const double renderer_seconds = context_seconds + seconds_of_step();
   if (!o.quiet) std::cerr << "renderer: " << compositor.Description() << "\n";
   for (const std::string& note : compositor.LoadNotes()) std::cerr << "note: " << note << "\n";
@@ -189,7 +200,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (tracker_error) std::rethrow_exception(tracker_error);
   seconds_of_step();
   if (!o.quiet && !tracker->index_note().empty()) std::cerr << "note: " << tracker->index_note() << "\n";
-  if (const auto note = CameraNote(*diagnoser, source_size); note && !o.quiet) std::cerr << "note: " << *note << "\n";
+  if (const auto note = CameraNote(map.camera, camera); note && !o.quiet) std::cerr << "note: " << *note << "\n";
   pipeline.diagnoser = &*diagnoser;
   if (first_view && !characters.empty()) {
     // Once, on the render thread (which alone animates and draws the characters), before the

@@ -48,10 +48,12 @@ struct SessionOptions {
   FadeOptions fade;
   PipelineOptions pipeline;
   tracker::TrackerOptions tracker;
-  // For the cause of each lost frame (tracker/loss_diagnosis.h). The camera the frames come
-  // from: a replay's camera.yaml; nothing: the map's (a live camera is calibrated as the map's,
-  // scaled to its size). `recording`: a replay's, which may hold a still-image map's keyframe
-  // images (app/session/keyframe_appearance.h); null for a live camera.
+  // The camera the frames come from, which tracks them and which the scene is drawn with: a
+  // replay's calibrated camera.yaml where it is not the map's (RecordingTrackingCamera), `run
+  // --camera`'s calibration, or the map's camera scaled to the device's size; nothing: the map's
+  // camera. The map gives only the world: the scene's placement stays in map units.
+  // `recording`: a replay's, which may hold a still-image map's keyframe images
+  // (app/session/keyframe_appearance.h, for the cause of each lost frame); null for a live camera.
   std::optional<calib::Camera> frame_camera;
   const recordings::Recording* recording = nullptr;
   long expected_frames = 0;                  // for the progress line (0: unknown)
@@ -110,7 +112,15 @@ double MedianFrameRate(const std::vector<recordings::FrameEntry>& frames);
 // Whether any of the scene's characters has `lines:` (its session then has sound to play or write).
 bool SceneHasLines(const authoring::Scene& scene);
 
-// `source_size` is the size of the source's frames: it must match the map's camera. `map_name`
+// The camera a recording's frames are tracked with on `map_camera`'s map: the recording's own
+// calibration where it is calibrated and differs from the map's camera (another size, or a
+// focal length or principal point more than 2% off: tracker::LossThresholds::camera_tolerance);
+// nothing (the map's camera) where the recording is uncalibrated (its camera is a guess, the
+// map holds the refined one) or is the map's camera (which may be refined from these frames).
+std::optional<calib::Camera> RecordingTrackingCamera(const calib::Camera& map_camera, const calib::Camera& recording);
+
+// `source_size` is the size of the source's frames: it must match the frames' camera
+// (options.frame_camera, else the map's). `map_name`
 // names the map in messages. Throws CancelledError when options.cancel was cancelled.
 SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, const map::Map& map,
                          const std::string& map_name, const SessionOptions& options);
