@@ -106,10 +106,15 @@ namespace arview::render {
   X(void, RenderbufferStorageMultisample, (GLenum, GLsizei, GLenum, GLsizei, GLsizei))                \
   X(void, BlitFramebuffer, (GLint, GLint, GLint, GLint, GLint, GLint, GLint, GLint, GLbitfield, GLenum))
 
+class SceneFences;
+
 struct GlApi {
 #define ARVIEW_GL_MEMBER(ret, name, params) ret(APIENTRY* name) params = nullptr;
   ARVIEW_GL_FUNCTIONS(ARVIEW_GL_MEMBER)
 #undef ARVIEW_GL_MEMBER
+  // The context's fences held for its read-backs (render/gl_objects.h), set by OffscreenContext;
+  // null where the entry points were loaded otherwise: each RenderTarget then holds its own.
+  SceneFences* scene_fences = nullptr;
 };
 
 using GlProcLoader = std::function<void*(const char* name)>;

@@ -158,8 +158,33 @@ void RequireComplete(const GlApi& gl, const std::string& what) {
 
 }  // namespace
 
-RenderTarget::RenderTarget(const GlApi& gl, int width, int height, int samples)
-    : gl_(&gl), width_(width), height_(height), samples_(samples) {
+SceneFences::~SceneFences() {
+  if (lifetime_ == Lifetime::kFreedWithTheContext) return;
+  for (GLsync fence : held_) gl_->DeleteSync(fence);
+}
+
+void SceneFences::HoldCurrent() {
+  // glFenceSync hands the scene drawn so far to the rasterizer and references llvmpipe's fence
+  // of the newest scene (its last_fence, when nothing new was drawn) until glDeleteSync.
+  held_.push_back(gl_->FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
+}
+
+void SceneFences::ReleaseOlder() {
+  // The newest fence has signalled: every rasterizer thread signalled the older ones before it
+  // (scenes are rasterized in order) and has let their mutexes go.
+  while (held_.size() > 1) {
+    gl_->DeleteSync(held_.front());
+    held_.erase(held_.begin());
+  }
+}
+
+std::shared_ptr<SceneFences> FencesFor(const GlApi& gl) {
+  if (gl.scene_fences != nullptr) return std::shared_ptr<SceneFences>(gl.scene_fences, [](SceneFences*) {});
+  return std::make_shared<SceneFences>(gl, SceneFences::Lifetime::kDeletedHere);
+}
+
+RenderTarget::RenderTarget(const GlApi& gl, int width, int height, int samples, std::shared_ptr<SceneFences> fences)
+    : gl_(&gl), width_(width), height_(height), samples_(samples), fences_(fences ? std::move(fences) : FencesFor(gl)) {
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     throw RenderError("render target size " + std::to_string(width) + "x" + std::to_string(height) +
                       " is not usable");
@@ -201,6 +226,7 @@ void RenderTarget::BindResolved(const cv::Rect& r) const {
   const GlApi& gl = *gl_;
   GLuint source = draw_fbo_.get();
   if (samples_ > 1) {
+    fences_->HoldCurrent();  // the drawing's scene, whose fence the resolve's scene may free (SceneFences)
     gl.BindFramebuffer(GL_READ_FRAMEBUFFER, draw_fbo_.get());
     gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo_.get());
     gl.Disable(GL_SCISSOR_TEST);
@@ -220,6 +246,8 @@ cv::Mat RenderTarget::Read(GLenum format, int channels, cv::Rect rect, bool top_
   BindResolved(r);
   cv::Mat bottom_up(r.height, r.width, CV_8UC(channels));
   gl.ReadPixels(r.x, r.y, r.width, r.height, format, GL_UNSIGNED_BYTE, bottom_up.data);
+  fences_->HoldCurrent();  // the read scene's fence, signalled now
+  fences_->ReleaseOlder();
   CheckGl(gl, "read-back");
   if (!top_down) return bottom_up;
   cv::Mat image;
@@ -231,6 +259,10 @@ void RenderTarget::StartReadBgra(const cv::Rect& rect, PixelReadback& readback) 
   const cv::Rect r = GlRect(rect);
   if (!r.empty()) BindResolved(r);
   readback.Start(r, GL_BGRA, 4);
+  // On llvmpipe the copy into the buffer is done inside Start: the read scene's fence has
+  // signalled (on a GPU the driver's own fences need none of this).
+  fences_->HoldCurrent();
+  fences_->ReleaseOlder();
 }
 
 PixelReadback::~PixelReadback() {
@@ -311,7 +343,8 @@ int RoundUpToTile(int pixels) { return (pixels + kTile - 1) / kTile * kTile; }
 
 }  // namespace
 
-RegionTarget::RegionTarget(const GlApi& gl, cv::Size image, int samples) : gl_(&gl), image_(image), samples_(samples) {
+RegionTarget::RegionTarget(const GlApi& gl, cv::Size image, int samples)
+    : gl_(&gl), image_(image), samples_(samples), fences_(FencesFor(gl)) {
   RenderTarget(gl, image.width, image.height, samples);  // validates the size and the sample count once
 }
 
@@ -335,7 +368,8 @@ void RegionTarget::Begin(const cv::Rect& rect) {
     // Growing keeps the other side's room; the image's own size always suffices.
     const int width = std::max(RoundUpToTile(needed.width * 5 / 4), fits ? 0 : have.width);
     const int height = std::max(RoundUpToTile(needed.height * 5 / 4), fits ? 0 : have.height);
-    target_ = std::make_unique<RenderTarget>(*gl_, std::min(width, image_.width), std::min(height, image_.height), samples_);
+    target_ = std::make_unique<RenderTarget>(*gl_, std::min(width, image_.width), std::min(height, image_.height), samples_,
+                                             fences_);
     small_in_a_row_ = 0;
   }
   const GlApi& gl = *gl_;
@@ -349,7 +383,7 @@ void RegionTarget::Begin(const cv::Rect& rect) {
 }
 
 void RegionTarget::ReserveWholeImage() {
-  target_ = std::make_unique<RenderTarget>(*gl_, image_.width, image_.height, samples_);
+  target_ = std::make_unique<RenderTarget>(*gl_, image_.width, image_.height, samples_, fences_);
   small_in_a_row_ = 0;
   Begin(cv::Rect(cv::Point(0, 0), image_));  // its memory touched by a clear
   rect_ = {};

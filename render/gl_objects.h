@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "render/gl_api.h"
 
@@ -93,11 +94,46 @@ class PixelReadback {
   bool mapped_ = false;
 };
 
+// Keeps llvmpipe's scene fences alive until a later scene's fence has signalled, as GL sync
+// objects (each holds a reference to the fence of the newest scene when it was made).
+// Why: Mesa 22.3's llvmpipe may free a scene's fence while the rasterizer thread that signalled
+// it has not yet unlocked the fence's mutex (the drawing thread reads the fence's count without
+// that lock, in lp_setup_get_empty_scene and fence_finish, and then drops its references), and
+// that unlock writes into freed memory: issue 57's live crash (docs/reliability.md, "The live
+// crash"). A fence whose last reference is one of these goes only after a later fence
+// signalled, when every rasterizer thread has let it go. One per context (OffscreenContext,
+// GlApi::scene_fences), so that the newest fence stays held after its target is gone.
+// Test: gl_fence_tests.
+class SceneFences {
+ public:
+  enum class Lifetime {
+    kDeletedHere,         // the destructor deletes what it holds (the context must be current)
+    kFreedWithTheContext  // the GL context, destroyed first, frees them
+  };
+  SceneFences(const GlApi& gl, Lifetime lifetime) : gl_(&gl), lifetime_(lifetime) {}
+  SceneFences(const SceneFences&) = delete;
+  SceneFences& operator=(const SceneFences&) = delete;
+  ~SceneFences();
+  // Hands the scene drawn so far to the rasterizer and holds the newest scene's fence.
+  void HoldCurrent();
+  // After a read-back returned (the newest fence signalled): lets go of all but the newest.
+  void ReleaseOlder();
+
+ private:
+  const GlApi* gl_;
+  Lifetime lifetime_;
+  std::vector<GLsync> held_;
+};
+
+// The fences `gl`'s read-backs hold: its context's, else a new set of their own.
+std::shared_ptr<SceneFences> FencesFor(const GlApi& gl);
+
 // A framebuffer to draw into: colour RGBA8 + depth 24, multisampled when samples > 1 and
-// resolved on read-back.
+// resolved on read-back. Its read-backs hold the scenes' fences (SceneFences: the context's, or
+// `fences` where the GlApi has none).
 class RenderTarget {
  public:
-  RenderTarget(const GlApi& gl, int width, int height, int samples);
+  RenderTarget(const GlApi& gl, int width, int height, int samples, std::shared_ptr<SceneFences> fences = nullptr);
   int width() const { return width_; }
   int height() const { return height_; }
   int samples() const { return samples_; }
@@ -129,6 +165,7 @@ class RenderTarget {
   int width_, height_, samples_;
   GlName draw_fbo_, color_rb_, depth_rb_;
   GlName resolve_fbo_, resolve_rb_;
+  std::shared_ptr<SceneFences> fences_;
 };
 
 // Draws one rectangle of a larger image into a target about the rectangle's size: the viewport
@@ -171,6 +208,7 @@ class RegionTarget {
   cv::Rect rect_;
   cv::Point origin_;    // the target's pixel (0, 0) in the image, OpenGL's rows (from the bottom)
   cv::Rect in_target_;  // rect_ in the target, OpenGL's rows
+  std::shared_ptr<SceneFences> fences_;  // outlives the targets it replaces
   std::unique_ptr<RenderTarget> target_;
   std::unique_ptr<PixelReadback> readback_;
   int small_in_a_row_ = 0;  // rectangles in a row with under half the target's area

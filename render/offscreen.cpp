@@ -403,6 +403,8 @@ std::unique_ptr<OffscreenContext> OffscreenContext::Create(const OffscreenOption
 
 void OffscreenContext::LoadApi(const GlProcLoader& loader) {
   gl_ = LoadGlApi(loader, ToString(info_.backend));
+  scene_fences_ = std::make_unique<SceneFences>(gl_, SceneFences::Lifetime::kFreedWithTheContext);
+  gl_.scene_fences = scene_fences_.get();
   auto text = [this](GLenum name) {
     const GLubyte* s = gl_.GetString(name);
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");

@@ -20,6 +20,7 @@
 
 #include "base/option_check.h"
 #include "render/gl_api.h"
+#include "render/gl_objects.h"
 #include "render/gl_selection.h"
 #include "render/render_error.h"
 
@@ -96,6 +97,9 @@ class OffscreenContext {
   RendererInfo info_;
   std::vector<GlAttempt> attempts_;
   GlApi gl_;
+  // For the whole context, not per target: a fence must stay held after the target that read it
+  // is gone, until a later read-back (SceneFences). Freed with the GL context.
+  std::unique_ptr<SceneFences> scene_fences_;
 };
 
 // The renderer each way would give on this machine: `arview info gl`.
