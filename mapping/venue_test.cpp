@@ -105,6 +105,10 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   MapBuildOptions options;
   options.UseFastPreset();
   options.match_engine = MatchEngine::kColmap;
+  // Six frames give the fold self-check five keyframe pairs, and one noisy pair is 20%: a CI run
+  // refused the venue's map so (3 models, each with one pair off). What this test holds is that
+  // the venue maps as the one recording does, which the comparison below checks pose by pose.
+  options.keep_folded = true;
   std::vector<VenueRoom> rooms;
   const recordings::Recording venue = VenueRecording({dir / "east", dir / "west"}, dir / "venue", &rooms);
   const MapBuildResult result = BuildMap(venue, dir / "venue", options);
