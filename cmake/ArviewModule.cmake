@@ -1,10 +1,11 @@
-# _arview_label_discovered(<test target> <labels> <tsan regex>)
+# _arview_label_discovered(<test target> <labels> <tsan regex> <serial regex>)
 #
 # Labels the tests that the last gtest_discover_tests call of <test target> found, once ctest
 # has read them: <labels> (a list: gtest_discover_tests (CMake 3.25) splits a list-valued
 # property) on each, and `tsan` besides on those whose name matches <tsan regex> (empty: none).
-# Tests labelled `slurm` also share the RESOURCE_LOCK arview_slurm_cluster.
-function(_arview_label_discovered target labels tsan_regex)
+# Tests labelled `slurm` also share the RESOURCE_LOCK arview_slurm_cluster; those whose name
+# matches <serial regex> (empty: none) run alone (RUN_SERIAL).
+function(_arview_label_discovered target labels tsan_regex serial_regex)
   get_property(counter TARGET ${target} PROPERTY CTEST_DISCOVERED_TEST_COUNTER)
   set(tests_file "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_tests.cmake")
   set(labels_script "${CMAKE_CURRENT_BINARY_DIR}/${target}[${counter}]_labels.cmake")
@@ -22,6 +23,9 @@ if(EXISTS \"${tests_file}\")
     endif()
     if(labels)
       set_tests_properties(\"\${name}\" PROPERTIES LABELS \"\${labels}\")
+    endif()
+    if(NOT \"${serial_regex}\" STREQUAL \"\" AND name MATCHES \"${serial_regex}\")
+      set_tests_properties(\"\${name}\" PROPERTIES RUN_SERIAL TRUE)
     endif()
     # The Slurm tests share one cluster, and one of them kills its node: never two at once.
     list(FIND labels slurm slurm_index)
@@ -48,7 +52,7 @@ function(_arview_gtest_filter_regex filter out)
 endfunction()
 
 # arview_discover_tests(<test target> [DATA <gtest filter>] [SLOW_DATA <gtest filter>]
-#                       [SLOW <gtest filter>] [SLURM <gtest filter>] [TSAN <gtest filter>]
+#                       [SLOW <gtest filter>] [SLURM <gtest filter>] [TSAN <gtest filter>] [SERIAL <gtest filter>]
 #                       [ENVIRONMENT <VAR=value>])
 #
 # Registers a GoogleTest binary's tests with ctest, labelled so that `ctest -LE slow` is the
@@ -63,9 +67,12 @@ endfunction()
 # call with a TEST_FILTER, so a binary can mix quick and slow tests.
 #   TSAN       tests that run threads of ours, whichever group they are in: label `tsan` besides,
 #              run under ThreadSanitizer by `ctest --preset tsan` (scripts/test.sh --tsan)
+#   SERIAL     tests that hold something to the wall clock and fail when starved (a sound
+#              player's deadlines), whichever group they are in: run alone (RUN_SERIAL)
 function(arview_discover_tests target)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN;ENVIRONMENT" "" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN;SERIAL;ENVIRONMENT" "" ${ARGN})
   _arview_gtest_filter_regex("${ARG_TSAN}" tsan_regex)
+  _arview_gtest_filter_regex("${ARG_SERIAL}" serial_regex)
   # One variable: gtest_discover_tests (CMake 3.25) would split a list of them.
   set(environment "ARVIEW_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
   if(ARG_ENVIRONMENT)
@@ -86,8 +93,8 @@ function(arview_discover_tests target)
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     PROPERTIES ENVIRONMENT "${environment}"
     DISCOVERY_TIMEOUT 60)
-  if(tsan_regex)
-    _arview_label_discovered(${target} "" "${tsan_regex}")
+  if(tsan_regex OR serial_regex)
+    _arview_label_discovered(${target} "" "${tsan_regex}" "${serial_regex}")
   endif()
   foreach(group DATA SLOW_DATA SLOW SLURM)
     if(NOT ARG_${group})
@@ -107,12 +114,13 @@ function(arview_discover_tests target)
       DISCOVERY_TIMEOUT 60)
     # Set by a ctest script that runs after the discovered tests are added: one list-valued
     # property would be split by gtest_discover_tests.
-    _arview_label_discovered(${target} "${labels}" "${tsan_regex}")
+    _arview_label_discovered(${target} "${labels}" "${tsan_regex}" "${serial_regex}")
   endforeach()
 endfunction()
 
 # arview_module(<name> [DEPS <targets...>] [TEST_DEPS <targets...>] [BENCH_DEPS <targets...>]
-#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>] [SLURM <filter>] [TSAN <filter>])
+#               [DATA <filter>] [SLOW_DATA <filter>] [SLOW <filter>] [SLURM <filter>] [TSAN <filter>]
+#               [SERIAL <filter>])
 #
 # One library per top-level folder: every *.cpp in the folder except *_test.cpp and
 # bench_*.cpp goes into the library `arview_<name>` (alias arview::<name>).
@@ -122,7 +130,7 @@ endfunction()
 # TEST_DEPS / BENCH_DEPS: what the tests / benchmarks link beyond the library (e.g. a runtime
 # library's tests loading assets through its authoring library).
 function(arview_module name)
-  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "DATA;SLOW_DATA;SLOW;SLURM;TSAN;SERIAL" "DEPS;TEST_DEPS;BENCH_DEPS" ${ARGN})
   file(GLOB all_sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(lib_sources "")
   set(test_sources "")
@@ -154,7 +162,7 @@ function(arview_module name)
     add_executable(${name}_tests ${test_sources})
     target_link_libraries(${name}_tests PRIVATE arview_${name} arview_testing ${ARG_TEST_DEPS} GTest::gtest GTest::gtest_main GTest::gmock)
     arview_discover_tests(${name}_tests DATA "${ARG_DATA}" SLOW_DATA "${ARG_SLOW_DATA}" SLOW "${ARG_SLOW}"
-                          SLURM "${ARG_SLURM}" TSAN "${ARG_TSAN}")
+                          SLURM "${ARG_SLURM}" TSAN "${ARG_TSAN}" SERIAL "${ARG_SERIAL}")
   endif()
 
   if(ARVIEW_BUILD_BENCHMARKS AND bench_sources)
