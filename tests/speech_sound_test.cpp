@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "recordings/recording.h"
 #include "tests/support/emulated_camera.h"
@@ -147,15 +148,19 @@ class SpeechSoundLive : public ::testing::Test {
     ::setenv("ARVIEW_CACHE_DIR", (dir_ / "cache").c_str(), 1);
     testing::WriteGraffitiMapFolder(dir_ / "map");
     testing::WriteGraffitiViews(dir_ / "views");  // its first 6 frames dark
-    // The emulated camera's loop (30 fps): 1.2 s dark (lost after 0.5 s: the `lost` line), then
-    // 1.8 s of the views (found: the `found` line), so that the character talks every loop.
+    // The emulated camera's loop (30 fps): 1.2 s black (lost after 0.5 s: the `lost` line), then
+    // 1.8 s of the views (found: the `found` line), so that the character talks every loop. Black,
+    // not the views' dark frames: the tracker follows those across a light change (docs/tracker.md).
     std::vector<recordings::FrameEntry> loop;
     for (int i = 0; i < 90; ++i) {
       char name[32];
-      std::snprintf(name, sizeof name, "frames/%06d.png", i < 36 ? i % 6 : 6 + (i - 36) / 3);
-      loop.push_back({i / 30.0, name});
+      std::snprintf(name, sizeof name, "frames/%06d.png", 6 + (i - 36) / 3);
+      loop.push_back({i / 30.0, i < 36 ? std::string("frames/black.png") : std::string(name)});
     }
     fs::copy(dir_ / "views", dir_ / "talk", fs::copy_options::recursive);
+    const cv::Mat view = cv::imread((dir_ / "talk" / "frames" / "000006.png").string());
+    ASSERT_FALSE(view.empty());
+    cv::imwrite((dir_ / "talk" / "frames" / "black.png").string(), cv::Mat::zeros(view.size(), view.type()));
     recordings::WriteFramesTxt(dir_ / "talk", loop);
     std::ofstream(dir_ / "scene.yaml")
         << "characters:\n  - asset: builtin:figure\n    keys: [{azimuth: 0, generate: lookat}]\n    lines:\n"
@@ -193,7 +198,9 @@ TEST_F(SpeechSoundLive, EachLinesFirstSampleIsHeardWithItsFrameAndNothingUnderru
   const nlohmann::json& s = stats.at("sound");
   ASSERT_TRUE(s.at("playing").get<bool>());
   EXPECT_EQ(s.at("underruns").get<int>(), 0);
+  EXPECT_EQ(s.at("underruns_in_lines").get<int>(), 0);
   EXPECT_EQ(s.at("clips_late").get<int>(), 0);
+  EXPECT_FALSE(s.at("player_scheduling").get<std::string>().empty());
   std::printf("%s", r.out.c_str());
   std::vector<double> latencies;
   for (const auto& f : stats.at("frames")) latencies.push_back(f.at("latency_ms").get<double>());
