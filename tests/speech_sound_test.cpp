@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -172,13 +173,14 @@ class SpeechSoundLive : public ::testing::Test {
     ::unsetenv("ARVIEW_CACHE_DIR");
     if (!HasFailure()) fs::remove_all(dir_);
   }
-  CommandResult Run(const std::string& audio_out, double seconds, const std::vector<std::string>& more = {}) {
+  CommandResult Run(const std::string& audio_out, double seconds, const std::vector<std::string>& more = {},
+                    std::map<std::string, std::string> env = {}) {
     std::vector<std::string> args = {"run", "--device", testing::kEmulatedCamera, "--map", (dir_ / "map").string(),
                                      "--scene", (dir_ / "scene.yaml").string(), "--out", "null",
                                      "--audio-out", audio_out, "--stats", (dir_ / "stats.json").string()};
     args.insert(args.end(), more.begin(), more.end());
-    return testing::RunWithEmulatedCamera(args, {{"ARVIEW_FAKE_CAMERA_RECORDING", (dir_ / "talk").string()}}, dir_,
-                                          {0, 0}, seconds * testing::kSanitizerSlowdown);
+    env["ARVIEW_FAKE_CAMERA_RECORDING"] = (dir_ / "talk").string();
+    return testing::RunWithEmulatedCamera(args, env, dir_, {0, 0}, seconds * testing::kSanitizerSlowdown);
   }
   fs::path dir_;
 };
@@ -251,6 +253,30 @@ TEST_F(SpeechSoundLive, NoSoundDeviceIsOneNoteAndTheSessionGoesOnSilent) {
   const CommandResult off = Run("none", 3);
   EXPECT_EQ(off.exit_code, 0) << off.err;
   EXPECT_EQ(off.err.find("no sound"), std::string::npos) << off.err;
+}
+
+// A speaker pulled out mid-session (tests/support/pcm_unplug.cpp: ALSA answers "no such device"
+// 2 s after the player's first write, which comes before the first frame): one note naming the
+// device, the session goes on silent to its end, and the stats say why.
+TEST_F(SpeechSoundLive, ASpeakerUnpluggedMidSessionIsOneNoteAndTheSessionGoesOnSilent) {
+  const testing::EmulatedSound sound(dir_ / "sound");
+  const CommandResult r = Run("arview_speaker", 9, {},
+                              {{"LD_PRELOAD", std::string(ARVIEW_FAKE_V4L2_LIBRARY) + ":" + ARVIEW_PCM_UNPLUG_LIBRARY},
+                               {"ARVIEW_PCM_UNPLUG", "playback"},
+                               {"ARVIEW_PCM_UNPLUG_AFTER_S", "2"}});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string note = "note: sound output 'arview_speaker': the device disappeared";
+  std::size_t notes = 0;
+  for (std::size_t at = r.err.find(note); at != std::string::npos; at = r.err.find(note, at + 1)) ++notes;
+  EXPECT_EQ(notes, 1u) << r.err;
+  EXPECT_NE(r.out.find("the device disappeared"), std::string::npos) << "the summary's sound line says why:\n" << r.out;
+  const nlohmann::json stats = nlohmann::json::parse(testing::ReadWholeFile((dir_ / "stats.json").string()));
+  const nlohmann::json& s = stats.at("sound");
+  EXPECT_NE(s.at("error").get<std::string>().find("the device disappeared (ALSA: No such device)"), std::string::npos) << s.dump();
+  // The session went on: frames were shown for at least 2 s after the unplug (which came at most
+  // 2 s after the first frame).
+  ASSERT_FALSE(stats.at("frames").empty());
+  EXPECT_GT(stats.at("frames").back().at("captured_s").get<double>() - stats.at("frames").front().at("captured_s").get<double>(), 4.0);
 }
 
 TEST_F(SpeechSoundLive, ReplayWritesTheLinesIntoTheVideosAudioTrack) {
