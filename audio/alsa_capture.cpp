@@ -47,7 +47,11 @@ AudioSource::Read AlsaCapture::ReadBlock(std::span<std::int16_t> block, const st
     std::this_thread::sleep_until(block_end);
     now = block_end;
   }
-  const TimePoint heard_at = now - SpeechDuration(delay + got);
+  // A card's block was heard `delay + got` samples before now. A device without a delay is
+  // paced by us alone: its block is heard where the pace puts it, even when this thread woke
+  // late (under load it can, and the block's time must not move with it).
+  device_reports_delay_ = device_reports_delay_ || delay > 0;
+  const TimePoint heard_at = device_reports_delay_ ? now - SpeechDuration(delay + got) : first_heard_ + SpeechDuration(read_);
   read_ += got;
   return {static_cast<std::size_t>(got), heard_at};
 }

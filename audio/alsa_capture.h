@@ -43,6 +43,9 @@ class AlsaCapture final : public AudioSource {
   bool started_ = false;
   TimePoint first_heard_;
   std::int64_t read_ = 0;
+  // A sound card reports the samples captured and not yet read; ALSA's `file` and `null`
+  // devices (the tests' microphone) never do, and their blocks are placed by our own pace.
+  bool device_reports_delay_ = false;
 };
 
 }  // namespace arview::audio

@@ -19,6 +19,10 @@
 // for a device that reports no delay, the player's own count of the queue running dry (it woke
 // too late to write the next period in time).
 //
+// The player's thread asks for real-time scheduling (base/thread_priority.h), falling back to a
+// raised nice value, so that compilers and the frame path on a loaded machine do not make it
+// wake late; PlayerStats::scheduling says what it got.
+//
 // Threads: Play, Stats and TakeReports may be called from any thread; they hold the player's
 // lock only to move a clip in or a copy out, never across a device call. A device failure ends
 // the thread; Stats().error says why (one line), later clips are dropped and counted.
@@ -68,6 +72,9 @@ struct ClipReport {
 struct PlayerStats {
   std::int64_t frames_written = 0;  // samples sent to the device, silence included
   std::int64_t underruns = 0;
+  // Of those, the ones while a clip was sounding: a gap heard in the speech. The others fell in
+  // silence, which a starved device only lengthens, but they show the thread woke late.
+  std::int64_t underruns_in_clips = 0;
   std::int64_t clips_played = 0;    // clips whose last sample was written
   std::int64_t clips_late = 0;
   std::int64_t clips_dropped = 0;   // played after a device failure
@@ -76,6 +83,7 @@ struct PlayerStats {
   // the queue ran dry).
   Clock::duration least_queued = Clock::duration::max();
   std::string error;                // the device's failure, one line; empty while it works
+  std::string scheduling;           // what the player's thread got: "real-time (SCHED_FIFO 20)", "nice -10", ...
 };
 
 class ClipPlayer {
@@ -105,6 +113,7 @@ class ClipPlayer {
   // while the queue is first filled up to the lead.
   void WritePeriod(std::vector<Active>& active, std::int64_t position, TimePoint heard_next,
                    std::optional<Clock::duration> queued, std::vector<std::int16_t>& period);
+  static bool ClipSoundingBefore(const std::vector<Active>& active, std::int64_t position);
 
   const std::string device_;
   std::unique_ptr<OpenedPcm> pcm_;

@@ -15,11 +15,13 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "recordings/recording.h"
 #include "tests/support/emulated_camera.h"
@@ -147,15 +149,19 @@ class SpeechSoundLive : public ::testing::Test {
     ::setenv("ARVIEW_CACHE_DIR", (dir_ / "cache").c_str(), 1);
     testing::WriteGraffitiMapFolder(dir_ / "map");
     testing::WriteGraffitiViews(dir_ / "views");  // its first 6 frames dark
-    // The emulated camera's loop (30 fps): 1.2 s dark (lost after 0.5 s: the `lost` line), then
-    // 1.8 s of the views (found: the `found` line), so that the character talks every loop.
+    // The emulated camera's loop (30 fps): 1.2 s black (lost after 0.5 s: the `lost` line), then
+    // 1.8 s of the views (found: the `found` line), so that the character talks every loop. Black,
+    // not the views' dark frames: the tracker follows those across a light change (docs/tracker.md).
     std::vector<recordings::FrameEntry> loop;
     for (int i = 0; i < 90; ++i) {
       char name[32];
-      std::snprintf(name, sizeof name, "frames/%06d.png", i < 36 ? i % 6 : 6 + (i - 36) / 3);
-      loop.push_back({i / 30.0, name});
+      std::snprintf(name, sizeof name, "frames/%06d.png", 6 + (i - 36) / 3);
+      loop.push_back({i / 30.0, i < 36 ? std::string("frames/black.png") : std::string(name)});
     }
     fs::copy(dir_ / "views", dir_ / "talk", fs::copy_options::recursive);
+    const cv::Mat view = cv::imread((dir_ / "talk" / "frames" / "000006.png").string());
+    ASSERT_FALSE(view.empty());
+    cv::imwrite((dir_ / "talk" / "frames" / "black.png").string(), cv::Mat::zeros(view.size(), view.type()));
     recordings::WriteFramesTxt(dir_ / "talk", loop);
     std::ofstream(dir_ / "scene.yaml")
         << "characters:\n  - asset: builtin:figure\n    keys: [{azimuth: 0, generate: lookat}]\n    lines:\n"
@@ -167,13 +173,14 @@ class SpeechSoundLive : public ::testing::Test {
     ::unsetenv("ARVIEW_CACHE_DIR");
     if (!HasFailure()) fs::remove_all(dir_);
   }
-  CommandResult Run(const std::string& audio_out, double seconds, const std::vector<std::string>& more = {}) {
+  CommandResult Run(const std::string& audio_out, double seconds, const std::vector<std::string>& more = {},
+                    std::map<std::string, std::string> env = {}) {
     std::vector<std::string> args = {"run", "--device", testing::kEmulatedCamera, "--map", (dir_ / "map").string(),
                                      "--scene", (dir_ / "scene.yaml").string(), "--out", "null",
                                      "--audio-out", audio_out, "--stats", (dir_ / "stats.json").string()};
     args.insert(args.end(), more.begin(), more.end());
-    return testing::RunWithEmulatedCamera(args, {{"ARVIEW_FAKE_CAMERA_RECORDING", (dir_ / "talk").string()}}, dir_,
-                                          {0, 0}, seconds * testing::kSanitizerSlowdown);
+    env["ARVIEW_FAKE_CAMERA_RECORDING"] = (dir_ / "talk").string();
+    return testing::RunWithEmulatedCamera(args, env, dir_, {0, 0}, seconds * testing::kSanitizerSlowdown);
   }
   fs::path dir_;
 };
@@ -193,7 +200,9 @@ TEST_F(SpeechSoundLive, EachLinesFirstSampleIsHeardWithItsFrameAndNothingUnderru
   const nlohmann::json& s = stats.at("sound");
   ASSERT_TRUE(s.at("playing").get<bool>());
   EXPECT_EQ(s.at("underruns").get<int>(), 0);
+  EXPECT_EQ(s.at("underruns_in_lines").get<int>(), 0);
   EXPECT_EQ(s.at("clips_late").get<int>(), 0);
+  EXPECT_FALSE(s.at("player_scheduling").get<std::string>().empty());
   std::printf("%s", r.out.c_str());
   std::vector<double> latencies;
   for (const auto& f : stats.at("frames")) latencies.push_back(f.at("latency_ms").get<double>());
@@ -244,6 +253,30 @@ TEST_F(SpeechSoundLive, NoSoundDeviceIsOneNoteAndTheSessionGoesOnSilent) {
   const CommandResult off = Run("none", 3);
   EXPECT_EQ(off.exit_code, 0) << off.err;
   EXPECT_EQ(off.err.find("no sound"), std::string::npos) << off.err;
+}
+
+// A speaker pulled out mid-session (tests/support/pcm_unplug.cpp: ALSA answers "no such device"
+// 2 s after the player's first write, which comes before the first frame): one note naming the
+// device, the session goes on silent to its end, and the stats say why.
+TEST_F(SpeechSoundLive, ASpeakerUnpluggedMidSessionIsOneNoteAndTheSessionGoesOnSilent) {
+  const testing::EmulatedSound sound(dir_ / "sound");
+  const CommandResult r = Run("arview_speaker", 9, {},
+                              {{"LD_PRELOAD", std::string(ARVIEW_FAKE_V4L2_LIBRARY) + ":" + ARVIEW_PCM_UNPLUG_LIBRARY},
+                               {"ARVIEW_PCM_UNPLUG", "playback"},
+                               {"ARVIEW_PCM_UNPLUG_AFTER_S", "2"}});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string note = "note: sound output 'arview_speaker': the device disappeared";
+  std::size_t notes = 0;
+  for (std::size_t at = r.err.find(note); at != std::string::npos; at = r.err.find(note, at + 1)) ++notes;
+  EXPECT_EQ(notes, 1u) << r.err;
+  EXPECT_NE(r.out.find("the device disappeared"), std::string::npos) << "the summary's sound line says why:\n" << r.out;
+  const nlohmann::json stats = nlohmann::json::parse(testing::ReadWholeFile((dir_ / "stats.json").string()));
+  const nlohmann::json& s = stats.at("sound");
+  EXPECT_NE(s.at("error").get<std::string>().find("the device disappeared (ALSA: No such device)"), std::string::npos) << s.dump();
+  // The session went on: frames were shown for at least 2 s after the unplug (which came at most
+  // 2 s after the first frame).
+  ASSERT_FALSE(stats.at("frames").empty());
+  EXPECT_GT(stats.at("frames").back().at("captured_s").get<double>() - stats.at("frames").front().at("captured_s").get<double>(), 4.0);
 }
 
 TEST_F(SpeechSoundLive, ReplayWritesTheLinesIntoTheVideosAudioTrack) {

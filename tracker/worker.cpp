@@ -1,9 +1,8 @@
 #include "tracker/worker.h"
 
 #include <pthread.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
+
+#include "base/thread_priority.h"
 
 namespace arview::tracker {
 
@@ -32,10 +31,7 @@ bool Worker::Busy() const {
 
 void Worker::Run(std::stop_token stop, int nice_increment) {
   pthread_setname_np(pthread_self(), "arview-trackwk");  // shown by top -H
-  // On Linux a thread's nice value is its own (setpriority on its thread id). Failing to lower
-  // it costs only the priority, so the result is not checked.
-  const auto tid = static_cast<id_t>(syscall(SYS_gettid));
-  (void)setpriority(PRIO_PROCESS, tid, getpriority(PRIO_PROCESS, tid) + nice_increment);
+  LowerCurrentThreadPriority(nice_increment);
   std::unique_lock lock(mutex_);
   // Returns false, nothing waiting, once a stop is asked.
   while (wake_.wait(lock, stop, [this] { return waiting_ != nullptr; })) {

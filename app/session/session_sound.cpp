@@ -132,7 +132,7 @@ SoundReport SessionSound::Finish() {
 std::string SoundSummaryText(const SoundReport& r) {
   if (!r.playing && !r.video_track) return "";
   std::string out = "sound: " + std::to_string(r.lines.size()) + (r.lines.size() == 1 ? " line" : " lines");
-  char part[200];
+  char part[320];
   if (r.playing) {
     std::size_t heard = 0;
     double worst_ms = 0;
@@ -143,8 +143,9 @@ std::string SoundSummaryText(const SoundReport& r) {
       if (std::abs(ms) > std::abs(worst_ms)) worst_ms = ms;
     }
     std::snprintf(part, sizeof part, "; played %zu (%lld late), first samples heard within %+.1f ms of their frames' display; "
-                  "%lld underruns",
-                  heard, static_cast<long long>(r.player.clips_late), worst_ms, static_cast<long long>(r.player.underruns));
+                  "%lld underruns (%lld in a line), player %s",
+                  heard, static_cast<long long>(r.player.clips_late), worst_ms, static_cast<long long>(r.player.underruns),
+                  static_cast<long long>(r.player.underruns_in_clips), r.player.scheduling.c_str());
     out += part;
     if (!r.player.error.empty()) out += "; " + r.player.error;
   }
@@ -173,6 +174,8 @@ nlohmann::ordered_json SoundJson(const SoundReport& r) {
   nlohmann::ordered_json j = {{"playing", r.playing}, {"video_track", r.video_track}, {"lines", lines}};
   if (r.playing) {
     j["underruns"] = r.player.underruns;
+    j["underruns_in_lines"] = r.player.underruns_in_clips;
+    j["player_scheduling"] = r.player.scheduling;
     j["clips_played"] = r.player.clips_played;
     j["clips_late"] = r.player.clips_late;
     j["clips_dropped"] = r.player.clips_dropped;
