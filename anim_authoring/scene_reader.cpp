@@ -1,4 +1,4 @@
-#include "anim_authoring/scene.h"
+#include "anim_authoring/scene_reader.h"
 
 #include "base/library_errors.h"
 
@@ -14,640 +14,284 @@
 #include <sstream>
 
 namespace arview::authoring {
-namespace {
 
 namespace fs = std::filesystem;
-using yaml::Node;
+using Node = yaml::Node;
 
-class SceneReader {
- public:
-  explicit SceneReader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void Fail(const Node& n, const std::string& what) const {
-    throw anim::Error(file_ + ":" + std::to_string(n.line) + ": " + what);
+CharacterSpec SceneReader::Character(const Node& n, const fs::path& base_dir) const {
+  OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "gesture",
+               "keys", "scopes", "idle", "schedule", "gaze", "voice", "lines"},
+           "a character");
+  CharacterSpec c;
+  c.where = file_ + ":" + std::to_string(n.line);
+  if (const Node* x = n.Find("name")) c.name = String(*x, "name");
+  const Node* asset = n.Find("asset");
+  if (!asset) Fail(n, "a character needs 'asset: <file>'");
+  fs::path a = String(*asset, "asset");
+  if (IsBuiltinAsset(a)) {  // generated in code, not a file: no path to resolve
+    c.asset = a;
+    if (c.name.empty()) c.name = a.string().substr(std::string(kBuiltinAssetPrefix).size());
+  } else {
+    if (a.is_relative()) a = base_dir / a;
+    c.asset = fs::absolute(a).lexically_normal();
   }
+  if (c.name.empty()) c.name = c.asset.stem().string();
+  if (const Node* x = n.Find("scale")) {
+    c.scale = Number(*x, "scale");
+    if (!(c.scale > 0)) Fail(*x, "scale must be positive");
+  }
+  if (const Node* x = n.Find("anchor")) c.anchor = AnchorOf(*x);
+  if (const Node* x = n.Find("forward")) c.forward = Direction(*x, "forward");
+  if (const Node* x = n.Find("up")) c.up = Direction(*x, "up");
+  if (std::abs(c.forward.dot(c.up)) > 0.999) Fail(n, "forward and up must not be parallel");
+  if (const Node* x = n.Find("weights")) {
+    OnlyKeys(*x, {"mode", "distance", "alpha"}, "weights");
+    if (const Node* y = x->Find("mode"))
+      c.weights.mode = Choice<anim::WeightingMode>(*y, "weights.mode",
+                                             {{"inverse-distance", anim::WeightingMode::kInverseDistance},
+                                              {"local", anim::WeightingMode::kLocalSupport}});
+    if (const Node* y = x->Find("distance"))
+      c.weights.distance = Choice<anim::DistanceKind>(*y, "weights.distance",
+                                                {{"geodesic", anim::DistanceKind::kGeodesic}, {"chordal", anim::DistanceKind::kChordal}});
+    if (const Node* y = x->Find("alpha")) {
+      c.weights.alpha = Number(*y, "weights.alpha");
+      if (!(c.weights.alpha > 0)) Fail(*y, "weights.alpha must be positive");
+    }
+  }
+  if (const Node* x = n.Find("blend")) {
+    OnlyKeys(*x, {"method", "precision", "max_iterations"}, "blend");
+    if (const Node* y = x->Find("method"))
+      c.blend = Choice<anim::BlendMethod>(*y, "blend.method", {{"dlb", anim::BlendMethod::kDlb}, {"dib", anim::BlendMethod::kDib}});
+    if (const Node* y = x->Find("precision")) {
+      c.dib.precision = Number(*y, "blend.precision");
+      if (!(c.dib.precision > 0)) Fail(*y, "blend.precision must be positive");
+    }
+    if (const Node* y = x->Find("max_iterations")) {
+      const double it = Number(*y, "blend.max_iterations");
+      if (it < 1 || it > 10000 || it != std::floor(it)) Fail(*y, "blend.max_iterations must be an integer in 1..10000");
+      c.dib.max_iterations = static_cast<int>(it);
+    }
+  }
+  if (const Node* x = n.Find("phase"))
+    c.phase = Choice<anim::PhaseMode>(*x, "phase", {{"shared", anim::PhaseMode::kShared}, {"independent", anim::PhaseMode::kIndependent}});
+  if (const Node* x = n.Find("sampling"))
+    c.nlerp_sampling = Choice<bool>(*x, "sampling", {{"slerp", false}, {"nlerp", true}});
+  if (const Node* x = n.Find("lookat")) {
+    OnlyKeys(*x, {"base_clip", "chain", "limits"}, "lookat");
+    c.has_lookat = true;
+    if (const Node* y = x->Find("base_clip")) c.lookat.base_clip = String(*y, "lookat.base_clip");
+    if (const Node* y = x->Find("chain")) {
+      if (!y->IsSequence() || y->items.empty()) Fail(*y, "lookat.chain: expected a list of joint names");
+      for (const Node& j : y->items) c.lookat.chain.push_back(String(j, "lookat.chain"));
+    }
+    if (const Node* y = x->Find("limits")) {
+      c.lookat.limits_deg = Numbers(*y, "lookat.limits");
+      for (double l : c.lookat.limits_deg)
+        if (!(l > 0) || l > 180) Fail(*y, "lookat.limits: each limit must be in (0, 180] degrees");
+    }
+  }
+  if (const Node* x = n.Find("gesture")) c.gesture = GestureOf(*x);
+  const Node* keys = n.Find("keys");
+  if (!keys || !keys->IsSequence() || keys->items.empty()) Fail(n, "a character needs a non-empty 'keys:' list");
+  for (const Node& k : keys->items) c.keys.push_back(Key(k, c));
+  if (const Node* x = n.Find("scopes")) c.scopes = Scopes(*x);
+  if (const Node* x = n.Find("idle")) c.idle = Idle(*x, base_dir);
+  if (const Node* x = n.Find("schedule")) c.schedule = ScheduleOf(*x);
+  if (const Node* x = n.Find("gaze")) c.gaze = GazeOf(*x);
+  if (const Node* x = n.Find("voice")) {
+    c.voice = String(*x, "voice");
+    c.voice_line = x->line;
+  }
+  if (const Node* x = n.Find("lines")) c.lines = Lines(*x);
+  return c;
+}
 
-  void OnlyKeys(const Node& n, const std::set<std::string>& allowed, const std::string& where) const {
-    if (!n.IsMapping()) Fail(n, where + " must be a mapping");
-    for (const auto& [k, v] : n.entries)
-      if (!allowed.count(k)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        Fail(v, "unknown key '" + k + "' in " + where + " (known: " + list + ")");
+std::vector<LineSpec> SceneReader::Lines(const Node& n) const {
+  if (!n.IsSequence()) Fail(n, "lines: expected a list of {when: ..., say: ...}");
+  if (n.items.size() > kMaxLinesPerCharacter)
+    Fail(n, "lines: " + std::to_string(n.items.size()) + " lines, at most " + std::to_string(kMaxLinesPerCharacter));
+  std::vector<LineSpec> lines;
+  for (const Node& item : n.items) lines.push_back(Line(item));
+  return lines;
+}
+
+LineSpec SceneReader::Line(const Node& n) const {
+  OnlyKeys(n, {"when", "say", "near", "far"}, "a line");
+  LineSpec l;
+  const Node* say = n.Find("say");
+  if (!say) Fail(n, "a line needs 'say: <text>'");
+  l.say = String(*say, "say");
+  l.line = say->line;
+  const Node* when = n.Find("when");
+  if (!when) Fail(n, "a line needs 'when: start | near | behind | lost | found'");
+  l.when = Choice<LineCue>(*when, "when", {{"start", LineCue::kStart},
+                                           {"near", LineCue::kNear},
+                                           {"behind", LineCue::kBehind},
+                                           {"lost", LineCue::kLost},
+                                           {"found", LineCue::kFound}});
+  const Node* near = n.Find("near");
+  const Node* far = n.Find("far");
+  if (l.when != LineCue::kNear && (near || far)) Fail(near ? *near : *far, "near and far are for 'when: near' lines");
+  if (near) {
+    l.near = NonNegative(*near, "near");
+    l.far = l.near * 1.25 + 0.1;  // the distance triggers' default hysteresis
+  }
+  if (far) l.far = Number(*far, "far");
+  if (!(l.far > l.near)) Fail(far ? *far : n, "far must be beyond near (hysteresis)");
+  return l;
+}
+
+GazeSpec SceneReader::GazeOf(const Node& n) const {
+  OnlyKeys(n, {"enabled", "mode", "blink_rate", "eye_range", "seed"}, "gaze");
+  GazeSpec g;
+  g.line = n.line;
+  if (const Node* x = n.Find("enabled")) g.enabled = Bool(*x, "gaze.enabled");
+  if (const Node* x = n.Find("mode"))
+    g.options.mode = Choice<anim::GazeMode>(*x, "gaze.mode", {{"listening", anim::GazeMode::kListening},
+                                                              {"talking", anim::GazeMode::kTalking},
+                                                              {"rest", anim::GazeMode::kRest}});
+  if (const Node* x = n.Find("blink_rate")) {
+    g.options.blink_rate_per_min = Number(*x, "gaze.blink_rate");
+    if (!(g.options.blink_rate_per_min > 0) || g.options.blink_rate_per_min > 100)
+      Fail(*x, "gaze.blink_rate: blinks per minute, in (0, 100]");
+  }
+  if (const Node* x = n.Find("eye_range")) {
+    OnlyKeys(*x, {"sideways", "up", "down"}, "gaze.eye_range");
+    auto angle = [&](const char* key, double& out) {
+      if (const Node* y = x->Find(key)) {
+        out = Number(*y, std::string("gaze.eye_range.") + key);
+        if (!(out > 0) || out > 60) Fail(*y, std::string("gaze.eye_range.") + key + ": degrees, in (0, 60]");
+      }
+    };
+    angle("sideways", g.options.range.sideways_deg);
+    angle("up", g.options.range.up_deg);
+    angle("down", g.options.range.down_deg);
+  }
+  if (const Node* x = n.Find("seed")) g.options.seed = static_cast<std::uint64_t>(Integer(*x, "gaze.seed", 0, 2147483647));
+  return g;
+}
+
+Anchor SceneReader::AnchorOf(const Node& n) const {
+  OnlyKeys(n, {"position", "rotation", "rotation_deg", "scale"}, "anchor");
+  Anchor a;
+  if (const Node* x = n.Find("position")) a.position = Vec3(*x, "anchor.position");
+  if (n.Find("rotation") && n.Find("rotation_deg")) Fail(n, "anchor: give rotation or rotation_deg, not both");
+  if (const Node* x = n.Find("rotation")) {
+    const auto q = Numbers(*x, "anchor.rotation (x, y, z, w)", 4);
+    Eigen::Quaterniond r(q[3], q[0], q[1], q[2]);
+    if (r.norm() < 1e-9) Fail(*x, "anchor.rotation has zero length");
+    a.rotation = r.normalized();
+  }
+  if (const Node* x = n.Find("rotation_deg")) {
+    const Eigen::Vector3d e = Vec3(*x, "anchor.rotation_deg") * (M_PI / 180);
+    a.rotation = Eigen::AngleAxisd(e.x(), Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(e.y(), Eigen::Vector3d::UnitY()) *
+                 Eigen::AngleAxisd(e.z(), Eigen::Vector3d::UnitZ());
+  }
+  if (const Node* x = n.Find("scale")) {
+    a.scale = Number(*x, "anchor.scale");
+    if (!(a.scale > 0)) Fail(*x, "anchor.scale must be positive");
+  }
+  return a;
+}
+
+GestureSpec SceneReader::GestureOf(const Node& n) const {
+  OnlyKeys(n, {"arm", "chain", "elbow", "shoulder_cone", "bend"}, "gesture");
+  GestureSpec g;
+  if (const Node* y = n.Find("arm"))
+    g.side = Choice<ArmSide>(*y, "gesture.arm", {{"right", ArmSide::kRight}, {"left", ArmSide::kLeft}});
+  if (const Node* y = n.Find("chain")) {
+    if (!y->IsSequence() || y->items.size() != 3)
+      Fail(*y, "gesture.chain: expected [upper arm, forearm, hand] joint names");
+    for (const Node& j : y->items) g.chain.push_back(String(j, "gesture.chain"));
+  }
+  if (const Node* y = n.Find("elbow")) {
+    const auto range = Numbers(*y, "gesture.elbow", 2);
+    if (!(range[0] >= 0 && range[0] <= range[1] && range[1] <= 180))
+      Fail(*y, "gesture.elbow: expected [min, max] bend with 0 <= min <= max <= 180 degrees");
+    g.limits.elbow_min_deg = range[0];
+    g.limits.elbow_max_deg = range[1];
+  }
+  if (const Node* y = n.Find("shoulder_cone")) {
+    g.limits.shoulder_cone_deg = Number(*y, "gesture.shoulder_cone");
+    if (!(g.limits.shoulder_cone_deg > 0 && g.limits.shoulder_cone_deg <= 180))
+      Fail(*y, "gesture.shoulder_cone must be in (0, 180] degrees");
+  }
+  if (const Node* y = n.Find("bend")) {
+    OnlyKeys(*y, {"point", "reach"}, "gesture.bend");
+    for (const char* which : {"point", "reach"})
+      if (const Node* z = y->Find(which)) {
+        const double b = Number(*z, std::string("gesture.bend.") + which);
+        if (!(b >= 0 && b <= 180)) Fail(*z, std::string("gesture.bend.") + which + " must be in [0, 180] degrees");
+        (std::string(which) == "point" ? g.limits.point_bend_deg : g.limits.reach_bend_deg) = b;
       }
   }
+  return g;
+}
 
-  double Number(const Node& n, const std::string& what) const {
-    if (!n.IsScalar() || n.scalar.empty()) Fail(n, what + ": expected a number");
-    std::size_t used = 0;
-    double x = 0;
-    try {
-      x = std::stod(n.scalar, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != n.scalar.size() || !std::isfinite(x)) Fail(n, what + ": expected a number, got '" + n.scalar + "'");
-    return x;
+KeySpec SceneReader::Key(const Node& n, const CharacterSpec& c) const {
+  OnlyKeys(n, {"viewpoint", "azimuth", "elevation", "clip", "generate", "gesture", "pose"}, "a key");
+  KeySpec k;
+  k.line = n.line;
+  const Node* vp = n.Find("viewpoint");
+  const Node* az = n.Find("azimuth");
+  const Node* el = n.Find("elevation");
+  if (vp && (az || el)) Fail(n, "a key gives either viewpoint or azimuth/elevation, not both");
+  if (vp) {
+    k.viewpoint = Direction(*vp, "key viewpoint");
+  } else if (az || el) {
+    const double a = az ? Number(*az, "azimuth") : 0.0;
+    const double e = el ? Number(*el, "elevation") : 0.0;
+    if (std::abs(e) > 90) Fail(el ? *el : n, "elevation must be within [-90, 90] degrees");
+    k.viewpoint = anim::DirectionFromAzimuthElevation(a, e, c.forward, c.up);
+  } else {
+    Fail(n, "a key needs 'viewpoint: [x, y, z]' or 'azimuth: <deg>'");
   }
-
-  std::string String(const Node& n, const std::string& what) const {
-    if (!n.IsScalar() || n.scalar.empty()) Fail(n, what + ": expected a non-empty string");
-    return n.scalar;
-  }
-
-  std::vector<double> Numbers(const Node& n, const std::string& what, std::size_t count = 0) const {
-    if (!n.IsSequence()) Fail(n, what + ": expected a list like [1, 2, 3]");
-    if (count && n.items.size() != count)
-      Fail(n, what + ": expected " + std::to_string(count) + " numbers, got " + std::to_string(n.items.size()));
-    std::vector<double> out;
-    for (const Node& x : n.items) out.push_back(Number(x, what));
-    return out;
-  }
-
-  Eigen::Vector3d Vec3(const Node& n, const std::string& what) const {
-    const auto v = Numbers(n, what, 3);
-    return {v[0], v[1], v[2]};
-  }
-
-  // A direction (anim::UnitDirection): its own line named, and why it gives none.
-  Eigen::Vector3d Direction(const Node& n, const std::string& what) const {
-    const Eigen::Vector3d v = Vec3(n, what);
-    try {
-      return anim::UnitDirection(v);
-    } catch (const anim::Error& e) {
-      Fail(n, what + " " + e.what());
-    }
-  }
-
-  template <class E>
-  E Choice(const Node& n, const std::string& what, const std::vector<std::pair<std::string, E>>& options) const {
-    const std::string s = String(n, what);
-    std::string list;
-    for (const auto& [name, value] : options) {
-      if (s == name) return value;
-      list += (list.empty() ? "" : " | ") + name;
-    }
-    Fail(n, what + ": '" + s + "' is not one of " + list);
-  }
-
-  CharacterSpec Character(const Node& n, const fs::path& base_dir) const {
-    OnlyKeys(n, {"name", "asset", "scale", "anchor", "forward", "up", "weights", "blend", "phase", "sampling", "lookat", "gesture",
-                 "keys", "scopes", "idle", "schedule", "gaze", "voice", "lines"},
-             "a character");
-    CharacterSpec c;
-    c.where = file_ + ":" + std::to_string(n.line);
-    if (const Node* x = n.Find("name")) c.name = String(*x, "name");
-    const Node* asset = n.Find("asset");
-    if (!asset) Fail(n, "a character needs 'asset: <file>'");
-    fs::path a = String(*asset, "asset");
-    if (IsBuiltinAsset(a)) {  // generated in code, not a file: no path to resolve
-      c.asset = a;
-      if (c.name.empty()) c.name = a.string().substr(std::string(kBuiltinAssetPrefix).size());
+  // A gesture key is a generated look-at key with the arm on top: `generate: lookat` may go with it.
+  const bool generated = n.Find("generate") || n.Find("gesture");
+  const int sources = (n.Find("clip") ? 1 : 0) + (generated ? 1 : 0) + (n.Find("pose") ? 1 : 0);
+  if (sources != 1)
+    Fail(n, "a key needs exactly one of 'clip: <name>', 'generate: lookat', 'gesture: point|reach', "
+            "'pose: rest|<clip>@<seconds>'");
+  if (const Node* x = n.Find("clip")) {
+    k.source = KeySpec::Source::kClip;
+    k.clip = String(*x, "clip");
+  } else if (generated) {
+    if (const Node* x = n.Find("generate"))
+      if (String(*x, "generate") != "lookat") Fail(*x, "generate: only 'lookat' is known (gestures: 'gesture: point|reach')");
+    k.source = KeySpec::Source::kLookAt;
+    if (const Node* x = n.Find("gesture"))
+      k.gesture = Choice<Gesture>(*x, "gesture", {{"point", Gesture::kPoint}, {"reach", Gesture::kReach}});
+  } else {
+    const Node& p = *n.Find("pose");
+    const std::string s = String(p, "pose");
+    if (s == "rest") {
+      k.source = KeySpec::Source::kRestPose;
     } else {
-      if (a.is_relative()) a = base_dir / a;
-      c.asset = fs::absolute(a).lexically_normal();
+      const auto at = s.rfind('@');
+      if (at == std::string::npos || at == 0) Fail(p, "pose: expected 'rest' or '<clip>@<seconds>'");
+      k.source = KeySpec::Source::kStaticPose;
+      k.clip = s.substr(0, at);
+      Node t = p;
+      t.scalar = s.substr(at + 1);
+      k.pose_time = Number(t, "pose time");
+      if (k.pose_time < 0) Fail(p, "pose time must not be negative");
     }
-    if (c.name.empty()) c.name = c.asset.stem().string();
-    if (const Node* x = n.Find("scale")) {
-      c.scale = Number(*x, "scale");
-      if (!(c.scale > 0)) Fail(*x, "scale must be positive");
-    }
-    if (const Node* x = n.Find("anchor")) c.anchor = AnchorOf(*x);
-    if (const Node* x = n.Find("forward")) c.forward = Direction(*x, "forward");
-    if (const Node* x = n.Find("up")) c.up = Direction(*x, "up");
-    if (std::abs(c.forward.dot(c.up)) > 0.999) Fail(n, "forward and up must not be parallel");
-    if (const Node* x = n.Find("weights")) {
-      OnlyKeys(*x, {"mode", "distance", "alpha"}, "weights");
-      if (const Node* y = x->Find("mode"))
-        c.weights.mode = Choice<anim::WeightingMode>(*y, "weights.mode",
-                                               {{"inverse-distance", anim::WeightingMode::kInverseDistance},
-                                                {"local", anim::WeightingMode::kLocalSupport}});
-      if (const Node* y = x->Find("distance"))
-        c.weights.distance = Choice<anim::DistanceKind>(*y, "weights.distance",
-                                                  {{"geodesic", anim::DistanceKind::kGeodesic}, {"chordal", anim::DistanceKind::kChordal}});
-      if (const Node* y = x->Find("alpha")) {
-        c.weights.alpha = Number(*y, "weights.alpha");
-        if (!(c.weights.alpha > 0)) Fail(*y, "weights.alpha must be positive");
-      }
-    }
-    if (const Node* x = n.Find("blend")) {
-      OnlyKeys(*x, {"method", "precision", "max_iterations"}, "blend");
-      if (const Node* y = x->Find("method"))
-        c.blend = Choice<anim::BlendMethod>(*y, "blend.method", {{"dlb", anim::BlendMethod::kDlb}, {"dib", anim::BlendMethod::kDib}});
-      if (const Node* y = x->Find("precision")) {
-        c.dib.precision = Number(*y, "blend.precision");
-        if (!(c.dib.precision > 0)) Fail(*y, "blend.precision must be positive");
-      }
-      if (const Node* y = x->Find("max_iterations")) {
-        const double it = Number(*y, "blend.max_iterations");
-        if (it < 1 || it > 10000 || it != std::floor(it)) Fail(*y, "blend.max_iterations must be an integer in 1..10000");
-        c.dib.max_iterations = static_cast<int>(it);
-      }
-    }
-    if (const Node* x = n.Find("phase"))
-      c.phase = Choice<anim::PhaseMode>(*x, "phase", {{"shared", anim::PhaseMode::kShared}, {"independent", anim::PhaseMode::kIndependent}});
-    if (const Node* x = n.Find("sampling"))
-      c.nlerp_sampling = Choice<bool>(*x, "sampling", {{"slerp", false}, {"nlerp", true}});
-    if (const Node* x = n.Find("lookat")) {
-      OnlyKeys(*x, {"base_clip", "chain", "limits"}, "lookat");
-      c.has_lookat = true;
-      if (const Node* y = x->Find("base_clip")) c.lookat.base_clip = String(*y, "lookat.base_clip");
-      if (const Node* y = x->Find("chain")) {
-        if (!y->IsSequence() || y->items.empty()) Fail(*y, "lookat.chain: expected a list of joint names");
-        for (const Node& j : y->items) c.lookat.chain.push_back(String(j, "lookat.chain"));
-      }
-      if (const Node* y = x->Find("limits")) {
-        c.lookat.limits_deg = Numbers(*y, "lookat.limits");
-        for (double l : c.lookat.limits_deg)
-          if (!(l > 0) || l > 180) Fail(*y, "lookat.limits: each limit must be in (0, 180] degrees");
-      }
-    }
-    if (const Node* x = n.Find("gesture")) c.gesture = GestureOf(*x);
-    const Node* keys = n.Find("keys");
-    if (!keys || !keys->IsSequence() || keys->items.empty()) Fail(n, "a character needs a non-empty 'keys:' list");
-    for (const Node& k : keys->items) c.keys.push_back(Key(k, c));
-    if (const Node* x = n.Find("scopes")) c.scopes = Scopes(*x);
-    if (const Node* x = n.Find("idle")) c.idle = Idle(*x, base_dir);
-    if (const Node* x = n.Find("schedule")) c.schedule = ScheduleOf(*x);
-    if (const Node* x = n.Find("gaze")) c.gaze = GazeOf(*x);
-    if (const Node* x = n.Find("voice")) {
-      c.voice = String(*x, "voice");
-      c.voice_line = x->line;
-    }
-    if (const Node* x = n.Find("lines")) c.lines = Lines(*x);
-    return c;
   }
+  return k;
+}
 
-  std::vector<LineSpec> Lines(const Node& n) const {
-    if (!n.IsSequence()) Fail(n, "lines: expected a list of {when: ..., say: ...}");
-    if (n.items.size() > kMaxLinesPerCharacter)
-      Fail(n, "lines: " + std::to_string(n.items.size()) + " lines, at most " + std::to_string(kMaxLinesPerCharacter));
-    std::vector<LineSpec> lines;
-    for (const Node& item : n.items) lines.push_back(Line(item));
-    return lines;
-  }
+Scene SceneReader::Read(const Node& root, const fs::path& file) const {
+  OnlyKeys(root, {"characters"}, "the scene");
+  const Node* chars = root.Find("characters");
+  if (!chars || !chars->IsSequence() || chars->items.empty())
+    throw anim::Error(file_ + ": a scene needs a non-empty 'characters:' list");
+  Scene s;
+  s.file = file;
+  const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  for (const Node& c : chars->items) s.characters.push_back(Character(c, base));
+  return s;
+}
 
-  LineSpec Line(const Node& n) const {
-    OnlyKeys(n, {"when", "say", "near", "far"}, "a line");
-    LineSpec l;
-    const Node* say = n.Find("say");
-    if (!say) Fail(n, "a line needs 'say: <text>'");
-    l.say = String(*say, "say");
-    l.line = say->line;
-    const Node* when = n.Find("when");
-    if (!when) Fail(n, "a line needs 'when: start | near | behind | lost | found'");
-    l.when = Choice<LineCue>(*when, "when", {{"start", LineCue::kStart},
-                                             {"near", LineCue::kNear},
-                                             {"behind", LineCue::kBehind},
-                                             {"lost", LineCue::kLost},
-                                             {"found", LineCue::kFound}});
-    const Node* near = n.Find("near");
-    const Node* far = n.Find("far");
-    if (l.when != LineCue::kNear && (near || far)) Fail(near ? *near : *far, "near and far are for 'when: near' lines");
-    if (near) {
-      l.near = NonNegative(*near, "near");
-      l.far = l.near * 1.25 + 0.1;  // the distance triggers' default hysteresis
-    }
-    if (far) l.far = Number(*far, "far");
-    if (!(l.far > l.near)) Fail(far ? *far : n, "far must be beyond near (hysteresis)");
-    return l;
-  }
-
-  GazeSpec GazeOf(const Node& n) const {
-    OnlyKeys(n, {"enabled", "mode", "blink_rate", "eye_range", "seed"}, "gaze");
-    GazeSpec g;
-    g.line = n.line;
-    if (const Node* x = n.Find("enabled")) g.enabled = Bool(*x, "gaze.enabled");
-    if (const Node* x = n.Find("mode"))
-      g.options.mode = Choice<anim::GazeMode>(*x, "gaze.mode", {{"listening", anim::GazeMode::kListening},
-                                                                {"talking", anim::GazeMode::kTalking},
-                                                                {"rest", anim::GazeMode::kRest}});
-    if (const Node* x = n.Find("blink_rate")) {
-      g.options.blink_rate_per_min = Number(*x, "gaze.blink_rate");
-      if (!(g.options.blink_rate_per_min > 0) || g.options.blink_rate_per_min > 100)
-        Fail(*x, "gaze.blink_rate: blinks per minute, in (0, 100]");
-    }
-    if (const Node* x = n.Find("eye_range")) {
-      OnlyKeys(*x, {"sideways", "up", "down"}, "gaze.eye_range");
-      auto angle = [&](const char* key, double& out) {
-        if (const Node* y = x->Find(key)) {
-          out = Number(*y, std::string("gaze.eye_range.") + key);
-          if (!(out > 0) || out > 60) Fail(*y, std::string("gaze.eye_range.") + key + ": degrees, in (0, 60]");
-        }
-      };
-      angle("sideways", g.options.range.sideways_deg);
-      angle("up", g.options.range.up_deg);
-      angle("down", g.options.range.down_deg);
-    }
-    if (const Node* x = n.Find("seed")) g.options.seed = static_cast<std::uint64_t>(Integer(*x, "gaze.seed", 0, 2147483647));
-    return g;
-  }
-
-  bool Bool(const Node& n, const std::string& what) const {
-    return Choice<bool>(n, what, {{"true", true}, {"false", false}});
-  }
-
-  int Integer(const Node& n, const std::string& what, int lo, int hi) const {
-    const double x = Number(n, what);
-    if (x != std::floor(x) || x < lo || x > hi)
-      Fail(n, what + ": expected an integer in " + std::to_string(lo) + ".." + std::to_string(hi));
-    return static_cast<int>(x);
-  }
-
-  double NonNegative(const Node& n, const std::string& what) const {
-    const double x = Number(n, what);
-    if (x < 0) Fail(n, what + " must not be negative");
-    return x;
-  }
-
-  anim::ScopeTable Scopes(const Node& n) const {
-    if (!n.IsMapping()) Fail(n, "scopes must be a mapping of name: [joints]");
-    anim::ScopeTable table;
-    for (const auto& [name, v] : n.entries) {
-      anim::ScopeSpec spec;
-      const Node* joints = &v;
-      if (v.IsMapping()) {
-        OnlyKeys(v, {"joints", "descendants"}, "scope '" + name + "'");
-        joints = v.Find("joints");
-        if (!joints) Fail(v, "scope '" + name + "' needs 'joints: [names]'");
-        if (const Node* d = v.Find("descendants")) spec.descendants = Bool(*d, "descendants");
-      }
-      if (!joints->IsSequence() || joints->items.empty()) Fail(*joints, "scope '" + name + "': expected a list of joint names");
-      for (const Node& j : joints->items) spec.joints.push_back(String(j, "scope joint"));
-      table[name] = spec;
-    }
-    return table;
-  }
-
-  IdleSpec Idle(const Node& n, const fs::path& base_dir) const {
-    OnlyKeys(n, {"motion", "clips", "joint_map", "seed", "components", "balance"}, "idle");
-    IdleSpec idle;
-    idle.given = true;
-    idle.line = n.line;
-    if (const Node* x = n.Find("motion")) {
-      if (!x->IsSequence()) Fail(*x, "idle.motion: expected a list of motion files");
-      for (const Node& f : x->items) {
-        fs::path p = String(f, "idle.motion");
-        if (p.is_relative()) p = base_dir / p;
-        idle.motion.push_back(fs::absolute(p).lexically_normal());
-      }
-    }
-    if (const Node* x = n.Find("clips")) {
-      if (!x->IsSequence()) Fail(*x, "idle.clips: expected a list of clip names");
-      for (const Node& c : x->items) idle.clips.push_back(String(c, "idle.clips"));
-    }
-    if (idle.motion.empty() && idle.clips.empty()) Fail(n, "idle needs 'motion: [files]' and/or 'clips: [names]' to learn from");
-    if (const Node* x = n.Find("joint_map")) {
-      if (!x->IsMapping()) Fail(*x, "idle.joint_map: expected data_joint: character_joint entries");
-      for (const auto& [from, to] : x->entries) idle.joint_map[from] = String(to, "idle.joint_map");
-    }
-    if (const Node* x = n.Find("seed")) idle.seed = static_cast<std::uint64_t>(Integer(*x, "idle.seed", 0, 2147483647));
-    if (const Node* x = n.Find("components")) idle.components = Integer(*x, "idle.components", 1, 64);
-    if (const Node* x = n.Find("balance")) idle.balance = Balance(*x, base_dir, idle.components);
-    return idle;
-  }
-
-  BalanceSpec Balance(const Node& n, const fs::path& base_dir, int idle_components) const {
-    OnlyKeys(n, {"motion", "clip", "seed", "components"}, "idle.balance");
-    BalanceSpec b;
-    b.given = true;
-    b.line = n.line;
-    const Node* motion = n.Find("motion");
-    const Node* clip = n.Find("clip");
-    if ((motion != nullptr) == (clip != nullptr))
-      Fail(n, "idle.balance needs exactly one of 'motion: <file>' (a recording of a person standing) or 'clip: <name>' "
-              "(a clip of the character)");
-    if (motion) {
-      fs::path p = String(*motion, "idle.balance.motion");
-      if (p.is_relative()) p = base_dir / p;
-      b.motion = fs::absolute(p).lexically_normal();
-    }
-    if (clip) b.clip = String(*clip, "idle.balance.clip");
-    if (const Node* x = n.Find("seed")) b.seed = static_cast<std::uint64_t>(Integer(*x, "idle.balance.seed", 0, 2147483647));
-    if (const Node* x = n.Find("components")) {
-      b.components = Integer(*x, "idle.balance.components", 1, 64);
-      if (b.components > idle_components)
-        Fail(*x, "idle.balance.components: " + std::to_string(b.components) + " is more than the idle model's " +
-                     std::to_string(idle_components) + " (idle.components)");
-    } else {
-      b.components = std::min(b.components, idle_components);
-    }
-    return b;
-  }
-
-  anim::Curve CurveOf(const Node& n, const std::string& what) const {
-    OnlyKeys(n, {"shape", "in", "out", "attack", "decay", "sustain", "release", "peak", "seconds"}, what);
-    anim::Curve c;
-    if (const Node* x = n.Find("shape"))
-      c.shape = Choice<anim::Curve::Shape>(*x, what + ".shape",
-                                     {{"constant", anim::Curve::Shape::kConstant},
-                                      {"linear-fade", anim::Curve::Shape::kLinearFade},
-                                      {"cosine-fade", anim::Curve::Shape::kCosineFade},
-                                      {"adsr", anim::Curve::Shape::kAdsr},
-                                      {"cosine-adsr", anim::Curve::Shape::kCosineAdsr}});
-    if (const Node* x = n.Find("in")) c.fade_in = NonNegative(*x, what + ".in");
-    if (const Node* x = n.Find("out")) c.fade_out = NonNegative(*x, what + ".out");
-    if (const Node* x = n.Find("attack")) c.attack = NonNegative(*x, what + ".attack");
-    if (const Node* x = n.Find("decay")) c.decay = NonNegative(*x, what + ".decay");
-    if (const Node* x = n.Find("release")) c.release = NonNegative(*x, what + ".release");
-    if (const Node* x = n.Find("sustain")) c.sustain = NonNegative(*x, what + ".sustain");
-    if (const Node* x = n.Find("peak")) c.peak = NonNegative(*x, what + ".peak");
-    if (const Node* x = n.Find("seconds")) c.in_seconds = Bool(*x, what + ".seconds");
-    if (c.sustain > 1) Fail(n, what + ".sustain is a fraction of the peak, at most 1");
-    return c;
-  }
-
-  std::vector<anim::Curve> Curves(const Node& n, const std::string& what) const {
-    std::vector<anim::Curve> out;
-    if (n.IsSequence())
-      for (const Node& c : n.items) out.push_back(CurveOf(c, what));
-    else
-      out.push_back(CurveOf(n, what));
-    return out;
-  }
-
-  // A mask weight: a number (rotation and translation alike) or {rotation: r, translation: t}.
-  std::pair<double, double> MaskWeight(const Node& n, const std::string& what) const {
-    if (n.IsMapping()) {
-      OnlyKeys(n, {"rotation", "translation"}, what);
-      const Node* r = n.Find("rotation");
-      const Node* t = n.Find("translation");
-      return {r ? NonNegative(*r, what + ".rotation") : 1.0, t ? NonNegative(*t, what + ".translation") : 1.0};
-    }
-    const double w = NonNegative(n, what);
-    return {w, w};
-  }
-
-  MaskSpec MaskOf(const Node& n) const {
-    if (!n.IsMapping()) Fail(n, "mask: expected {default: w, <scope>: w, ...}");
-    MaskSpec m;
-    m.line = n.line;
-    for (const auto& [key, v] : n.entries) {
-      const auto [r, t] = MaskWeight(v, "mask." + key);
-      if (key == "default") {
-        m.default_rotation = r;
-        m.default_translation = t;
-      } else {
-        m.scopes.push_back({key, r, t});
-      }
-    }
-    return m;
-  }
-
-  ObjectSpec ObjectOf(const Node& n) const {
-    OnlyKeys(n, {"clip", "pose", "view_adaptive", "idle", "schedule", "window", "stretch", "loop", "mirror", "transform"},
-             "an object");
-    ObjectSpec o;
-    o.line = n.line;
-    const int kinds = (n.Find("clip") ? 1 : 0) + (n.Find("pose") ? 1 : 0) + (n.Find("view_adaptive") ? 1 : 0) +
-                      (n.Find("idle") ? 1 : 0) + (n.Find("schedule") ? 1 : 0);
-    if (kinds != 1)
-      Fail(n, "an object needs exactly one of 'clip: <name>', 'pose: rest|<clip>@<s>', 'view_adaptive: true', 'idle: true', "
-              "'schedule: {actions: [...]}'");
-    if (const Node* x = n.Find("clip")) {
-      o.kind = ObjectSpec::Kind::kClip;
-      o.clip = String(*x, "clip");
-    } else if (const Node* x = n.Find("pose")) {
-      o.kind = ObjectSpec::Kind::kPose;
-      const std::string p = String(*x, "pose");
-      if (p != "rest") {
-        const auto at = p.rfind('@');
-        if (at == std::string::npos || at == 0) Fail(*x, "pose: expected 'rest' or '<clip>@<seconds>'");
-        o.clip = p.substr(0, at);
-        Node t = *x;
-        t.scalar = p.substr(at + 1);
-        o.pose_time = NonNegative(t, "pose time");
-      }
-    } else if (const Node* x = n.Find("view_adaptive")) {
-      if (!Bool(*x, "view_adaptive")) Fail(*x, "view_adaptive: only 'true' makes an object");
-      o.kind = ObjectSpec::Kind::kViewAdaptive;
-    } else if (const Node* x = n.Find("idle")) {
-      if (!Bool(*x, "idle")) Fail(*x, "idle: only 'true' makes an object");
-      o.kind = ObjectSpec::Kind::kIdle;
-    } else {
-      const Node& sched = *n.Find("schedule");
-      OnlyKeys(sched, {"actions"}, "a nested schedule");
-      const Node* actions = sched.Find("actions");
-      if (!actions || !actions->IsSequence() || actions->items.empty()) Fail(sched, "a nested schedule needs 'actions: [...]'");
-      o.kind = ObjectSpec::Kind::kSchedule;
-      for (const Node& a : actions->items) o.actions.push_back(ActionOf(a));
-    }
-    if (const Node* x = n.Find("window")) {
-      const auto w = Numbers(*x, "window", 2);
-      if (!(w[0] >= 0) || !(w[1] > w[0])) Fail(*x, "window: needs [from, to] with 0 <= from < to (seconds)");
-      o.has_window = true;
-      o.window_from = w[0];
-      o.window_to = w[1];
-    }
-    if (const Node* x = n.Find("stretch")) {
-      o.stretch = Number(*x, "stretch");
-      if (!(o.stretch > 0)) Fail(*x, "stretch: the new length must be positive (seconds)");
-    }
-    if (const Node* x = n.Find("loop")) {
-      if (x->IsScalar() && (x->scalar == "true" || x->scalar == "false")) o.loop = x->scalar == "true" ? 0 : -1;
-      else o.loop = Integer(*x, "loop (true or a count)", 1, 1000000);
-    }
-    if (const Node* x = n.Find("mirror")) o.mirror = Bool(*x, "mirror");
-    if (const Node* x = n.Find("transform")) {
-      o.has_transform = true;
-      o.transform = AnchorOf(*x);
-    }
-    return o;
-  }
-
-  ActionSpec ActionOf(const Node& n) const {
-    OnlyKeys(n, {"name", "object", "start", "keep_rendering", "layer", "weight", "curve", "curves", "scaling", "mask", "masks",
-                 "trigger", "distance"},
-             "an action");
-    ActionSpec a;
-    a.line = n.line;
-    if (const Node* x = n.Find("name")) a.name = String(*x, "name");
-    const Node* object = n.Find("object");
-    if (!object) Fail(n, "an action needs 'object: {...}'");
-    a.object = ObjectOf(*object);
-    if (const Node* x = n.Find("start")) a.start = Number(*x, "start");
-    if (const Node* x = n.Find("keep_rendering")) a.keep_rendering = Bool(*x, "keep_rendering");
-    if (const Node* x = n.Find("layer")) a.layer = Integer(*x, "layer", 0, 15);
-    if (const Node* x = n.Find("weight")) a.weight = NonNegative(*x, "weight");
-    if (n.Find("curve") && n.Find("curves")) Fail(n, "give 'curve' or 'curves', not both");
-    if (const Node* x = n.Find("curve")) a.curves = Curves(*x, "curve");
-    if (const Node* x = n.Find("curves")) a.curves = Curves(*x, "curves");
-    if (const Node* x = n.Find("scaling")) a.scalings = Curves(*x, "scaling");
-    if (n.Find("mask") && n.Find("masks")) Fail(n, "give 'mask' or 'masks', not both");
-    if (const Node* x = n.Find("mask")) a.masks.push_back(MaskOf(*x));
-    if (const Node* x = n.Find("masks")) {
-      if (!x->IsSequence()) Fail(*x, "masks: expected a list of masks");
-      for (const Node& m : x->items) a.masks.push_back(MaskOf(m));
-    }
-    if (const Node* x = n.Find("trigger")) {
-      OnlyKeys(*x, {"near", "far"}, "trigger");
-      const Node* near = x->Find("near");
-      if (!near) Fail(*x, "trigger needs 'near: <metres>'");
-      a.has_trigger = true;
-      a.trigger_near = NonNegative(*near, "trigger.near");
-      a.trigger_far = a.trigger_near * 1.25 + 0.1;  // default hysteresis band
-      if (const Node* far = x->Find("far")) a.trigger_far = Number(*far, "trigger.far");
-      if (!(a.trigger_far > a.trigger_near)) Fail(*x, "trigger: far must be beyond near (hysteresis)");
-    }
-    if (const Node* x = n.Find("distance")) {
-      if (!x->IsSequence() || x->items.empty()) Fail(*x, "distance: expected [[metres, weight], ...]");
-      for (const Node& p : x->items) {
-        const auto v = Numbers(p, "distance point [metres, weight]", 2);
-        if (v[1] < 0) Fail(p, "distance: weights must not be negative");
-        if (!a.distance_weight.empty() && !(v[0] > a.distance_weight.back().first))
-          Fail(p, "distance: distances must increase");
-        a.distance_weight.emplace_back(v[0], v[1]);
-      }
-    }
-    return a;
-  }
-
-  ScheduleSpec ScheduleOf(const Node& n) const {
-    OnlyKeys(n, {"actions", "rest_threshold", "tracking_loss"}, "schedule");
-    ScheduleSpec s;
-    s.given = true;
-    const Node* actions = n.Find("actions");
-    if (!actions || !actions->IsSequence() || actions->items.empty()) Fail(n, "schedule needs a non-empty 'actions:' list");
-    for (const Node& a : actions->items) s.actions.push_back(ActionOf(a));
-    if (const Node* x = n.Find("rest_threshold")) s.rest_threshold = NonNegative(*x, "rest_threshold");
-    if (const Node* x = n.Find("tracking_loss")) {
-      OnlyKeys(*x, {"hold", "fade", "action"}, "tracking_loss");
-      if (const Node* y = x->Find("hold")) s.hold_seconds = NonNegative(*y, "tracking_loss.hold");
-      if (const Node* y = x->Find("fade")) s.fade_seconds = NonNegative(*y, "tracking_loss.fade");
-      if (const Node* y = x->Find("action")) s.view_action = String(*y, "tracking_loss.action");
-    }
-    std::set<std::string> names;
-    for (const ActionSpec& a : s.actions)
-      if (!a.name.empty() && !names.insert(a.name).second) Fail(*actions, "two actions named '" + a.name + "'");
-    return s;
-  }
-
-  Anchor AnchorOf(const Node& n) const {
-    OnlyKeys(n, {"position", "rotation", "rotation_deg", "scale"}, "anchor");
-    Anchor a;
-    if (const Node* x = n.Find("position")) a.position = Vec3(*x, "anchor.position");
-    if (n.Find("rotation") && n.Find("rotation_deg")) Fail(n, "anchor: give rotation or rotation_deg, not both");
-    if (const Node* x = n.Find("rotation")) {
-      const auto q = Numbers(*x, "anchor.rotation (x, y, z, w)", 4);
-      Eigen::Quaterniond r(q[3], q[0], q[1], q[2]);
-      if (r.norm() < 1e-9) Fail(*x, "anchor.rotation has zero length");
-      a.rotation = r.normalized();
-    }
-    if (const Node* x = n.Find("rotation_deg")) {
-      const Eigen::Vector3d e = Vec3(*x, "anchor.rotation_deg") * (M_PI / 180);
-      a.rotation = Eigen::AngleAxisd(e.x(), Eigen::Vector3d::UnitX()) * Eigen::AngleAxisd(e.y(), Eigen::Vector3d::UnitY()) *
-                   Eigen::AngleAxisd(e.z(), Eigen::Vector3d::UnitZ());
-    }
-    if (const Node* x = n.Find("scale")) {
-      a.scale = Number(*x, "anchor.scale");
-      if (!(a.scale > 0)) Fail(*x, "anchor.scale must be positive");
-    }
-    return a;
-  }
-
-  GestureSpec GestureOf(const Node& n) const {
-    OnlyKeys(n, {"arm", "chain", "elbow", "shoulder_cone", "bend"}, "gesture");
-    GestureSpec g;
-    if (const Node* y = n.Find("arm"))
-      g.side = Choice<ArmSide>(*y, "gesture.arm", {{"right", ArmSide::kRight}, {"left", ArmSide::kLeft}});
-    if (const Node* y = n.Find("chain")) {
-      if (!y->IsSequence() || y->items.size() != 3)
-        Fail(*y, "gesture.chain: expected [upper arm, forearm, hand] joint names");
-      for (const Node& j : y->items) g.chain.push_back(String(j, "gesture.chain"));
-    }
-    if (const Node* y = n.Find("elbow")) {
-      const auto range = Numbers(*y, "gesture.elbow", 2);
-      if (!(range[0] >= 0 && range[0] <= range[1] && range[1] <= 180))
-        Fail(*y, "gesture.elbow: expected [min, max] bend with 0 <= min <= max <= 180 degrees");
-      g.limits.elbow_min_deg = range[0];
-      g.limits.elbow_max_deg = range[1];
-    }
-    if (const Node* y = n.Find("shoulder_cone")) {
-      g.limits.shoulder_cone_deg = Number(*y, "gesture.shoulder_cone");
-      if (!(g.limits.shoulder_cone_deg > 0 && g.limits.shoulder_cone_deg <= 180))
-        Fail(*y, "gesture.shoulder_cone must be in (0, 180] degrees");
-    }
-    if (const Node* y = n.Find("bend")) {
-      OnlyKeys(*y, {"point", "reach"}, "gesture.bend");
-      for (const char* which : {"point", "reach"})
-        if (const Node* z = y->Find(which)) {
-          const double b = Number(*z, std::string("gesture.bend.") + which);
-          if (!(b >= 0 && b <= 180)) Fail(*z, std::string("gesture.bend.") + which + " must be in [0, 180] degrees");
-          (std::string(which) == "point" ? g.limits.point_bend_deg : g.limits.reach_bend_deg) = b;
-        }
-    }
-    return g;
-  }
-
-  KeySpec Key(const Node& n, const CharacterSpec& c) const {
-    OnlyKeys(n, {"viewpoint", "azimuth", "elevation", "clip", "generate", "gesture", "pose"}, "a key");
-    KeySpec k;
-    k.line = n.line;
-    const Node* vp = n.Find("viewpoint");
-    const Node* az = n.Find("azimuth");
-    const Node* el = n.Find("elevation");
-    if (vp && (az || el)) Fail(n, "a key gives either viewpoint or azimuth/elevation, not both");
-    if (vp) {
-      k.viewpoint = Direction(*vp, "key viewpoint");
-    } else if (az || el) {
-      const double a = az ? Number(*az, "azimuth") : 0.0;
-      const double e = el ? Number(*el, "elevation") : 0.0;
-      if (std::abs(e) > 90) Fail(el ? *el : n, "elevation must be within [-90, 90] degrees");
-      k.viewpoint = anim::DirectionFromAzimuthElevation(a, e, c.forward, c.up);
-    } else {
-      Fail(n, "a key needs 'viewpoint: [x, y, z]' or 'azimuth: <deg>'");
-    }
-    // A gesture key is a generated look-at key with the arm on top: `generate: lookat` may go with it.
-    const bool generated = n.Find("generate") || n.Find("gesture");
-    const int sources = (n.Find("clip") ? 1 : 0) + (generated ? 1 : 0) + (n.Find("pose") ? 1 : 0);
-    if (sources != 1)
-      Fail(n, "a key needs exactly one of 'clip: <name>', 'generate: lookat', 'gesture: point|reach', "
-              "'pose: rest|<clip>@<seconds>'");
-    if (const Node* x = n.Find("clip")) {
-      k.source = KeySpec::Source::kClip;
-      k.clip = String(*x, "clip");
-    } else if (generated) {
-      if (const Node* x = n.Find("generate"))
-        if (String(*x, "generate") != "lookat") Fail(*x, "generate: only 'lookat' is known (gestures: 'gesture: point|reach')");
-      k.source = KeySpec::Source::kLookAt;
-      if (const Node* x = n.Find("gesture"))
-        k.gesture = Choice<Gesture>(*x, "gesture", {{"point", Gesture::kPoint}, {"reach", Gesture::kReach}});
-    } else {
-      const Node& p = *n.Find("pose");
-      const std::string s = String(p, "pose");
-      if (s == "rest") {
-        k.source = KeySpec::Source::kRestPose;
-      } else {
-        const auto at = s.rfind('@');
-        if (at == std::string::npos || at == 0) Fail(p, "pose: expected 'rest' or '<clip>@<seconds>'");
-        k.source = KeySpec::Source::kStaticPose;
-        k.clip = s.substr(0, at);
-        Node t = p;
-        t.scalar = s.substr(at + 1);
-        k.pose_time = Number(t, "pose time");
-        if (k.pose_time < 0) Fail(p, "pose time must not be negative");
-      }
-    }
-    return k;
-  }
-
-  Scene Read(const Node& root, const fs::path& file) const {
-    OnlyKeys(root, {"characters"}, "the scene");
-    const Node* chars = root.Find("characters");
-    if (!chars || !chars->IsSequence() || chars->items.empty())
-      throw anim::Error(file_ + ": a scene needs a non-empty 'characters:' list");
-    Scene s;
-    s.file = file;
-    const fs::path base = file.has_parent_path() ? file.parent_path() : fs::path(".");
-    for (const Node& c : chars->items) s.characters.push_back(Character(c, base));
-    return s;
-  }
-
- private:
-  std::string file_;
-};
-
-}  // namespace
 
 Scene ParseScene(const std::string& text, const fs::path& file) {
   const Node root = yaml::Parse(text, file.string());
