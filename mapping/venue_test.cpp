@@ -16,6 +16,7 @@
 #include "calib/camera.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_pipeline.h"
+#include "map/map_file.h"
 #include "mapping/venue.h"
 #include "recordings/importers.h"
 #include "recordings/trajectory.h"
@@ -136,9 +137,16 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   options.keep_folded = true;
   std::vector<VenueRoom> rooms;
   const recordings::Recording venue = VenueRecording({dir / "east", dir / "west"}, dir / "venue", &rooms);
+  options.rooms = rooms;
   const MapBuildResult result = BuildMap(venue, dir / "venue", options);
   WriteVenueFile(rooms, result.map, dir / "venue");
   EXPECT_EQ(result.map.keyframes.size(), 6u);
+  // The map file names the rooms and each keyframe's.
+  const map::Map saved = map::LoadMap(dir / "venue");
+  EXPECT_EQ(saved.rooms, (std::vector<std::string>{"east", "west"}));
+  for (const map::Keyframe& k : saved.keyframes) EXPECT_EQ(k.room, k.frame_index < 3 ? 0 : 1) << k.name;
+  EXPECT_EQ(DescribeMapRooms(saved, rooms),
+            (std::vector<std::string>{"east: 3 keyframes of 3 frames (0-2)", "west: 3 keyframes of 3 frames (3-5)"}));
   const auto read = ReadVenueFile(dir / "venue");
   ASSERT_TRUE(read.has_value());
   ASSERT_EQ(read->size(), 2u);
@@ -147,7 +155,9 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   EXPECT_FALSE(ReadVenueFile(dir / "temple").has_value()) << "a folder without venue.json is no venue";
 
   options.frames_spec = "6-11";
+  options.rooms.clear();
   BuildMap(temple, dir / "one", options);
+  EXPECT_TRUE(map::LoadMap(dir / "one").rooms.empty()) << "one recording's map has no rooms";
 
   // The databases: the same features and the same verified pairs with the same inliers.
   std::vector<std::string> venue_names, one_names;
