@@ -46,6 +46,7 @@ struct Keyframe {
   double timestamp = 0;
   calib::Pose pose;          // world → camera
   std::vector<KeyframeObservation> observations;
+  int room = -1;             // index into Map::rooms; -1: no room (one recording's map)
 };
 
 // Where the map's scale and "up" come from (docs/mapping.md, "Metric scale and up").
@@ -82,7 +83,14 @@ struct Map {
   std::vector<std::uint32_t> descriptor_point;  // row → index into points
   // Filled by mapping/: row → index into keyframes (the keyframe whose keypoint gave the row).
   std::vector<std::uint32_t> descriptor_keyframe;
+  // A venue's rooms (its recordings, docs/mapping.md "A venue of several recordings"), named as in
+  // its venue.json; each keyframe names its own. Empty for the map of one recording.
+  std::vector<std::string> rooms;
 };
+
+// The room of the keyframe whose centre is nearest `centre` (map units), or -1 when the map has
+// no rooms: where a camera localized there stands.
+int RoomAt(const Map& map, const Eigen::Vector3d& centre);
 
 // Reading and writing maps, and what `arview map info` prints: map/map_file.h.
 

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <type_traits>
 
 namespace arview::map {
@@ -154,6 +155,10 @@ void WritePayload(const Map& map, Writer& w) {
   w.Put(f.from_colmap.scale);
   for (int i = 0; i < 9; ++i) w.Put(f.from_colmap.R(i / 3, i % 3));
   for (int i = 0; i < 3; ++i) w.Put(f.from_colmap.t[i]);
+
+  w.Put<std::uint64_t>(map.rooms.size());
+  for (const std::string& room : map.rooms) w.PutString(room);
+  for (const Keyframe& k : map.keyframes) w.Put<std::int32_t>(k.room);
 }
 
 void ReadFrame(Reader& r, MapFrame* f) {
@@ -168,6 +173,12 @@ void ReadFrame(Reader& r, MapFrame* f) {
   f->from_colmap.scale = r.Get<double>("map frame");
   for (int i = 0; i < 9; ++i) f->from_colmap.R(i / 3, i % 3) = r.Get<double>("map frame");
   for (int i = 0; i < 3; ++i) f->from_colmap.t[i] = r.Get<double>("map frame");
+}
+
+void ReadRooms(Reader& r, Map* map) {
+  map->rooms.resize(r.GetCount("room count", 4));
+  for (std::string& room : map->rooms) room = r.GetString("room name");
+  for (Keyframe& k : map->keyframes) k.room = r.Get<std::int32_t>("keyframe room");
 }
 
 Map ReadPayload(Reader& r, std::uint32_t version) {
@@ -223,6 +234,7 @@ Map ReadPayload(Reader& r, std::uint32_t version) {
   map.descriptor_keyframe.resize(rows);
   r.GetBytes(map.descriptor_keyframe.data(), rows * sizeof(std::uint32_t), "descriptor keyframes");
   if (version >= 2) ReadFrame(r, &map.frame);
+  if (version >= 3) ReadRooms(r, &map);
   if (!r.AtEnd()) r.Fail("unexpected bytes after the payload");
   return map;
 }
@@ -250,8 +262,15 @@ void ValidateMap(const Map& map, const std::string& source) {
   if (map.descriptor_point.size() != rows || map.descriptor_keyframe.size() != rows) {
     fail("descriptor_point / descriptor_keyframe sizes differ from the descriptor count");
   }
+  for (const std::string& room : map.rooms) {
+    if (room.empty() || room.find('\n') != std::string::npos) fail("a room's name is empty or holds a line break");
+  }
   for (std::size_t i = 0; i < map.keyframes.size(); ++i) {
     const Keyframe& k = map.keyframes[i];
+    if (k.room < -1 || k.room >= static_cast<int>(map.rooms.size())) {
+      fail("keyframe " + std::to_string(i) + " ('" + k.name + "') names room " + std::to_string(k.room) + " of " +
+           std::to_string(map.rooms.size()));
+    }
     // Values far beyond any real scene (a corrupted file with its checksum recomputed) are
     // refused: the maths downstream would print nan or overflow.
     if (!std::isfinite(k.pose.q_cw.norm()) || std::abs(k.pose.q_cw.norm() - 1.0) > 1e-6 || !k.pose.t_cw.allFinite() ||
@@ -374,6 +393,20 @@ std::optional<std::string> DegeneratePoints(const Map& map) {
   points.reserve(map.points.size());
   for (const MapPoint& p : map.points) points.push_back(p.xyz);
   return WhyNotAPlane(points, "points");
+}
+
+int RoomAt(const Map& map, const Eigen::Vector3d& centre) {
+  int room = -1;
+  if (map.rooms.empty()) return room;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Keyframe& k : map.keyframes) {
+    const double d = (k.pose.Center() - centre).squaredNorm();
+    if (k.room >= 0 && d < nearest) {
+      nearest = d;
+      room = k.room;
+    }
+  }
+  return room;
 }
 
 MapStats ComputeStats(const Map& map) {

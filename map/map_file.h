@@ -6,9 +6,10 @@
 // uint64 payload size, uint64 payload checksum (64-bit FNV-1a over 8-byte words, tail bytes
 // one by one), then the payload: camera (version 2: with its focus), keyframes (with their observations), points,
 // descriptor rows, descriptor → point, descriptor → keyframe, and (version 2) the map's frame:
-// scale source, z-up, scale error, its one-line description, COLMAP → map similarity. Every
-// count and index is checked on load; any mismatch throws MapError naming the file. Version 1
-// files (no frame record) load as COLMAP's frame.
+// scale source, z-up, scale error, its one-line description, COLMAP → map similarity, and
+// (version 3) the rooms: their count and names, then each keyframe's room (int32, -1: none).
+// Every count and index is checked on load; any mismatch throws MapError naming the file.
+// Version 1 files (no frame record) load as COLMAP's frame, versions 1 and 2 without rooms.
 
 #include <filesystem>
 #include <optional>
@@ -19,7 +20,7 @@
 namespace arview::map {
 
 inline constexpr const char* kMapFileName = "map.arvmap";
-inline constexpr std::uint32_t kMapFileVersion = 2;
+inline constexpr std::uint32_t kMapFileVersion = 3;
 
 // Writes atomically (a temporary file renamed into place). Throws MapError.
 void SaveMap(const Map& map, const std::filesystem::path& file);

@@ -130,22 +130,19 @@ TEST_F(MapFileTest, TheMetricFrameRecordRoundTrips) {
   }
 }
 
-// A map written before the frame record (version 1: the same payload without it) loads as
-// COLMAP's frame. The file is made from a version 2 one: the record and the camera's focus cut, the version and the
-// checksum (map_file.h's FNV-1a over 8-byte words) put back.
-TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
-  Map map = SmallMap();
-  SaveMap(map, dir_ / kMapFileName);
+// The bytes of `file` with its last `cut` payload bytes cut, then `erase` bytes at `erase_at`
+// (offsets in the file), as a file of `version`: the payload size and the checksum (map_file.h's
+// FNV-1a over 8-byte words) put back. How the tests make files of the versions before.
+std::string AsOlderVersion(const fs::path& file, std::size_t cut, std::size_t erase_at, std::size_t erase,
+                           std::uint32_t version) {
   std::string bytes;
   {
-    std::ifstream in(dir_ / kMapFileName, std::ios::binary);
+    std::ifstream in(file, std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(in), {});
   }
-  const std::size_t record = 1 + 1 + 8 + 4 + map.frame.how.size() + 8 + 9 * 8 + 3 * 8;
-  bytes.resize(bytes.size() - record);
+  bytes.resize(bytes.size() - cut);
+  bytes.erase(erase_at, erase);
   const std::size_t header = 32;
-  bytes.erase(header + 4 + 4 + 4 * 8 + 5 * 8, 1 + 8);  // the camera's focus, after its distortion
-  const std::uint32_t version = 1;
   const std::uint64_t payload = bytes.size() - header;
   std::uint64_t h = 0xcbf29ce484222325ULL;
   std::size_t i = header;
@@ -159,9 +156,22 @@ TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
   std::memcpy(bytes.data() + 8, &version, 4);
   std::memcpy(bytes.data() + 16, &payload, 8);
   std::memcpy(bytes.data() + 24, &h, 8);
+  return bytes;
+}
+
+// The rooms record of a map without rooms: their count, and each keyframe's -1.
+std::size_t NoRoomsRecord(const Map& map) { return 8 + 4 * map.keyframes.size(); }
+
+// A map written before the frame record (version 1: the same payload without it and without the
+// camera's focus) loads as COLMAP's frame, without rooms.
+TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
+  Map map = SmallMap();
+  SaveMap(map, dir_ / kMapFileName);
+  const std::size_t frame_record = 1 + 1 + 8 + 4 + map.frame.how.size() + 8 + 9 * 8 + 3 * 8;
+  const std::size_t focus_at = 32 + 4 + 4 + 4 * 8 + 5 * 8;  // after the camera's distortion
   {
     std::ofstream out(dir_ / "v1.arvmap", std::ios::binary);
-    out << bytes;
+    out << AsOlderVersion(dir_ / kMapFileName, frame_record + NoRoomsRecord(map), focus_at, 1 + 8, 1);
   }
   const Map back = LoadMap(dir_ / "v1.arvmap");
   EXPECT_FALSE(back.frame.metric());
@@ -170,6 +180,64 @@ TEST_F(MapFileTest, AVersionOneFileLoadsInColmapsFrame) {
   EXPECT_EQ(back.camera.fx, map.camera.fx);
   EXPECT_EQ(back.keyframes.size(), map.keyframes.size());
   EXPECT_EQ(back.points.size(), map.points.size());
+  EXPECT_TRUE(back.rooms.empty());
+}
+
+// A venue's rooms: their names and each keyframe's room come back; a map of version 2 (before
+// rooms) loads with none.
+TEST_F(MapFileTest, TheRoomsRoundTripAndAVersionTwoFileHasNone) {
+  Map map = SmallMap();
+  map.rooms = {"east", "west"};
+  map.keyframes[0].room = 0;
+  map.keyframes[1].room = 1;  // keyframe 2 in none (a frame added later by 'map extend')
+  SaveMap(map, dir_ / kMapFileName);
+  const Map back = LoadMap(dir_);
+  EXPECT_EQ(back.rooms, map.rooms);
+  ASSERT_EQ(back.keyframes.size(), 3u);
+  EXPECT_EQ(back.keyframes[0].room, 0);
+  EXPECT_EQ(back.keyframes[1].room, 1);
+  EXPECT_EQ(back.keyframes[2].room, -1);
+
+  const Map plain = SmallMap();
+  SaveMap(plain, dir_ / kMapFileName);
+  {
+    std::ofstream out(dir_ / "v2.arvmap", std::ios::binary);
+    out << AsOlderVersion(dir_ / kMapFileName, NoRoomsRecord(plain), 0, 0, 2);
+  }
+  const Map v2 = LoadMap(dir_ / "v2.arvmap");
+  EXPECT_TRUE(v2.rooms.empty());
+  for (const Keyframe& k : v2.keyframes) EXPECT_EQ(k.room, -1);
+  EXPECT_EQ(v2.keyframes.size(), 3u);
+}
+
+TEST_F(MapFileTest, AKeyframeInARoomTheMapDoesNotHaveIsRefused) {
+  Map map = SmallMap();
+  map.rooms = {"east"};
+  map.keyframes[2].room = 1;
+  try {
+    SaveMap(map, dir_ / kMapFileName);
+    FAIL() << "a keyframe in room 1 of 1 was saved";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("keyframe 2 ('frames/2.png') names room 1 of 1"), std::string::npos) << e.what();
+  }
+  map.keyframes[2].room = 0;
+  map.rooms = {""};
+  EXPECT_THROW(SaveMap(map, dir_ / kMapFileName), MapError) << "a room without a name";
+  EXPECT_FALSE(fs::exists(dir_ / kMapFileName)) << "nothing written";
+}
+
+// The room a camera stands in is its nearest keyframe's (keyframes at x = 0, 0.3, 0.6).
+TEST(RoomAt, TheNearestKeyframesRoomOrNoneWithoutRooms) {
+  Map map = SmallMap();
+  EXPECT_EQ(RoomAt(map, Eigen::Vector3d(0.1, 0, 0)), -1) << "a map without rooms";
+  map.rooms = {"east", "west"};
+  map.keyframes[0].room = 0;
+  map.keyframes[1].room = 1;
+  map.keyframes[2].room = 1;
+  EXPECT_EQ(RoomAt(map, Eigen::Vector3d(0.1, 0, 0)), 0);
+  EXPECT_EQ(RoomAt(map, Eigen::Vector3d(0.2, 0.1, -1)), 1);
+  map.keyframes[1].room = -1;  // a keyframe without a room is passed over
+  EXPECT_EQ(RoomAt(map, Eigen::Vector3d(0.29, 0, 0)), 0);
 }
 
 TEST_F(MapFileTest, EveryTruncationIsAClearError) {

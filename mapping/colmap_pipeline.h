@@ -23,6 +23,7 @@
 #include "mapping/metric_frame.h"
 #include "mapping/pair_matching.h"
 #include "mapping/slurm_engine.h"
+#include "mapping/venue.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -122,6 +123,9 @@ struct MapBuildOptions {
   // cannot be used falls back to the camera-height estimate, and MapBuildResult::scale_failure
   // says why; with kCameraHeight, a map without a floor stays in COLMAP's frame (a note says so).
   ScaleRequest scale;
+  // A venue's rooms (mapping/venue.h, VenueRecording): the map file names each keyframe's room.
+  // Empty for one recording.
+  std::vector<VenueRoom> rooms;
 
   // `arview map --preset fast`: 850 features and one orientation per keypoint, fewer bundle
   // adjustments (chosen on templeRing: a third less CPU, about twice the tracking error).

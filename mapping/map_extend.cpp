@@ -40,6 +40,13 @@ map::Map CarryFrameRecord(const map::Map& old_map, map::Map model) {
   extended.descriptors = model.descriptors;
   extended.descriptor_point = std::move(model.descriptor_point);
   extended.descriptor_keyframe = std::move(model.descriptor_keyframe);
+  // A venue's rooms: each keyframe it had keeps its room; the session's frames are in none.
+  std::map<std::string, int> rooms;
+  for (const map::Keyframe& k : old_map.keyframes) rooms[k.name] = k.room;
+  for (map::Keyframe& k : extended.keyframes) {
+    const auto it = rooms.find(k.name);
+    k.room = it == rooms.end() ? -1 : it->second;
+  }
   return extended;
 }
 

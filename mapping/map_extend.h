@@ -84,7 +84,8 @@ MapExtendResult ExtendMap(const std::filesystem::path& map_dir, const recordings
 
 // The extended map: `model` (camera, keyframes, points, descriptors read from the extended COLMAP
 // model) with every other record `old_map` carries, such as its metric frame: the extension holds
-// the old frame, so whatever says what that frame is stays true.
+// the old frame, so whatever says what that frame is stays true. A venue's rooms stay: the old
+// keyframes keep theirs (by name), the new ones are in none.
 map::Map CarryFrameRecord(const map::Map& old_map, map::Map model);
 
 // The similarity from the frame of COLMAP's model to the frame of the map file, found on the

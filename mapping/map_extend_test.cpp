@@ -90,6 +90,29 @@ TEST(CarryFrameRecord, TakesTheModelsCameraKeyframesPointsAndDescriptorsAndKeeps
   EXPECT_EQ(extended.frame.from_colmap.scale, 0.37);
 }
 
+// A venue's map extended: the rooms stay, each old keyframe in its own, the session's in none.
+TEST(CarryFrameRecord, TheOldKeyframesKeepTheirRoomsAndTheNewOnesHaveNone) {
+  map::Map old_map;
+  old_map.camera = CameraOfSize(640, 480);
+  old_map.rooms = {"east", "west"};
+  old_map.keyframes.resize(2);
+  old_map.keyframes[0].name = "east/frames/000006.png";
+  old_map.keyframes[0].room = 0;
+  old_map.keyframes[1].name = "west/frames/000009.png";
+  old_map.keyframes[1].room = 1;
+  map::Map model;
+  model.camera = old_map.camera;
+  model.keyframes.resize(3);
+  model.keyframes[0].name = "west/frames/000009.png";  // the model's order, not the map's
+  model.keyframes[1].name = "frames/000003.png";       // the new session's
+  model.keyframes[2].name = "east/frames/000006.png";
+  const map::Map extended = CarryFrameRecord(old_map, model);
+  EXPECT_EQ(extended.rooms, old_map.rooms);
+  EXPECT_EQ(extended.keyframes[0].room, 1);
+  EXPECT_EQ(extended.keyframes[1].room, -1);
+  EXPECT_EQ(extended.keyframes[2].room, 0);
+}
+
 std::vector<map::Keyframe> FourKeyframes() {
   std::vector<map::Keyframe> keyframes(4);
   const Eigen::Vector3d centres[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.2}, {0.5, 0.5, 1}};

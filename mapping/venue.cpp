@@ -86,6 +86,15 @@ recordings::Recording VenueRecording(const std::vector<fs::path>& folders, const
   return venue;
 }
 
+void NameRooms(const std::vector<VenueRoom>& rooms, map::Map* map) {
+  map->rooms.clear();
+  for (const VenueRoom& room : rooms) map->rooms.push_back(room.name);
+  for (map::Keyframe& k : map->keyframes) {
+    const auto in = std::find_if(rooms.begin(), rooms.end(), [&](const VenueRoom& r) { return r.Holds(k.frame_index); });
+    k.room = in == rooms.end() ? -1 : static_cast<int>(in - rooms.begin());
+  }
+}
+
 void WriteVenueFile(std::vector<VenueRoom> rooms, const map::Map& map, const fs::path& out_dir) {
   json list = json::array();
   for (VenueRoom& room : rooms) {
@@ -130,6 +139,21 @@ std::optional<std::vector<VenueRoom>> ReadVenueFile(const fs::path& map_dir) {
 std::string DescribeRoom(const VenueRoom& room) {
   return room.name + ": " + std::to_string(room.frames) + " frames (" + std::to_string(room.first_frame) + "-" +
          std::to_string(room.first_frame + room.frames - 1) + "), " + std::to_string(room.keyframes) + " registered";
+}
+
+std::vector<std::string> DescribeMapRooms(const map::Map& map, const std::vector<VenueRoom>& venue) {
+  std::vector<std::string> lines;
+  for (std::size_t r = 0; r < map.rooms.size(); ++r) {
+    const auto keyframes = std::count_if(map.keyframes.begin(), map.keyframes.end(),
+                                         [&](const map::Keyframe& k) { return k.room == static_cast<int>(r); });
+    std::string line = map.rooms[r] + ": " + std::to_string(keyframes) + " keyframes";
+    const auto named = std::find_if(venue.begin(), venue.end(), [&](const VenueRoom& v) { return v.name == map.rooms[r]; });
+    if (named != venue.end())
+      line += " of " + std::to_string(named->frames) + " frames (" + std::to_string(named->first_frame) + "-" +
+              std::to_string(named->first_frame + named->frames - 1) + ")";
+    lines.push_back(line);
+  }
+  return lines;
 }
 
 }  // namespace arview::mapping

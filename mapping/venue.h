@@ -38,6 +38,9 @@ constexpr const char* kVenueFileName = "venue.json";
 recordings::Recording VenueRecording(const std::vector<std::filesystem::path>& recordings,
                                      const std::filesystem::path& out_dir, std::vector<VenueRoom>* rooms);
 
+// The rooms' names in `map` and each keyframe's room (the room holding its frame; -1: none).
+void NameRooms(const std::vector<VenueRoom>& rooms, map::Map* map);
+
 // Each room's keyframes counted from the map, then <out_dir>/venue.json written (atomically).
 void WriteVenueFile(std::vector<VenueRoom> rooms, const map::Map& map, const std::filesystem::path& out_dir);
 
@@ -47,5 +50,9 @@ std::optional<std::vector<VenueRoom>> ReadVenueFile(const std::filesystem::path&
 
 // "hall: 24 frames (0-23), 24 registered"
 std::string DescribeRoom(const VenueRoom& room);
+
+// One line per room of the map file (map::Map::rooms): "hall: 24 keyframes", and with the room of
+// that name in `venue` (venue.json) its frames: "hall: 24 keyframes of 24 frames (0-23)".
+std::vector<std::string> DescribeMapRooms(const map::Map& map, const std::vector<VenueRoom>& venue);
 
 }  // namespace arview::mapping

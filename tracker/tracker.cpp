@@ -668,6 +668,11 @@ bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D
   return true;
 }
 
+void Tracker::NameRoom(FrameResult* result) const {
+  const int room = map::RoomAt(map_, result->center);
+  if (room >= 0) result->room = map_.rooms[static_cast<std::size_t>(room)];
+}
+
 FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
   const auto start = std::chrono::steady_clock::now();
   const double cpu_start = ThreadCpuMilliseconds();
@@ -697,6 +702,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
       MaybePrefetch(gray, result);
       result.center = result.pose.Center();
       result.smoothed_center = smoother_.Filter(result.center, timestamp);
+      NameRoom(&result);
     }
     result.times.total_ms = MillisecondsSince(start);
     result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;
@@ -762,6 +768,7 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
     MaybePrefetch(gray, result);
     result.center = result.pose.Center();
     result.smoothed_center = smoother_.Filter(result.center, timestamp);
+    NameRoom(&result);
   }
   result.times.total_ms = MillisecondsSince(start);
   result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;  // with a prefetch's worker CPU

@@ -218,6 +218,9 @@ struct FrameResult {
   // Lost: what relocalization's pose solver failed at (kNone: it did not run, e.g. a frame of
   // the wrong size); tracker/loss_diagnosis.h turns it and the frame's numbers into a cause.
   PoseFailure relocalization_failure = PoseFailure::kNone;
+  // A venue's map (map::Map::rooms): the room the frame was localized in, its nearest keyframe's
+  // (map::RoomAt); empty when lost or when the map has no rooms.
+  std::string room;
   StageTimes times;
 };
 
@@ -294,6 +297,8 @@ class Tracker {
   // that changes with frame_counter_.
   AbsolutePoseOptions TrackedPoseOptions(int ransac_iterations) const;
   void Remember(const FrameResult& result, double timestamp, const Track2D3D& inliers);
+  // The room of a localized frame (FrameResult::room) from its centre.
+  void NameRoom(FrameResult* result) const;
   // Starts extracting this frame's guided features on a worker thread when its flow tracks are
   // thinning (TrackingOptions::prefetch_below).
   void MaybePrefetch(const cv::Mat& gray, const FrameResult& result);

@@ -222,6 +222,28 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
   ExpectNear(r, far, 0.003, 0.2);
 }
 
+// A venue's map (map::Map::rooms): a localized frame names its nearest keyframe's room, and the
+// name changes when the camera moves over to the other room's keyframes; a lost frame and a map
+// without rooms name none.
+TEST_F(PlanarTrackerTest, ALocalizedFrameNamesTheRoomOfItsNearestKeyframe) {
+  map::Map venue = *map_;
+  venue.rooms = {"west", "east"};
+  const int room_of_keyframe[] = {0, 1, 0, 1};  // GraffitiKeyframes(): centre, right, left, low
+  for (std::size_t k = 0; k < venue.keyframes.size(); ++k) venue.keyframes[k].room = room_of_keyframe[k];
+  Tracker tracker(venue);
+  const FrameResult right = tracker.Track(world_->Render(LookAt({0.27, 0.02, -0.85}, {0.05, 0, 0})), 0.0);
+  ASSERT_NE(right.status, TrackStatus::kLost) << right.reason;
+  EXPECT_EQ(right.room, "east");
+  const FrameResult left = tracker.Track(world_->Render(LookAt({-0.27, 0.08, -0.85}, {-0.05, 0, 0})), 1.0);
+  ASSERT_NE(left.status, TrackStatus::kLost) << left.reason;
+  EXPECT_EQ(left.room, "west");
+  const FrameResult lost = tracker.Track(cv::Mat(world_->Render(PathPose(0)).size(), CV_8UC3, cv::Scalar::all(0)), 2.0);
+  EXPECT_EQ(lost.status, TrackStatus::kLost);
+  EXPECT_EQ(lost.room, "");
+  Tracker plain(*map_);
+  EXPECT_EQ(plain.Track(world_->Render(PathPose(0)), 0.0).room, "") << "a map without rooms";
+}
+
 // Fresh features: a tracked frame far from the last one in time (by default over 0.25 s: photos,
 // a sub-sampled clip) is posed again from its own SIFT matched against the whole map, and that
 // pose (close to the truth) is kept; frames at a video's rate are left to the flow, as with

@@ -145,6 +145,7 @@ void RunMap(const MapArgs& args) {
         args.recordings.size() == 1
             ? recordings::LoadRecording(args.recordings.front())
             : mapping::VenueRecording({args.recordings.begin(), args.recordings.end()}, args.out, &rooms);
+    options.rooms = rooms;
     const auto result = mapping::BuildMap(recording, args.out, options, callbacks);
     if (!rooms.empty()) {
       mapping::WriteVenueFile(rooms, result.map, args.out);
@@ -273,8 +274,15 @@ void RunInfo(const std::string& dir, bool recheck) {
     std::cout << "check:               not recorded (" << mapping::kMapCheckFileName
               << " is written by arview map since issue 17)\n";
   }
-  if (const auto venue = mapping::ReadVenueFile(folder)) {
-    std::cout << "rooms:               " << venue->size() << " (" << mapping::kVenueFileName << ")\n";
+  const auto venue = mapping::ReadVenueFile(folder);
+  if (!map.rooms.empty()) {
+    const std::string frames_from = venue ? "; their frames from " + std::string(mapping::kVenueFileName) : "";
+    std::cout << "rooms:               " << map.rooms.size() << " (the map file's" << frames_from << ")\n";
+    for (const std::string& line : mapping::DescribeMapRooms(map, venue ? *venue : std::vector<mapping::VenueRoom>{}))
+      std::cout << "                     " << line << "\n";
+  } else if (venue) {
+    std::cout << "rooms:               " << venue->size() << " (" << mapping::kVenueFileName
+              << "; the map file names none: it is older, 'arview map' again names them)\n";
     for (const auto& room : *venue) std::cout << "                     " << mapping::DescribeRoom(room) << "\n";
   }
   if (const auto why = map::DegeneratePoints(map)) {

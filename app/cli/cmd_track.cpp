@@ -89,6 +89,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
     j["center"] = {r.center[0], r.center[1], r.center[2]};
     j["smoothed_center"] = {r.smoothed_center[0], r.smoothed_center[1], r.smoothed_center[2]};
   }
+  if (!r.room.empty()) j["room"] = r.room;  // a venue's map: the room the frame was localized in
   return j;
 }
 

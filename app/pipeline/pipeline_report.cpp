@@ -122,6 +122,7 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
     frame["center"] = {f.track.center[0], f.track.center[1], f.track.center[2]};
     frame["smoothed_center"] = {f.track.smoothed_center[0], f.track.smoothed_center[1], f.track.smoothed_center[2]};
   }
+  if (!f.track.room.empty()) frame["room"] = f.track.room;  // a venue's map: where the frame was localized
   if (f.track.align_zncc > 0) frame["align_zncc"] = f.track.align_zncc;  // a whip-pan frame
   if (f.gaze_error_deg) frame["gaze_error_deg"] = *f.gaze_error_deg;
   if (f.actions_triggered) frame["actions_triggered"] = f.actions_triggered;

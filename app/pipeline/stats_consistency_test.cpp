@@ -88,6 +88,17 @@ TEST(StatsConsistency, EyesOnTheViewerAndBlinksAreRecordedPerFrameAndCounted) {
 namespace arview::app {
 namespace {
 
+// A venue's map: each localized frame's record names the room the tracker put it in; a frame
+// of a map without rooms has no "room".
+TEST(StatsConsistency, TheRoomOfAVenuesFrameIsRecorded) {
+  FrameLog plain;
+  plain.track.status = tracker::TrackStatus::kTracking;
+  EXPECT_FALSE(FrameLogJson(plain).contains("room"));
+  FrameLog in_venue = plain;
+  in_venue.track.room = "east";
+  EXPECT_EQ(FrameLogJson(in_venue).at("room"), "east");
+}
+
 // A character with a face speech drives (anim/face.h): each frame's record has the mouth's
 // opening, the strongest viseme while it talks, and the line being said; without a face, none.
 TEST(StatsConsistency, TheMouthTheVisemeAndTheLineAreRecordedPerFrame) {
