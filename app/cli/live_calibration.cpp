@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "app/cli/commands.h"
+#include "app/cli/window_panel.h"
 
 namespace arview::app {
 
@@ -66,22 +66,6 @@ bool CalibrateAsked(video::DisplayWindow& window) {
   return asked;
 }
 
-// `text` in lines of at most `width` characters, broken between words.
-std::vector<std::string> Wrap(const std::string& text, size_t width) {
-  std::vector<std::string> lines;
-  std::istringstream words(text);
-  std::string word, line;
-  while (words >> word) {
-    if (!line.empty() && line.size() + 1 + word.size() > width) {
-      lines.push_back(line);
-      line.clear();
-    }
-    line += (line.empty() ? "" : " ") + word;
-  }
-  if (!line.empty()) lines.push_back(line);
-  return lines;
-}
-
 }  // namespace
 
 cv::Size CalibrationWindowSize(cv::Size frame_size) {
@@ -107,16 +91,13 @@ cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const std::vector<cv::Point2
   for (const calib::CoverageBar& bar : selector.Bars()) {
     text(bar.name, y + 14);
     const cv::Rect outline(left + 50, y, bar_width - 50, 18);
-    const int filled = static_cast<int>(outline.width * bar.progress);
-    const cv::Scalar colour = bar.progress >= 1.0 ? cv::Scalar(60, 200, 60) : cv::Scalar(40, 150, 240);
-    cv::rectangle(picture, {outline.x, outline.y, filled, outline.height}, colour, cv::FILLED);
-    cv::rectangle(picture, outline, {200, 200, 200}, 1);
+    DrawBar(picture, outline, bar.progress, bar.progress >= 1.0 ? cv::Scalar(60, 200, 60) : cv::Scalar(40, 150, 240));
     y += 34;
   }
   text("views taken: " + std::to_string(selector.taken().size()), y + 12);
   text(selector.Sufficient() ? "enough: calibrating" : "c: calibrate now, q: stop", y + 40, 0.5, {180, 180, 180});
   int status_y = y + 76;
-  for (const std::string& line : Wrap(status, 26)) {
+  for (const std::string& line : WrapWords(status, 26)) {
     text(line, status_y, 0.5, {120, 230, 255});
     status_y += 20;
   }
