@@ -2,8 +2,8 @@
 // (tests/support/fake_v4l2_device.cpp) plays a chessboard waved in front of a camera whose
 // intrinsics and distortion are known exactly (tests/support/rendered_board.h: held still at
 // places across the image, near and far, tilted, carried between them with motion blur, sensor
-// noise), and the calibration the command writes must match them; the window under Xvfb, and the
-// inputs that hold no board.
+// noise), and the calibration the command writes must match them; the same for a ChArUco board
+// seen in part; the window under Xvfb, and the inputs that hold no board.
 
 #include <gtest/gtest.h>
 
