@@ -30,6 +30,16 @@ struct BoardPlacement {
 // row as calib::FindChessboardCorners gives them) placed in an image of `image_size`.
 BoardPlacement PlaceBoard(const std::vector<cv::Point2f>& corners, cv::Size board, cv::Size image_size);
 
+// The part of a board seen (a ChArUco board's corners found, at least 4, each with its place on
+// the board, z = 0): the outline of the board's rectangle that holds them, carried into the image
+// by the homography they fit, placed as PlaceBoard places a whole board's outline. A board half
+// out of the image is placed by its visible half; its skew is the board's own.
+BoardPlacement PlacePartialBoard(const std::vector<cv::Point2f>& corners, const std::vector<cv::Point3f>& on_board,
+                                 cv::Size image_size);
+// That outline, for drawing (four image points; empty when the corners fit no homography).
+std::vector<cv::Point2f> PartialBoardOutline(const std::vector<cv::Point2f>& corners,
+                                             const std::vector<cv::Point3f>& on_board);
+
 // One coverage bar: the range of a placement number the taken views span, and how much of the
 // range a calibration needs they cover (0..1).
 struct CoverageBar {
@@ -52,6 +62,9 @@ struct ViewSelectionOptions {
   // whatever the bars say (ROS: 40), since some placements cannot be reached with every lens.
   int min_views = 12;
   int max_views = 40;
+  // A board seen in part counts with at least this many corners (ChArUco: calib's detection
+  // keeps 6 or more).
+  int min_partial_corners = 6;
 
   // Throws OptionError naming the first field out of range.
   void Check(const OptionNames& names = {}) const;
@@ -71,8 +84,16 @@ class ViewSelector {
   // The next frame's corners (empty: no board found) and its time (seconds, increasing). A frame
   // without a board forgets the last corners, so that a board seen again is never still at once.
   Decision Offer(const std::vector<cv::Point2f>& corners, double timestamp);
+  // The same for a board seen in part (ChArUco): its corners found (fewer than min_partial_corners:
+  // no board) and their places on the board, which say which corner is which from frame to frame
+  // (its stillness is measured on the corners seen in both).
+  Decision OfferPartial(const std::vector<cv::Point2f>& corners, const std::vector<cv::Point3f>& on_board,
+                        double timestamp);
 
   const std::vector<std::vector<cv::Point2f>>& taken_corners() const { return taken_corners_; }
+  // Each view's outline in the image (four points): a chessboard's outer corners, a part's
+  // PartialBoardOutline.
+  const std::vector<std::vector<cv::Point2f>>& taken_outlines() const { return taken_outlines_; }
   const std::vector<BoardPlacement>& taken() const { return taken_; }
   std::vector<CoverageBar> Bars() const;  // X, Y, size, skew
   bool Sufficient() const;
@@ -80,13 +101,22 @@ class ViewSelector {
   double last_speed_px_per_s() const { return last_speed_; }
 
  private:
+  // The corners' mean speed since the last frame over the corners seen in both (by their place on
+  // the board); negative when fewer than 4 are.
+  double SpeedSince(const std::vector<cv::Point2f>& corners, const std::vector<cv::Point3f>& on_board,
+                    double timestamp) const;
+  Decision Decide(const std::vector<cv::Point2f>& corners, const std::vector<cv::Point3f>& on_board, double timestamp,
+                  const BoardPlacement& placement, std::vector<cv::Point2f> outline);
+
   cv::Size board_, image_size_;
   ViewSelectionOptions options_;
   std::vector<cv::Point2f> previous_;
+  std::vector<cv::Point3f> previous_on_board_;
   double previous_time_ = 0;
   double last_speed_ = -1;
   std::vector<BoardPlacement> taken_;
   std::vector<std::vector<cv::Point2f>> taken_corners_;
+  std::vector<std::vector<cv::Point2f>> taken_outlines_;
 };
 
 }  // namespace arview::calib

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <opencv2/calib3d.hpp>
 
@@ -164,6 +166,65 @@ TEST(ViewSelectionOptions, ChecksNameTheField) {
   options = {};
   options.max_views = 5;
   EXPECT_THROW(options.Check(), OptionError);
+}
+
+// The same board as places on it (row, column): what a ChArUco detection pairs its corners with.
+std::vector<cv::Point3f> Places() {
+  std::vector<cv::Point3f> places;
+  for (int row = 0; row < kBoard.height; ++row) {
+    for (int column = 0; column < kBoard.width; ++column) places.emplace_back(column * 0.025f, row * 0.025f, 0.f);
+  }
+  return places;
+}
+
+TEST(PlacePartialBoard, AWholeBoardInAnyOrderIsPlacedAsPlaceBoardPlacesIt) {
+  const std::vector<cv::Point2f> corners = SeenBoard({0.05, -0.02, 0.6}, 30);
+  std::vector<cv::Point2f> shuffled(corners.rbegin(), corners.rend());
+  std::vector<cv::Point3f> places = Places();
+  std::reverse(places.begin(), places.end());
+  const BoardPlacement whole = PlaceBoard(corners, kBoard, kImage), part = PlacePartialBoard(shuffled, places, kImage);
+  EXPECT_NEAR(part.x, whole.x, 1e-3);
+  EXPECT_NEAR(part.y, whole.y, 1e-3);
+  EXPECT_NEAR(part.size, whole.size, 1e-3);
+  EXPECT_NEAR(part.skew, whole.skew, 1e-3);
+}
+
+TEST(PlacePartialBoard, TheLeftHalfIsSmallerAndFurtherLeft) {
+  const std::vector<cv::Point2f> corners = SeenBoard({0, 0, 0.6}, 0);
+  const std::vector<cv::Point3f> places = Places();
+  std::vector<cv::Point2f> left;
+  std::vector<cv::Point3f> left_places;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    if (static_cast<int>(i) % kBoard.width < 4) {
+      left.push_back(corners[i]);
+      left_places.push_back(places[i]);
+    }
+  }
+  const BoardPlacement whole = PlaceBoard(corners, kBoard, kImage), half = PlacePartialBoard(left, left_places, kImage);
+  EXPECT_LT(half.size, 0.8 * whole.size);
+  EXPECT_NEAR(half.skew, 0, 0.01);
+  const cv::Point2f mean_left = std::accumulate(left.begin(), left.end(), cv::Point2f()) / static_cast<float>(left.size());
+  EXPECT_LT(mean_left.x, 300);
+  // Corners on one line fix no homography: no placement.
+  EXPECT_TRUE(PartialBoardOutline({corners[0], corners[1], corners[2], corners[3]},
+                                  {places[0], places[1], places[2], places[3]}).empty());
+}
+
+TEST(ViewSelector, APartialBoardHeldStillIsTakenWhateverTheOrderOfItsCorners) {
+  ViewSelector selector(kBoard, kImage);
+  const std::vector<cv::Point2f> corners = SeenBoard({0, 0, 0.6}, 20);
+  std::vector<cv::Point2f> part(corners.begin(), corners.begin() + 20);
+  const std::vector<cv::Point3f> all = Places();
+  std::vector<cv::Point3f> places(all.begin(), all.begin() + 20);
+  EXPECT_EQ(selector.OfferPartial(part, places, 0.0), ViewSelector::Decision::kMoving);
+  std::reverse(part.begin(), part.end());
+  std::reverse(places.begin(), places.end());
+  EXPECT_EQ(selector.OfferPartial(part, places, 0.1), ViewSelector::Decision::kTaken);
+  EXPECT_EQ(selector.taken_outlines().back().size(), 4u);
+  // Five corners are not a board.
+  part.resize(5);
+  places.resize(5);
+  EXPECT_EQ(selector.OfferPartial(part, places, 0.2), ViewSelector::Decision::kNoBoard);
 }
 
 }  // namespace

@@ -354,11 +354,15 @@ cv::Mat DrawCalibrationReport(const CalibrationResult& r) {
   return out;
 }
 
-cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square) {
+cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square, int margin_px) {
   const auto board = MakeCharucoBoard(options);
   cv::Mat image;
-  board->draw(cv::Size(options.board.width * pixels_per_square, options.board.height * pixels_per_square), image,
-              pixels_per_square / 2);
+  const cv::Size squares(options.board.width * pixels_per_square, options.board.height * pixels_per_square);
+  if (margin_px < 0) {
+    board->draw(squares, image, pixels_per_square / 2);
+  } else {
+    board->draw(squares + cv::Size(2 * margin_px, 2 * margin_px), image, margin_px);
+  }
   return image;
 }
 

@@ -100,7 +100,9 @@ std::vector<cv::Point2f> FindChessboardCorners(const cv::Mat& gray, cv::Size inn
 // refinement.
 std::vector<cv::Point2f> FindChessboardCornersQuickly(const cv::Mat& gray, cv::Size inner_corners);
 
-// Renders a ChArUco board image for printing or for tests.
-cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square);
+// Renders a ChArUco board image for printing or for tests: `margin_px` of white all round (-1:
+// half a square, the squares then a little smaller than `pixels_per_square`; 0 or more: every
+// square exactly `pixels_per_square`, the image the squares plus twice the margin).
+cv::Mat DrawCharucoBoard(const CalibrationOptions& options, int pixels_per_square, int margin_px = -1);
 
 }  // namespace arview::calib

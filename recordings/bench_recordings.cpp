@@ -1,5 +1,6 @@
 // Speed of the per-frame work of live capture and recording, at 640x480: decoding the two
-// V4L2 formats, and writing one frame the way RecordingWriter does (PNG, compression 1); and of
+// V4L2 formats, writing one frame the way RecordingWriter does (PNG, compression 1), and the capture
+// guidance record adds to each frame; and of
 // reading one of phone-fox's 1920x1080 JPEG frames, through ReadImageFile (the checks and the
 // decoder replay uses) and through cv::imdecode alone (what it is measured against); and the
 // same for templeRing's 640x480 PNG photos, all of them each iteration.
@@ -18,6 +19,7 @@
 
 #include "base/image_file.h"
 #include "base/png_decoder.h"
+#include "recordings/capture_guidance.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
 #include "tests/support/test_data.h"
@@ -78,6 +80,20 @@ void BM_RecordFrame640x480(benchmark::State& state) {
   std::filesystem::remove_all(dir);
 }
 BENCHMARK(BM_RecordFrame640x480)->Unit(benchmark::kMillisecond);
+
+// The capture guidance `record` adds to each frame (recordings/capture_guidance.h): the scene
+// sliding 4 px a frame, so that points are followed and views kept as a walking camera's are.
+void BM_CaptureGuidance640x480(benchmark::State& state) {
+  cv::Mat wide;
+  cv::hconcat(std::vector<cv::Mat>(4, Scene()), wide);
+  CaptureGuidance guidance;
+  int i = 0;
+  for (auto _ : state) {
+    const int x = (4 * i) % (wide.cols - 640);
+    guidance.Add(wide(cv::Rect(x, 0, 640, 480)), i++ / 30.0);
+  }
+}
+BENCHMARK(BM_CaptureGuidance640x480)->Unit(benchmark::kMillisecond);
 
 // phone-fox's first frame (1920x1080, 4:2:0, 387 KB), or empty when ../shared/data is absent.
 std::filesystem::path PhoneFoxFrame() {

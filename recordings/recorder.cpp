@@ -113,7 +113,8 @@ void RecordingWriter::Append(const cv::Mat& image, double timestamp) {
 }
 
 RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double max_seconds,
-                         const CancellationToken& cancel, const std::function<void(const RecordStats&)>& progress) {
+                         const CancellationToken& cancel,
+                         const std::function<void(const Frame&, const RecordStats&)>& progress) {
   RecordStats stats;
   const auto wall_start = std::chrono::steady_clock::now();
   Frame frame;
@@ -135,7 +136,8 @@ RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double ma
     stats.seconds = t;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     stats.fps = wall > 0 ? stats.frames / wall : 0;
-    if (progress) progress(stats);
+    frame.timestamp = t;
+    if (progress) progress(frame, stats);
   }
   return stats;
 }

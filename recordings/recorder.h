@@ -55,10 +55,11 @@ struct RecordStats {
 
 // Copies frames from `source` into `writer` until the source ends, `cancel` is cancelled, or the
 // frame timestamps span `max_seconds` (0 = no limit). Timestamps are stored relative to the
-// first frame. `progress` (optional) is called after every frame. A SourceError from the
+// first frame. `progress` (optional) is called after every frame written, with that frame (its
+// timestamp relative to the first, as stored). A SourceError from the
 // source propagates; the frames written before it stay a valid recording.
 RecordStats RecordFrames(FrameSource& source, RecordingWriter& writer, double max_seconds,
                          const CancellationToken& cancel,
-                         const std::function<void(const RecordStats&)>& progress = {});
+                         const std::function<void(const Frame&, const RecordStats&)>& progress = {});
 
 }  // namespace arview::recordings

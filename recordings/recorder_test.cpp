@@ -70,7 +70,7 @@ TEST(RecordFrames, StopsOnTheFlagAndLeavesAConsistentRecording) {
   FakeSource source(100, &stop, 12);
   RecordingWriter writer(dir.path() / "rec", SmallCamera(), false);
   int calls = 0;
-  const RecordStats stats = RecordFrames(source, writer, 0, stop, [&](const RecordStats&) { ++calls; });
+  const RecordStats stats = RecordFrames(source, writer, 0, stop, [&](const Frame&, const RecordStats&) { ++calls; });
   // The flag rose while frame 12 was delivered: that frame is kept, nothing after it.
   EXPECT_EQ(stats.frames, 13);
   EXPECT_EQ(calls, 13);

@@ -10,6 +10,7 @@
 #include <array>
 #include <map>
 #include <cmath>
+#include <optional>
 #include <future>
 #include <random>
 #include <string_view>
@@ -362,6 +363,58 @@ calib::Camera RoomCamera(int width, int height) {
   return calib::Camera::Pinhole(width, height, 525.0 * s, 525.0 * s, cx, cy);
 }
 
+calib::Camera SynthCamera(const SynthRoomOptions& o) {
+  calib::Camera camera = RoomCamera(o.width, o.height);
+  camera.fx *= o.focal_scale;
+  camera.fy *= o.focal_scale;
+  for (int i = 0; i < 5; ++i) camera.dist[i] = o.distortion[i];
+  return camera;
+}
+
+DistortedRoom::DistortedRoom(const calib::Camera& lens) {
+  // The rays of the frame's border bound the pinhole picture (a lens whose distortion is monotonic
+  // out from the centre bends no inner ray beyond them).
+  double left = 0, right = 0, top = 0, bottom = 0;
+  const auto widen = [&](double u, double v) {
+    const Eigen::Vector2d n = lens.PixelToNormalized({u, v});
+    left = std::min(left, n.x());
+    right = std::max(right, n.x());
+    top = std::min(top, n.y());
+    bottom = std::max(bottom, n.y());
+  };
+  for (int u = 0; u < lens.width; ++u) {
+    widen(u, -0.5);
+    widen(u, lens.height - 0.5);
+  }
+  for (int v = 0; v < lens.height; ++v) {
+    widen(-0.5, v);
+    widen(lens.width - 0.5, v);
+  }
+  const double span_x = lens.fx * (right - left), span_y = lens.fy * (bottom - top);
+  if (!(span_x <= 3.0 * lens.width - 4 && span_y <= 3.0 * lens.height - 4)) {  // NaN too: no lens
+    throw render::RenderError("synth room: the distortion bends the frame's edge rays too far (a pinhole picture more "
+                              "than 3 times " + std::to_string(lens.width) + "x" + std::to_string(lens.height) +
+                              " would be needed to hold them)");
+  }
+  const int width = static_cast<int>(std::ceil(span_x)) + 4, height = static_cast<int>(std::ceil(span_y)) + 4;
+  pinhole_ = calib::Camera::Pinhole(width, height, lens.fx, lens.fy, 2 - lens.fx * left, 2 - lens.fy * top);
+  map_x_.create(lens.height, lens.width, CV_32F);
+  map_y_.create(lens.height, lens.width, CV_32F);
+  for (int v = 0; v < lens.height; ++v) {
+    for (int u = 0; u < lens.width; ++u) {
+      const Eigen::Vector2d p = pinhole_.NormalizedToPixel(lens.PixelToNormalized({u, v}));
+      map_x_.at<float>(v, u) = static_cast<float>(p.x());
+      map_y_.at<float>(v, u) = static_cast<float>(p.y());
+    }
+  }
+}
+
+cv::Mat DistortedRoom::Distort(const cv::Mat& pinhole_picture) const {
+  cv::Mat out;
+  cv::remap(pinhole_picture, out, map_x_, map_y_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return out;
+}
+
 RoomPath::RoomPath(double duration, uint64_t seed) : duration_(duration) {
   std::mt19937_64 engine(seed);
   angle0_ = 2 * M_PI * Unit(engine);
@@ -454,6 +507,13 @@ void ValidateOptions(const SynthRoomOptions& o) {
     fail("--lamp-on needs an earlier --lamp-off (the lamp is on until then)");
   }
   if (l.sun && o.light != SynthLighting::kWindow) fail("--sun needs --light window (the sun comes through its window)");
+  if (!(o.focal_scale >= 0.25 && o.focal_scale <= 4)) fail("--focal-scale must be in [0.25, 4]");
+  for (const double k : o.distortion) {
+    if (!(std::abs(k) <= 10)) fail("--distortion's terms must be finite and within [-10, 10]");
+  }
+  const bool distorted = std::any_of(o.distortion.begin(), o.distortion.end(), [](double k) { return k != 0; });
+  if (distorted && o.walkers.count > 0) fail("--distortion with --walkers is not rendered (the walkers' mask is the pinhole's)");
+  if (distorted && o.rolling_shutter_s > 0) fail("--distortion with --rolling-shutter is not rendered");
   if (!o.board.empty()) {
     if (!(o.board.square > 0 && o.board.square <= 1)) fail("--square must be in (0, 1] metres");
     const double reach = 0.5 * o.board.square * std::hypot(o.board.inner_corners.width + 3, o.board.inner_corners.height + 3);
@@ -618,10 +678,15 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options, const std::funct
   o.lights.duration_s = RecordingFrames(o) / o.fps;
   const std::vector<int> indices = FramesToRender(o);
   const RoomScene scene = MakeRoomScene(o.data_dir, o.light, o.board);
+  const calib::Camera camera = SynthCamera(o);
+  const bool distorted = camera.HasDistortion();
+  std::optional<DistortedRoom> lens;
+  if (distorted) lens.emplace(camera);
   std::unique_ptr<render::OffscreenContext> context = render::OffscreenContext::Create(o.gl);
   PrepareFolder(o);
-  const calib::Camera camera = RoomCamera(o.width, o.height);
-  RoomRenderer renderer(*context, scene, camera, o.samples);
+  // What is drawn and lit: the camera's own picture, or the pinhole one a distorted lens resamples.
+  const calib::Camera& drawn = distorted ? lens->pinhole() : camera;
+  RoomRenderer renderer(*context, scene, drawn, o.samples);
   renderer.SetWalkers(o.walkers);
   const RoomPath room_path(o.frames / o.fps, o.seed);
   const OrbitWalk orbit_walk(o.frames / o.fps, o.seed, o.orbit);
@@ -650,7 +715,8 @@ SynthRoomReport SynthesizeRoom(const SynthRoomOptions& options, const std::funct
       walkers = WalkerPixels(renderer, path(t), t, o, image);
       covered.emplace_back(t, static_cast<double>(cv::countNonZero(walkers)) / static_cast<double>(walkers.total()));
     }
-    ApplyLightChanges(image, o.lights, camera, path(t), o.fps, i, walkers);
+    ApplyLightChanges(image, o.lights, drawn, path(t), o.fps, i, walkers);
+    if (distorted) image = lens->Distort(image);
     ApplyGain(image, o.gain_drift, t);
     AddNoise(image, o.noise_sigma, o.seed, i);
     char name[32];

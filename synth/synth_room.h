@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -89,6 +90,21 @@ double RoomRayDepth(const Eigen::Vector3d& origin, const Eigen::Vector3d& direct
 // width / 640, pixel centres in OpenCV's convention); a wider aspect crops top and bottom.
 calib::Camera RoomCamera(int width = 640, int height = 480);
 
+// A distorted camera's frames from a pinhole rendering: the pinhole camera to render with (the
+// same focal length, big enough for every ray of the lens, at most 3 times the frame's side; a
+// RenderError beyond), and the map that resamples its picture into the lens's.
+class DistortedRoom {
+ public:
+  explicit DistortedRoom(const calib::Camera& lens);
+  const calib::Camera& pinhole() const { return pinhole_; }
+  // The pinhole picture (the pinhole camera's size) as the lens sees it (the lens's size).
+  cv::Mat Distort(const cv::Mat& pinhole_picture) const;
+
+ private:
+  calib::Camera pinhole_;
+  cv::Mat map_x_, map_y_;
+};
+
 // The hand-held path: camera pose (world → camera) at time t (seconds) for a sequence of
 // `duration` seconds; deterministic for a seed. The fast turn (90° in 0.6 s) starts at 55% of
 // the duration.
@@ -120,6 +136,11 @@ struct SynthRoomOptions {
   double exposure_s = 1.0 / 60;  // shutter time spanned by motion blur
   double noise_sigma = 0.0;      // additive Gaussian sensor noise, grey levels (8-bit)
   int width = 640, height = 480; // frame size (e.g. 1280x720, 1920x1080)
+  // Another lens than RoomCamera's: its focal length times this (0.7: a wider lens), and OpenCV's
+  // distortion k1 k2 p1 p2 k3 (all zero: none). A distorted frame is rendered as a pinhole picture
+  // wide enough for every ray of the lens, then resampled through the distortion (DistortedRoom).
+  double focal_scale = 1.0;
+  std::array<double, 5> distortion{};
   int jpeg_quality = 0;          // 0: frames as PNG; 1..100: JPEG at this quality
   // Exposure/gain change over time: brightness multiplied by 1 + gain_drift·sin(2πt / 7 s)
   // (auto-exposure hunting); 0: off.
@@ -149,6 +170,10 @@ struct SynthRoomOptions {
   std::filesystem::path data_dir = kOpenCvDocData;
   render::OffscreenOptions gl;
 };
+
+// The camera of a recording of `options` (RoomCamera at its size, its focal length scaled by
+// focal_scale, its distortion).
+calib::Camera SynthCamera(const SynthRoomOptions& options);
 
 // The recording's frame count: the walk's `frames` and the still segment's.
 int RecordingFrames(const SynthRoomOptions& options);

@@ -2,8 +2,8 @@
 // (tests/support/fake_v4l2_device.cpp) plays a chessboard waved in front of a camera whose
 // intrinsics and distortion are known exactly (tests/support/rendered_board.h: held still at
 // places across the image, near and far, tilted, carried between them with motion blur, sensor
-// noise), and the calibration the command writes must match them; the window under Xvfb, and the
-// inputs that hold no board.
+// noise), and the calibration the command writes must match them; the same for a ChArUco board
+// seen in part; the window under Xvfb, and the inputs that hold no board.
 
 #include <gtest/gtest.h>
 
@@ -28,18 +28,24 @@ namespace {
 namespace fs = std::filesystem;
 using testing::ShellQuote;
 
-// The walk, rendered once per machine (a minute on a loaded machine; about 40 s of footage).
-fs::path SharedBoardWalk() {
-  const fs::path walk = fs::temp_directory_path() / ("arview_board_walk_v2_" + std::to_string(::getuid()));
+// A walk rendered once per machine into `name` (a minute or two on a loaded machine).
+fs::path SharedWalk(const std::string& name, const testing::BoardWalk& board_walk) {
+  const fs::path walk = fs::temp_directory_path() / (name + "_" + std::to_string(::getuid()));
   if (fs::exists(walk / "frames.txt")) return walk;
   const fs::path rendering = walk.string() + ".rendering_" + std::to_string(::getpid());
   fs::remove_all(rendering);
-  testing::WriteBoardWalk(rendering);
+  testing::WriteBoardWalk(rendering, board_walk);
   std::error_code ec;
   fs::rename(rendering, walk, ec);  // fails harmlessly when a parallel test got there first
   fs::remove_all(rendering, ec);
   return walk;
 }
+
+// The chessboard's walk (about 35 s of footage).
+fs::path SharedBoardWalk() { return SharedWalk("arview_board_walk_v2", {}); }
+
+// The ChArUco board's (26 s at 10 fps, part of the board out of the image at the corners).
+fs::path SharedCharucoWalk() { return SharedWalk("arview_charuco_walk_v3", testing::CharucoWalk()); }
 
 fs::path TestDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("arview_calibrate_live_" + name + "_" + std::to_string(::getpid()));
@@ -142,10 +148,42 @@ TEST(CalibrateLive, ALiveCameraThatSeesNoBoardIsOneClearLine) {
             std::string::npos)
       << r.err;
   EXPECT_FALSE(fs::exists(dir / "camera.yaml"));
-  const auto charuco = testing::RunArview({"calibrate", "--device", testing::kEmulatedCamera, "--charuco", "--out",
-                                           (dir / "camera.yaml").string()});
-  EXPECT_EQ(charuco.exit_code, 2);
-  EXPECT_NE(charuco.err.find("--charuco is for --images only"), std::string::npos) << charuco.err;
+  const auto charuco = testing::RunWithEmulatedCamera(
+      {"calibrate", "--device", testing::kEmulatedCamera, "--charuco", "--board", "10x7", "--out",
+       (dir / "camera.yaml").string(), "--no-window", "--seconds", "1"},
+      {}, dir);
+  EXPECT_EQ(charuco.exit_code, 1) << charuco.out << charuco.err;
+  EXPECT_NE(charuco.err.find(std::string("arview: ") + testing::kEmulatedCamera +
+                             ": no 10x7 ChArUco board in any of its"),
+            std::string::npos)
+      << charuco.err;
+  EXPECT_NE(charuco.err.find("(--board counts squares, columns x rows; --dictionary DICT_5X5_100)"), std::string::npos)
+      << charuco.err;
+  fs::remove_all(dir);
+}
+
+// ChArUco live (issue 56): the board's corners are told apart by its markers, so a view of part of
+// it counts: the walk holds it half out of the image at the image's corners, where a chessboard
+// cannot be found at all, and the lens must come out as the chessboard's does.
+TEST(CalibrateLive, AChArUcoBoardSeenInPartGivesTheLensWithinHalfAPercent) {
+  const fs::path walk = SharedCharucoWalk();
+  const fs::path dir = TestDir("charuco");
+  const auto r = testing::RunWithEmulatedCamera(
+      {"calibrate", "--device", testing::kEmulatedCamera, "--fps", "10", "--charuco", "--board", "10x7", "--square",
+       "0.05", "--out", (dir / "camera.yaml").string(), "--no-window", "--seconds", "40"},
+      {{"ARVIEW_FAKE_CAMERA_RECORDING", walk.string()}}, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  std::printf("%s", r.out.c_str());
+  EXPECT_NE(r.out.find("coverage suffices: "), std::string::npos) << r.out;
+  EXPECT_LT(FootageSeconds(r.out), 90) << r.out;
+  // Views of part of the board were taken: fewer than its 54 corners.
+  int partial = 0;
+  const std::regex view(R"(frame \d+ at [0-9.]+ s\s+(\d+)\s)");
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), view); it != std::sregex_iterator(); ++it) {
+    partial += std::stoi((*it)[1]) < 54;
+  }
+  EXPECT_GE(partial, 2) << r.out;
+  ExpectTheTruth(calib::LoadCamera(dir / "camera.yaml"), calib::LoadCamera(walk / "truth.yaml"));
   fs::remove_all(dir);
 }
 

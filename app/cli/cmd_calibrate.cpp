@@ -152,9 +152,6 @@ void RequireFlagsFitTheSource(const CLI::App& cmd, bool images, bool device) {
 
 // --device or --recording: views picked from the frames, then calibrated.
 void CalibrateFromFrames(const CalibrateArgs& args, const calib::CalibrationOptions& calibration) {
-  if (calibration.kind == calib::BoardKind::kCharuco) {
-    throw CommandError("--charuco is for --images only: --device and --recording pick views of a chessboard", 2);
-  }
   const ScopedSignalCancellation signals;
   std::unique_ptr<recordings::FrameSource> source;
   recordings::V4l2Source* camera = nullptr;
@@ -187,8 +184,12 @@ void CalibrateFromFrames(const CalibrateArgs& args, const calib::CalibrationOpti
   const std::string where = args.device.empty() ? "--recording " + args.recording : args.device;
   if (collected.frames == 0) throw CommandError(where + ": no frame came; nothing was written");
   if (collected.frames_with_board == 0) {
-    throw CommandError(where + ": no " + args.board + " chessboard in any of its " + std::to_string(collected.frames) +
-                       " frames (--board counts inner corners, columns x rows); nothing was written");
+    const bool charuco = calibration.kind == calib::BoardKind::kCharuco;
+    throw CommandError(where + ": no " + BoardName(calibration) + " in any of its " + std::to_string(collected.frames) +
+                       " frames (" +
+                       (charuco ? "--board counts squares, columns x rows; --dictionary " + calibration.charuco_dictionary
+                                : std::string("--board counts inner corners, columns x rows")) +
+                       "); nothing was written");
   }
   if (static_cast<int>(collected.views.size()) < calibration.min_views) {
     throw CommandError(where + ": only " + std::to_string(collected.views.size()) +
@@ -226,7 +227,7 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("--board", args->board, "Chessboard: inner corners, columns x rows. ChArUco: squares, columns x rows")
       ->capture_default_str();
   cmd->add_option("--square", args->square, "Side of one board square in metres")->capture_default_str()->check(CLI::PositiveNumber);
-  cmd->add_flag("--charuco", args->charuco, "The board is a ChArUco board (OpenCV aruco) rather than a chessboard (--images only)");
+  cmd->add_flag("--charuco", args->charuco, "The board is a ChArUco board (OpenCV aruco) rather than a chessboard; live, it may be seen in part");
   cmd->add_option("--marker", args->marker, "ChArUco marker side in metres (default: 0.7 x --square)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--dictionary", args->dictionary, "ChArUco marker dictionary")->capture_default_str();
   cmd->add_option("--out", args->out, "Camera file to write (OpenCV FileStorage YAML)")->required();

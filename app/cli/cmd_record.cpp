@@ -1,6 +1,6 @@
 // arview record --device /dev/video0 --out <recording> [--size 640x480] [--fps N] [--seconds N]
 //               [--format auto|yuyv|mjpeg] [--focus lock|auto|keep|N] [--exposure auto|lock|N]
-//               [--camera camera.yaml] [--force]
+//               [--camera camera.yaml] [--force] [--window]
 
 #include <cstdio>
 #include <iostream>
@@ -10,9 +10,12 @@
 #include "app/cli/camera_flags.h"
 #include "app/cli/commands.h"
 #include "app/cli/numeric_flags.h"
+#include "app/cli/record_window.h"
 #include "base/cancellation.h"
+#include "recordings/capture_guidance.h"
 #include "recordings/recorder.h"
 #include "recordings/v4l2_source.h"
+#include "video/window.h"
 
 namespace arview::app {
 
@@ -25,6 +28,7 @@ struct RecordArgs {
   double seconds = 0;
   std::string camera;
   bool force = false;
+  bool window = false;
 };
 
 constexpr const char* kDefaultSize = "640x480";
@@ -44,6 +48,23 @@ std::string LostText(const recordings::SourceCounts& counts, int out_of_order) {
   add(counts.stale_skipped, "waiting behind newer ones");
   add(out_of_order, "out of order");
   return text + " (" + parts + ")";
+}
+
+// Events since the last frame: q, Escape or closing the window ends the recording (what was
+// recorded stays, as with Ctrl-C).
+bool StopAsked(video::DisplayWindow& window) {
+  for (const video::InputEvent& event : window.Poll()) {
+    if (event.type == video::InputEvent::Type::kClose ||
+        (event.type == video::InputEvent::Type::kKey && (event.key == "q" || event.key == "Escape"))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The end's verdict: whether the recording is likely to map, and why not.
+void PrintGuidance(const recordings::CaptureGuidance& guidance) {
+  std::cout << "capture guidance: " << guidance.Summary().Line() << "\n";
 }
 
 void RunRecord(const RecordArgs& args) {
@@ -91,7 +112,23 @@ void RunRecord(const RecordArgs& args) {
   recordings::RecordingWriter writer(args.out, camera, args.force);
   std::cerr << "recording into " << args.out << (args.seconds > 0 ? "" : "; Ctrl-C stops") << "\n";
   bool progress_shown = false;  // the progress line is redrawn in place: ended before any other line
-  auto progress = [&](const recordings::RecordStats& s) {
+  const recordings::CaptureGuidanceOptions guidance_options;
+  recordings::CaptureGuidance guidance(guidance_options);
+  std::unique_ptr<video::DisplayWindow> window;
+  if (args.window) {
+    window = video::DisplayWindow::Open("arview record " + args.out, RecordWindowSize(source.size()),
+                                        "record without a window: leave out --window");
+  }
+  auto progress = [&](const recordings::Frame& frame, const recordings::RecordStats& s) {
+    guidance.Add(frame.image, frame.timestamp);
+    for (const recordings::GuidanceNote& note : guidance.NewNotes()) {
+      std::fprintf(stderr, "%snote: %.1f s: %s\n", progress_shown ? "\n" : "", note.time, note.text.c_str());
+      progress_shown = false;
+    }
+    if (window) {
+      window->Show(DrawRecordWindow(frame.image, guidance, guidance_options, {s.seconds, s.frames}));
+      if (StopAsked(*window)) signals.token().Cancel(0);
+    }
     const recordings::SourceCounts c = source.Counts();
     std::fprintf(stderr, "\r%8.1f s  %6d frames  %5.1f fps  %5lld lost", s.seconds, s.frames, s.fps,
                  static_cast<long long>(c.driver_dropped + c.corrupt_skipped + c.stale_skipped + s.skipped));
@@ -115,14 +152,17 @@ void RunRecord(const RecordArgs& args) {
     signals.token().ThrowIfCancelled("stopped before the first frame; nothing was recorded");
     throw CommandError("stopped before the first frame; nothing was recorded");
   }
-  if (args.seconds > 0 && signals.token().IsCancelled()) {
+  const bool stopped_in_window = signals.token().IsCancelled() && signals.token().Signal() == 0;
+  if (args.seconds > 0 && signals.token().IsCancelled() && !stopped_in_window) {
+    PrintGuidance(guidance);
     std::ostringstream what;
     what << "stopped after " << stats.seconds << " of " << args.seconds << " s; the " << stats.frames
          << " frames recorded stay a valid recording in " << args.out;
     signals.token().ThrowIfCancelled(what.str());
   }
   std::cout << "recorded " << stats.frames << " frames over " << stats.seconds << " s into " << args.out
-            << LostText(source.Counts(), stats.skipped) << "\n";
+            << LostText(source.Counts(), stats.skipped) << (stopped_in_window ? " (stopped in the window)" : "") << "\n";
+  PrintGuidance(guidance);
   if (!camera) {
     std::cout << "note: no --camera given: put a camera.yaml (arview calibrate) into " << args.out
               << " before mapping or tracking\n";
@@ -142,6 +182,9 @@ void AddRecordCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--camera", args->camera, "camera.yaml to store with the recording (its size must match)");
   cmd->add_flag("--force", args->force, "Replace a recording already in --out");
+  cmd->add_flag("--window", args->window,
+                "Show the camera's picture with the capture guidance (too fast, too few features, too little "
+                "parallax, exposure, views so far); q stops");
   cmd->callback([args] { RunRecord(*args); });
 }
 

@@ -22,6 +22,7 @@ struct SynthArgs {
   std::string board;                     // inner corners, e.g. 9x6; empty: no board
   std::vector<double> board_at;          // x, y on the floor; empty: the walk's centre
   double board_yaw_deg = 0;
+  std::vector<double> distortion;        // k1 k2 p1 p2 k3; empty: none
   bool quiet = false;
 };
 
@@ -49,6 +50,7 @@ void RunSynthRoom(SynthArgs& args) {
   o.width = size.width;
   o.height = size.height;
   SetUpBoard(args);
+  for (size_t i = 0; i < args.distortion.size(); ++i) o.distortion[i] = args.distortion[i];
   const auto start = std::chrono::steady_clock::now();
   o.gl = ToOffscreenOptions(args.gl);
   const synth::SynthRoomReport report = synth::SynthesizeRoom(o, [&](int done, int total) {
@@ -142,6 +144,15 @@ void AddSynthCommand(CLI::App& app) {
   room->add_option("--square", o.board.square, "The board's square side, metres")
       ->default_val(o.board.square)
       ->check(CLI::Range(0.005, 1.0));
+  room->add_option("--focal-scale", o.focal_scale,
+                  "Another lens: the camera's focal length times this (0.7: wider), the frame size kept")
+      ->default_val(o.focal_scale)
+      ->check(CLI::Range(0.25, 4.0));
+  room->add_option("--distortion", args->distortion,
+                   "The lens's distortion, OpenCV's k1,k2,p1,p2,k3 (fewer: the rest 0); written to camera.yaml")
+      ->delimiter(',')
+      ->expected(1, 5)
+      ->check(CLI::Range(-10.0, 10.0));
   room->add_option("--board-at", args->board_at,
                    "The board's centre on the floor, X,Y in metres (default: 1.1 m beside the orbit's character spot, or the "
                    "room's centre)")

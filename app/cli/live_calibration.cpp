@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "app/cli/commands.h"
+#include "app/cli/window_panel.h"
 
 namespace arview::app {
 
@@ -16,10 +16,8 @@ namespace {
 
 constexpr int kPanelWidth = 260;
 
-// The outline of a chessboard's inner corners: its four outer corners.
-std::vector<cv::Point> Outline(const std::vector<cv::Point2f>& corners, cv::Size board) {
-  return {corners.front(), corners[board.width - 1], corners.back(), corners[corners.size() - board.width]};
-}
+std::vector<cv::Point> Rounded(const std::vector<cv::Point2f>& points) { return {points.begin(), points.end()}; }
+
 
 // What to do to fill the emptiest bar.
 std::string Advice(const std::vector<calib::CoverageBar>& bars) {
@@ -32,11 +30,13 @@ std::string Advice(const std::vector<calib::CoverageBar>& bars) {
   return "tilt it";
 }
 
-std::string StatusOf(calib::ViewSelector::Decision decision, const calib::ViewSelector& selector, cv::Size board) {
+std::string StatusOf(calib::ViewSelector::Decision decision, const calib::ViewSelector& selector,
+                     const calib::CalibrationOptions& board) {
   using Decision = calib::ViewSelector::Decision;
   switch (decision) {
     case Decision::kNoBoard:
-      return "no board: show the whole " + std::to_string(board.width) + "x" + std::to_string(board.height) + " board";
+      return board.kind == calib::BoardKind::kCharuco ? "no board: show the " + BoardName(board) + " (part of it will do)"
+                                                      : "no board: show the whole " + BoardName(board);
     case Decision::kMoving: return "hold the board still";
     case Decision::kKnown: return "seen already: " + Advice(selector.Bars());
     case Decision::kTaken: return "view " + std::to_string(selector.taken().size()) + " taken";
@@ -66,37 +66,43 @@ bool CalibrateAsked(video::DisplayWindow& window) {
   return asked;
 }
 
-// `text` in lines of at most `width` characters, broken between words.
-std::vector<std::string> Wrap(const std::string& text, size_t width) {
-  std::vector<std::string> lines;
-  std::istringstream words(text);
-  std::string word, line;
-  while (words >> word) {
-    if (!line.empty() && line.size() + 1 + word.size() > width) {
-      lines.push_back(line);
-      line.clear();
-    }
-    line += (line.empty() ? "" : " ") + word;
+}  // namespace
+
+calib::BoardDetection DetectLive(const cv::Mat& gray, const calib::CalibrationOptions& board) {
+  calib::BoardDetection found;
+  if (board.kind == calib::BoardKind::kCharuco) {
+    if (!calib::DetectBoard(gray, board, &found)) found = {};
+    return found;
   }
-  if (!line.empty()) lines.push_back(line);
-  return lines;
+  found.image_points = calib::FindChessboardCornersQuickly(gray, board.board);
+  if (!found.image_points.empty()) found.object_points = calib::ChessboardObjectPoints(board);
+  return found;
 }
 
-}  // namespace
+std::string BoardName(const calib::CalibrationOptions& board) {
+  const std::string size = std::to_string(board.board.width) + "x" + std::to_string(board.board.height);
+  return size + (board.kind == calib::BoardKind::kCharuco ? " ChArUco board" : " chessboard");
+}
 
 cv::Size CalibrationWindowSize(cv::Size frame_size) {
   return {frame_size.width + kPanelWidth, std::max(frame_size.height, 360)};
 }
 
-cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const std::vector<cv::Point2f>& corners, cv::Size board,
-                              const calib::ViewSelector& selector, const std::string& status) {
+cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const calib::BoardDetection& found,
+                              const calib::CalibrationOptions& board, const calib::ViewSelector& selector,
+                              const std::string& status) {
   cv::Mat picture(CalibrationWindowSize(frame.size()), CV_8UC3, cv::Scalar(40, 40, 40));
   cv::Mat shown = picture(cv::Rect({0, 0}, frame.size()));
   frame.copyTo(shown);
-  for (const auto& view : selector.taken_corners()) {
-    cv::polylines(shown, Outline(view, board), true, {200, 160, 60}, 1, cv::LINE_AA);
+  for (const auto& outline : selector.taken_outlines()) {
+    cv::polylines(shown, Rounded(outline), true, {200, 160, 60}, 1, cv::LINE_AA);
   }
-  if (corners.size() == static_cast<size_t>(board.area())) cv::drawChessboardCorners(shown, board, corners, true);
+  const std::vector<cv::Point2f>& corners = found.image_points;
+  if (board.kind == calib::BoardKind::kCharuco) {
+    for (const cv::Point2f& p : corners) cv::circle(shown, p, 3, {60, 220, 60}, cv::FILLED, cv::LINE_AA);
+  } else if (corners.size() == static_cast<size_t>(board.board.area())) {
+    cv::drawChessboardCorners(shown, board.board, corners, true);
+  }
 
   const int left = frame.cols + 16, bar_width = kPanelWidth - 32;
   const auto text = [&](const std::string& line, int y, double scale = 0.55, cv::Scalar colour = {235, 235, 235}) {
@@ -107,16 +113,13 @@ cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const std::vector<cv::Point2
   for (const calib::CoverageBar& bar : selector.Bars()) {
     text(bar.name, y + 14);
     const cv::Rect outline(left + 50, y, bar_width - 50, 18);
-    const int filled = static_cast<int>(outline.width * bar.progress);
-    const cv::Scalar colour = bar.progress >= 1.0 ? cv::Scalar(60, 200, 60) : cv::Scalar(40, 150, 240);
-    cv::rectangle(picture, {outline.x, outline.y, filled, outline.height}, colour, cv::FILLED);
-    cv::rectangle(picture, outline, {200, 200, 200}, 1);
+    DrawBar(picture, outline, bar.progress, bar.progress >= 1.0 ? cv::Scalar(60, 200, 60) : cv::Scalar(40, 150, 240));
     y += 34;
   }
   text("views taken: " + std::to_string(selector.taken().size()), y + 12);
   text(selector.Sufficient() ? "enough: calibrating" : "c: calibrate now, q: stop", y + 40, 0.5, {180, 180, 180});
   int status_y = y + 76;
-  for (const std::string& line : Wrap(status, 26)) {
+  for (const std::string& line : WrapWords(status, 26)) {
     text(line, status_y, 0.5, {120, 230, 255});
     status_y += 20;
   }
@@ -126,8 +129,8 @@ cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const std::vector<cv::Point2
 CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const LiveCalibrationOptions& options,
                                        const CalibrationWindowOpener& open_window, const CalibrationLog& log,
                                        const CancellationToken& cancel) {
-  const cv::Size board = options.calibration.board;
-  const std::vector<cv::Point3f> object_points = calib::ChessboardObjectPoints(options.calibration);
+  const calib::CalibrationOptions& board = options.calibration;
+  const bool charuco = board.kind == calib::BoardKind::kCharuco;
   CollectedViews collected;
   std::unique_ptr<calib::ViewSelector> selector;
   std::unique_ptr<video::DisplayWindow> window;
@@ -142,7 +145,7 @@ CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const Li
     }
     if (!selector) {
       collected.image_size = frame.image.size();
-      selector = std::make_unique<calib::ViewSelector>(board, collected.image_size, options.selection);
+      selector = std::make_unique<calib::ViewSelector>(board.board, collected.image_size, options.selection);
       first_time = frame.timestamp;
       if (open_window) window = open_window(CalibrationWindowSize(collected.image_size));
     } else if (frame.image.size() != collected.image_size) {
@@ -154,11 +157,13 @@ CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const Li
     ++collected.frames;
     collected.seconds = frame.timestamp - first_time;
     cv::cvtColor(frame.image, gray, cv::COLOR_BGR2GRAY);
-    const std::vector<cv::Point2f> corners = calib::FindChessboardCornersQuickly(gray, board);
-    if (!corners.empty()) ++collected.frames_with_board;
-    const calib::ViewSelector::Decision decision = selector->Offer(corners, frame.timestamp);
+    const calib::BoardDetection found = DetectLive(gray, board);
+    if (!found.image_points.empty()) ++collected.frames_with_board;
+    const calib::ViewSelector::Decision decision =
+        charuco ? selector->OfferPartial(found.image_points, found.object_points, frame.timestamp)
+                : selector->Offer(found.image_points, frame.timestamp);
     if (decision == calib::ViewSelector::Decision::kTaken) {
-      collected.views.push_back({corners, object_points});
+      collected.views.push_back(found);
       char label[64];
       std::snprintf(label, sizeof label, "frame %lld at %.2f s", static_cast<long long>(frame.index), collected.seconds);
       collected.labels.emplace_back(label);
@@ -166,7 +171,7 @@ CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const Li
     }
     bool asked = false;
     if (window) {
-      window->Show(DrawCalibrationWindow(frame.image, corners, board, *selector, StatusOf(decision, *selector, board)));
+      window->Show(DrawCalibrationWindow(frame.image, found, board, *selector, StatusOf(decision, *selector, board)));
       asked = CalibrateAsked(*window);
     }
     if (selector->Sufficient()) {

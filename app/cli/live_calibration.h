@@ -52,10 +52,18 @@ CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const Li
                                        const CalibrationWindowOpener& open_window, const CalibrationLog& log,
                                        const CancellationToken& cancel);
 
-// The window's picture: the frame with the board's corners (coloured when found, the outlines of
-// the views taken faint), and on the right the coverage bars, the number of views and `status`.
-cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const std::vector<cv::Point2f>& corners, cv::Size board,
-                              const calib::ViewSelector& selector, const std::string& status);
+// The window's picture: the frame with the board's corners found (a chessboard's coloured, a
+// ChArUco board's as dots) and the outlines of the views taken, faint; on the right the coverage
+// bars, the number of views and `status`.
+cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const calib::BoardDetection& found,
+                              const calib::CalibrationOptions& board, const calib::ViewSelector& selector,
+                              const std::string& status);
+
+// The board of a live frame: a chessboard whole (the quick detector), a ChArUco board in part (at
+// least 6 corners, each with its place on the board); empty when none.
+calib::BoardDetection DetectLive(const cv::Mat& gray, const calib::CalibrationOptions& board);
+// "9x6 chessboard", "10x7 ChArUco board".
+std::string BoardName(const calib::CalibrationOptions& board);
 // The window's size for frames of `frame_size`.
 cv::Size CalibrationWindowSize(cv::Size frame_size);
 

@@ -22,6 +22,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/calibration.h"
 #include "calib/camera.h"
 
 namespace arview::testing {
@@ -41,13 +42,43 @@ struct BoardWalk {
   double exposure = 1.0 / 30;  // the shutter's open time: the smear of a moving board
   double noise_sigma = 2.0;    // grey levels
   unsigned seed = 5;
+  // A ChArUco board of (board + 1) squares (DICT_5X5_100, markers 0.7 of a square) instead of the
+  // chessboard: the same squares, its inner corners where the chessboard's are.
+  bool charuco = false;
 };
+
+// The walk of a ChArUco board (tests/calibrate_live_test.cpp): twice the chessboard's size, so
+// that it fills more of the image at each place; fewer frames (10 a second, shorter holds and
+// moves); and places at the image's corners where part of the board leaves the image, which only
+// ChArUco's partial views can use.
+inline BoardWalk CharucoWalk() {
+  BoardWalk walk;
+  walk.charuco = true;
+  // 50 mm squares (an A3 print): a marker's 5x5 bits are 3 px wide at 0.8 m, where 25 mm ones
+  // (1.6 px) were found in part or not at all.
+  walk.square = 0.05;
+  walk.fps = 10;
+  walk.hold_seconds = 0.6;
+  walk.move_seconds = 0.8;
+  walk.seed = 6;
+  return walk;
+}
+
+// The calibration options of the walk's board.
+inline calib::CalibrationOptions BoardOptions(const BoardWalk& walk) {
+  calib::CalibrationOptions o;
+  o.kind = walk.charuco ? calib::BoardKind::kCharuco : calib::BoardKind::kChessboard;
+  o.board = walk.charuco ? walk.board + cv::Size(1, 1) : walk.board;
+  o.square_size = walk.square;
+  return o;
+}
 
 // Where the board is held: its centre's image position (fractions of the width and height), its
 // distance, and its turn (Rodrigues, radians; zero faces the camera).
 struct BoardPlace {
   double u, v, depth;
   Eigen::Vector3d turn;
+  bool partly_out = false;  // the centre where (u, v) says, though part of the board leaves the image
 };
 
 // Places across the image at half a metre, tilted about alternating axes; near, filling most of
@@ -70,14 +101,33 @@ inline std::vector<BoardPlace> BoardPlaces() {
   return places;
 }
 
+// ChArUco's walk: across the image at half a metre, near, at the image's four corners with the
+// board half out of it, and the far corners; the board's centre where each place says, however
+// much of it leaves the image.
+inline std::vector<BoardPlace> CharucoPlaces() {
+  const std::vector<BoardPlace> all = BoardPlaces();
+  std::vector<BoardPlace> places(all.begin(), all.begin() + 11);  // across at 0.5 m, then the two near
+  const double tilt = 0.5;
+  places.push_back({0.02, 0.03, 0.4, {tilt, 0, 0}, true});
+  places.push_back({0.98, 0.03, 0.4, {0, tilt, 0}, true});
+  places.push_back({0.98, 0.97, 0.4, {-tilt, 0, 0}, true});
+  places.push_back({0.02, 0.97, 0.4, {0, -tilt, 0}, true});
+  for (int i : {11, 13, 17, 19}) places.push_back(all[i]);  // far, at the corners
+  // Nowhere pulled in to keep the whole board in the image: held where a person holds it.
+  for (BoardPlace& place : places) place.partly_out = true;
+  return places;
+}
+
+inline std::vector<BoardPlace> WalkPlaces(const BoardWalk& walk) { return walk.charuco ? CharucoPlaces() : BoardPlaces(); }
+
 // The board's pose in the camera (x_camera = R x_board + t) for a place: the board's centre on
 // the ray through (u, v), clamped so that the whole board stays in the image.
 inline Eigen::Isometry3d PoseOfPlace(const BoardWalk& walk, const BoardPlace& place) {
   const double width = (walk.board.width + 1) * walk.square, height = (walk.board.height + 1) * walk.square;
   const double half_u = 0.5 * width * walk.camera.fx / place.depth / walk.camera.width + 0.04;
   const double half_v = 0.5 * height * walk.camera.fy / place.depth / walk.camera.height + 0.04;
-  const double u = std::clamp(place.u, std::min(0.5, half_u), std::max(0.5, 1 - half_u));
-  const double v = std::clamp(place.v, std::min(0.5, half_v), std::max(0.5, 1 - half_v));
+  const double u = place.partly_out ? place.u : std::clamp(place.u, std::min(0.5, half_u), std::max(0.5, 1 - half_u));
+  const double v = place.partly_out ? place.v : std::clamp(place.v, std::min(0.5, half_v), std::max(0.5, 1 - half_v));
   const double x = (u * walk.camera.width - walk.camera.cx) / walk.camera.fx * place.depth;
   const double y = (v * walk.camera.height - walk.camera.cy) / walk.camera.fy * place.depth;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
@@ -113,7 +163,7 @@ inline Eigen::Isometry3d PoseAt(const BoardWalk& walk, const std::vector<Eigen::
 }
 
 inline double BoardWalkSeconds(const BoardWalk& walk) {
-  return BoardPlaces().size() * (walk.hold_seconds + walk.move_seconds) - walk.move_seconds;
+  return WalkPlaces(walk).size() * (walk.hold_seconds + walk.move_seconds) - walk.move_seconds;
 }
 
 // Renders the walk's camera seeing the board at its poses. Keeps the per-pixel rays of the
@@ -133,6 +183,11 @@ class BoardRenderer {
     }
     // The board's picture: squares of kTexel px, one white square's margin all round.
     const int columns = walk.board.width + 1, rows = walk.board.height + 1;
+    if (walk.charuco) {
+      // Printed black (25) on white (235), as the chessboard.
+      calib::DrawCharucoBoard(BoardOptions(walk), kTexel, kTexel).convertTo(texture_, CV_32F, 210.0 / 255, 25);
+      return;
+    }
     texture_ = cv::Mat((rows + 2) * kTexel, (columns + 2) * kTexel, CV_32F, cv::Scalar(235));
     for (int r = 0; r < rows; ++r) {
       for (int c = 0; c < columns; ++c) {
@@ -186,7 +241,7 @@ inline int WriteBoardWalk(const std::filesystem::path& folder, const BoardWalk& 
   namespace fs = std::filesystem;
   fs::create_directories(folder / "frames");
   std::vector<Eigen::Isometry3d> places;
-  for (const BoardPlace& place : BoardPlaces()) places.push_back(PoseOfPlace(walk, place));
+  for (const BoardPlace& place : WalkPlaces(walk)) places.push_back(PoseOfPlace(walk, place));
   const BoardRenderer renderer(walk);
   std::mt19937 random(walk.seed);
   const int frames = static_cast<int>(BoardWalkSeconds(walk) * walk.fps);
