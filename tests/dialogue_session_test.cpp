@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <thread>
 #include <unistd.h>
 
 #include <fstream>
@@ -23,6 +24,7 @@
 #include "tests/support/graffiti_map.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
+#include "tests/support/virtual_display.h"
 #include "tracker/test_planar_scene.h"
 
 namespace {
@@ -147,6 +149,24 @@ TEST(DialogueSession, PushToTalkHearsOnlyWhatIsSaidBetweenTwoPressesOfTheKey) {
   fs::remove_all(dir);
 }
 
+// The graffiti wall's host: greets the viewer once tracked, then answers "what is this place".
+void WriteHostDialogue(const fs::path& file) {
+  std::ofstream(file) << "dialogue: 1\n"
+                         "personality: {openness: 0.5, conscientiousness: 0.5, extraversion: 0.5, "
+                         "agreeableness: 0.5, neuroticism: 0.5}\n"
+                         "decay: 0.01\n"
+                         "machines:\n"
+                         "  - name: host\n"
+                         "    states: [waiting, greeted, answered]\n"
+                         "    final: [answered]\n"
+                         "    transitions:\n"
+                         "      - {from: waiting, to: greeted, when: [{viewer_tracked: true}], do: [{say: Hello.}]}\n"
+                         "      - from: greeted\n"
+                         "        to: answered\n"
+                         "        when: [{heard: what is this place}]\n"
+                         "        do: [{say: This is the graffiti wall.}, {emotional_influence: {emotion: joy, value: 0.5}}]\n";
+}
+
 // `arview replay --dialogue --audio-in --stats` as the user runs it: the graffiti map's views
 // (tests/support/graffiti_map.h) replayed four times over, the figure standing in front of the
 // first localized view, a WAV saying "what is this place". The greeting and the answer are the
@@ -159,20 +179,7 @@ class DialogueReplay : public ::testing::Test {
     ::setenv("ARVIEW_CACHE_DIR", (dir_ / "cache").c_str(), 1);
     arview::testing::WriteGraffitiMapFolder(dir_ / "map");
     arview::testing::WriteGraffitiViews(dir_ / "views");
-    std::ofstream(dir_ / "d.yaml") << "dialogue: 1\n"
-                                      "personality: {openness: 0.5, conscientiousness: 0.5, extraversion: 0.5, "
-                                      "agreeableness: 0.5, neuroticism: 0.5}\n"
-                                      "decay: 0.01\n"
-                                      "machines:\n"
-                                      "  - name: host\n"
-                                      "    states: [waiting, greeted, answered]\n"
-                                      "    final: [answered]\n"
-                                      "    transitions:\n"
-                                      "      - {from: waiting, to: greeted, when: [{viewer_tracked: true}], do: [{say: Hello.}]}\n"
-                                      "      - from: greeted\n"
-                                      "        to: answered\n"
-                                      "        when: [{heard: what is this place}]\n"
-                                      "        do: [{say: This is the graffiti wall.}, {emotional_influence: {emotion: joy, value: 0.5}}]\n";
+    WriteHostDialogue(dir_ / "d.yaml");
   }
   void TearDown() override {
     ::unsetenv("ARVIEW_CACHE_DIR");
@@ -247,6 +254,49 @@ TEST_F(DialogueLive, RunHearsALineSpokenIntoTheMicrophoneAndAnswersIt) {
   std::printf("run --mic: heard \"%s\" (confidence %.3f), answered %.0f ms after the words ended\n",
               turns[1]["heard"].get<std::string>().c_str(), turns[1]["confidence"].get<double>(),
               turns[1]["latency_ms"].get<double>());
+}
+
+// The space bar in the window under Xvfb, as a user presses it: `replay --paced --out window
+// --push-to-talk` on the graffiti views, a WAV saying "what is this place" 4 s after the first
+// frame; space pressed once the window shows frames (about 1 s in) and again 7 s later, then Esc.
+// The phrase between the presses is heard and answered.
+class DialogueWindow : public arview::testing::XSessionTest<::testing::Test> {};
+using arview::testing::ReadWholeFile;
+using arview::testing::ShellQuote;
+
+TEST_F(DialogueWindow, TheSpaceBarOpensListeningAndThePhraseBetweenTwoPressesIsAnswered) {
+  if (ModelMissing()) GTEST_SKIP() << "needs the Debian package pocketsphinx-en-us";
+  ARVIEW_REQUIRE_DATA_PATH(tracker::testing::kGraffitiTexture, "Debian package opencv-doc");
+  StartXSession("dialogue_window");
+  if (HasFatalFailure() || IsSkipped()) return;
+  arview::testing::WriteGraffitiMapFolder(dir_ / "map");
+  arview::testing::WriteGraffitiViews(dir_ / "views");
+  WriteHostDialogue(dir_ / "d.yaml");
+  const app::testing::UserSide user = app::testing::SynthesizeUserSide({"what is this place"}, speech::Voice::kSlt, 4.0, 6.0);
+  app::testing::WriteSpeechWav(dir_ / "talk.wav", user.samples);
+  const char* bin = std::getenv("ARVIEW_BIN");
+  const std::string line =
+      "exec env DISPLAY=" + display_->name() + " ARVIEW_CACHE_DIR=" + ShellQuote((dir_ / "cache").string()) + " " +
+      ShellQuote(bin ? bin : "arview") + " replay " + ShellQuote((dir_ / "views").string()) + " --map " +
+      ShellQuote((dir_ / "map").string()) + " --paced --loop 1000 --out window --audio-out none --push-to-talk --dialogue " +
+      ShellQuote((dir_ / "d.yaml").string()) + " --audio-in " + ShellQuote((dir_ / "talk.wav").string()) + " --stats " +
+      ShellQuote((dir_ / "s.json").string()) + " 2>" + ShellQuote((dir_ / "stderr.txt").string());
+  arview::testing::Child app({"sh", "-c", line}, (dir_ / "stdout.txt").string());
+  const std::string id = WaitForLiveWindow(app);
+  ASSERT_FALSE(id.empty()) << "no window with a live status appeared\n" << ReadWholeFile((dir_ / "stderr.txt").string());
+  const std::string key = "DISPLAY=" + display_->name() + " xdotool key --window " + id + " ";
+  EXPECT_EQ(std::system((key + "space >/dev/null 2>&1").c_str()), 0);
+  std::this_thread::sleep_for(std::chrono::seconds(7));
+  EXPECT_EQ(std::system((key + "space >/dev/null 2>&1").c_str()), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the words decoded, the answer made
+  (void)std::system((key + "Escape >/dev/null 2>&1").c_str());
+  ASSERT_EQ(app.Wait(10), 0) << ReadWholeFile((dir_ / "stderr.txt").string());
+  const nlohmann::json stats = nlohmann::json::parse(std::ifstream(dir_ / "s.json"));
+  ASSERT_TRUE(stats.contains("dialogue_turns"));
+  const nlohmann::json& turns = stats["dialogue_turns"];
+  ASSERT_EQ(turns.size(), 2u) << turns.dump(1);
+  EXPECT_EQ(turns[1]["heard"], "what is this place");
+  EXPECT_EQ(turns[1]["said"], "This is the graffiti wall.");
 }
 
 TEST_F(DialogueReplay, BadInputsAreOneLineEach) {
