@@ -113,9 +113,17 @@ const Eigen::VectorXd& BalanceShifter::DrawRest(Support c) {
   return postures[std::min(postures.size() - 1, static_cast<std::size_t>(Uniform(rng_) * postures.size()))];
 }
 
+// The thesis's pause (§4.1.2): a minimum p_m (the shortest recorded rest) and a random offset up to
+// p_o (to the longest), the offset scaled by the activation's factor. One draw whatever the scale,
+// so that streams under different scales make the same choices.
 double BalanceShifter::DrawDwell(Support c) {
   const int i = static_cast<int>(c);
-  return model_->dwell_min[i] + Uniform(rng_) * (model_->dwell_max[i] - model_->dwell_min[i]);
+  const double offset = model_->dwell_max[i] - model_->dwell_min[i];
+  return model_->dwell_min[i] + Uniform(rng_) * offset * pause_offset_scale_;
+}
+
+void BalanceShifter::SetPauseOffsetScale(double scale) {
+  pause_offset_scale_ = std::isfinite(scale) && scale >= 0 ? scale : 1.0;
 }
 
 // The first rest: a category that can be left, drawn evenly (the thesis's "random category"),
@@ -163,8 +171,9 @@ const Eigen::VectorXd& BalanceShifter::Posture(double t) {
   return posture_;
 }
 
-bool BalanceShifter::Sample(double t, const FrameInputs&, LocalPose& out) {
+bool BalanceShifter::Sample(double t, const FrameInputs& inputs, LocalPose& out) {
   if (out.size() != skeleton_->size()) return false;
+  SetPauseOffsetScale(inputs.pause_offset_scale);
   Posture(t);
   if (variations_) posture_ += variations_->Posture(t) - variations_->model().mean;
   PoseFromPosture(*skeleton_, rest_, model_->joints, model_->root, posture_, out);

@@ -92,7 +92,12 @@ class BalanceShifter : public Blendable {
 
   double Duration() const override { return kUnbounded; }
   // Time runs forward; sampling before the current rest or transition replays from the seed.
+  // inputs.pause_offset_scale sets the random part of the rests drawn from then on (a rest under
+  // way keeps its length), so the walk is a function of (seed, t) only while the scale holds.
   bool Sample(double t, const FrameInputs& inputs, LocalPose& out) override;
+  // The factor on each rest's random part from now on (FrameInputs::pause_offset_scale; negative
+  // or not finite: 1). Sample sets it from its inputs.
+  void SetPauseOffsetScale(double scale);
   int joint_count() const override { return skeleton_->size(); }
 
   // Where the walk is: resting in `from` (segment −1), or in transition `segment` from `from`
@@ -123,6 +128,7 @@ class BalanceShifter : public Blendable {
   std::uint64_t seed_;
   std::shared_ptr<IdleSynthesizer> variations_;
   std::mt19937_64 rng_;
+  double pause_offset_scale_ = 1;
   State state_;
   Eigen::VectorXd p_, q_;       // resting postures: the current (rest) or the two joined (transition)
   Eigen::VectorXd posture_;     // scratch, sized once

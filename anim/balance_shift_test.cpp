@@ -96,5 +96,71 @@ TEST(BalanceShift, ModelCheckRefusesAGraphThatCannotGoOn) {
   EXPECT_THROW(m.Check(1), Error);  // a segment of one frame
 }
 
+// Left and right, each resting 1–5 s (so the random part of a pause is up to 4 s), a 0.5 s shift
+// between them: the walk's rests as the activation's pause scale (FrameInputs) sets them.
+BalanceModel LeftRightModel() {
+  BalanceModel m = TwoComponentModel();
+  std::vector<Eigen::VectorXd> left_to_right, right_to_left;
+  for (int k = 0; k <= 15; ++k) {
+    left_to_right.push_back(Posture(k / 15.0, 0));
+    right_to_left.push_back(Posture(1 - k / 15.0, 0));
+  }
+  m.segments = {Segment(Support::kLeft, Support::kRight, left_to_right), Segment(Support::kRight, Support::kLeft, right_to_left)};
+  m.counts[0][2] = m.counts[2][0] = 1;
+  m.rests[0] = {Posture(0, 0)};
+  m.rests[2] = {Posture(1, 0)};
+  m.dwell_min[0] = m.dwell_min[2] = 1;
+  m.dwell_max[0] = m.dwell_max[2] = 5;
+  return m;
+}
+
+// The rests that began and ended within `seconds` of a walk sampled at 30 Hz under `scale`.
+std::vector<double> RestsUnder(double scale, std::uint64_t seed, double seconds) {
+  auto sk = std::make_shared<Skeleton>();
+  sk->names = {"root"};
+  sk->parents = {-1};
+  sk->rest = {Transform{}};
+  sk->inverse_bind = {Eigen::Matrix4d::Identity()};
+  BalanceShifter walk(sk, std::make_shared<const BalanceModel>(LeftRightModel()), seed);
+  FrameInputs inputs;
+  inputs.pause_offset_scale = scale;
+  LocalPose pose = LocalPose::Rest(*sk);
+  std::vector<double> rests;
+  double rest_began = -1;
+  for (int frame = 0; frame < seconds * 30; ++frame) {
+    EXPECT_TRUE(walk.Sample(frame / 30.0, inputs, pose));
+    const BalanceShifter::State& s = walk.state();
+    if (s.segment < 0 && s.t0 > 0 && s.t0 != rest_began) {
+      rest_began = s.t0;
+      rests.push_back(s.t1 - s.t0);
+    }
+  }
+  return rests;
+}
+
+double Mean(const std::vector<double>& v) {
+  double sum = 0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0 : sum / static_cast<double>(v.size());
+}
+
+TEST(BalanceShift, HigherActivationGivesShorterPausesInASeededWalk) {
+  // The thesis's Eq. 4.2 with α = β = 1: activation 0.9 scales the pauses' random part by 0.1,
+  // activation −0.5 by 1.5 (dialogue::PauseOffsetScale); the same seed makes the same draws.
+  const std::vector<double> excited = RestsUnder(0.1, 17, 120), calm = RestsUnder(1.5, 17, 120);
+  const std::vector<double> neutral = RestsUnder(1.0, 17, 120);
+  ASSERT_GE(calm.size(), 10u);
+  EXPECT_GT(excited.size(), calm.size());  // shorter pauses, more shifts
+  for (double r : excited) EXPECT_LE(r, 1 + 0.1 * 4 + 1e-9);  // p_m + 0.1·p_o at most
+  for (double r : calm) EXPECT_GE(r, 1 - 1e-9);               // never below the recorded minimum
+  EXPECT_GT(Mean(calm), Mean(neutral));
+  EXPECT_GT(Mean(neutral), Mean(excited));
+  // The default (no emotion) is the data's own pauses: within the recorded range.
+  for (double r : neutral) {
+    EXPECT_GE(r, 1 - 1e-9);
+    EXPECT_LE(r, 5 + 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace arview::anim

@@ -33,6 +33,10 @@ struct FrameInputs {
   // The viewer's eyes (the camera centre) in model space, for gaze (anim/gaze.h); not finite
   // when unknown.
   Eigen::Vector3d viewer = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  // The idle's pause length (thesis §4.1.2, Eq. 4.2): the factor on the random part of each rest
+  // between balance shifts, p_o' = (α − activation)·β·p_o. 1: the data's pauses; 0: the shortest
+  // (high activation); 2: the calmest. Set from the character's emotion (dialogue::PauseOffsetScale).
+  double pause_offset_scale = 1;
 };
 
 class Blendable {

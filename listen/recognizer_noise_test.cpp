@@ -24,30 +24,6 @@ const std::vector<std::string> kDialoguePhrases = {
 constexpr std::size_t kSegment = 10 * kSampleRate;  // ten seconds of each kind, in turn
 constexpr double kMinutes = 5;
 
-struct NoiseKind {
-  std::string name;
-  std::function<std::vector<std::int16_t>(std::uint32_t seed)> make;
-};
-
-// Digital silence, a dithered floor, white and pink noise from a quiet room to a loud fan, and
-// the tone mix from background music to loud (peaks at 3% to 76% of full scale).
-std::vector<NoiseKind> Kinds() {
-  using namespace testing;
-  return {
-      {"silence", [](std::uint32_t) { return Silence(kSegment); }},
-      {"dither", [](std::uint32_t s) { return WhiteNoise(kSegment, 3, s); }},
-      {"white-30", [](std::uint32_t s) { return WhiteNoise(kSegment, 30, s); }},
-      {"white-300", [](std::uint32_t s) { return WhiteNoise(kSegment, 300, s); }},
-      {"white-3000", [](std::uint32_t s) { return WhiteNoise(kSegment, 3000, s); }},
-      {"pink-30", [](std::uint32_t s) { return PinkNoise(kSegment, 30, s); }},
-      {"pink-300", [](std::uint32_t s) { return PinkNoise(kSegment, 300, s); }},
-      {"pink-3000", [](std::uint32_t s) { return PinkNoise(kSegment, 3000, s); }},
-      {"music-1000", [](std::uint32_t s) { return ToneMix(kSegment, 1000, s); }},
-      {"music-8000", [](std::uint32_t s) { return ToneMix(kSegment, 8000, s); }},
-      {"music-25000", [](std::uint32_t s) { return ToneMix(kSegment, 25000, s); }},
-  };
-}
-
 struct Closest {
   std::size_t results = 0;
   std::size_t with_words = 0;
@@ -62,12 +38,12 @@ struct Closest {
 // each segment. Returns the accepted results; prints how close the others came.
 std::vector<Recognition> HearNoise(const RecognizerOptions& options) {
   Recognizer recognizer(options, kDialoguePhrases);
-  const std::vector<NoiseKind> kinds = Kinds();
+  const std::vector<testing::NoiseKind> kinds = testing::NoiseKinds(kSegment);
   const auto segments = static_cast<std::size_t>(kMinutes * 60 * kSampleRate / kSegment);
   std::vector<Recognition> accepted;
   Closest closest;
   for (std::size_t i = 0; i < segments; ++i) {
-    const NoiseKind& kind = kinds[i % kinds.size()];
+    const testing::NoiseKind& kind = kinds[i % kinds.size()];
     const std::vector<std::int16_t> samples = kind.make(static_cast<std::uint32_t>(54 + i));
     if (options.mode == ListenMode::kPushToTalk) recognizer.StartUtterance();
     for (std::size_t done = 0; done < samples.size(); done += 1600) {

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <random>
@@ -164,6 +165,30 @@ inline std::vector<std::int16_t> ToneMix(std::size_t count, double peak, std::ui
   std::vector<std::int16_t> samples(count);
   for (std::size_t i = 0; i < count; ++i) samples[i] = Clip(mix[i] * peak / highest);
   return samples;
+}
+
+// The generated inputs that must not become commands, each `count` samples from a seed: digital
+// silence, a dithered floor, white and pink noise from a quiet room to a loud fan, and the tone
+// mix from background music to loud (peaks at 3% to 76% of full scale). docs/listen.md.
+struct NoiseKind {
+  std::string name;
+  std::function<std::vector<std::int16_t>(std::uint32_t seed)> make;
+};
+
+inline std::vector<NoiseKind> NoiseKinds(std::size_t count) {
+  return {
+      {"silence", [count](std::uint32_t) { return Silence(count); }},
+      {"dither", [count](std::uint32_t s) { return WhiteNoise(count, 3, s); }},
+      {"white-30", [count](std::uint32_t s) { return WhiteNoise(count, 30, s); }},
+      {"white-300", [count](std::uint32_t s) { return WhiteNoise(count, 300, s); }},
+      {"white-3000", [count](std::uint32_t s) { return WhiteNoise(count, 3000, s); }},
+      {"pink-30", [count](std::uint32_t s) { return PinkNoise(count, 30, s); }},
+      {"pink-300", [count](std::uint32_t s) { return PinkNoise(count, 300, s); }},
+      {"pink-3000", [count](std::uint32_t s) { return PinkNoise(count, 3000, s); }},
+      {"music-1000", [count](std::uint32_t s) { return ToneMix(count, 1000, s); }},
+      {"music-8000", [count](std::uint32_t s) { return ToneMix(count, 8000, s); }},
+      {"music-25000", [count](std::uint32_t s) { return ToneMix(count, 25000, s); }},
+  };
 }
 
 }  // namespace arview::listen::testing

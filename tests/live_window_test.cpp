@@ -110,22 +110,6 @@ class LiveWindow : public testing::XSessionTest<::testing::TestWithParam<Case>> 
     line += " 2>" + ShellQuote((dir_ / "stderr.txt").string());
     return {"sh", "-c", line};
   }
-
-  // The window's id once its title shows the live status (frames have been shown), or "".
-  std::string WaitForLiveWindow(Child& app) {
-    const std::string d = display_->name();
-    for (int i = 0; i < 600 && app.Wait(0) < 0; ++i) {
-      const int rc = std::system(("DISPLAY=" + d + " xdotool search --name '^arview .*fps' > " +
-                                  ShellQuote((dir_ / "window_id").string()) + " 2>/dev/null").c_str());
-      if (rc == 0) {
-        std::string id = ReadWholeFile((dir_ / "window_id").string());
-        id = id.substr(0, id.find('\n'));
-        if (!id.empty()) return id;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-    return "";
-  }
 };
 
 TEST_P(LiveWindow, ShowsFramesAndEndsPromptlyWithItsOutputs) {

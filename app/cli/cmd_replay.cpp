@@ -76,7 +76,7 @@ void AddReplayCommand(CLI::App& app) {
 
     SessionOptions o;
     ApplySessionFlags(a->session, /*live_source=*/a->paced, o);
-    ApplyDialogueFlags(a->dialogue, o);
+    ApplyDialogueFlags(a->dialogue, video::IsWindowTarget(a->out), o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

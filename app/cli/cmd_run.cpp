@@ -71,7 +71,7 @@ void AddRunCommand(CLI::App& app) {
     SessionOptions o;
     o.command_start = Clock::now();
     ApplySessionFlags(a->session, /*live_source=*/true, o);
-    ApplyDialogueFlags(a->dialogue, o);
+    ApplyDialogueFlags(a->dialogue, video::IsWindowTarget(a->out), o);
     // No per-frame record kept (--stats streams them to disk) and the trajectory only for
     // --trajectory: a long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;

@@ -53,6 +53,10 @@ std::vector<std::string> DialogueHudLines(const CharacterDialogue& dialogue) {
   } else {
     lines.push_back(d.listening ? "heard: nothing yet" : "heard: not listening");
   }
+  if (d.push_to_talk) {
+    const std::string key(kPushToTalkKey);
+    lines.push_back(d.talking ? "talk: listening, press " + key + " when done" : "talk: press " + key + " to speak");
+  }
   std::snprintf(line, sizeof line, "machine: %.*s   emotion: %.*s %.2f   face: %.*s %.2f",
                 static_cast<int>(d.machine.empty() ? 1 : d.machine.size()), d.machine.empty() ? "-" : d.machine.data(),
                 static_cast<int>(d.emotion.empty() ? 7 : d.emotion.size()), d.emotion.empty() ? "neutral" : d.emotion.data(),

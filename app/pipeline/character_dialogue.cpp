@@ -221,6 +221,19 @@ void CharacterDialogue::Update(double time, const anim::Placement& placement, co
   frame_.expression = expression_ ? StableName(*expression_) : std::string_view();
   frame_.expression_weight = expression_weight_;
   frame_.activation = mood.activation;
+  frame_.pause_offset_scale = dialogue::PauseOffsetScale(mood.activation);
+  frame_.push_to_talk = options_.push_to_talk && recognizer_;
+  frame_.talking = frame_.push_to_talk && talking_;
+}
+
+bool CharacterDialogue::TogglePushToTalk() {
+  if (!options_.push_to_talk || !recognizer_) return false;
+  std::lock_guard lock(talk_mutex_);
+  const bool open = !talking_;
+  if (open) recognizer_->StartUtterance();
+  else recognizer_->StopUtterance();
+  talking_ = open;
+  return open;
 }
 
 void CharacterDialogue::ShowExpression(anim::Animator& animator, const anim::AnimatorFrame& frame) const {

@@ -103,7 +103,17 @@ struct DialogueFrame {
   double expression_weight = 0;  // its weight on the face (0..1)
   double activation = 0;
   bool listening = false;       // a recognizer is being fed
+  bool push_to_talk = false;    // the recognizer hears only while the key has opened it
+  bool talking = false;         // push-to-talk: the key has opened listening
+  // The idle's pause offset scale from the activation (dialogue::PauseOffsetScale, thesis Eq. 4.2):
+  // handed to the animator as anim::FrameInputs::pause_offset_scale.
+  double pause_offset_scale = 1;
 };
+
+// The window's key that opens and closes listening in push-to-talk mode (an X keysym name). A
+// toggle, not a held key: the window reports key presses only, and X's auto-repeat sends
+// release-press pairs while a key is held, so a held key could not be told from fast presses.
+inline constexpr std::string_view kPushToTalkKey = "space";
 
 // The morph targets of each of Ekman's six expressions at full intensity (dialogue::Expression's
 // order), found on the character at load; and the mouth targets that speech owns while talking.
@@ -129,6 +139,9 @@ struct DialogueOptions {
   std::function<double(std::int64_t sample, double frame_time)> sample_time;
   // A WAV's pacing clock, advanced to each frame's time at the start of Update (null: none).
   FramePacingClock* frame_clock = nullptr;
+  // The recognizer is in push-to-talk mode (listen::ListenMode::kPushToTalk): it hears what comes
+  // between two TogglePushToTalk calls (kPushToTalkKey in the window).
+  bool push_to_talk = false;
 };
 
 class CharacterDialogue {
@@ -159,6 +172,11 @@ class CharacterDialogue {
   // The recognizer's input is gone (a microphone unplugged): the session goes on without
   // listening, and the HUD says so. Any thread (the audio source's).
   void StopListening() { listening_ = false; }
+  // Push-to-talk (DialogueOptions::push_to_talk): the key opens listening, the next press closes
+  // it and the utterance between is decoded. Any thread (the window's key handler on arview-sink):
+  // the recognizer's StartUtterance/StopUtterance take effect at its input's position when called.
+  // Returns whether listening is now open; false, and nothing done, without push-to-talk.
+  bool TogglePushToTalk();
 
  private:
   dialogue::ViewerInput Viewer(const anim::Placement& placement, const std::optional<Eigen::Vector3d>& camera_center,
@@ -174,6 +192,8 @@ class CharacterDialogue {
   ExpressionTargets expressions_;
   DialogueOptions options_;
   std::atomic<bool> listening_{true};
+  std::mutex talk_mutex_;                  // one toggle at a time: the recognizer sees start, stop, start, ...
+  std::atomic<bool> talking_{false};       // push-to-talk: the key has opened listening
   bool broken_ = false;                    // a DialogueError at run time: no more turns
   double heard_confidence_ = 0, heard_end_s_ = -1;  // of the phrase taken this frame
   std::optional<double> last_time_;

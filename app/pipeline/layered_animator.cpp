@@ -39,7 +39,10 @@ const anim::AnimatorFrame& LayeredAnimator::Update(const std::optional<Eigen::Ve
     cues.distance = inputs.distance;
     cues.viewpoint = inputs.viewpoint;
   }
-  if (dialogue_) dialogue_->Update(time, placement, camera_center, optical_axis, *speech_, *animator_);
+  if (dialogue_) {
+    dialogue_->Update(time, placement, camera_center, optical_axis, *speech_, *animator_);
+    inputs.pause_offset_scale = dialogue_->frame().pause_offset_scale;  // the emotion's pace of the idle
+  }
   const anim::FaceTrack& face = speech_->Update(time, cues, *animator_);
   const anim::AnimatorFrame& frame = animator_->Update(time, inputs, &face);
   if (dialogue_) dialogue_->ShowExpression(*animator_, frame);

@@ -215,8 +215,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
       if (o.first_view->on_placed) o.first_view->on_placed(placement.anchor, frame.pose, milliseconds);
     };
   }
-  sink->SetKeyHandler([&compositor](const std::string& key) {
+  sink->SetKeyHandler([&compositor, &dialogue](const std::string& key) {
     if (key == "h") compositor.ToggleHud();
+    if (key == kPushToTalkKey && dialogue) dialogue->TogglePushToTalk();
   });
 
   if (dialogue) dialogue->Start();

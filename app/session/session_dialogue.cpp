@@ -146,7 +146,7 @@ SessionDialogue::SessionDialogue(const DialogueSessionOptions& o, const authorin
   if (hears && every_phrase.empty()) load_notes_.push_back(file + ": the dialogue hears nothing (no heard: condition): not listening");
   if (hears && !every_phrase.empty()) {
     listen::RecognizerOptions ro;
-    ro.mode = listen::ListenMode::kVoiceActivity;
+    ro.mode = o.push_to_talk ? listen::ListenMode::kPushToTalk : listen::ListenMode::kVoiceActivity;
     ro.decoder.vad_postspeech_frames = o.end_of_speech_frames;
     ro.min_confidence = o.min_confidence;
     recognizer_ = std::make_unique<listen::Recognizer>(ro, every_phrase);  // every word checked now
@@ -157,6 +157,7 @@ SessionDialogue::SessionDialogue(const DialogueSessionOptions& o, const authorin
   options.origin = file;
   options.forward = character.spec().forward;
   options.up = character.spec().up;
+  options.push_to_talk = o.push_to_talk;
   if (recognizer_ && !o.audio_in.empty()) {
     frame_clock_ = std::make_unique<FramePacingClock>();
     audio::WavSourceOptions wav;
@@ -223,6 +224,8 @@ void SessionDialogue::Stop() {
   source_->RequestStop();
   source_->Join();
 }
+
+bool SessionDialogue::TogglePushToTalk() { return dialogue_->TogglePushToTalk(); }
 
 std::string SessionDialogue::audio_error() const {
   std::lock_guard lock(mutex_);

@@ -38,6 +38,9 @@ struct DialogueSessionOptions {
   int end_of_speech_frames = 20;
   // The recognizer's confidence gate (listen::RecognizerOptions::min_confidence).
   double min_confidence = listen::RecognizerOptions{}.min_confidence;
+  // `--push-to-talk`: the recognizer hears only between two presses of the window's key
+  // (kPushToTalkKey, TogglePushToTalk); otherwise it listens by voice activity.
+  bool push_to_talk = false;
   bool enabled() const { return !dialogue_file.empty(); }
 };
 
@@ -59,6 +62,10 @@ class SessionDialogue {
   void Start();
   // Stops the audio and the recognizer's input; after the pipeline has ended.
   void Stop();
+  // Push-to-talk's key (the window's key handler, arview-sink; any thread): opens listening, or
+  // closes it and the utterance is decoded. Whether listening is now open; false without
+  // push-to-talk or a recognizer.
+  bool TogglePushToTalk();
   // What the user should be told at load (a gesture the character lacks, ...), one line each.
   const std::vector<std::string>& load_notes() const { return load_notes_; }
   // The microphone's end, when it failed (empty otherwise); after Stop.

@@ -11,10 +11,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "app/pipeline/ar_compositor.h"
 #include "app/session/character_setup.h"
 #include "app/session/session_dialogue.h"
 #include "audio/wav.h"
@@ -79,13 +81,16 @@ struct ExchangeRun {
   std::vector<double> expression_weight;      // per frame
   std::vector<double> joy;                    // per frame
   std::vector<std::string> results;           // every recognition: "12.30 s: \"text\" 0.123 taken|not taken"
+  std::vector<std::string> talk_hud;          // per frame, the HUD's push-to-talk line ("" without push-to-talk)
   bool ended = false;
 };
 
 // Runs frames until the conversation ended and every reply started (or `max_s` of frame time).
+// `before_frame` (optional) is called with each frame's time before it is animated (a key pressed).
 inline ExchangeRun RunExchange(const std::filesystem::path& dialogue_file, const std::filesystem::path& wav,
                                const std::string& figure_voice, double speed, double max_s, std::uint64_t seed = 7,
-                               DialogueSessionOptions o = {}) {
+                               DialogueSessionOptions o = {},
+                               const std::function<void(double, SessionDialogue&)>& before_frame = {}) {
   const authoring::AnimatedCharacter character(FigureForDialogue(figure_voice));
   std::unique_ptr<LayeredAnimator> animator = MakeLayeredAnimator(character);
   ExchangeRun run;
@@ -103,9 +108,12 @@ inline ExchangeRun RunExchange(const std::filesystem::path& dialogue_file, const
     const double t = k * kFrame;
     std::this_thread::sleep_until(wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                    std::chrono::duration<double>(t / speed)));
+    if (before_frame) before_frame(t, session);
     animator->Update(eye, t, axis);
     const CharacterDialogue& d = *animator->dialogue();
     run.expression_weight.push_back(d.frame().expression_weight);
+    const std::vector<std::string> hud = DialogueHudLines(d);
+    run.talk_hud.push_back(d.frame().push_to_talk && hud.size() > 2 ? hud[1] : "");
     if (d.frame().heard_this_frame) {
       char line[256];
       std::snprintf(line, sizeof line, "%.2f s: \"%s\" %.3f %s", t, d.frame().heard_now.c_str(), d.frame().heard_confidence,

@@ -149,6 +149,22 @@ class XSessionTest : public Base {
   static bool Answers(const std::string& display) {
     return std::system(("DISPLAY=" + display + " xdotool getdisplaygeometry >/dev/null 2>&1").c_str()) == 0;
   }
+  // The id of arview's window once its title shows the live status (frames have been shown), or
+  // "" when `app` ended first or none came within 60 s.
+  std::string WaitForLiveWindow(Child& app) {
+    const std::string d = display_->name();
+    for (int i = 0; i < 600 && app.Wait(0) < 0; ++i) {
+      const int rc = std::system(("DISPLAY=" + d + " xdotool search --name '^arview .*fps' > " +
+                                  ShellQuote((dir_ / "window_id").string()) + " 2>/dev/null").c_str());
+      if (rc == 0) {
+        std::string id = ReadWholeFile((dir_ / "window_id").string());
+        id = id.substr(0, id.find('\n'));
+        if (!id.empty()) return id;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return "";
+  }
   void TearDown() override {
     display_.reset();
     if (!this->HasFailure() && !dir_.empty()) std::filesystem::remove_all(dir_);
