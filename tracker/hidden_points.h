@@ -18,7 +18,9 @@
 namespace arview::tracker {
 
 struct HiddenPointOptions {
-  bool enabled = true;
+  // Off by default: with two walkers on the demo's lap they took 9 re-search frames of 72 off
+  // and cost the worst frames (two over 5 px; docs/tracker.md, "Second round").
+  bool enabled = false;
   int max_age_frames = 60;  // tracked frames a lost point is kept for (2 s at 30 fps)
   // A point followed back is taken when LK ends within this many working pixels of where the
   // pose of the frame's flow tracks projects it, with a patch error within the moving-track
