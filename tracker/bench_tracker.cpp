@@ -151,7 +151,7 @@ static void BM_MovingTrackRejection(benchmark::State& state) {
   MovingTrackFilter filter({}, kTracks * 13);
   std::uint32_t frame_number = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(MatchMeanBrightness(frame, reference, 0.05).data);
+    benchmark::DoNotOptimize(MatchMeanBrightness(frame, reference, 0.05).image.data);
     const MovingTrackVerdict verdict = filter.Judge({ids, pixels, predicted, errors}, ++frame_number);
     int near = 0;
     for (const Eigen::Vector2d& g : guided) near += MovingTrackFilter::NearRejected(verdict, g, 16);

@@ -10,8 +10,16 @@
 
 namespace arview::tracker {
 
+struct BrightnessMatch {
+  cv::Mat image;      // the frame LK follows into
+  double gain = 1.0;  // what `image` was scaled by (1: it is the frame itself)
+  // The light changed beyond the tolerance: the frame was scaled, and its patches (clipped,
+  // shadowed unevenly) fit the last frame's less exactly than a steady frame's do.
+  bool light_changed() const { return gain != 1.0; }
+};
+
 // `gray` (8-bit) scaled by mean(reference) / mean(gray) (saturating) when that ratio is off 1 by
 // more than `tolerance`; otherwise `gray` itself. An empty reference or a black frame: `gray`.
-cv::Mat MatchMeanBrightness(const cv::Mat& gray, const cv::Mat& reference, double tolerance);
+BrightnessMatch MatchMeanBrightness(const cv::Mat& gray, const cv::Mat& reference, double tolerance);
 
 }  // namespace arview::tracker

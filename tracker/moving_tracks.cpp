@@ -44,15 +44,24 @@ MovingTrackVerdict MovingTrackFilter::Judge(const FlowTracks& tracks, std::uint3
   for (std::size_t i = 0; i < n; ++i) scratch_.push_back(static_cast<float>((tracks.pixels[i] - tracks.predicted[i] - shared).norm()));
   const double bound = std::max(options_.against_prediction_min_px, options_.against_prediction_scale * Median(scratch_));
   scratch_.assign(tracks.lk_errors.begin(), tracks.lk_errors.end());
-  const double patch_bound = options_.patch_error_ratio * std::max(Median(scratch_), std::numeric_limits<float>::min());
+  const float median_error = std::max(Median(scratch_), std::numeric_limits<float>::min());
 
   for (std::size_t i = 0; i < n; ++i) {
     Streak& streak = streaks_[tracks.point_ids[i]];
-    if (streak.frame + 1 != frame) streak.count = 0;
+    // Judged in the frame before this one (frame 0 is "never": the tracker counts from 1).
+    const bool followed_before = streak.frame != 0 && streak.frame + 1 == frame;
+    if (!followed_before) streak.count = 0;
     streak.frame = frame;
     const bool disagrees = (tracks.pixels[i] - tracks.predicted[i] - shared).norm() > bound;
     streak.count = disagrees ? static_cast<std::uint8_t>(std::min(streak.count + 1, 255)) : 0;
-    const bool changed_patch = tracks.lk_errors[i] > patch_bound;
+    // A patch's LK error grows with its contrast: a sharp corner's is several times the frame's
+    // median on every frame (with two walkers on the demo's lap, a bound on the median alone
+    // dropped 10-45 tracks of ~250 a frame, most of them on the static room, and the tracks ran
+    // out every 10-15 frames). So a track's error is compared with its own in the frame before;
+    // a track followed for the first time is judged by its motion alone.
+    const bool changed_patch =
+        followed_before && tracks.lk_errors[i] > options_.patch_error_ratio * std::max(streak.error, median_error);
+    streak.error = tracks.lk_errors[i];
     const bool moving = streak.count >= options_.streak_frames;
     if (!changed_patch && !moving) continue;
     verdict.keep[i] = false;

@@ -2,9 +2,10 @@
 // Matches on things that move in front of the map (people walking through, a door swinging):
 // rejected before the pose is fitted, so that they are never averaged into it. Two tests on the
 // flow tracks, one on guided matching's matches:
-//   - a track whose LK patch error is many times the frame's median: its patch changed (a person
-//     stepped over the point, or the point went behind one), so where LK put it is not the
-//     point's; a global light change scales every track's error alike and passes;
+//   - a track whose LK patch error is many times its own in the frame before (and the frame's
+//     median): its patch changed (a person stepped over the point, or the point went behind
+//     one), so where LK put it is not the point's; a global light change scales every track's
+//     error alike and passes;
 //   - a track that moved against the pose's prediction by more than the frame's tracks did, in
 //     `streak_frames` consecutive frames: a static point's flow agrees with the prediction up to
 //     an error all tracks share (the prediction's), a point carried by a moving object does not;
@@ -25,8 +26,8 @@ namespace arview::tracker {
 
 struct MovingTrackOptions {
   bool enabled = true;
-  // The LK error (mean absolute patch difference) over the frame's median beyond which a track's
-  // patch has changed.
+  // The LK error (mean absolute patch difference) over the larger of the track's own in the
+  // frame before and the frame's median beyond which a track's patch has changed.
   double patch_error_ratio = 4.0;
   // A track disagrees with the prediction when its flow, less the frame's median disagreement
   // (the prediction's own error), is off by more than max(min_px, scale x the tracks' median
@@ -69,6 +70,7 @@ class MovingTrackFilter {
   struct Streak {
     std::uint32_t frame = 0;  // the frame it was last judged in
     std::uint8_t count = 0;   // consecutive frames the track disagreed, up to that frame
+    float error = 0;          // its LK patch error in that frame
   };
   MovingTrackOptions options_;
   std::vector<Streak> streaks_;  // per map point

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tracker/brightness_match.h"
+#include "tracker/hidden_points.h"
 
 namespace arview::tracker {
 namespace {
@@ -70,6 +71,43 @@ TEST(MovingTracks, AChangedPatchIsDroppedAtOnceAndAGlobalLightChangeIsNot) {
   EXPECT_TRUE(filter.Judge(darker.View(), 3).rejected.empty());
 }
 
+TEST(MovingTracks, ASharpCornerWhoseErrorIsAlwaysHighIsKeptAndItsJumpIsNot) {
+  MovingTrackFilter filter({}, 100);
+  Frame f = MakeFrame(0);
+  f.errors[7] = 12.f;  // a high-contrast patch: 6 times the frame's median on every frame
+  for (std::uint32_t frame = 1; frame < 4; ++frame) EXPECT_TRUE(filter.Judge(f.View(), frame).keep[7]) << frame;
+  f.errors[7] = 60.f;  // then someone steps over it
+  const MovingTrackVerdict v = filter.Judge(f.View(), 4);
+  EXPECT_FALSE(v.keep[7]);
+  EXPECT_EQ(v.by_patch, 1);
+}
+
+TEST(MovingTracks, ATrackFollowedForTheFirstTimeIsJudgedByItsMotionAlone) {
+  MovingTrackFilter filter({}, 100);
+  Frame f = MakeFrame(0);
+  f.errors[3] = 40.f;
+  EXPECT_TRUE(filter.Judge(f.View(), 1).keep[3]) << "no error of its own to compare with yet";
+}
+
+TEST(HiddenPoints, KeptUntilTooOldOrFoundAgain) {
+  HiddenPoints hidden;
+  hidden.Add({10, {}, {{1, 1}, {2, 2}}, {5, 6}});
+  hidden.Add({12, {}, {{3, 3}}, {7}});
+  hidden.Add({13, {}, {}, {}});  // nothing lost: not kept
+  EXPECT_EQ(hidden.batches().size(), 2u);
+  EXPECT_EQ(hidden.size(), 3u);
+  hidden.Remove([](std::uint32_t id) { return id == 5; });
+  ASSERT_EQ(hidden.size(), 2u);
+  EXPECT_EQ(hidden.batches().front().point_ids, std::vector<std::uint32_t>{6});
+  EXPECT_EQ(hidden.batches().front().pixels.front(), cv::Point2f(2, 2)) << "pixels stay with their points";
+  hidden.Expire(70, 60);  // frame 10 is 60 frames before: kept
+  EXPECT_EQ(hidden.size(), 2u);
+  hidden.Expire(71, 60);
+  EXPECT_EQ(hidden.size(), 1u);
+  hidden.Remove([](std::uint32_t id) { return id == 7; });
+  EXPECT_TRUE(hidden.batches().empty()) << "an emptied batch is dropped";
+}
+
 TEST(MovingTracks, GuidedMatchesNearARejectedTrackAreTheMoversRegion) {
   MovingTrackVerdict verdict;
   verdict.rejected = {{100, 100}};
@@ -101,12 +139,16 @@ TEST(BrightnessMatch, AFrameTwoStopsDarkerIsScaledToTheReferenceAndAnOrdinaryOne
   cv::Mat reference(48, 64, CV_8U), dark, slightly;
   cv::randu(reference, 40, 200);
   reference.convertTo(dark, CV_8U, 0.25);
-  const cv::Mat matched = MatchMeanBrightness(dark, reference, 0.05);
-  EXPECT_NEAR(cv::mean(matched)[0], cv::mean(reference)[0], 1.0);
+  const BrightnessMatch matched = MatchMeanBrightness(dark, reference, 0.05);
+  EXPECT_NEAR(cv::mean(matched.image)[0], cv::mean(reference)[0], 1.0);
+  EXPECT_TRUE(matched.light_changed());
+  EXPECT_NEAR(matched.gain, 4.0, 0.1);
   reference.convertTo(slightly, CV_8U, 0.98);
-  EXPECT_EQ(MatchMeanBrightness(slightly, reference, 0.05).data, slightly.data) << "within the tolerance: the frame itself";
+  const BrightnessMatch ordinary = MatchMeanBrightness(slightly, reference, 0.05);
+  EXPECT_EQ(ordinary.image.data, slightly.data) << "within the tolerance: the frame itself";
+  EXPECT_FALSE(ordinary.light_changed());
   const cv::Mat black = cv::Mat::zeros(48, 64, CV_8U);
-  EXPECT_EQ(MatchMeanBrightness(black, reference, 0.05).data, black.data);
+  EXPECT_EQ(MatchMeanBrightness(black, reference, 0.05).image.data, black.data);
 }
 
 }  // namespace

@@ -11,7 +11,10 @@ namespace arview::tracker {
 
 struct OneEuroOptions {
   double min_cutoff_hz = 1.0;  // cutoff at rest: lower = smoother, more lag
-  double beta = 0.5;           // cutoff growth per unit of speed (units/s): higher = less lag
+  // Cutoff growth per unit of speed (units/s): higher = less lag. 5: the smoothed centre trails
+  // the raw one by under a frame on the demo's lap (docs/tracker.md, "Registration as the viewer
+  // sees it").
+  double beta = 5.0;
   double derivative_cutoff_hz = 1.0;
 
   // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).

@@ -20,6 +20,7 @@
 #include "map/descriptor_index.h"
 #include "map/map.h"
 #include "tracker/centre_fitter.h"
+#include "tracker/hidden_points.h"
 #include "tracker/moving_tracks.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
@@ -142,6 +143,9 @@ struct TrackingOptions {
   // Flow tracks and guided matches on things that move in front of the map, rejected before the
   // pose (tracker/moving_tracks.h; docs/tracker.md, "People walking through").
   MovingTrackOptions moving;
+  // Points whose tracks someone walking through took away, followed back when the flow thins
+  // out, before guided matching (tracker/hidden_points.h; docs/tracker.md, "People walking through").
+  HiddenPointOptions hidden;
 
   // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
   void Check(const OptionNames& names = {}) const;
@@ -200,6 +204,7 @@ struct FrameResult {
   double flow_motion_px = 0;  // their median move from the last frame, pixels of the working frame
   int guided_matches = 0;  // added by guided matching
   int moving_rejected = 0; // flow tracks and guided matches rejected as on something moving
+  int recovered_tracks = 0;  // hidden points followed back from the last frame that saw them
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
   // > 0: the tracked pose was replaced by the pose of the frame's own SIFT matched globally, on
@@ -341,6 +346,15 @@ class Tracker {
   // them: the rejected ones removed from `c` (the rest keep their order); the verdict.
   MovingTrackVerdict DropMovingTracks(const std::vector<Eigen::Vector2d>& predicted, const std::vector<float>& lk_errors,
                                       Correspondences* c, FrameResult* result);
+  // The last frame's tracks that did not survive into this one although the prediction puts their
+  // points in view (`in_view`, per track), kept as hidden points with the last frame's pyramid.
+  void HideLostTracks(const std::vector<bool>& in_view);
+  // Hidden points followed by LK from the frame that last saw them into `pyramid`, started where
+  // `projecting` puts them, and appended to `c` when they end within HiddenPointOptions::radius_px
+  // of it with a patch error within the moving-track filter's bound over `flow_lk_errors`; the
+  // number appended.
+  int RecoverHiddenPoints(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting,
+                          const std::vector<float>& flow_lk_errors, Correspondences* c);
   // Correspondences c[from, end) that lie where the verdict rejected tracks, removed.
   void DropNearMoving(const MovingTrackVerdict& verdict, std::size_t from, Correspondences* c, FrameResult* result) const;
   // The pose from a prior: refined from it, and when that explains fewer than
@@ -390,11 +404,13 @@ class Tracker {
   CentreFitter feature_centres_;       // their recent centres
   double velocity_dt_ = 0;  // the time velocity_ spans
   std::vector<cv::Mat> last_pyramid_;
+  double last_light_gain_ = 1;  // what the last frame was scaled by for LK (tracker/brightness_match.h)
   Track2D3D last_inliers_;
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it
   std::vector<std::uint32_t> point_stamp_;  // per map point: frame number it was last gathered
   std::uint32_t frame_counter_ = 0;
   MovingTrackFilter moving_filter_;
+  HiddenPoints hidden_;
   // Background work (TrackingOptions::background, prefetch_below): its own relocalizer and SIFT,
   // so that no object here but the map and the index is touched by two threads
   // (tracker/tracking_worker.h). Last: destroyed first, so that a running job finishes while

@@ -92,6 +92,7 @@ void TrackingOptions::Check(const OptionNames& names) const {
                 fresh_features_after_s);
   RequireOption(flow_brightness_tolerance >= 0, names("flow_brightness_tolerance"), "0 or more", flow_brightness_tolerance);
   moving.Check(names.Nested("moving"));
+  hidden.Check(names.Nested("hidden"));
 }
 
 void TrackerOptions::Check(const OptionNames& names) const {
