@@ -29,8 +29,10 @@
 # the pipeline's, otherwise gets too little CPU to relocalise in time), --heap-check (cheap
 # glibc heap-corruption detectors, one per session in turn: MALLOC_CHECK_=3 with
 # libc_malloc_debug.so, MALLOC_PERTURB_, tcache off; `long` uses the first), --out DIR
-# (default soak-live). Every session runs with `ulimit -c unlimited` in a folder of its own, so
-# that a core file (core_pattern "core") lands beside its outputs. Xvfb is started on a free display unless DISPLAY is set.
+# (default soak-live); after `--`, more options for `arview run` (e.g. `-- --dialogue FILE --mic
+# DEV --audio-out DEV`: the dialogue's recognizer and the sound sink's threads). Every session
+# runs with `ulimit -c unlimited` in a folder of its own, so that a core file (core_pattern
+# "core") lands beside its outputs. Xvfb is started on a free display unless DISPLAY is set.
 set -euo pipefail
 
 # Checks session folder $1 stopped by $2; prints one line; returns 1 when anything is wrong.
@@ -104,7 +106,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 arview=$root/build/release/app/arview
 fake=$root/build/release/tests/libarview_fake_v4l2.so
 map="" scene="" recording="" size="" format=mjpeg out=soak-live seconds=3600 count=200 heap_check=0 preload=0 nice=0
-first=1
+first=1 run_args=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --arview) arview=$2; shift ;;
@@ -121,6 +123,7 @@ while [ $# -gt 0 ]; do
     --heap-check) heap_check=1 ;;
     --preload) preload=1 ;;
     --nice) nice=$2; shift ;;
+    --) shift; run_args=("$@"); break ;;
     *) echo "soak-live.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -182,7 +185,8 @@ run_session() {
     ulimit -c unlimited
     exec nice -n "$nice" env LD_PRELOAD="$preload_libs" ARVIEW_FAKE_CAMERA_RECORDING="$recording" "${env_args[@]}" \
       "$arview" run --device /dev/video-arview-fake --map "$map" --scene "$scene" --format "$format" "${size_args[@]}" \
-      --out "$out_arg" --tracking-worker on --hud --stats stats.json --trajectory traj.txt >cmd.out 2>cmd.err </dev/null
+      --out "$out_arg" --tracking-worker on --hud --stats stats.json --trajectory traj.txt "${run_args[@]}" \
+      >cmd.out 2>cmd.err </dev/null
   ) &
   local pid=$! start=$SECONDS
   if [ "$sample_rss" = 1 ]; then
