@@ -20,6 +20,12 @@
 //                                without morphing)
 //   BM_ArFrameFace/weighted:<n>  the same tube with a 4000-triangle head mesh on top that the 52
 //                                targets move alone (a face of its own)
+//   BM_ArFrameFences/<c>_<way>   BM_ArFrame with the read-backs' scene fences held (hold: the fix
+//                                of issue 57's crash, render::SceneFences), a sync object made and
+//                                deleted at once (release_at_once), or none (none: as before the
+//                                fix); compare with --benchmark_enable_random_interleaving
+//   BM_SmallReadbackFences/<way> the same three ways on a cleared 4x MSAA 640x480 target's
+//                                64x64 read-back alone (the fixed cost a read-back)
 // llvmpipe's thread count is fixed per process: run once per count,
 //   bench_render --gl_threads=1    and    bench_render --gl_threads=2
 // (also --gl=auto|egl-device|egl|osmesa, and --gl_device=N; ARVIEW_GL_DEVICE is honoured). Characters come from ../shared/data; missing ones are skipped.
@@ -39,6 +45,7 @@
 #include "anim_authoring/scene.h"
 #include "base/heap_reuse.h"
 #include "render/ar_renderer.h"
+#include "render/scene_fence_policy.h"
 #include "synth/synth_room.h"
 #include "tests/support/test_data.h"
 
@@ -313,19 +320,23 @@ void BM_ArFrameNoAa(benchmark::State& state, std::string name) { RunArFrame(stat
 void BM_ArFrameLit(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kMsaa, true); }
 void BM_ArFrameLitNoAa(benchmark::State& state, std::string name) { RunArFrame(state, name, Antialiasing::kNone, true); }
 
+// BM_ArFrame under one of SceneFences' policies (the cost of the fence hold), put back after.
+void BM_ArFrameFences(benchmark::State& state, std::string name, SceneFencePolicy policy) {
+  SetSceneFencePolicyForTiming(policy);
+  RunArFrame(state, name, Antialiasing::kMsaa);
+  SetSceneFencePolicyForTiming(SceneFencePolicy::kHold);
+}
+
 // The same at 1920x1080 (the field of view kept: the character covers the same share).
 void BM_ArFrameLit1080p(benchmark::State& state, std::string name) {
   RunArFrame(state, name, Antialiasing::kMsaa, true, LitPart::kNothing, k1080p);
 }
 
-// Resolving a 4x multisampled 1920x1080 target and reading it back, directly (glReadPixels into
-// memory) or through a pixel buffer (PixelReadback: a copy into a buffer, a fence, a map). On a
-// GPU the direct read waits for the GPU; on llvmpipe both are CPU copies.
-void BM_Readback1080p(benchmark::State& state, bool pixel_buffer) {
+// Clears a 4x MSAA target of `size` and reads `rect` back, each iteration.
+void RunReadbacks(benchmark::State& state, cv::Size size, const cv::Rect& rect, bool pixel_buffer) {
   const GlApi& gl = Context().gl();
-  RenderTarget target(gl, k1080p.width, k1080p.height, 4);
+  RenderTarget target(gl, size.width, size.height, 4);
   PixelReadback readback(gl);
-  const cv::Rect all(cv::Point(0, 0), k1080p);
   std::uint64_t checksum = 0;
   const double cpu_start = ProcessCpuSeconds();
   for (auto _ : state) {
@@ -333,15 +344,31 @@ void BM_Readback1080p(benchmark::State& state, bool pixel_buffer) {
     gl.ClearColor(0.2f, 0.4f, 0.6f, 1.0f);
     gl.Clear(GL_COLOR_BUFFER_BIT);
     if (pixel_buffer) {
-      target.StartReadBgra(all, readback);
+      target.StartReadBgra(rect, readback);
       checksum += readback.Map().data[0];
       readback.Unmap();
     } else {
-      checksum += target.ReadBgraBottomUp(all).data[0];
+      checksum += target.ReadBgraBottomUp(rect).data[0];
     }
   }
   benchmark::DoNotOptimize(checksum);
   CountProcessCpu(state, cpu_start);
+}
+
+// Resolving a 4x multisampled 1920x1080 target and reading it back, directly (glReadPixels into
+// memory) or through a pixel buffer (PixelReadback: a copy into a buffer, a fence, a map). On a
+// GPU the direct read waits for the GPU; on llvmpipe both are CPU copies.
+void BM_Readback1080p(benchmark::State& state, bool pixel_buffer) {
+  RunReadbacks(state, k1080p, cv::Rect(cv::Point(0, 0), k1080p), pixel_buffer);
+}
+
+// The fence hold's fixed cost a read-back, without a frame's drawing around it: a 4x MSAA
+// 640x480 target cleared, a 64x64 corner resolved and read back, under one of SceneFences'
+// policies (BM_ArFrameFences gives the same in a whole frame).
+void BM_SmallReadbackFences(benchmark::State& state, SceneFencePolicy policy) {
+  SetSceneFencePolicyForTiming(policy);
+  RunReadbacks(state, {640, 480}, cv::Rect(0, 0, 64, 64), false);
+  SetSceneFencePolicyForTiming(SceneFencePolicy::kHold);
 }
 
 // The lit frame without one of its parts: where its added cost goes.
@@ -401,6 +428,16 @@ BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_prt, std::string("tube25k"), Lit
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameLitWithout, tube25k_exposure, std::string("tube25k"), LitPart::kExposure)
     ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameFences, tube25k_hold, std::string("tube25k"), SceneFencePolicy::kHold)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameFences, tube25k_release_at_once, std::string("tube25k"), SceneFencePolicy::kReleaseAtOnce)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ArFrameFences, tube25k_none, std::string("tube25k"), SceneFencePolicy::kNone)
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_SmallReadbackFences, hold, SceneFencePolicy::kHold)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_SmallReadbackFences, release_at_once, SceneFencePolicy::kReleaseAtOnce)
+    ->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_SmallReadbackFences, none, SceneFencePolicy::kNone)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ArFrameLit1080p, tube25k, std::string("tube25k"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Readback1080p, direct, false)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Readback1080p, pixel_buffer, true)->Unit(benchmark::kMillisecond)->UseRealTime();

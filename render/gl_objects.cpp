@@ -3,9 +3,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <vector>
 
 #include "render/offscreen.h"
+#include "render/scene_fence_policy.h"
 
 namespace arview::render {
 namespace {
@@ -156,7 +158,11 @@ void RequireComplete(const GlApi& gl, const std::string& what) {
   }
 }
 
+std::atomic<SceneFencePolicy> g_fence_policy{SceneFencePolicy::kHold};
+
 }  // namespace
+
+void SetSceneFencePolicyForTiming(SceneFencePolicy policy) { g_fence_policy.store(policy); }
 
 SceneFences::~SceneFences() {
   if (lifetime_ == Lifetime::kFreedWithTheContext) return;
@@ -164,9 +170,16 @@ SceneFences::~SceneFences() {
 }
 
 void SceneFences::HoldCurrent() {
+  const SceneFencePolicy policy = g_fence_policy.load(std::memory_order_relaxed);
+  if (policy == SceneFencePolicy::kNone) return;
   // glFenceSync hands the scene drawn so far to the rasterizer and references llvmpipe's fence
   // of the newest scene (its last_fence, when nothing new was drawn) until glDeleteSync.
-  held_.push_back(gl_->FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0));
+  GLsync fence = gl_->FenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  if (policy == SceneFencePolicy::kReleaseAtOnce) {
+    gl_->DeleteSync(fence);
+    return;
+  }
+  held_.push_back(fence);
 }
 
 void SceneFences::ReleaseOlder() {

@@ -7,15 +7,19 @@
 #       one session, Ctrl-C after --seconds; resident memory sampled every 10 s (rss.tsv), then
 #       the figures: resident memory after the warm-up (first 5 minutes) against its range,
 #       latency p50/p99 of the first and last 10 minutes (from stats.json's frames).
-#   scripts/soak-live.sh short --map M --scene S --recording R [--count 200] [--out DIR]
-#       sessions of 20-60 s each, stopped in turn by SIGINT, SIGTERM and the camera unplugged
-#       (ARVIEW_FAKE_CAMERA_UNPLUG_AFTER); each checked: the exit status (0 for a signal, 1 and
-#       the line naming the unplugged device for an unplug), no core file, no allocator or
-#       sanitizer message on stderr, stats.json complete (valid JSON, one record per frame
-#       processed) and the trajectory a TUM line for at least every localized frame shown. A failed session's
-#       folder is kept, the others' outputs are removed.
+#   scripts/soak-live.sh short --map M --scene S --recording R [--count 200] [--first 1] [--out DIR]
+#       --count sessions numbered from --first (a later call goes on where one stopped), of
+#       20-60 s each, stopped in turn by SIGINT, SIGTERM and the camera unplugged
+#       (ARVIEW_FAKE_CAMERA_UNPLUG_AFTER), into the window and into a video file (video.mp4) in
+#       turn, three sessions each (so every stop with every output in six sessions); each
+#       checked: the exit status (0 for a signal, 1 and the line naming the unplugged device for
+#       an unplug), no core file, no allocator or sanitizer message on stderr, stats.json
+#       complete (valid JSON, one record per frame processed), the trajectory a TUM line for at
+#       least every localized frame shown, and the video (when it was the output) readable by
+#       ffprobe to its end with one frame per frame processed. A failed session's folder is
+#       kept, the others' outputs are removed.
 #   scripts/soak-live.sh check DIR int|term|unplug
-#       the short sessions' check of one session folder again.
+#       the short sessions' check of one session folder again (its output: the file `sink`).
 #
 # Common options: --arview BIN (default build/release/app/arview), --fake LIB (the emulated
 # camera, default build/release/tests/libarview_fake_v4l2.so), --size WxH, --format
@@ -25,8 +29,10 @@
 # the pipeline's, otherwise gets too little CPU to relocalise in time), --heap-check (cheap
 # glibc heap-corruption detectors, one per session in turn: MALLOC_CHECK_=3 with
 # libc_malloc_debug.so, MALLOC_PERTURB_, tcache off; `long` uses the first), --out DIR
-# (default soak-live). Every session runs with `ulimit -c unlimited` in a folder of its own, so
-# that a core file (core_pattern "core") lands beside its outputs. Xvfb is started on a free display unless DISPLAY is set.
+# (default soak-live); after `--`, more options for `arview run` (e.g. `-- --dialogue FILE --mic
+# DEV --audio-out DEV`: the dialogue's recognizer and the sound sink's threads). Every session
+# runs with `ulimit -c unlimited` in a folder of its own, so that a core file (core_pattern
+# "core") lands beside its outputs. Xvfb is started on a free display unless DISPLAY is set.
 set -euo pipefail
 
 # Checks session folder $1 stopped by $2; prints one line; returns 1 when anything is wrong.
@@ -66,7 +72,22 @@ try:
     if localized >= 0 and len(lines) < localized: problems.append(f"traj.txt: {len(lines)} poses, {localized} localized")
 except Exception as e:
     problems.append(f"traj.txt: {type(e).__name__}: {e}")
-print(f"{os.path.basename(d)} stop={stop}{' (the camera stalled first)' if stalled else ''} exit={code} "
+sink_file = os.path.join(d, "sink")
+sink = open(sink_file).read().strip() if os.path.exists(sink_file) else "window"
+video = os.path.join(d, "video.mp4")
+if sink == "video" and frames > 0:
+    # Decoded to its end: a file cut short (no index written) or damaged fails here.
+    import subprocess
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=nb_read_frames", "-of", "csv=p=0", video], capture_output=True, text=True)
+    read = probe.stdout.strip().split(",")[0]
+    if probe.returncode != 0 or probe.stderr.strip():
+        problems.append(f"video.mp4: ffprobe: {(probe.stderr.strip() or 'exit ' + str(probe.returncode)).splitlines()[0]}")
+    elif not read.isdigit() or int(read) != frames:
+        problems.append(f"video.mp4: {read} frames, {frames} processed")
+elif sink == "video" and os.path.exists(video) and os.path.getsize(video) > 0:
+    notes.append("a video of no frame")
+print(f"{os.path.basename(d)} {sink} stop={stop}{' (the camera stalled first)' if stalled else ''} exit={code} "
       f"frames={frames} localized={localized}: " +
       ("ok" if not problems else "; ".join(problems)) + "".join(f" ({n})" for n in notes))
 sys.exit(1 if problems else 0)
@@ -85,6 +106,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 arview=$root/build/release/app/arview
 fake=$root/build/release/tests/libarview_fake_v4l2.so
 map="" scene="" recording="" size="" format=mjpeg out=soak-live seconds=3600 count=200 heap_check=0 preload=0 nice=0
+first=1 run_args=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --arview) arview=$2; shift ;;
@@ -97,9 +119,11 @@ while [ $# -gt 0 ]; do
     --out) out=$2; shift ;;
     --seconds) seconds=$2; shift ;;
     --count) count=$2; shift ;;
+    --first) first=$2; shift ;;
     --heap-check) heap_check=1 ;;
     --preload) preload=1 ;;
     --nice) nice=$2; shift ;;
+    --) shift; run_args=("$@"); break ;;
     *) echo "soak-live.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -138,10 +162,14 @@ heap_env() {
 }
 
 # Runs one session in folder $1 for $2 seconds, stopped by $3 (int, term or unplug), with the
-# extra environment $4. Writes cmd.err, cmd.code, stats.json, traj.txt there; rss.tsv when $5=1.
+# extra environment $4, into $6 (window or video). Writes cmd.err, cmd.code, sink, stats.json,
+# traj.txt (and video.mp4) there; rss.tsv when $5=1.
 run_session() {
-  local dir=$1 secs=$2 stop=$3 extra=$4 sample_rss=${5:-0}
+  local dir=$1 secs=$2 stop=$3 extra=$4 sample_rss=${5:-0} sink=${6:-window}
   mkdir -p "$dir"
+  echo "$sink" >"$dir/sink"
+  local out_arg=window
+  [ "$sink" = video ] && out_arg=video.mp4
   local preload_libs=$fake env_args=() size_args=()
   for kv in $extra; do
     case $kv in
@@ -157,7 +185,8 @@ run_session() {
     ulimit -c unlimited
     exec nice -n "$nice" env LD_PRELOAD="$preload_libs" ARVIEW_FAKE_CAMERA_RECORDING="$recording" "${env_args[@]}" \
       "$arview" run --device /dev/video-arview-fake --map "$map" --scene "$scene" --format "$format" "${size_args[@]}" \
-      --tracking-worker on --hud --stats stats.json --trajectory traj.txt >cmd.out 2>cmd.err </dev/null
+      --out "$out_arg" --tracking-worker on --hud --stats stats.json --trajectory traj.txt "${run_args[@]}" \
+      >cmd.out 2>cmd.err </dev/null
   ) &
   local pid=$! start=$SECONDS
   if [ "$sample_rss" = 1 ]; then
@@ -222,15 +251,17 @@ fi
 
 failed=0
 stops=(int term unplug)
-for i in $(seq 1 "$count"); do
+sinks=(window video)
+for i in $(seq "$first" $((first + count - 1))); do
   stop=${stops[$(((i - 1) % 3))]}
+  sink=${sinks[$((((i - 1) / 3) % 2))]}
   secs=$((20 + (i * 13) % 41))  # 20-60 s, spread
   dir=$out/session-$(printf %03d "$i")
   extra=$(heap_env "$i")
-  run_session "$dir" "$secs" "$stop" "$extra"
+  run_session "$dir" "$secs" "$stop" "$extra" 0 "$sink"
   if line=$(check_session "$dir" "$stop"); then
     echo "$line ${secs}s ${extra}"
-    rm -f "$dir/stats.json" "$dir/traj.txt"
+    rm -f "$dir/stats.json" "$dir/traj.txt" "$dir/video.mp4"
   else
     echo "$line ${secs}s ${extra} FAILED"
     failed=$((failed + 1))

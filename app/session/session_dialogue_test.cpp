@@ -14,6 +14,7 @@
 #include "app/pipeline/ar_compositor.h"
 #include "app/session/test_dialogue_exchange.h"
 #include "figure/face_targets.h"
+#include "tests/support/sanitizer_slowdown.h"
 
 namespace arview::app {
 namespace {
@@ -35,8 +36,10 @@ const char* kViewerDialogue =
     "  - {name: lost, states: [a, b], final: [b], transitions: [{from: a, to: b, when: [{viewer_tracked: false}], "
     "do: [{say: Where did you go.}]}]}\n";
 
-// A frame every 10 ms, three times real time: the replies' synthesis (on its own thread) keeps up.
-constexpr std::chrono::milliseconds kPace(10);
+// A frame every 10 ms, three times real time: the replies' synthesis (on its own thread) keeps up;
+// under a sanitizer, slower (under TSan at 10 ms a frame a reply came over 1 s late, and the
+// next one still talked where the face's joy is read).
+constexpr std::chrono::milliseconds kPace(static_cast<int>(10 * arview::testing::kSanitizerSlowdown));
 
 struct Step {
   double until_s;

@@ -13,19 +13,11 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/run_command.h"
+#include "tests/support/sanitizer_slowdown.h"
 
 namespace arview::testing {
 
 inline constexpr const char* kEmulatedCamera = "/dev/video-arview-fake";
-
-// Under AddressSanitizer (the asan preset) arview runs several times slower: `run` had not shown
-// its first frame 3 s after its start, and a reader paused 1 s after its start was paused before
-// its camera streamed. Tests that time a whole command scale their waits by this, or skip.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr double kSanitizerSlowdown = 5;
-#else
-inline constexpr double kSanitizerSlowdown = 1;
-#endif
 
 // `env`: the emulated camera's settings (ARVIEW_FAKE_CAMERA_*). `pause` (seconds after the
 // start, for how long): the process is stopped in between (SIGSTOP), as a reader that falls

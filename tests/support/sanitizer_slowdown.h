@@ -1,0 +1,18 @@
+#pragma once
+// How much slower the code under test runs in a sanitizer build, for tests that time a whole
+// command or pace frames against a thread of the code's own.
+
+namespace arview::testing {
+
+// Under AddressSanitizer (the asan preset) arview runs several times slower: `run` had not shown
+// its first frame 3 s after its start, and a reader paused 1 s after its start was paused before
+// its camera streamed. Under ThreadSanitizer (the tsan preset) as much or more: Flite synthesized
+// a session dialogue's reply over 1 s late at load 16 (docs/reliability.md, "TSan on this
+// round's threads"). Tests that time a whole command scale their waits by this, or skip.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr double kSanitizerSlowdown = 5;
+#else
+inline constexpr double kSanitizerSlowdown = 1;
+#endif
+
+}  // namespace arview::testing
