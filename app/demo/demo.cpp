@@ -418,6 +418,21 @@ calib::Pose LookingAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& targ
   return calib::Pose::FromCameraToWorld(Eigen::Quaterniond(camera_to_map), centre);
 }
 
+// The video frame (the replay's processing order: a replay drops none) in which the first
+// character's mouth is open widest while it speaks; none if it never speaks.
+std::optional<int> MouthMostOpen(const PipelineReport& report) {
+  std::optional<int> widest;
+  float widest_open = 0;
+  for (std::size_t i = 0; i < report.frames.size(); ++i) {
+    const anim::FaceFrame& face = report.frames[i].face;
+    if (face.talking > 0 && face.jaw_open > widest_open) {
+      widest_open = face.jaw_open;
+      widest = static_cast<int>(i);
+    }
+  }
+  return widest;
+}
+
 // The replayed frames in which the eyes met the viewer's, not blinking, nearest viewer first.
 std::vector<const FrameLog*> EyeContactFrames(const PipelineReport& report, const Eigen::Vector3d& character_map) {
   std::vector<const FrameLog*> frames;
@@ -491,7 +506,8 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
   for (const auto& g : second_lap) distances.push_back((g.pose.Center() - orbit.Subject()).head<2>().norm());
   const fs::path sheet_file = out.parent_path() / "contact_sheet.png";
   const double seconds = result.report.frames.empty() ? 0.0 : result.report.frames.back().timestamp - result.report.frames.front().timestamp;
-  cv::Mat sheet = ContactSheet(out, 12, 4, 320);
+  const std::optional<int> open_mouth = MouthMostOpen(result.report);
+  cv::Mat sheet = ContactSheet(out, 12, 4, 320, open_mouth);
   const std::optional<FaceCloseUp> close_up = RenderFaceCloseUp(character, result.report, walk.camera, o.gl);
   if (close_up) {
     char lines[4][96];
@@ -524,6 +540,9 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
     else
       std::printf("  close-up for the contact sheet: none (no frame kept the eyes on a camera at %.1f m)\n", kCloseUpMetres);
   }
+  if (open_mouth)
+    std::printf("  open mouth for the contact sheet: frame %d, the greeting's widest (jaw at %.0f%% of jawOpen)\n", *open_mouth,
+                100.0 * result.report.frames[static_cast<std::size_t>(*open_mouth)].face.jaw_open);
   std::printf("  the viewer's distance to the character: median %.2f m, %.2f to %.2f m\n", Median(distances),
               *std::min_element(distances.begin(), distances.end()), *std::max_element(distances.begin(), distances.end()));
   const ScenePlacement& placed = character.placed;

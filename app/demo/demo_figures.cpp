@@ -4,6 +4,7 @@
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -81,7 +82,24 @@ InViewSummary MeasureInView(const calib::Camera& camera, const std::vector<std::
   return s;
 }
 
-cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width) {
+namespace {
+
+// The frames of a sheet of `n` tiles over `frames`: spread evenly, first to last, with `include`
+// in the place of the spread frame nearest it.
+std::vector<int> SheetFrames(int n, int frames, std::optional<int> include) {
+  std::vector<int> picked;
+  for (int i = 0; i < n; ++i) picked.push_back(n == 1 ? 0 : static_cast<int>(std::lround(double(i) * (frames - 1) / (n - 1))));
+  if (include && *include >= 0 && *include < frames) {
+    const auto nearest = std::min_element(picked.begin(), picked.end(),
+                                          [&](int a, int b) { return std::abs(a - *include) < std::abs(b - *include); });
+    *nearest = *include;
+  }
+  return picked;
+}
+
+}  // namespace
+
+cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width, std::optional<int> include) {
   cv::VideoCapture capture(video.string());
   if (!capture.isOpened()) throw std::runtime_error(video.string() + ": cannot open the video for the contact sheet");
   // Frame counts from container metadata can be approximate: read every frame, keep the chosen.
@@ -92,8 +110,9 @@ cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns,
   const int tile_height = tile_width * frames[0].rows / frames[0].cols;
   const int rows = (n + columns - 1) / columns;
   cv::Mat sheet(rows * tile_height, columns * tile_width, CV_8UC3, cv::Scalar::all(0));
+  const std::vector<int> picked = SheetFrames(n, static_cast<int>(frames.size()), include);
   for (int i = 0; i < n; ++i) {
-    const int index = n == 1 ? 0 : static_cast<int>(std::lround(double(i) * (frames.size() - 1) / (n - 1)));
+    const int index = picked[static_cast<std::size_t>(i)];
     cv::Mat tile;
     cv::resize(frames[index], tile, {tile_width, tile_height}, 0, 0, cv::INTER_AREA);
     const std::string label = "frame " + std::to_string(index);

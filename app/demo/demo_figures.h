@@ -43,9 +43,12 @@ InViewSummary MeasureInView(const calib::Camera& camera, const std::vector<std::
                             const CharacterMarkers& markers);
 
 // `count` frames spread evenly over `video` (first to last), each scaled to `tile_width`,
-// tiled `columns` wide, each labelled with its frame number. Throws std::runtime_error naming
-// the video when it cannot be read.
-cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width);
+// tiled `columns` wide, each labelled with its frame number. `include`, a frame of the video,
+// takes the place of the evenly spread frame nearest it (the demo's open mouth: a line lasts a
+// second, which twelve frames over 22 s can miss). Throws std::runtime_error naming the video
+// when it cannot be read.
+cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width,
+                     std::optional<int> include = std::nullopt);
 
 // `sheet` with a row of `tile_height` added below: `close_up` cropped about its centre to one
 // tile of tile_width x tile_height at its own scale (a still of the face, centred on it), and

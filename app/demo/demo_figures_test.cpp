@@ -67,6 +67,26 @@ TEST(DemoFigures, ContactSheetSpreadsFramesOverTheVideo) {
   EXPECT_THROW(ContactSheet(video, 12, 4, 80), std::runtime_error);
 }
 
+// A frame to include takes the place of the spread frame nearest it, and only that one.
+TEST(DemoFigures, ContactSheetIncludesTheFrameAskedForInPlaceOfTheNearest) {
+  const std::filesystem::path video = std::filesystem::temp_directory_path() / "arview_contact_sheet_include_test.avi";
+  {
+    cv::VideoWriter writer(video.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, {160, 120});
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < 23; ++i) writer.write(cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(10 * i)));
+  }
+  // Spread: frames 0, 2, 4, ..., 22; frame 9 is nearest 8 (tile 4) and 10 (tile 5): the first.
+  const cv::Mat sheet = ContactSheet(video, 12, 4, 80, 9);
+  for (int k = 0; k < 12; ++k) {
+    const cv::Vec3b centre = sheet.at<cv::Vec3b>((k / 4) * 60 + 20, (k % 4) * 80 + 40);
+    EXPECT_NEAR(centre[0], k == 4 ? 90 : 20 * k, 3) << "tile " << k;
+  }
+  // A frame the video does not have changes nothing.
+  const cv::Mat unchanged = ContactSheet(video, 12, 4, 80, 99);
+  EXPECT_EQ(cv::norm(unchanged, ContactSheet(video, 12, 4, 80), cv::NORM_INF), 0);
+  std::filesystem::remove(video);
+}
+
 TEST(DemoFigures, TheCloseUpIsARowBelowTheSheetCroppedAboutItsCentre) {
   const cv::Mat sheet(3 * 60, 4 * 80, CV_8UC3, cv::Scalar::all(40));
   cv::Mat close_up(120, 160, CV_8UC3, cv::Scalar::all(0));
