@@ -194,9 +194,13 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   }
   std::cout << "the venue against the one recording's map: rotation max " << rotation_deg << " deg, centre max "
             << 100 * centre / extent << " % of the path's extent\n";
-  // keyframes.txt holds 17 digits: the same poses read back within a rounding of the last.
-  EXPECT_LT(rotation_deg, 1e-6);
-  EXPECT_LT(centre, 1e-9 * extent);
+  // The same database gives the same poses up to the mapper's floating-point order: its bundle
+  // adjustments sum over threads in the order they finish, so under load two runs part in the
+  // last digits (idle: 8e-16 deg and 0; in a CI run beside other tests: 4.4e-5 deg and 4.6e-7 of
+  // the path). Two COLMAP matchers' runs parted by 0.03-1.68 deg (docs/mapping.md): these bounds
+  // are a thousand times under that.
+  EXPECT_LT(rotation_deg, 1e-3);
+  EXPECT_LT(centre, 1e-5 * extent);
 }
 
 TEST(VenueFile, ANonVenueFileIsOneClearError) {
