@@ -211,7 +211,9 @@ TEST_F(SpeechSoundLive, EachLinesFirstSampleIsHeardWithItsFrameAndNothingUnderru
   int heard = 0;
   for (const auto& line : s.at("lines")) {
     const double start = line.at("start_s").get<double>(), heard_s = line.at("heard_s").get<double>();
-    if (heard_s < 0) continue;  // the session ended before it played
+    // The session ended before it played, or before the frame its mouth starts on was shown
+    // (the player had its first samples already: a line is handed over ahead of its frame).
+    if (heard_s < 0 || line.at("shown_s").get<double>() < 0) continue;
     // The frame on which the mouth starts to move: the first shown whose animation time reaches the line's start.
     const nlohmann::json* frame = nullptr;
     for (const auto& f : stats.at("frames"))
