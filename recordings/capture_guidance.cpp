@@ -80,7 +80,7 @@ CaptureGuidance::CaptureGuidance(const CaptureGuidanceOptions& options) : option
 
 const FrameGuidance& CaptureGuidance::Add(const cv::Mat& image, double time) {
   new_notes_.clear();
-  if (frames_ > 0 && time - previous_time_ < 0.9 / options_.max_rate_hz) return last_;
+  if (counts_.frames > 0 && time - previous_time_ < 0.9 / options_.max_rate_hz) return last_;
   scale_ = static_cast<double>(options_.working_width) / image.cols;
   cv::Mat gray, small;
   if (image.channels() == 3) {
@@ -106,10 +106,10 @@ const FrameGuidance& CaptureGuidance::Add(const cv::Mat& image, double time) {
   previous_gray_ = small;
   previous_time_ = time;
 
-  ++frames_;
-  few_features_ += frame.few_features;
-  too_fast_ += frame.too_fast;
-  badly_exposed_ += frame.too_dark || frame.too_bright;
+  ++counts_.frames;
+  counts_.few_features += frame.few_features;
+  counts_.too_fast += frame.too_fast;
+  counts_.badly_exposed += frame.too_dark || frame.too_bright;
   UpdateConditions(frame);
   for (cv::Point2f& p : frame.points = tracked_) p *= static_cast<float>(1 / scale_);
   last_ = std::move(frame);
@@ -144,16 +144,16 @@ void CaptureGuidance::FollowPoints(const cv::Mat& gray, FrameGuidance& frame) {
 // A new view once the picture has moved on (or lost most of its points): the step from the last
 // one is judged for parallax, and fresh points are picked to follow.
 void CaptureGuidance::KeepView(const cv::Mat& gray, FrameGuidance& frame) {
-  const bool first = views_ == 0;
+  const bool first = counts_.views == 0;
   const bool moved_on = !at_view_.empty() && MedianShift(at_view_, tracked_) > options_.view_shift * gray.cols;
   const bool lost_most = static_cast<int>(tracked_.size()) < kMinStepPoints;
   if (!first && !moved_on && !lost_most) return;
   if (frame.few_features && !first && !moved_on) return;  // nothing new to keep on a blank surface
   if (!first && static_cast<int>(tracked_.size()) >= kMinStepPoints) {
     frame.parallax = ShareOffHomography(at_view_, tracked_, options_.parallax_px);
-    ++steps_;
+    ++counts_.steps;
     const bool flat = frame.parallax < options_.parallax_share;
-    steps_with_parallax_ += !flat;
+    counts_.steps_with_parallax += !flat;
     flat_steps_in_a_row_ = flat ? flat_steps_in_a_row_ + 1 : 0;
   }
   std::vector<cv::Point2f> fresh;
@@ -162,7 +162,7 @@ void CaptureGuidance::KeepView(const cv::Mat& gray, FrameGuidance& frame) {
     // Not a view one could map from: keep following what is left.
     return;
   }
-  ++views_;
+  ++counts_.views;
   frame.new_view = true;
   tracked_ = fresh;
   at_view_ = fresh;
@@ -193,34 +193,27 @@ std::string CaptureGuidance::Advice() const {
 }
 
 GuidanceSummary CaptureGuidance::Summary() const {
-  GuidanceSummary s;
-  s.frames = frames_;
-  s.views = views_;
-  s.steps = steps_;
-  s.steps_with_parallax = steps_with_parallax_;
-  s.few_features = few_features_;
-  s.too_fast = too_fast_;
-  s.badly_exposed = badly_exposed_;
-  const double bad = options_.max_bad_share * frames_;
-  if (badly_exposed_ > bad) {
-    s.reasons.push_back("badly exposed in " + Percent(badly_exposed_, frames_) +
+  GuidanceSummary s = counts_;
+  const double bad = options_.max_bad_share * counts_.frames;
+  if (counts_.badly_exposed > bad) {
+    s.reasons.push_back("badly exposed in " + Percent(counts_.badly_exposed, counts_.frames) +
                         " of the frames (too dark or clipped white to find features in): light the room evenly");
   }
-  if (few_features_ > bad) {
-    s.reasons.push_back("too few features in " + Percent(few_features_, frames_) +
+  if (counts_.few_features > bad) {
+    s.reasons.push_back("too few features in " + Percent(counts_.few_features, counts_.frames) +
                         " of the frames (a blank wall or floor): film textured things");
   }
-  if (too_fast_ > bad) {
-    s.reasons.push_back("too fast in " + Percent(too_fast_, frames_) + " of the frames (motion blur): move slower");
+  if (counts_.too_fast > bad) {
+    s.reasons.push_back("too fast in " + Percent(counts_.too_fast, counts_.frames) + " of the frames (motion blur): move slower");
   }
-  if (steps_ > 0 && steps_with_parallax_ < options_.min_parallax_share * steps_) {
-    s.reasons.push_back("too little parallax: " + std::to_string(steps_with_parallax_) + " of " +
-                        std::to_string(steps_) +
+  if (counts_.steps > 0 && counts_.steps_with_parallax < options_.min_parallax_share * counts_.steps) {
+    s.reasons.push_back("too little parallax: " + std::to_string(counts_.steps_with_parallax) + " of " +
+                        std::to_string(counts_.steps) +
                         " steps between views moved the camera past things at other depths (turning on the spot?): "
                         "walk sideways through the room");
   }
-  if (views_ < options_.min_views) {
-    s.reasons.push_back("too little coverage: " + std::to_string(views_) +
+  if (counts_.views < options_.min_views) {
+    s.reasons.push_back("too little coverage: " + std::to_string(counts_.views) +
                         " view(s), the picture hardly changed: look at the room from several places");
   }
   s.likely_to_map = s.reasons.empty();

@@ -112,9 +112,9 @@ class CaptureGuidance {
   GuidanceSummary Summary() const;
   const FrameGuidance& last() const { return last_; }
   // The steps between views so far, and those with parallax (the window's coverage line).
-  int steps() const { return steps_; }
-  int steps_with_parallax() const { return steps_with_parallax_; }
-  int views() const { return views_; }
+  int steps() const { return counts_.steps; }
+  int steps_with_parallax() const { return counts_.steps_with_parallax; }
+  int views() const { return counts_.views; }
 
  private:
   enum Condition { kFewFeatures, kTooFast, kNoParallax, kDark, kBright, kConditionCount };
@@ -129,8 +129,7 @@ class CaptureGuidance {
   std::vector<cv::Point2f> tracked_;       // in the previous frame
   std::vector<cv::Point2f> at_view_;       // the same points where the last view saw them
   FrameGuidance last_;
-  int frames_ = 0, views_ = 0, steps_ = 0, steps_with_parallax_ = 0;
-  int few_features_ = 0, too_fast_ = 0, badly_exposed_ = 0;
+  GuidanceSummary counts_;  // the counts so far; Summary() adds the verdict
   bool last_step_flat_ = false;  // the last step between views had no parallax
   int flat_steps_in_a_row_ = 0;
   double since_[kConditionCount];  // when each condition started (-1: not on)
