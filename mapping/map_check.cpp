@@ -227,8 +227,10 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
 }  // namespace
 
 bool Folded(const MapCheck& check, const MapCheckLimits& limits) {
+  const long disagreeing_pairs = std::lround(check.disagreeing_fraction * check.two_view_pairs);
   return check.two_view_pairs > 0 &&
-         (check.disagreeing_fraction > limits.max_disagreeing_fraction ||
+         ((check.disagreeing_fraction > limits.max_disagreeing_fraction &&
+           disagreeing_pairs >= limits.min_disagreeing_pairs) ||
           check.off_neighbours > 0);
 }
 

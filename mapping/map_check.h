@@ -53,6 +53,10 @@ struct MapCheckLimits {
   int two_view_min_inliers = 300;        // pairs matched at least this well are compared
   double two_view_max_disagreement_deg = 10.0;
   double max_disagreeing_fraction = 0.15;   // more of the compared pairs disagreeing: a fold
+  // ... and at least this many of them: on a small map one pair's minimal-sample essential matrix
+  // off by over 10 degrees is over the fraction alone (1 of 5 pairs: 20%; a right 6-frame
+  // templeRing map, docs/mapping.md "A milder fold").
+  int min_disagreeing_pairs = 2;
   // A keyframe is "off" when the median disagreement of its pairs (at least
   // keyframe_min_pairs of them) exceeds keyframe_off_factor x the median over all the map's
   // pairs, clamped to [keyframe_min_off_deg, two_view_max_disagreement_deg]. Two neighbouring
@@ -105,7 +109,7 @@ struct MapCheck {
 };
 
 // Whether `check` found a fold: its rotations disagree with the two-view geometry in more of the
-// compared pairs than `limits` allow, or two neighbouring keyframes are off.
+// compared pairs than `limits` allow (a fraction, and a count), or two neighbouring keyframes are off.
 bool Folded(const MapCheck& check, const MapCheckLimits& limits = {});
 
 // The keyframe (index into map.keyframes) a new mapper run should start from when `check` found a

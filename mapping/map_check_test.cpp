@@ -275,6 +275,25 @@ TEST(MapCheck, AMildFoldIsFlaggedByTheKeyframesOwnPairs) {
   EXPECT_FALSE(Folded(apart));
 }
 
+// On a small map one pair's essential matrix off by over 10 degrees is over the fraction alone (1 of
+// 6 pairs: 17%): not a fold. A second such pair is.
+TEST(MapCheck, OnePairOffOnASmallMapIsNotAFold) {
+  const map::Map m = TurningPath(4);
+  std::vector<TwoViewGeometry> geometry = TrueGeometries(m, 300);
+  ASSERT_EQ(geometry.size(), 6u);
+  const Eigen::Matrix3d turned = Eigen::AngleAxisd(12 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  geometry[0].essential = turned * geometry[0].essential;
+  const MapCheck one = CheckMap(m, {}, geometry);
+  EXPECT_NEAR(one.disagreeing_fraction, 1.0 / 6, 1e-9);
+  EXPECT_FALSE(Folded(one)) << DescribeMapCheck(one);
+  EXPECT_FALSE(HasWarning(one, "two-view geometry"));
+
+  geometry[5].essential = turned * geometry[5].essential;
+  const MapCheck two = CheckMap(m, {}, geometry);
+  EXPECT_NEAR(two.disagreeing_fraction, 2.0 / 6, 1e-9);
+  EXPECT_TRUE(Folded(two)) << DescribeMapCheck(two);
+}
+
 // A new mapper run starts from a keyframe that is right, far from the fold, and not one an earlier
 // run started from.
 TEST(MapCheck, ARetryStartsFromARightKeyframeFarFromTheFold) {
