@@ -3,7 +3,7 @@
 # camera (tests/support/fake_v4l2_device.cpp) without a dialogue, and with `--dialogue --mic` on
 # the emulated microphone (tests/support/emulated.asoundrc: ALSA's `file` plugin, paced by
 # arview's capture clock) hearing Debian's pocketsphinx-testdata human recordings, the two in
-# turn (off, on, off, on, ...) so that both see the same load. Each session: Ctrl-C after
+# turn (off, on, on, off, off, on, ...) so that both see the same load. Each session: Ctrl-C after
 # --seconds, --stats written (after one session not counted, which makes the caches); the frames' latency (from the capture timestamp) after the first
 # second, per session and over all sessions of each kind. docs/app.md, "The frame path with the
 # dialogue on".
@@ -100,9 +100,11 @@ run_session() {
 # A first session not counted: the caches (the map's descriptor index, the scene's PRT) made.
 run_session "$out/warm-up" off
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+# Pairs in the order off-on, on-off, off-on, ...: a drift over the run (the machine's load, the
+# emulated camera's producer) then weighs on both kinds alike instead of always on the second.
 for i in $(seq 1 "$pairs"); do
-  run_session "$out/off-$i" off
-  run_session "$out/on-$i" on
+  if [ $((i % 2)) = 1 ]; then order="off on"; else order="on off"; fi
+  for mode in $order; do run_session "$out/$mode-$i" "$mode"; done
 done
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 
@@ -127,7 +129,7 @@ def session(d):
 kinds = {"off": [], "on": []}
 print("session   exit  frames  localized  turns heard  latency median / p95 / p99 ms")
 for i in range(1, pairs + 1):
-    for k in ("off", "on"):
+    for k in (("off", "on") if i % 2 else ("on", "off")):
         code, lat, n, loc, heard = session(os.path.join(out, f"{k}-{i}"))
         kinds[k] += lat
         print(f"{k + '-' + str(i):8}  {code:4}  {n:6}  {loc:9}  {heard:11}  {pct(lat, .5):.1f} / {pct(lat, .95):.1f} / {pct(lat, .99):.1f}")
