@@ -43,6 +43,7 @@ void ArRenderer::MoveCharacter(int index, const anim::Placement& placement) {
 int ArRenderer::AddCharacter(const anim::Character& character, const anim::Placement& placement) {
   characters_.push_back({&character, placement, std::make_unique<CharacterRenderer>(context_->gl(), character),
                          FitShadowCapsules(character), false, LightView{}, cv::Mat()});
+  characters_.back().renderer->set_cpu_morph_max_deltas(options_.cpu_morph_max_deltas);
   if (options_.lighting == LightingMode::kShShadowed) {
     const PrtCacheResult prt = ShadowedTransferCached(character, options_.prt, options_.prt_cache_folder);
     characters_.back().renderer->SetTransfer(prt.transfer);

@@ -62,6 +62,10 @@ struct ArOptions {
   float shadow_strength = 0.55f;
   cv::Scalar empty_background{128, 128, 128};  // BGR, when no camera image is given
   bool full_frame = false;  // draw and read the whole frame (for checking the bounds)
+  // A mesh's weighted morph targets holding at most this many vertex deltas together are added
+  // on the CPU, more in the vertex shader (CharacterRenderer::set_cpu_morph_max_deltas; 0: always
+  // the shader).
+  int cpu_morph_max_deltas = CharacterRenderer::kDefaultCpuMorphMaxDeltas;
   Readback readback = Readback::kAuto;
   // The room's light (SetRoomLight) for kShUnshadowed / kShShadowed; kShShadowed ray casts
   // each character's PRT transfer in AddCharacter (prt_seconds() says how long it took).

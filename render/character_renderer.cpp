@@ -361,6 +361,45 @@ void CharacterRenderer::UploadMorphs(const anim::Mesh& mesh, const std::string& 
   gpu.morph_buffer = MakeBuffer(gl, GL_TEXTURE_BUFFER, texels.data(), texels.size() * sizeof(float));
   gl.BindBuffer(GL_TEXTURE_BUFFER, 0);
   gpu.morph_texture = MakeBufferTexture(gl, gpu.morph_buffer.get(), GL_RGB32F);
+  MakeCpuMorphPath(mesh, gpu);
+}
+
+void CharacterRenderer::MakeCpuMorphPath(const anim::Mesh& mesh, GpuMesh& gpu) {
+  const GlApi& gl = *gl_;
+  gpu.cpu_morphs = std::make_unique<CpuMorphs>(mesh, morph_targets_);
+  gpu.morphed_vao = MakeVertexArray(gl);
+  gl.BindVertexArray(gpu.morphed_vao.get());
+  gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.ibo.get());  // the mesh's triangles, as in its own vertex array
+  const size_t floats = mesh.positions.size() * CpuMorphs::kFloatsPerVertex;
+  gpu.morphed_vbo = MakeBuffer(gl, GL_ARRAY_BUFFER, nullptr, floats * sizeof(float), GL_STREAM_DRAW);
+  const auto morphed_stride = static_cast<GLsizei>(CpuMorphs::kFloatsPerVertex * sizeof(float));
+  for (GLuint location : {0u, 1u}) {  // position, normal
+    gl.EnableVertexAttribArray(location);
+    gl.VertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, morphed_stride,
+                           reinterpret_cast<void*>(location * 3 * sizeof(float)));
+  }
+  gl.BindBuffer(GL_ARRAY_BUFFER, gpu.vbo.get());
+  const auto stride = static_cast<GLsizei>(sizeof(CharacterVertex));
+  gl.EnableVertexAttribArray(2);
+  gl.VertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, uv)));
+  gl.EnableVertexAttribArray(3);
+  gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
+  gl.EnableVertexAttribArray(4);
+  gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, weights)));
+  gl.BindVertexArray(0);
+}
+
+bool CharacterRenderer::MorphOnCpu(GpuMesh& mesh, int count) {
+  if (!mesh.cpu_morphs || count == 0) return false;
+  const std::span<const int> targets(active_target_.data(), static_cast<size_t>(count));
+  if (mesh.cpu_morphs->DeltaCount(targets) > static_cast<size_t>(std::max(cpu_morph_max_deltas_, 0))) return false;
+  const std::span<const float> morphed =
+      mesh.cpu_morphs->Apply(targets, std::span<const float>(active_weight_.data(), static_cast<size_t>(count)));
+  const GlApi& gl = *gl_;
+  gl.BindBuffer(GL_ARRAY_BUFFER, mesh.morphed_vbo.get());
+  gl.BufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(morphed.size_bytes()), morphed.data());
+  ++morphed_on_cpu_;
+  return true;
 }
 
 void CharacterRenderer::AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind) {
@@ -411,6 +450,7 @@ int CharacterRenderer::ActiveMorphs(const GpuMesh& mesh, std::span<const float> 
     const int target = morph_candidates_[i].second;
     active_base_[i] = mesh.morph_base[target];
     active_weight_[i] = weights[target];
+    active_target_[i] = target;
   }
   morph_applied_ += count;
   return count;
@@ -449,11 +489,15 @@ void CharacterRenderer::SetTransfer(const CharacterTransfer& transfer) {
   }
   for (size_t m = 0; m < meshes_.size(); ++m) {
     GpuMesh& mesh = meshes_[m];
-    gl.BindVertexArray(mesh.vao.get());
     mesh.transfer_vbo = MakeBuffer(gl, GL_ARRAY_BUFFER, transfer.meshes[m].data(), transfer.meshes[m].size() * sizeof(Sh9f));
-    for (GLuint k = 0; k < 3; ++k) {
-      gl.EnableVertexAttribArray(5 + k);
-      gl.VertexAttribPointer(5 + k, 3, GL_FLOAT, GL_FALSE, sizeof(Sh9f), reinterpret_cast<void*>(k * 3 * sizeof(float)));
+    for (const GlName* vao : {&mesh.vao, &mesh.morphed_vao}) {
+      if (!vao->get()) continue;  // no CPU morph path
+      gl.BindVertexArray(vao->get());
+      gl.BindBuffer(GL_ARRAY_BUFFER, mesh.transfer_vbo.get());
+      for (GLuint k = 0; k < 3; ++k) {
+        gl.EnableVertexAttribArray(5 + k);
+        gl.VertexAttribPointer(5 + k, 3, GL_FLOAT, GL_FALSE, sizeof(Sh9f), reinterpret_cast<void*>(k * 3 * sizeof(float)));
+      }
     }
     gl.BindVertexArray(0);
   }
@@ -471,7 +515,7 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
     throw RenderError("character draw: " + std::to_string(d.morph_weights.size()) + " morph weights for " +
                       std::to_string(morph_targets_) + " targets");
   }
-  morph_applied_ = morph_dropped_ = 0;
+  morph_applied_ = morph_dropped_ = morphed_on_cpu_ = 0;
   // DQ skinning drops scale; with scaled joints linear blend is the correct one.
   const bool dual = d.method == anim::SkinningMethod::kDualQuaternion && anim::RigidSkinning(d.skinning_matrices);
   used_linear_fallback_ = d.method == anim::SkinningMethod::kDualQuaternion && !dual;
@@ -512,9 +556,11 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
   gl.ActiveTexture(GL_TEXTURE0);
   for (const bool textured : {true, false}) {
     const Program* bound = nullptr;
-    for (const GpuMesh& mesh : meshes_) {
+    for (GpuMesh& mesh : meshes_) {
       if ((mesh.texture >= 0) != textured) continue;
-      const int morphs = ActiveMorphs(mesh, d.morph_weights);
+      int morphs = ActiveMorphs(mesh, d.morph_weights);
+      const bool on_cpu = MorphOnCpu(mesh, morphs);
+      if (on_cpu) morphs = 0;  // the shader's part done
       const Program& program = ProgramFor(dual, u.lighting, textured, morphs > 0);
       if (bound != &program) bound = &UseProgram(program, u, d);
       if (textured) gl.BindTexture(GL_TEXTURE_2D, textures_[mesh.texture].get());
@@ -528,7 +574,7 @@ void CharacterRenderer::Draw(const Eigen::Matrix4d& projection, const Eigen::Mat
         gl.Uniform1i(bound->loc.morph_vertices, mesh.vertex_count);
       }
       gl.Uniform4f(bound->loc.base_color, mesh.base_color[0], mesh.base_color[1], mesh.base_color[2], mesh.base_color[3]);
-      gl.BindVertexArray(mesh.vao.get());
+      gl.BindVertexArray(on_cpu ? mesh.morphed_vao.get() : mesh.vao.get());
       gl.DrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
     }
   }

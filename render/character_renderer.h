@@ -5,7 +5,9 @@
 // Morph targets (anim/morph.h) are added in the vertex shader before skinning: each mesh's deltas
 // live in a buffer texture, and a draw passes the targets with a non-zero weight (at most
 // kMaxActiveMorphTargets a mesh) as uniforms; a mesh with none weighted uses the program without
-// morphing (docs/render.md, "Morph targets").
+// morphing (docs/render.md, "Morph targets"). A mesh whose weighted targets move few vertices
+// together (at most cpu_morph_max_deltas()) is morphed on the CPU instead (render/cpu_morphs.h)
+// and drawn with the program without morphing.
 
 #include <Eigen/Core>
 
@@ -18,6 +20,7 @@
 
 #include "anim/character.h"
 #include "anim/pose.h"
+#include "render/cpu_morphs.h"
 #include "render/gl_objects.h"
 #include "render/prt.h"
 #include "room/sh.h"
@@ -80,6 +83,16 @@ class CharacterRenderer {
   // kMaxActiveMorphTargets.
   int morph_targets_applied() const { return morph_applied_; }
   int morph_targets_dropped() const { return morph_dropped_; }
+  // Of the last draw: the meshes morphed on the CPU (the others with weighted targets used the
+  // morph program).
+  int morphed_meshes_on_cpu() const { return morphed_on_cpu_; }
+  // A mesh's weighted targets are added on the CPU when they hold at most this many vertex deltas
+  // together, else in the vertex shader. 0: always the shader. The default: a face's few targets
+  // (the built-in figure's mouth, lids and brows move 50-900 vertices each) take microseconds on
+  // the CPU, while a head whose 52 targets each move all its vertices stays in the shader.
+  static constexpr int kDefaultCpuMorphMaxDeltas = 16384;
+  void set_cpu_morph_max_deltas(int deltas) { cpu_morph_max_deltas_ = deltas; }
+  int cpu_morph_max_deltas() const { return cpu_morph_max_deltas_; }
 
  private:
   struct GpuMesh {
@@ -93,10 +106,18 @@ class CharacterRenderer {
     // first texel of a target's, −1 where it does not move this mesh.
     GlName morph_buffer, morph_texture;
     std::vector<int> morph_base;
+    // The CPU path: the mesh's rest pose and deltas, and a vertex array whose positions and
+    // normals come from morphed_vbo (rewritten each draw that uses it), the rest from vbo.
+    std::unique_ptr<CpuMorphs> cpu_morphs;
+    GlName morphed_vao, morphed_vbo;
   };
   // This draw's targets for one mesh, in active_base_/active_weight_; returns their count.
   int ActiveMorphs(const GpuMesh& mesh, std::span<const float> weights);
   void UploadMorphs(const anim::Mesh& mesh, const std::string& source, GpuMesh& gpu);
+  void MakeCpuMorphPath(const anim::Mesh& mesh, GpuMesh& gpu);
+  // Whether this draw's `count` active targets of `mesh` go through the CPU; if so, uploads the
+  // morphed vertices.
+  bool MorphOnCpu(GpuMesh& mesh, int count);
   void AddMorphReach(const anim::Mesh& mesh, const std::vector<Eigen::Matrix4f>& inverse_bind);
   const GlApi* gl_;
   int joints_ = 0;
@@ -139,6 +160,9 @@ class CharacterRenderer {
   std::vector<std::pair<float, int>> morph_candidates_;  // (|weight|, target); reserved at upload
   std::array<GLint, kMaxActiveMorphTargets> active_base_{};
   std::array<GLfloat, kMaxActiveMorphTargets> active_weight_{};
+  std::array<int, kMaxActiveMorphTargets> active_target_{};
+  int cpu_morph_max_deltas_ = kDefaultCpuMorphMaxDeltas;
+  int morphed_on_cpu_ = 0;
 };
 
 // A soft elliptical shadow on a ground plane, drawn before the character into the transparent

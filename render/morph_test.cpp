@@ -1,6 +1,7 @@
-// Morph targets in the vertex shader: AnimatedMorphCube (Debian's assimp-testmodels) drawn with
-// its targets weighted against the same cube with the deltas added on the CPU (anim/morph.h),
-// drawn through the same renderer, camera and placement without targets.
+// Morph targets, in the vertex shader and on the renderer's CPU path (render/cpu_morphs.h):
+// AnimatedMorphCube (Debian's assimp-testmodels) drawn with its targets weighted against the same
+// cube with the deltas added by anim/morph.h, drawn through the same renderer, camera and
+// placement without targets.
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -66,8 +67,12 @@ class MorphCube : public ::testing::Test {
     frame_buffers_.Finish(cube_.skeleton, frame_, "rest", "skin");
   }
 
-  Comparison Compare(std::span<const float> weights, anim::SkinningMethod method, const std::string& label) {
+  // `cpu_morph_max_deltas`: ArOptions' (0: the vertex shader; the cube's 24 vertices go through
+  // the CPU at the default).
+  Comparison Compare(std::span<const float> weights, anim::SkinningMethod method, const std::string& label,
+                     int cpu_morph_max_deltas = 0) {
     ArOptions options;
+    options.cpu_morph_max_deltas = cpu_morph_max_deltas;
     options.shadow = false;
     options.skinning = method;
     options.empty_background = cv::Scalar(255, 0, 255);
@@ -128,6 +133,21 @@ TEST_F(MorphCube, WeightedTargetsMatchTheDeltasAddedOnTheCpuWithinOneLevel) {
       EXPECT_GT(c.pixels, 5000) << label << ": the cube fills part of the view";
       EXPECT_LE(c.max_difference, 1) << label;
     }
+  }
+}
+
+// The renderer's CPU path (the default for few deltas) gives the same picture as the shader.
+TEST_F(MorphCube, TheCpuPathDrawsWhatTheShaderDraws) {
+  for (const std::vector<float>& w : {std::vector<float>{1, 0}, std::vector<float>{0.8f, -0.3f}}) {
+    const Comparison shader = Compare(w, anim::SkinningMethod::kDualQuaternion, "shader");
+    const Comparison cpu = Compare(w, anim::SkinningMethod::kDualQuaternion, "cpu_path",
+                                   CharacterRenderer::kDefaultCpuMorphMaxDeltas);
+    cv::Mat diff;
+    cv::absdiff(shader.gpu, cpu.gpu, diff);
+    double most = 0;
+    cv::minMaxLoc(diff.reshape(1), nullptr, &most);
+    EXPECT_LE(most, 1) << w[0] << ", " << w[1];
+    EXPECT_LE(cpu.max_difference, 1) << "against anim/morph.h's deltas";
   }
 }
 
