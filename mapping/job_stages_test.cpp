@@ -115,7 +115,11 @@ TEST(TempleStagesOnSlurm, ExtractionAndMatchingAsJobsGiveTheDatabaseAndMapOfTheL
   const double error_there = recordings::EvaluateTrajectory(recordings::ReadTum(scratch / "jobs" / "keyframes.txt"), truth).ate.median;
   std::cout << "centre error against the ground truth, median: local stages " << 1000 * error_here << " mm, jobs "
             << 1000 * error_there << " mm\n";
-  EXPECT_LT(error_there, 1.5 * error_here);
+  // Within 1.5x of the local map's, or under 2 mm: right 6-frame maps differ from build to build
+  // (above; 0.89 and 0.80 mm in one CI run), and two draws can land 1.5x apart at about a
+  // millimetre, while features or matches lost or mixed up by the jobs put frames centimetres
+  // off or leave them out.
+  EXPECT_LT(error_there, std::max(1.5 * error_here, 0.002));
   if (!HasFailure()) fs::remove_all(scratch);  // kept to look at otherwise
 }
 
