@@ -253,8 +253,9 @@ TEST_F(CalibrateWindow, ShowsTheCornersTheBarsAndTheViewsAndCalibratesWhenTheyAr
   ExpectTheFrameAndFilledBars(window);
 }
 
-// A ChArUco board: the part of it found now is outlined in green (2 px) on the frame, its corners
-// ringed; the outlines of the views taken are blue.
+// A ChArUco board, end to end in the window: the frame, the bars and the overlay's green (the
+// outline of the part found and the corners' dots; the outline itself is checked in cli_tests,
+// CalibrationWindow.*), and a calibration written.
 TEST_F(CalibrateWindow, OutlinesThePartOfAChArUcoBoardFoundAndCalibrates) {
   const cv::Mat window = CalibrateAndShoot(SharedCharucoWalk(), "--fps 10 --charuco --board 10x7 --square 0.05",
                                            "ARVIEW_CALIBRATE_CHARUCO_SCREENSHOT");
