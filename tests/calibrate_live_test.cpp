@@ -188,55 +188,82 @@ TEST(CalibrateLive, AChArUcoBoardSeenInPartGivesTheLensWithinHalfAPercent) {
 }
 
 // The window as a person sees it: the frame with the corners, the coverage bars filling, the
-// views taken; a screenshot (xwd, ImageMagick) while it runs. ARVIEW_CALIBRATE_SCREENSHOT names
-// a file to keep it in (docs/first-hour.md's picture).
+// views taken; a screenshot (xwd, ImageMagick) while it runs. ARVIEW_CALIBRATE_SCREENSHOT and
+// ARVIEW_CALIBRATE_CHARUCO_SCREENSHOT name files to keep them in (docs/calibration.md's pictures).
 class CalibrateWindow : public testing::XSessionTest<::testing::Test> {
  protected:
   void SetUp() override {
-    SharedBoardWalk();
     REQUIRE_PROGRAM("xwd");
     REQUIRE_PROGRAM("convert");
     StartXSession("calibrate_window");
   }
+
+  // Runs `arview calibrate --device` in the window on the emulated camera playing `walk` with
+  // `board_args`, takes a screenshot once six views are taken, waits for the calibration and
+  // returns the window (the frame, 640x480, and the panel on its right).
+  cv::Mat CalibrateAndShoot(const fs::path& walk, const std::string& board_args, const char* keep_env) {
+    const char* bin_env = std::getenv("ARVIEW_BIN");
+    const std::string line = "exec env DISPLAY=" + display_->name() + " LD_PRELOAD=" +
+                             ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
+                             " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\" ARVIEW_FAKE_CAMERA_RECORDING=" +
+                             ShellQuote(walk.string()) + " " + ShellQuote(bin_env ? bin_env : "arview") +
+                             " calibrate --device " + testing::kEmulatedCamera + " " + board_args + " --out " +
+                             ShellQuote((dir_ / "camera.yaml").string()) + " 2>" +
+                             ShellQuote((dir_ / "stderr.txt").string());
+    const fs::path out = dir_ / "stdout.txt";
+    testing::Child app({"sh", "-c", line}, out.string());
+    // A screenshot once a few views are taken: the bars part-filled.
+    bool shot = false;
+    for (int i = 0; i < 1200 && app.Wait(0) < 0; ++i) {
+      if (testing::ReadWholeFile(out.string()).find("view 6 taken") != std::string::npos) {
+        testing::Shell("xwd -root -silent | convert xwd:- " + ShellQuote((dir_ / "window.png").string()),
+                       display_->name());
+        shot = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    EXPECT_TRUE(shot) << testing::ReadWholeFile(out.string()) << testing::ReadWholeFile((dir_ / "stderr.txt").string());
+    EXPECT_EQ(app.Wait(120), 0) << testing::ReadWholeFile((dir_ / "stderr.txt").string());
+    EXPECT_TRUE(fs::exists(dir_ / "camera.yaml"));
+    const cv::Mat screen = cv::imread((dir_ / "window.png").string());
+    if (screen.empty()) return {};
+    if (const char* keep = std::getenv(keep_env)) {
+      fs::copy_file(dir_ / "window.png", keep, fs::copy_options::overwrite_existing);
+    }
+    // The window at the top-left corner of the bare X screen.
+    return screen(cv::Rect(0, 0, 640 + 260, 480)).clone();
+  }
 };
 
-TEST_F(CalibrateWindow, ShowsTheCornersTheBarsAndTheViewsAndCalibratesWhenTheyAreFull) {
-  const fs::path walk = SharedBoardWalk();
-  const char* bin_env = std::getenv("ARVIEW_BIN");
-  const std::string line = "exec env DISPLAY=" + display_->name() + " LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
-                           " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\" ARVIEW_FAKE_CAMERA_RECORDING=" +
-                           ShellQuote(walk.string()) + " " + ShellQuote(bin_env ? bin_env : "arview") +
-                           " calibrate --device " + testing::kEmulatedCamera + " --fps 15 --out " +
-                           ShellQuote((dir_ / "camera.yaml").string()) + " 2>" + ShellQuote((dir_ / "stderr.txt").string());
-  const fs::path out = dir_ / "stdout.txt";
-  testing::Child app({"sh", "-c", line}, out.string());
-  // A screenshot once a few views are taken: the bars part-filled.
-  bool shot = false;
-  for (int i = 0; i < 1200 && app.Wait(0) < 0; ++i) {
-    if (testing::ReadWholeFile(out.string()).find("view 6 taken") != std::string::npos) {
-      testing::Shell("xwd -root -silent | convert xwd:- " + ShellQuote((dir_ / "window.png").string()), display_->name());
-      shot = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  ASSERT_TRUE(shot) << testing::ReadWholeFile(out.string()) << testing::ReadWholeFile((dir_ / "stderr.txt").string());
-  EXPECT_EQ(app.Wait(120), 0) << testing::ReadWholeFile((dir_ / "stderr.txt").string());
-  EXPECT_TRUE(fs::exists(dir_ / "camera.yaml"));
-  const cv::Mat screen = cv::imread((dir_ / "window.png").string());
-  ASSERT_FALSE(screen.empty());
-  // The window at the top-left corner of the bare X screen: the frame (640x480) and the panel.
-  const cv::Mat window = screen(cv::Rect(0, 0, 640 + 260, 480));
+// The frame shown, and some bar filled (green or orange) on the panel.
+void ExpectTheFrameAndFilledBars(const cv::Mat& window) {
+  ASSERT_FALSE(window.empty());
   cv::Scalar mean, spread;
   cv::meanStdDev(window(cv::Rect(0, 0, 640, 480)), mean, spread);
   EXPECT_GT(spread[0], 20) << "the frame is not shown";
-  // The panel's bars: some green or orange fill.
-  cv::Mat panel = window(cv::Rect(640, 40, 260, 150)), hsv;
-  cv::cvtColor(panel, hsv, cv::COLOR_BGR2HSV);
-  cv::Mat saturated;
+  cv::Mat hsv, saturated;
+  cv::cvtColor(window(cv::Rect(640, 40, 260, 150)), hsv, cv::COLOR_BGR2HSV);
   cv::inRange(hsv, cv::Scalar(0, 120, 120), cv::Scalar(180, 255, 255), saturated);
   EXPECT_GT(cv::countNonZero(saturated), 500) << "no bar is filled";
-  if (const char* keep = std::getenv("ARVIEW_CALIBRATE_SCREENSHOT")) fs::copy_file(dir_ / "window.png", keep, fs::copy_options::overwrite_existing);
+}
+
+TEST_F(CalibrateWindow, ShowsTheCornersTheBarsAndTheViewsAndCalibratesWhenTheyAreFull) {
+  const cv::Mat window = CalibrateAndShoot(SharedBoardWalk(), "--fps 15", "ARVIEW_CALIBRATE_SCREENSHOT");
+  ExpectTheFrameAndFilledBars(window);
+}
+
+// A ChArUco board, end to end in the window: the frame, the bars and the overlay's green (the
+// outline of the part found and the corners' dots; the outline itself is checked in cli_tests,
+// CalibrationWindow.*), and a calibration written.
+TEST_F(CalibrateWindow, OutlinesThePartOfAChArUcoBoardFoundAndCalibrates) {
+  const cv::Mat window = CalibrateAndShoot(SharedCharucoWalk(), "--fps 10 --charuco --board 10x7 --square 0.05",
+                                           "ARVIEW_CALIBRATE_CHARUCO_SCREENSHOT");
+  ExpectTheFrameAndFilledBars(window);
+  if (window.empty()) return;
+  cv::Mat green;
+  cv::inRange(window(cv::Rect(0, 0, 640, 480)), cv::Scalar(40, 200, 40), cv::Scalar(80, 240, 80), green);
+  EXPECT_GT(cv::countNonZero(green), 400) << "the board found is not outlined";
 }
 
 }  // namespace

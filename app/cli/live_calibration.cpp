@@ -98,8 +98,15 @@ cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const calib::BoardDetection&
     cv::polylines(shown, Rounded(outline), true, {200, 160, 60}, 1, cv::LINE_AA);
   }
   const std::vector<cv::Point2f>& corners = found.image_points;
-  if (board.kind == calib::BoardKind::kCharuco) {
-    for (const cv::Point2f& p : corners) cv::circle(shown, p, 3, {60, 220, 60}, cv::FILLED, cv::LINE_AA);
+  if (board.kind == calib::BoardKind::kCharuco && !corners.empty()) {
+    // The part of the board found now, outlined as a view of it would be taken, and its corners
+    // ringed in black: small green dots alone were lost on the board's black and white squares.
+    const std::vector<cv::Point2f> seen = calib::PartialBoardOutline(corners, found.object_points);
+    if (!seen.empty()) cv::polylines(shown, Rounded(seen), true, {60, 220, 60}, 2, cv::LINE_AA);
+    for (const cv::Point2f& p : corners) {
+      cv::circle(shown, p, 5, {0, 0, 0}, cv::FILLED, cv::LINE_AA);
+      cv::circle(shown, p, 3, {60, 220, 60}, cv::FILLED, cv::LINE_AA);
+    }
   } else if (corners.size() == static_cast<size_t>(board.board.area())) {
     cv::drawChessboardCorners(shown, board.board, corners, true);
   }

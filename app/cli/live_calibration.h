@@ -53,8 +53,9 @@ CollectedViews CollectCalibrationViews(recordings::FrameSource& source, const Li
                                        const CancellationToken& cancel);
 
 // The window's picture: the frame with the board's corners found (a chessboard's coloured, a
-// ChArUco board's as dots) and the outlines of the views taken, faint; on the right the coverage
-// bars, the number of views and `status`.
+// ChArUco board's as dots ringed in black inside the green outline of the part found) and the
+// outlines of the views taken, faint; on the right the coverage bars, the number of views and
+// `status`.
 cv::Mat DrawCalibrationWindow(const cv::Mat& frame, const calib::BoardDetection& found,
                               const calib::CalibrationOptions& board, const calib::ViewSelector& selector,
                               const std::string& status);
