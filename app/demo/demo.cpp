@@ -12,6 +12,7 @@
 #include "anim_authoring/character_builder.h"
 #include "anim_authoring/import.h"
 #include "anim_authoring/scene.h"
+#include "app/demo/demo_exchange.h"
 #include "app/demo/demo_figures.h"
 #include "app/pipeline/pipeline_report.h"
 #include "app/placement/place_character.h"
@@ -306,10 +307,49 @@ DemoCharacter PlaceDemoCharacter(const DemoOptions& o, const map::Map& map, cons
   return c;
 }
 
+// Step 4's exchange (issue 54): the dialogue and the visitor's questions written into the work
+// folder, for a character that speaks (as the greeting's line is given).
+std::optional<DemoExchange> PrepareExchange(const DemoCharacter& character, const fs::path& work) {
+  if (character.placed.behaviour.lines.empty()) {
+    std::printf("  no scripted exchange: the character cannot speak\n");
+    return std::nullopt;
+  }
+  DemoExchange exchange = WriteDemoExchange(work);
+  std::string asked;
+  for (std::size_t i = 0; i < VisitorLines().size(); ++i) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%s\"%s\" at %.1f s", i ? ", " : "", VisitorLines()[i].text.c_str(),
+                  VisitorLines()[i].start_s);
+    asked += line;
+  }
+  std::printf("  a visitor (Flite's %s voice) asks %s into the replay -> %s; the character answers through %s\n",
+              ToString(kVisitorVoice).c_str(), asked.c_str(), exchange.wav.c_str(), exchange.dialogue.c_str());
+  return exchange;
+}
+
+// Step 7's line on the exchange: which questions were heard as said and answered, and how soon.
+void ReportExchange(const PipelineReport& replayed, const fs::path& work) {
+  std::size_t answered = 0;
+  std::string latencies;
+  for (std::size_t i = 0; i < VisitorLines().size(); ++i) {
+    const auto turn = std::find_if(replayed.dialogue_turns.begin(), replayed.dialogue_turns.end(),
+                                   [&](const DialogueTurnRecord& t) { return t.heard == VisitorLines()[i].text; });
+    if (turn == replayed.dialogue_turns.end() || turn->reply_start_s < 0) continue;
+    ++answered;
+    char latency[32];
+    std::snprintf(latency, sizeof latency, "%s%.2f", latencies.empty() ? "" : ", ", turn->LatencyS());
+    latencies += latency;
+  }
+  std::printf("  the visitor's questions (%s): %zu of %zu heard as said and answered%s\n", (work / "visitor.wav").c_str(),
+              answered, VisitorLines().size(),
+              latencies.empty() ? "" : ("; replies " + latencies + " s after the words, on the replay's frame clock").c_str());
+}
+
 // Step 5: the second lap through the whole pipeline into the video.
 SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording& walk, const map::Map& map,
-                              const fs::path& scene, const fs::path& out, const render::OffscreenOptions& gl,
-                              const fs::path& work, int half, const CancellationToken& cancel) {
+                              const fs::path& scene, const std::optional<DemoExchange>& exchange, const fs::path& out,
+                              const render::OffscreenOptions& gl, const fs::path& work, int half,
+                              const CancellationToken& cancel) {
   SessionOptions session;
   session.scene_file = scene;
   PendingOutput video(out);
@@ -329,7 +369,12 @@ SessionResult ReplaySecondLap(const DemoOptions& o, const recordings::Recording&
   session.expected_frames = o.frames - half;
   session.cancel = cancel;
   session.output_name = out.string();
-  session.audio_track = true;  // the greeting spoken in the video
+  session.audio_track = true;  // the greeting spoken in the video, the visitor's questions and the replies
+  if (exchange) {
+    // `replay --dialogue --audio-in`: the visitor's WAV heard on the replay's frame clock.
+    session.dialogue.dialogue_file = exchange->dialogue;
+    session.dialogue.audio_in = exchange->wav;
+  }
   recordings::ReplayOptions replay;
   for (int i = half; i < o.frames; ++i) replay.frames.push_back(i);
   const recordings::Recording replayed = WithUncompressedFrames(walk, half, work / "replay-frames", cancel);
@@ -489,7 +534,7 @@ std::optional<FaceCloseUp> RenderFaceCloseUp(const DemoCharacter& character, con
 void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& walk, const DemoCharacter& character,
                            const recordings::Sim3& to_room, const synth::OrbitWalk& orbit, const SessionResult& result,
                            const recordings::AccuracyReport& report, const recordings::Trajectory& second_lap,
-                           const fs::path& out, const fs::path& work) {
+                           bool exchanged, const fs::path& out, const fs::path& work) {
   const authoring::Scene loaded = authoring::LoadScene(character.scene);
   const CharacterMarkers markers = MarkersOf(character.asset, to_room.Matrix() * loaded.characters[0].placement().ModelToMap());
   std::map<double, bool> localized;
@@ -541,7 +586,7 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
       std::printf("  close-up for the contact sheet: none (no frame kept the eyes on a camera at %.1f m)\n", kCloseUpMetres);
   }
   if (open_mouth)
-    std::printf("  open mouth for the contact sheet: frame %d, the greeting's widest (jaw at %.0f%% of jawOpen)\n", *open_mouth,
+    std::printf("  open mouth for the contact sheet: frame %d, the widest while it speaks (jaw at %.0f%% of jawOpen)\n", *open_mouth,
                 100.0 * result.report.frames[static_cast<std::size_t>(*open_mouth)].face.jaw_open);
   std::printf("  the viewer's distance to the character: median %.2f m, %.2f to %.2f m\n", Median(distances),
               *std::min_element(distances.begin(), distances.end()), *std::max_element(distances.begin(), distances.end()));
@@ -552,13 +597,15 @@ void ReportWhatAViewerSees(const DemoOptions& o, const recordings::Recording& wa
     std::printf("  greetings (%s when the viewer came within %.2f m): %zu%s\n", placed.behaviour.greet_clip.c_str(),
                 o.greet_within, greetings.size(), when.c_str());
   }
+  if (exchanged) ReportExchange(result.report, work);
   std::printf("  tracking: %zu/%zu localized, centre error median %.1f mm, latency median %.1f ms\n",
               result.report.frames_localized, result.report.frames_processed, 1000 * report.ate.median, latency);
   std::printf("  end to end: %.1f frames per second at %dx%d\n", result.report.fps, walk.camera.width, walk.camera.height);
-  std::printf("\nwrote %s\n      %s (12 frames%s), %s (plot), %s, %s, %s\n", out.c_str(), sheet_file.c_str(),
+  std::printf("\nwrote %s\n      %s (12 frames%s), %s (plot), %s, %s, %s%s\n", out.c_str(), sheet_file.c_str(),
               close_up ? " and the face's close-up" : "",
               (work / "trajectory.png").c_str(), (work / "trajectory.txt").c_str(), (work / "stats.json").c_str(),
-              character.scene.c_str());
+              character.scene.c_str(),
+              exchanged ? (", " + (work / "dialogue.yaml").string() + ", " + (work / "visitor.wav").string()).c_str() : "");
 }
 
 }  // namespace
@@ -586,16 +633,18 @@ void RunDemo(const DemoOptions& o) {
 
   Step(4, "Standing the character on the walk's spot with 8 look-at keys");
   const DemoCharacter character = PlaceDemoCharacter(o, built.map, to_room, orbit, work);
+  const std::optional<DemoExchange> exchange = PrepareExchange(character, work);
 
   Step(5, "Replaying the second lap: track, animate, render, composite");
-  const SessionResult result = ReplaySecondLap(o, walk, built.map, character.scene, out, gl, work, half, signals.token());
+  const SessionResult result =
+      ReplaySecondLap(o, walk, built.map, character.scene, exchange, out, gl, work, half, signals.token());
 
   Step(6, "Tracking accuracy against the exact ground truth");
   const recordings::Trajectory second_lap(walk.groundtruth->begin() + half, walk.groundtruth->end());
   const recordings::AccuracyReport report = ReportAccuracy(result.report, to_room, second_lap, work);
 
   Step(7, "What a viewer sees");
-  ReportWhatAViewerSees(o, walk, character, to_room, orbit, result, report, second_lap, out, work);
+  ReportWhatAViewerSees(o, walk, character, to_room, orbit, result, report, second_lap, exchange.has_value(), out, work);
 }
 
 }  // namespace arview::app

@@ -8,7 +8,9 @@
 // passes behind it, glances away fast once and comes close once — through the whole pipeline
 // (tracking, view-adaptive animation, rendering, compositing) into an MP4, judges the tracking
 // against the ground truth, measures what a viewer sees (the character in the picture, its head
-// toward the camera) and writes a contact sheet of the video.
+// toward the camera) and writes a contact sheet of the video. During the replay a visitor's two
+// questions (a WAV the demo synthesizes) are heard and answered by a built-in dialogue
+// (app/demo/demo_exchange.h).
 
 
 #include <string>

@@ -248,6 +248,29 @@ std::string PipelineReportText(const PipelineReport& r) {
                   r.eye_frames, 100.0 * r.eye_contact_frames / r.eye_frames, r.blinks);
     out += line;
   }
+  return out + DialogueTurnsText(r.dialogue_turns);
+}
+
+std::string DialogueTurnsText(const std::vector<DialogueTurnRecord>& turns) {
+  if (turns.empty()) return "";
+  std::string out = "dialogue: " + std::to_string(turns.size()) + (turns.size() == 1 ? " turn" : " turns") +
+                    " (times on the frame clock)\n";
+  for (const DialogueTurnRecord& t : turns) {
+    char head[160];
+    if (t.heard.empty())
+      std::snprintf(head, sizeof head, "  %.2f s: what the viewer did -> %s says ", t.time_s, t.machine.c_str());
+    else
+      std::snprintf(head, sizeof head, "  %.2f s: heard \"%s\" (confidence %.2f, ended %.2f s) -> %s says ", t.time_s,
+                    t.heard.c_str(), t.confidence, t.heard_end_s, t.machine.c_str());
+    char tail[96];
+    if (t.reply_start_s < 0)
+      std::snprintf(tail, sizeof tail, ", not said before the end");
+    else if (t.LatencyS() >= 0)
+      std::snprintf(tail, sizeof tail, ", from %.2f s: %.0f ms after the words", t.reply_start_s, 1000 * t.LatencyS());
+    else
+      std::snprintf(tail, sizeof tail, ", from %.2f s", t.reply_start_s);
+    out += head + ("\"" + t.said + "\"") + tail + "\n";
+  }
   return out;
 }
 

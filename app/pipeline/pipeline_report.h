@@ -32,6 +32,9 @@ nlohmann::ordered_json PipelineSummaryJson(const PipelineReport& report, const s
 // One element of stats.json's "frames": the frame's way through the stages and its tracking.
 nlohmann::ordered_json FrameLogJson(const FrameLog& frame);
 std::string PipelineReportText(const PipelineReport& report);
+// The dialogue's turns for the summary, one line each (heard, confidence, the machine, the reply
+// and its latency); PipelineReportText ends with it. Empty without turns.
+std::string DialogueTurnsText(const std::vector<DialogueTurnRecord>& turns);
 // The lost frames grouped by cause, with advice (tracker/loss_diagnosis.h), one line each after
 // "lost N frames:"; empty when none was lost or no cause was given. `map_folder` names map.png.
 std::string LossAdviceText(const PipelineReport& report, const std::string& map_folder);

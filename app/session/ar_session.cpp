@@ -101,7 +101,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
                          "is wrong ('arview map scale' makes the map metric)\n",
                  map_name.c_str(), o.compositor.ipd_m);
   }
-  // The scene (its lines decide whether a video gets an audio track), then the output: a window
+  // The scene (its lines and a dialogue decide whether a video gets an audio track), then the output: a window
   // without a display, or an unwritable file, is said before anything else loads.
   const bool first_view = o.scene_file.empty() && o.first_view;
   std::optional<authoring::Scene> scene;
@@ -109,7 +109,9 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (first_view) scene = o.first_view->scene;
   std::unique_ptr<video::FrameSink> sink =
       video::OpenSink(o.sink, ArCompositor::OutputSizeFor(camera, o.compositor), o.sink_fps, o.window,
-                      o.audio_track && scene && SceneHasLines(*scene) ? std::optional(video::AudioTrackOptions{}) : std::nullopt);
+                      o.audio_track && scene && (SceneHasLines(*scene) || o.dialogue.enabled())
+                          ? std::optional(video::AudioTrackOptions{})
+                          : std::nullopt);
   SessionSound sound(o.sound_out, *sink, o.sink_fps);
   // --stats: each frame's record goes to disk as it comes (pipeline_report.h), none is kept.
   std::optional<StatsFileWriter> stats;
@@ -185,8 +187,10 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (o.dialogue.enabled()) {
     if (characters.empty())
       throw Error(o.dialogue.dialogue_file.string() + ": a dialogue needs a character to answer (not with --no-figure)");
-    dialogue = std::make_unique<SessionDialogue>(o.dialogue, *characters.front(), *animators.front(), o.on_utterance,
+    // The replies go where the scene's lines go (the sound, the video's track, o.on_utterance).
+    dialogue = std::make_unique<SessionDialogue>(o.dialogue, *characters.front(), *animators.front(), on_utterance,
                                                  [](const std::string& line) { std::cerr << "note: " << line << "\n"; });
+    sound.AddHeardAudio(dialogue->heard_samples());
     for (const std::string& note : dialogue->load_notes()) std::cerr << "note: " << note << "\n";
   }
 

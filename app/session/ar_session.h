@@ -72,7 +72,8 @@ struct SessionOptions {
   // Issue 53's sound (app/session/session_sound.h). `sound_out`: the player the lines are played
   // on live (the caller's, kept until RunSession returns; null: no live sound). With one, lines
   // start kLiveSpeechDelay after their cues, so that the sound reaches the player its lead ahead.
-  // `audio_track`: a video file sink gets an AAC track with the lines, when the scene has lines.
+  // `audio_track`: a video file sink gets an AAC track with the lines, when the scene has lines or
+  // a dialogue (its replies, and what it hears from a WAV: SessionSound::AddHeardAudio).
   audio::ClipPlayer* sound_out = nullptr;
   bool audio_track = false;
   // The first character listens and answers (issue 54): --dialogue, --mic, --audio-in.

@@ -160,9 +160,9 @@ SessionDialogue::SessionDialogue(const DialogueSessionOptions& o, const authorin
   options.push_to_talk = o.push_to_talk;
   if (recognizer_ && !o.audio_in.empty()) {
     frame_clock_ = std::make_unique<FramePacingClock>();
-    audio::WavSourceOptions wav;
-    wav.conversion = audio::SpeechConversion::kResample;  // another rate, or stereo, converted to 16 kHz mono
-    source_ = std::make_unique<audio::WavFileSource>(o.audio_in, *frame_clock_, wav);
+    // Read once: the source hears it, and a video's audio track gets it too (heard_samples).
+    heard_samples_ = audio::ReadSpeechWav(o.audio_in, audio::SpeechConversion::kResample);  // another rate, or stereo, converted
+    source_ = std::make_unique<audio::WavFileSource>(heard_samples_, *frame_clock_);
     options.frame_clock = frame_clock_.get();
     // Sample 0 is heard at frame time 0 (the source starts before the first frame).
     options.sample_time = [](std::int64_t sample, double) { return static_cast<double>(sample) / audio::kSpeechRate; };

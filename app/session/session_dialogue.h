@@ -70,11 +70,15 @@ class SessionDialogue {
   const std::vector<std::string>& load_notes() const { return load_notes_; }
   // The microphone's end, when it failed (empty otherwise); after Stop.
   std::string audio_error() const;
+  // `--audio-in`'s samples as the recognizer hears them (16 kHz mono, sample 0 at frame time 0);
+  // empty for the microphone or without listening.
+  const std::vector<std::int16_t>& heard_samples() const { return heard_samples_; }
 
  private:
   std::unique_ptr<listen::Recognizer> recognizer_;
   std::unique_ptr<FramePacingClock> frame_clock_;
   std::unique_ptr<audio::AudioSource> source_;
+  std::vector<std::int16_t> heard_samples_;
   std::vector<std::string> load_notes_;
   std::function<void(const std::string&)> on_line_;
   CharacterDialogue* dialogue_ = nullptr;  // owned by the animator

@@ -40,6 +40,10 @@ void SessionSound::OnUtterance(const speech::Utterance& utterance) {
   incoming_.push_back(std::move(line));
 }
 
+void SessionSound::AddHeardAudio(std::vector<std::int16_t> samples) {
+  if (sink_.HasAudio()) heard_ = std::move(samples);
+}
+
 double SessionSound::SinceStart(Clock::time_point t) const {
   return pipeline_start_ ? std::chrono::duration<double>(t - *pipeline_start_).count() : -1;
 }
@@ -67,6 +71,12 @@ void SessionSound::OnFrameShown(const FrameLog& frame, Clock::time_point shown) 
     incoming_.clear();
   }
   if (frame.animation_s >= 0) {
+    if (!heard_.empty() && !heard_written_) {
+      // Frame time 0 in the video, as a line's start (HandOver).
+      const double video_s = static_cast<double>(frames_shown_) / fps_ - frame.animation_s;
+      sink_.WriteAudio(std::llround(video_s * speech::SpokenLine::kSampleRate), heard_);
+      heard_written_ = true;
+    }
     for (Pending& line : lines_) HandOver(line, frame, shown);
   }
   ++frames_shown_;
@@ -110,6 +120,7 @@ SoundReport SessionSound::Finish() {
   report.playing = player_ != nullptr;
   report.video_track = sink_.HasAudio();
   if (report.video_track) report.video_samples_dropped = sink_.AudioSamplesDropped();
+  if (heard_written_) report.heard_in_video_s = static_cast<double>(heard_.size()) / speech::SpokenLine::kSampleRate;
   {
     const std::lock_guard lock(mutex_);
     for (Pending& line : incoming_) lines_.push_back(std::move(line));
@@ -154,6 +165,10 @@ std::string SoundSummaryText(const SoundReport& r) {
     for (const LineSound& l : r.lines) written += l.in_video;
     std::snprintf(part, sizeof part, "; %zu in the video's audio track", written);
     out += part;
+    if (r.heard_in_video_s > 0) {
+      std::snprintf(part, sizeof part, " with the %.1f s heard (--audio-in)", r.heard_in_video_s);
+      out += part;
+    }
     if (r.video_samples_dropped) out += " (" + std::to_string(r.video_samples_dropped) + " samples dropped)";
   }
   return out + "\n";
@@ -184,6 +199,7 @@ nlohmann::ordered_json SoundJson(const SoundReport& r) {
     if (!r.player.error.empty()) j["error"] = r.player.error;
   }
   if (r.video_track) j["video_samples_dropped"] = r.video_samples_dropped;
+  if (r.video_track) j["heard_in_video_s"] = r.heard_in_video_s;
   return j;
 }
 

@@ -59,6 +59,7 @@ struct SoundReport {
   audio::PlayerStats player;           // when playing
   std::int64_t video_samples_dropped = 0;  // the video file's track (FrameSink::AudioSamplesDropped)
   bool video_track = false;
+  double heard_in_video_s = 0;  // seconds of the dialogue's heard WAV in the video's track (AddHeardAudio)
 };
 
 class SessionSound {
@@ -70,6 +71,11 @@ class SessionSound {
   bool active() const { return player_ != nullptr || sink_.HasAudio(); }
   // arview-render: a line has started.
   void OnUtterance(const speech::Utterance& utterance);
+  // Before the pipeline starts: what the dialogue hears from a WAV (`replay --audio-in`, 16 kHz
+  // mono), for the video's audio track, where its sample 0 goes at frame time 0 (the recognizer
+  // hears it so) with the lines summed over it: the video then has both sides of the exchange.
+  // Not played live. Nothing without a video track.
+  void AddHeardAudio(std::vector<std::int16_t> samples);
   // The sink's thread, after the frame was written (shown).
   void OnFrameShown(const FrameLog& frame, Clock::time_point shown);
   // After the pipeline has ended.
@@ -93,7 +99,9 @@ class SessionSound {
   std::vector<Pending> incoming_;
   std::uint64_t next_id_ = 0;       // under mutex_
 
-  // The sink's thread's.
+  // The sink's thread's (heard_ set before it starts).
+  std::vector<std::int16_t> heard_;
+  bool heard_written_ = false;
   std::vector<Pending> lines_;
   std::vector<std::int64_t> offsets_ns_;  // shown − animation time, the last 31 frames, a ring
   std::size_t next_offset_ = 0;
