@@ -57,10 +57,15 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
 namespace {
 
 bool SiftReducesFrame(const calib::Camera& camera, const RelocalizerOptions& options) {
-  return WorkingResolution(camera, options.sift_long_side).reduced();
+  return WorkingResolution(camera, SiftLongSide(camera, options)).reduced();
 }
 
 }  // namespace
+
+int SiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options) {
+  const int long_side = std::max(camera.width, camera.height);
+  return long_side <= options.sift_own_size_up_to ? 0 : options.sift_long_side;
+}
 
 const FeatureOptions& ActiveFeatures(const calib::Camera& camera, const RelocalizerOptions& options) {
   return SiftReducesFrame(camera, options) ? options.reduced_features : options.features;
@@ -94,11 +99,11 @@ Relocalizer::Relocalizer(const map::Map& map, const calib::Camera& camera,
       index_(index),
       options_(options),
       extractor_(ActiveFeatures(camera, options)),
-      sift_resolution_(camera, options.sift_long_side),
+      sift_resolution_(camera, SiftLongSide(camera, options)),
       reloc_resolution_(camera, RelocSiftLongSide(camera, options)) {}
 
 int RelocSiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options) {
-  if (!SiftReducesFrame(camera, options)) return options.sift_long_side;
+  if (!SiftReducesFrame(camera, options)) return SiftLongSide(camera, options);
   return options.reloc_sift_long_side > 0 ? options.reloc_sift_long_side : options.sift_long_side;
 }
 

@@ -70,6 +70,13 @@ struct RelocalizerOptions {
   // (more extrema to refine and describe, and to search the map for).
   FeatureOptions reduced_features = {.max_features = 1000, .contrast_threshold = 0.04};
   int sift_long_side = 640;
+  // Working frames up to this longest side are given to SIFT at their own size, with `features`,
+  // however short sift_long_side is (0: none). A still photo is posed by its relocalization
+  // alone, so its SIFT's scale is the pose's precision: Herz-Jesus-P25's 768x512 photos came
+  // 1.4x closer to COLMAP's registration at their own size than reduced to 640 and relocalised
+  // at 480 (docs/tracker.md, "Herz-Jesus-P25"). 768 leaves phone-fox's 540x960 and every frame
+  // the working resolution reduces to 960 as they were.
+  int sift_own_size_up_to = 768;
   // Relocalization's own SIFT (a frame on which guided matching extracted nothing: the first of
   // a session, or after tracking was lost) on a smaller image still, this longest side, when the
   // working frame is longer than `sift_long_side` (0: as sift_long_side). Relocalization has to
@@ -109,7 +116,7 @@ class Relocalizer {
   Relocalizer(const map::Map& map, const calib::Camera& camera, const map::DescriptorIndex& index,
               const RelocalizerOptions& options);
   RelocalizationResult Relocalize(const cv::Mat& gray) const;
-  // SIFT of `gray` (the camera's size) by `extractor` on the image reduced to sift_long_side,
+  // SIFT of `gray` (the camera's size) by `extractor` on the image reduced to SiftLongSide,
   // keypoints in `gray`'s pixels. Another size is given to SIFT as it is.
   Features Extract(const cv::Mat& gray, const SiftExtractor& extractor) const {
     return ExtractAt(gray, extractor, sift_resolution_);
@@ -140,7 +147,11 @@ class Relocalizer {
   WorkingResolution reloc_resolution_;  // the same for relocalization's own extraction
 };
 
-// The SIFT options for frames of `camera`: options.reduced_features when sift_long_side reduces
+// The longest side of the image SIFT runs on for frames of `camera` (sift_long_side, or 0: the
+// frame as it is, when it is no longer than sift_own_size_up_to).
+int SiftLongSide(const calib::Camera& camera, const RelocalizerOptions& options);
+
+// The SIFT options for frames of `camera`: options.reduced_features when SiftLongSide reduces
 // them, else options.features.
 const FeatureOptions& ActiveFeatures(const calib::Camera& camera, const RelocalizerOptions& options);
 

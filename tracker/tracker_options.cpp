@@ -51,6 +51,7 @@ void RelocalizerOptions::Check(const OptionNames& names) const {
   reduced_features.Check(names.Nested("reduced_features"));
   RequireSideOrZero(sift_long_side, names("sift_long_side"), "the working resolution");
   RequireSideOrZero(reloc_sift_long_side, names("reloc_sift_long_side"), "as " + names("sift_long_side"));
+  RequireOption(sift_own_size_up_to >= 0, names("sift_own_size_up_to"), "0 or more", sift_own_size_up_to);
   matching.Check(names.Nested("matching"));
   pose.Check(names.Nested("pose"));
 }

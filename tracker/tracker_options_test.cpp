@@ -61,6 +61,30 @@ TEST(TrackerOptionsCheck, AbsolutePoseOptionsNameTheBadField) {
   EXPECT_EQ(Refusal([&] { o.Check(); }), "ransac_success_probability must be in (0, 1) (got 1)");
 }
 
+// Which image SIFT sees, and with which settings, by the working frame's size: still photos up to
+// sift_own_size_up_to at their own size with `features` (Herz-Jesus-P25's 768x512), longer frames
+// reduced to sift_long_side with `reduced_features` and relocalised at reloc_sift_long_side.
+TEST(SiftImage, FramesUpToTheOwnSizeKeepItAndTheOwnSizeSettings) {
+  const RelocalizerOptions o;
+  const calib::Camera photo = calib::Camera::Pinhole(768, 512, 690, 691, 380, 251);
+  EXPECT_EQ(SiftLongSide(photo, o), 0);
+  EXPECT_EQ(RelocSiftLongSide(photo, o), 0);
+  EXPECT_EQ(&ActiveFeatures(photo, o), &o.features);
+  const calib::Camera vga = calib::Camera::Pinhole(640, 480, 500, 500, 320, 240);
+  EXPECT_EQ(SiftLongSide(vga, o), 0);
+  EXPECT_EQ(&ActiveFeatures(vga, o), &o.features);
+  const calib::Camera phone_working = calib::Camera::Pinhole(540, 960, 688, 687, 277, 482);
+  EXPECT_EQ(SiftLongSide(phone_working, o), 640);
+  EXPECT_EQ(RelocSiftLongSide(phone_working, o), 480);
+  EXPECT_EQ(&ActiveFeatures(phone_working, o), &o.reduced_features);
+
+  RelocalizerOptions reduce_photos;
+  reduce_photos.sift_own_size_up_to = 0;  // the rule before: every frame over sift_long_side reduced
+  EXPECT_EQ(SiftLongSide(photo, reduce_photos), 640);
+  EXPECT_EQ(RelocSiftLongSide(photo, reduce_photos), 480);
+  EXPECT_EQ(&ActiveFeatures(photo, reduce_photos), &reduce_photos.reduced_features);
+}
+
 TEST(TrackerOptionsCheck, RelocalizerOptionsNameTheBadFieldAndItsMembers) {
   RelocalizerOptions o;
   o.sift_long_side = 32;
@@ -68,6 +92,9 @@ TEST(TrackerOptionsCheck, RelocalizerOptionsNameTheBadFieldAndItsMembers) {
   o = {};
   o.reloc_sift_long_side = 10;
   EXPECT_EQ(Refusal([&] { o.Check(); }), "reloc_sift_long_side must be 0 (as sift_long_side) or at least 64 (got 10)");
+  o = {};
+  o.sift_own_size_up_to = -1;
+  EXPECT_EQ(Refusal([&] { o.Check(); }), "sift_own_size_up_to must be 0 or more (got -1)");
   o = {};
   o.pose.inlier_threshold_px = -1;
   EXPECT_EQ(Refusal([&] { o.Check(); }), "pose.inlier_threshold_px must be above 0 (got -1)");

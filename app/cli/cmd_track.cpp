@@ -324,6 +324,11 @@ void AddTrackCommand(CLI::App& app) {
         "Longest side of the image SIFT runs on (relocalization, guided matching; smaller "
         "working frames are kept as they are); 0: the working resolution")
       ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--sift-own-size", ARVIEW_OPTION_FIELD(o, relocalization.sift_own_size_up_to),
+        "Working frames up to this longest side are given to SIFT at their own size with the "
+        "--max-features and --sift-contrast settings, whatever --sift-size says (still photos: "
+        "relocalization's SIFT is their pose's precision); 0: none")
+      ->check(CLI::Range(0, 100000));
   f.Add(cmd, "--reloc-sift-size", ARVIEW_OPTION_FIELD(o, relocalization.reloc_sift_long_side),
         "Longest side of the image relocalization's own SIFT runs on when --sift-size reduces "
         "the working frame (working frames up to --sift-size are kept as they are); 0: as --sift-size")
