@@ -3,7 +3,8 @@
 # `arview map --engine slurm`: starts munged, slurmctld and slurmd without systemd, from
 # tests/support/slurm/slurm.conf.in, and waits until sinfo shows the node idle; `stop` stops
 # them. Everything (configuration, state, logs, munge's socket) lives in $ARVIEW_SLURM_DIR
-# (default /tmp/arview-slurm-<uid>).
+# (default /tmp/arview-slurm-<uid>). The node offers $ARVIEW_SLURM_CPUS CPUs (default: all of
+# this machine's, nproc): fewer make it stand for a smaller node (scripts/venue-scale.sh).
 #
 #   scripts/slurm-local.sh start    # then: export SLURM_CONF=$ARVIEW_SLURM_DIR/slurm.conf
 #   scripts/slurm-local.sh stop
@@ -16,6 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 dir="${ARVIEW_SLURM_DIR:-/tmp/arview-slurm-$(id -u)}"
 conf="$dir/slurm.conf"
+cpus="${ARVIEW_SLURM_CPUS:-$(nproc)}"
 export SLURM_CONF="$conf"
 
 die() { echo "slurm-local: $*" >&2; exit 1; }
@@ -44,7 +46,7 @@ write_conf() {
   mkdir -p "$dir/ctld" "$dir/slurmd" "$dir/munge"
   chmod 700 "$dir/munge"
   sed -e "s|@HOST@|$(hostname -s)|g" -e "s|@USER@|$(id -un)|g" -e "s|@STATE@|$dir|g" \
-      -e "s|@CPUS@|$(nproc)|g" -e "s|@CTLD_PORT@|${ARVIEW_SLURMCTLD_PORT:-6817}|g" \
+      -e "s|@CPUS@|$cpus|g" -e "s|@CTLD_PORT@|${ARVIEW_SLURMCTLD_PORT:-6817}|g" \
       -e "s|@SLURMD_PORT@|${ARVIEW_SLURMD_PORT:-6818}|g" \
       tests/support/slurm/slurm.conf.in > "$conf"
 }
@@ -54,6 +56,8 @@ start() {
     command -v "$tool" >/dev/null || [ -x "/usr/sbin/$tool" ] ||
       die "$tool not found (bash scripts/install-deps.sh installs munge, slurmctld, slurmd, slurm-client)"
   done
+  [[ "$cpus" =~ ^[0-9]+$ ]] && [ "$cpus" -ge 1 ] && [ "$cpus" -le "$(nproc)" ] ||
+    die "ARVIEW_SLURM_CPUS=$cpus: give 1 to $(nproc) (this machine's CPUs)"
   [ "$(id -u)" -eq 0 ] || die "slurmd must run as root (it starts jobs as their user)"
   if pid_alive "$dir/slurmctld.pid" && pid_alive "$dir/slurmd.pid"; then
     echo "slurm-local: already running ($conf)"
@@ -79,7 +83,7 @@ start() {
     stop >/dev/null
     die "the node did not become idle in 30 s (state '${state:-none}'): see $dir/slurmctld.log and $dir/slurmd.log"
   fi
-  echo "slurm-local: running, one node '$(hostname -s)' with $(nproc) CPUs; export SLURM_CONF=$conf"
+  echo "slurm-local: running, one node '$(hostname -s)' with $cpus CPUs; export SLURM_CONF=$conf"
 }
 
 kill_node() {

@@ -18,6 +18,7 @@
 #include "recordings/recording.h"
 #include "recordings/trajectory.h"
 #include "render/projection.h"
+#include "synth/recording_folder.h"
 
 namespace arview::synth {
 namespace {
@@ -94,10 +95,7 @@ class SceneBuilder {
   void Panel(const char* image, const Eigen::Vector3d& center, const Eigen::Vector3d& right,
              const Eigen::Vector3d& up, double width, double height, const Eigen::Vector3f& shade) {
     RoomPanel panel{image, {}, Texture(image)};
-    panel.corners[0] = center - right * width / 2 + up * height / 2;
-    panel.corners[1] = center + right * width / 2 + up * height / 2;
-    panel.corners[2] = center + right * width / 2 - up * height / 2;
-    panel.corners[3] = center - right * width / 2 - up * height / 2;
+    SetPanelCorners(panel, center, right, up, width, height);
     render::TriangleBatch batch;
     batch.texture = panel.texture;
     render::AppendQuad(batch, panel.corners, Eigen::Vector4f(0, 0, 1, 1), shade);
@@ -538,18 +536,7 @@ std::vector<int> FramesToRender(const SynthRoomOptions& o) {
 }
 
 void PrepareFolder(const SynthRoomOptions& o) {
-  std::error_code ec;
-  if (fs::exists(o.out, ec) && !fs::is_directory(o.out, ec)) {
-    throw render::RenderError(o.out.string() + ": exists and is not a folder");
-  }
-  if (fs::exists(o.out, ec) && !fs::is_empty(o.out, ec)) {
-    if (!o.overwrite) throw render::RenderError(o.out.string() + ": folder exists and is not empty (--force replaces the recording)");
-    // Only what a recording consists of, never anything else the user keeps there.
-    fs::remove_all(o.out / "frames", ec);
-    for (const char* file : {"frames.txt", "groundtruth.txt", "camera.yaml", "walkers.txt"}) fs::remove(o.out / file, ec);
-  }
-  fs::create_directories(o.out / "frames", ec);
-  if (ec) throw render::RenderError(o.out.string() + ": cannot create the recording folder (" + ec.message() + ")");
+  PrepareRecordingFolder(o.out, o.overwrite, {"frames.txt", "groundtruth.txt", "camera.yaml", "walkers.txt"});
 }
 
 using PoseAt = std::function<calib::Pose(double)>;

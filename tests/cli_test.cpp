@@ -134,6 +134,7 @@ TEST(Cli, BadInputsOfEveryCommandAreOneClearLine) {
       {{"demo", "--size", "12x9"}, "--size"},
       {{"demo", "--size", "1280x720x"}, "--size"},
       {{"synth", "room", "--out", tmp + "/arview_cli_room", "--size", "1920x"}, "--size"},
+      {{"synth", "venue", "--out", tmp + "/arview_cli_venue", "--rooms", "5"}, "--rooms"},
       {{"view", "--size", "32x32"}, "--size"},
       {{"record", "--device", "/dev/null", "--out", tmp + "/arview_cli_rec", "--size", "-640x480"}, "--size"},
       {{"demo", "--aa", "fxaa"}, "--aa"},

@@ -8,6 +8,7 @@
 #include "app/cli/gl_flags.h"
 #include "app/cli/numeric_flags.h"
 #include "synth/synth_room.h"
+#include "synth/synth_venue.h"
 
 namespace arview::app {
 
@@ -62,10 +63,61 @@ void RunSynthRoom(SynthArgs& args) {
             << ") with ground truth to " << args.out << " in " << seconds << " s [" << report.gl_description << "]\n";
 }
 
+struct SynthVenueArgs {
+  synth::SynthVenueOptions options;
+  std::string out;
+  GlFlags gl{2};
+  std::string size = "640x480";
+  bool quiet = false;
+};
+
+void RunSynthVenue(SynthVenueArgs& args) {
+  synth::SynthVenueOptions& o = args.options;
+  o.out = args.out;
+  const cv::Size size = *ParseFrameSize(args.size);  // checked by --size's validator
+  o.width = size.width;
+  o.height = size.height;
+  o.gl = ToOffscreenOptions(args.gl);
+  const auto start = std::chrono::steady_clock::now();
+  const int frames = synth::SynthesizeVenue(o, [&](int done, int total) {
+    if (!args.quiet && (done % 30 == 0 || done == total)) std::cerr << "\rframe " << done << "/" << total << std::flush;
+  });
+  if (!args.quiet) std::cerr << "\n";
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "wrote " << frames << " frames of a walk through " << o.layout.rooms << " rooms (" << o.width << "x" << o.height
+            << ") with ground truth and each frame's room (rooms.txt) to " << args.out << " in " << seconds << " s\n";
+}
+
+void AddSynthVenueCommand(CLI::App* synth) {
+  auto* venue = synth->add_subcommand(
+      "venue", "Rooms in a row joined by doors, each textured apart, filmed on a walk that turns round each room "
+               "and goes through the doors (640x480, 30 fps); rooms.txt names each frame's room");
+  auto args = std::make_shared<SynthVenueArgs>();
+  synth::SynthVenueOptions& o = args->options;
+  venue->add_option("--out", args->out, "Recording folder to create")->required();
+  venue->add_option("--rooms", o.layout.rooms, "Rooms, each 5 x 4 x 2.6 m")
+      ->default_val(o.layout.rooms)
+      ->check(CLI::Range(2, synth::kMaxVenueRooms));
+  venue->add_option("--frames", o.frames, "Frames of the whole walk (30 per second)")
+      ->default_val(o.frames)
+      ->check(CLI::Range(2, 1000000));
+  venue->add_option("--seed", o.seed, "Seed of the rooms' textures")->default_val(o.seed);
+  venue->add_option("--size", args->size, "Frame size WxH (field of view kept)")
+      ->default_val(args->size)
+      ->check(FrameSizeCheck({64, 48}, {7680, 4320}));
+  venue->add_option("--subset", o.frames_subset,
+                    "Render only these frames of the walk, e.g. 0-239:3 (one room's frames as a recording of its "
+                    "own, from rooms.txt); each exactly as in the whole recording");
+  AddGlFlags(venue, args->gl);
+  venue->add_flag("--force", o.overwrite, "Replace a recording already in --out");
+  venue->add_flag("--quiet", args->quiet, "No progress on stderr");
+  venue->callback([args] { RunSynthVenue(*args); });
+}
+
 }  // namespace
 
 void AddSynthCommand(CLI::App& app) {
-  auto* synth = app.add_subcommand("synth", "Render synthetic recordings with exact ground truth ('synth room')");
+  auto* synth = app.add_subcommand("synth", "Render synthetic recordings with exact ground truth ('synth room', 'synth venue')");
   synth->require_subcommand(1);
   auto* room = synth->add_subcommand(
       "room", "A room textured with opencv-doc photos, filmed along a hand-held-like path (640x480, 30 fps)");
@@ -165,6 +217,7 @@ void AddSynthCommand(CLI::App& app) {
   room->add_flag("--force", o.overwrite, "Replace a recording already in --out");
   room->add_flag("--quiet", args->quiet, "No progress on stderr");
   room->callback([args] { RunSynthRoom(*args); });
+  AddSynthVenueCommand(synth);
 }
 
 }  // namespace arview::app

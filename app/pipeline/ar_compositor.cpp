@@ -88,6 +88,8 @@ std::vector<std::string> ArCompositor::HudStatus(const FrameToCompose& input) co
 
 ArCompositor::HudDraw ArCompositor::MakeHud(const FrameToCompose& input) {
   // Without a character the HUD still says what the tracker does (and, when lost, why).
+  // The room is followed on every frame, so that a HUD shown again knows where the camera came from.
+  std::vector<std::string> room_lines = room_hud_.Update(input.track->room, input.frame->timestamp);
   if (!hud_visible_) return {};
   // Everything the drawing needs is copied now: the animations' frames change with the next one.
   std::vector<render::HudSphere> spheres;
@@ -100,6 +102,7 @@ ArCompositor::HudDraw ArCompositor::MakeHud(const FrameToCompose& input) {
   }
   render::HudText text;
   text.status = HudStatus(input);
+  text.status.insert(text.status.begin() + 1, room_lines.begin(), room_lines.end());  // under the frame's line
   const calib::Pose pose = localized ? input.track->pose : calib::Pose{};
   return [spheres = std::move(spheres), text = std::move(text), pose, camera = renderer_->pinhole()](
              cv::Mat& view, double eye_offset_m) {

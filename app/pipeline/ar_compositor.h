@@ -13,6 +13,7 @@
 
 #include "app/pipeline/ar_pipeline.h"
 #include "app/pipeline/recent_rate.h"
+#include "app/pipeline/room_hud.h"
 #include "render/ar_renderer.h"
 #include "render/hmd.h"
 #include "render/offscreen.h"
@@ -82,7 +83,8 @@ class ArCompositor : public FrameCompositor {
   cv::Mat ComposeForHmd(const FrameToCompose& input, bool localized);
   // The video alone, undistorted like the augmented frames: a lost frame.
   cv::Mat VideoAlone(const FrameToCompose& input);
-  // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight.
+  // The overlay's status lines: the frame, the tracking status, the output rate, the idle weight
+  // (the room's lines are added by MakeHud).
   std::vector<std::string> HudStatus(const FrameToCompose& input) const;
 
   calib::Camera camera_;
@@ -97,6 +99,7 @@ class ArCompositor : public FrameCompositor {
   cv::Mat undistort_x_, undistort_y_;  // for lost frames of a distorted camera
   RecentRate composed_{std::chrono::seconds(1)};  // the overlay's frame rate (wall clock)
   std::atomic<bool> hud_visible_;  // starts as options_.hud
+  RoomHud room_hud_;               // a venue's room and its changes, kept while the HUD is hidden
   std::optional<render::HmdPresenter> presenter_;  // hmd with a profile
 };
 
