@@ -3,8 +3,6 @@
 #include "tracker/brightness_match.h"
 #include "tracker/tracker_internal.h"
 
-#include <opencv2/video/tracking.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -88,52 +86,10 @@ void Tracker::ForgetPrior() {
   has_velocity_ = false;
   last_pyramid_.clear();
   last_light_gain_ = 1;
+  last_light_switch_timestamp_ = -std::numeric_limits<double>::infinity();
   last_inliers_ = {};
   hidden_.Clear();
   smoother_.Reset();
-}
-
-std::vector<cv::Mat> Tracker::FlowPyramid(const cv::Mat& gray) const {
-  const TrackingOptions& opt = options_.tracking;
-  return tracker::FlowPyramid(gray, opt.lk_window_px, opt.lk_pyramid_levels);
-}
-
-std::vector<unsigned char> Tracker::FollowByLk(const std::vector<cv::Mat>& from_pyramid,
-                                               const std::vector<cv::Mat>& to_pyramid,
-                                               const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>* to,
-                                               std::vector<float>* errors) const {
-  const TrackingOptions& opt = options_.tracking;
-  std::vector<unsigned char> status;
-  std::vector<float> own_errors;
-  std::vector<float>& error = errors ? *errors : own_errors;
-  cv::calcOpticalFlowPyrLK(
-      from_pyramid, to_pyramid, from, *to, status, error, cv::Size(opt.lk_window_px, opt.lk_window_px),
-      opt.lk_pyramid_levels,
-      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, opt.lk_max_iterations, 0.03),
-      cv::OPTFLOW_USE_INITIAL_FLOW);
-  return status;
-}
-
-int Tracker::FollowIntoFrame(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
-                             const std::vector<cv::Point2f>& from, const std::vector<std::uint32_t>& point_ids,
-                             std::vector<cv::Point2f> guesses, Correspondences* out,
-                             const std::function<bool(std::size_t, const Eigen::Vector2d&)>& keep,
-                             std::vector<float>* appended_errors) const {
-  if (from.empty()) return 0;
-  const calib::Camera& camera = resolution_.work();
-  std::vector<float> errors;
-  const std::vector<unsigned char> status = FollowByLk(from_pyramid, to_pyramid, from, &guesses, &errors);
-  int added = 0;
-  for (std::size_t i = 0; i < guesses.size(); ++i) {
-    const Eigen::Vector2d px(guesses[i].x, guesses[i].y);
-    if (!status[i] || !camera.InImage(px, 1.0) || (keep && !keep(i, px))) continue;
-    out->pixels.push_back(px);
-    out->points.push_back(map_.points[point_ids[i]].xyz);
-    out->point_ids.push_back(point_ids[i]);
-    if (appended_errors) appended_errors->push_back(errors[i]);
-    ++added;
-  }
-  return added;
 }
 
 Tracker::PriorPose Tracker::PoseFromPrior(const Correspondences& c, AbsolutePoseOptions options,
@@ -272,13 +228,18 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
     }
     std::vector<double> motion_px;  // each surviving track's move from the last frame
     std::vector<Eigen::Vector2d> predicted_px;  // where the prediction puts each surviving track
+    int followed_in_view = 0;
     FollowIntoFrame(last_pyramid_, pyramid, last_inliers_.pixels, last_inliers_.points, guess, &c,
                     [&](std::size_t i, const Eigen::Vector2d& px) {
+                      if (in_view[i]) ++followed_in_view;
                       motion_px.push_back((px - Eigen::Vector2d(last_inliers_.pixels[i].x, last_inliers_.pixels[i].y)).norm());
                       predicted_px.emplace_back(guess[i].x, guess[i].y);
                       return true;
                     },
                     &lk_errors);
+    result->flow_followed_from = static_cast<int>(last_inliers_.pixels.size());
+    result->flow_lost_in_view = static_cast<int>(std::count(in_view.begin(), in_view.end(), true)) -
+                                followed_in_view;
     moving = DropMovingTracks(predicted_px, lk_errors, &c, result);
     for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
     HideLostTracks(in_view);
@@ -298,9 +259,15 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // through and lights changing"). Such a frame is held to the gate's upper bound instead.
   // Only the frames whose light changed from the last one's: the scaling goes on for as long as
   // the light stays changed, and a gate open all that while let drifted poses through.
+  // A light switched (a step of `light_switch_ev` or more: the lamp) keeps the gate open
+  // `light_switch_hold_s`: an auto-exposure then steps back on frames still clipped white, which
+  // fit at 1.1-1.4 px too (nine relocalizations without the hold). Not after the exposure's own
+  // steps (1/3 EV): held after each, the gate stayed open through its whole ramp and let drifted
+  // poses through (docs/tracker.md, "Third round").
   const double light_step = lit.gain / last_light_gain_;
   last_light_gain_ = lit.gain;
-  if (std::abs(light_step - 1) > opt.flow_brightness_tolerance)
+  if (std::abs(std::log2(light_step)) >= opt.light_switch_ev) last_light_switch_timestamp_ = timestamp;
+  if (std::abs(light_step - 1) > opt.flow_brightness_tolerance || LightSwitchHeld(timestamp))
     pose_options.max_rms_px = std::max(pose_options.max_rms_px, rms_gate_.options().max_px);
   result->rms_gate_px = pose_options.max_rms_px;
 
@@ -384,6 +351,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   }
   result->pose = pose.pose;
   Track2D3D& inliers = *tracked_inliers;
+  result->flow_outliers = result->flow_tracks - static_cast<int>(std::count_if(
+      pose.inliers.begin(), pose.inliers.end(), [&](int i) { return i < result->flow_tracks; }));
   for (int i : pose.inliers) {
     inliers.pixels.emplace_back(c.pixels[i].x(), c.pixels[i].y());
     inliers.points.push_back(c.point_ids[i]);
@@ -561,6 +530,10 @@ void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) 
   result->times.refine_ms += MillisecondsSince(start);
 }
 
+bool Tracker::LightSwitchHeld(double timestamp) const {
+  return timestamp - last_light_switch_timestamp_ < options_.tracking.light_switch_hold_s;
+}
+
 Track2D3D Tracker::DropDriftedTracks(const Track2D3D& inliers, const calib::Pose& pose) const {
   const double bound = options_.tracking.max_track_residual_scales * rms_gate_.Scale();
   Track2D3D kept;
@@ -581,7 +554,11 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
   } else {
     has_velocity_ = false;
   }
-  if (result.status == TrackStatus::kTracking && result.align_zncc == 0) rms_gate_.Observe(result.rms_px);
+  // Not a frame held to the gate's upper bound after a light step: its RMS (clipped, relit
+  // frames fit at 1.1-1.4 px) raised the learnt gate to 2.2 px for the next 5 s, and drifted
+  // poses passed it (docs/tracker.md, "Third round").
+  if (result.status == TrackStatus::kTracking && result.align_zncc == 0 && !LightSwitchHeld(timestamp))
+    rms_gate_.Observe(result.rms_px);
   if (result.align_zncc == 0) {
     last_feature_timestamp_ = timestamp;
     // Relocalised centres only when nothing better is known: a relocalization in a blurred frame,

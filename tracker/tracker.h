@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -140,6 +141,16 @@ struct TrackingOptions {
   // The frame LK follows into is scaled to the previous flow image's mean grey when the two
   // differ by more than this share (a light change; tracker/brightness_match.h).
   double flow_brightness_tolerance = 0.05;
+  // A light switched: a frame whose brightness scaling stepped by `light_switch_ev` or more from
+  // the last one's (a lamp: 2 EV, 0.6 EV when it comes back on frames an exposure raised and
+  // clips; an auto-exposure's own steps are 1/3 EV). For
+  // `light_switch_hold_s` after it a tracked pose is held to the RMS gate's upper bound
+  // (rms_gate.max_px), not the gate learnt on steady frames, and those frames do not teach the
+  // gate (docs/tracker.md, "Third round"). Off by default (0 s): held 0.5 s on the lights
+  // sequence, no frame was relocalised, but the relit step frame passed 68 mm off at 1.46 px and
+  // recall at 2 cm/2 deg fell from 99.7% to 93.9%.
+  double light_switch_ev = 0.5;
+  double light_switch_hold_s = 0;
   // Flow tracks and guided matches on things that move in front of the map, rejected before the
   // pose (tracker/moving_tracks.h; docs/tracker.md, "People walking through").
   MovingTrackOptions moving;
@@ -201,9 +212,17 @@ struct FrameResult {
   double rms_px = 0;       // inlier RMS, working pixels
   double rms_gate_px = 0;  // the largest RMS a tracked pose could have had (tracking only)
   int flow_tracks = 0;     // LK tracks that survived into this frame
+  // Why the flow's tracks thin out (docs/tracker.md, "Third round"): the last frame's tracks it
+  // started from, those LK lost (or that left the picture) of them whose points the prediction
+  // put in view, and those the pose then left out as outliers.
+  int flow_followed_from = 0;
+  int flow_lost_in_view = 0;
+  int flow_outliers = 0;
   double flow_motion_px = 0;  // their median move from the last frame, pixels of the working frame
   int guided_matches = 0;  // added by guided matching
   int moving_rejected = 0; // flow tracks and guided matches rejected as on something moving
+  int moving_by_patch = 0;   // of those, flow tracks whose patch changed
+  int moving_by_motion = 0;  // of those, flow tracks that moved against the prediction
   int recovered_tracks = 0;  // hidden points followed back from the last frame that saw them
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
@@ -371,6 +390,8 @@ class Tracker {
                   Correspondences* correspondences);
   // The inliers whose reprojection error under `pose` (working camera) is within
   // max_track_residual_scales residual scales.
+  // Within light_switch_hold_s of the last light switch (TrackingOptions::light_switch_ev).
+  bool LightSwitchHeld(double timestamp) const;
   Track2D3D DropDriftedTracks(const Track2D3D& inliers, const calib::Pose& pose) const;
   std::vector<int> NearestKeyframes(const calib::Pose& pose) const;
   std::vector<int> CovisibleKeyframes(const std::vector<std::uint32_t>& points) const;
@@ -404,6 +425,7 @@ class Tracker {
   CentreFitter feature_centres_;       // their recent centres
   double velocity_dt_ = 0;  // the time velocity_ spans
   std::vector<cv::Mat> last_pyramid_;
+  double last_light_switch_timestamp_ = -std::numeric_limits<double>::infinity();  // the last light switch's
   double last_light_gain_ = 1;  // what the last frame was scaled by for LK (tracker/brightness_match.h)
   Track2D3D last_inliers_;
   std::vector<std::vector<std::uint32_t>> point_keyframes_;  // per map point: keyframes seeing it

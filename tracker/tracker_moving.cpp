@@ -32,6 +32,8 @@ MovingTrackVerdict Tracker::DropMovingTracks(const std::vector<Eigen::Vector2d>&
   const std::size_t n = predicted.size();
   MovingTrackVerdict verdict = moving_filter_.Judge(
       {std::span(c->point_ids).first(n), std::span(c->pixels).first(n), predicted, lk_errors}, static_cast<std::uint32_t>(frames_tracked_));
+  result->moving_by_patch = verdict.by_patch;
+  result->moving_by_motion = verdict.by_motion;
   result->moving_rejected += KeepCorrespondences(
       0, [&](std::size_t i) { return i >= n || verdict.keep[i]; }, c->pixels, c->points, c->point_ids);
   return verdict;

@@ -92,6 +92,8 @@ void TrackingOptions::Check(const OptionNames& names) const {
   RequireOption(!std::isnan(fresh_features_after_s), names("fresh_features_after_s"), "a number (negative: never)",
                 fresh_features_after_s);
   RequireOption(flow_brightness_tolerance >= 0, names("flow_brightness_tolerance"), "0 or more", flow_brightness_tolerance);
+  RequireOption(light_switch_ev > 0, names("light_switch_ev"), "above 0", light_switch_ev);
+  RequireOption(light_switch_hold_s >= 0, names("light_switch_hold_s"), "0 or more", light_switch_hold_s);
   moving.Check(names.Nested("moving"));
   hidden.Check(names.Nested("hidden"));
 }

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <memory>
 #include <random>
 #include <thread>
@@ -220,6 +221,34 @@ TEST_F(PlanarTrackerTest, TracksASequenceThenRelocalizesAfterAJump) {
       << r.reason << " flow " << r.flow_tracks << " guided " << r.guided_matches << " inliers "
       << r.inliers << " err " << (r.pose.Center() - far.Center()).norm();
   ExpectNear(r, far, 0.003, 0.2);
+}
+
+// A light switched (a brightness step of light_switch_ev or more: the lamp's -2 EV) holds the
+// tracked pose to the RMS gate's upper bound for light_switch_hold_s, where an auto-exposure
+// stepping back on clipped frames fit above the gate learnt on steady ones (the lamp's nine
+// relocalizations; docs/tracker.md, "Third round"); then the learnt gate is back. A smaller step
+// (an exposure's 1/3 EV) opens the gate on its own frame only.
+TEST_F(PlanarTrackerTest, ALightSwitchOpensTheRmsGateForTheHoldAnExposureStepForItsFrame) {
+  TrackerOptions options;
+  options.tracking.light_switch_hold_s = 0.5;  // off by default; a switch from 0.5 EV
+  Tracker tracker(*map_, options);
+  const double upper = options.tracking.rms_gate.max_px;
+  const int lamp_off = 10, exposure_step = 35;  // frames
+  for (int i = 0; i < 40; ++i) {
+    const double gain = i < lamp_off ? 1.0 : i < exposure_step ? 0.25 : 0.25 * std::pow(2.0, 1.0 / 3);
+    cv::Mat frame;
+    world_->Render(PathPose(i)).convertTo(frame, -1, gain);
+    const FrameResult r = tracker.Track(frame, i / 30.0);
+    ASSERT_EQ(r.status, i == 0 ? TrackStatus::kRelocalized : TrackStatus::kTracking) << "frame " << i << ": " << r.reason;
+    ExpectNear(r, PathPose(i), 0.003, 0.2);
+    if (i == 0 || i == lamp_off + 15) continue;  // 0.5 s after the switch, up to rounding
+    const bool held = (i >= lamp_off && i < lamp_off + 15) || i == exposure_step;
+    if (held) {
+      EXPECT_EQ(r.rms_gate_px, upper) << "frame " << i;
+    } else {
+      EXPECT_LT(r.rms_gate_px, upper) << "frame " << i;
+    }
+  }
 }
 
 // A venue's map (map::Map::rooms): a localized frame names its nearest keyframe's room, and the
