@@ -186,7 +186,14 @@ TEST(RelocSiftLongSide, ReducesOnlyFramesThatSiftReduces) {
   const RelocalizerOptions defaults;
   ASSERT_EQ(defaults.sift_long_side, 640);
   ASSERT_EQ(defaults.reloc_sift_long_side, 480);
-  EXPECT_EQ(RelocSiftLongSide(vga, defaults), 640);        // as SIFT sees it: not reduced
+  // Up to sift_own_size_up_to (768) SIFT takes the frame as it is (0): not reduced.
+  EXPECT_EQ(RelocSiftLongSide(vga, defaults), 0);
+  const calib::Camera photo = calib::Camera::Pinhole(768, 512, 700, 700, 383.5, 255.5);  // Herz-Jesus' size
+  EXPECT_EQ(RelocSiftLongSide(photo, defaults), 0);
+  RelocalizerOptions no_own_size = defaults;
+  no_own_size.sift_own_size_up_to = 0;
+  EXPECT_EQ(RelocSiftLongSide(vga, no_own_size), 640);    // as SIFT sees it: not reduced either
+  EXPECT_EQ(RelocSiftLongSide(photo, no_own_size), 480);  // reduced to 640 by SIFT, 480 here
   EXPECT_EQ(RelocSiftLongSide(working_hd, defaults), 480);  // SIFT reduces it: further still
   RelocalizerOptions same_as_sift = defaults;
   same_as_sift.reloc_sift_long_side = 0;
