@@ -24,6 +24,25 @@ struct CharacterVertex {
   float weights[4];
 };
 
+// Points the bound vertex array's attributes at the bound GL_ARRAY_BUFFER of CharacterVertex:
+// position and normal (0, 1) when `with_position_and_normal`, always uv, joints and weights
+// (2, 3, 4). The CPU morph path's vertex array takes 0 and 1 from a buffer of its own.
+void PointAtCharacterVertices(const GlApi& gl, bool with_position_and_normal) {
+  const auto stride = static_cast<GLsizei>(sizeof(CharacterVertex));
+  const auto attribute = [&](GLuint location, GLint size, size_t offset) {
+    gl.EnableVertexAttribArray(location);
+    gl.VertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offset));
+  };
+  if (with_position_and_normal) {
+    attribute(0, 3, offsetof(CharacterVertex, position));
+    attribute(1, 3, offsetof(CharacterVertex, normal));
+  }
+  attribute(2, 2, offsetof(CharacterVertex, uv));
+  gl.EnableVertexAttribArray(3);
+  gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
+  attribute(4, 4, offsetof(CharacterVertex, weights));
+}
+
 struct ProgramVariant {
   bool dual_quaternion = true;
   LightingMode lighting = LightingMode::kFixed;
@@ -302,17 +321,7 @@ CharacterRenderer::CharacterRenderer(const GlApi& gl, const anim::Character& cha
     gl.BindVertexArray(gpu.vao.get());
     gpu.vbo = MakeBuffer(gl, GL_ARRAY_BUFFER, vertices.data(), vertices.size() * sizeof(CharacterVertex));
     gpu.ibo = MakeBuffer(gl, GL_ELEMENT_ARRAY_BUFFER, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
-    const auto stride = static_cast<GLsizei>(sizeof(CharacterVertex));
-    auto attribute = [&](GLuint location, GLint size, size_t offset) {
-      gl.EnableVertexAttribArray(location);
-      gl.VertexAttribPointer(location, size, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offset));
-    };
-    attribute(0, 3, offsetof(CharacterVertex, position));
-    attribute(1, 3, offsetof(CharacterVertex, normal));
-    attribute(2, 2, offsetof(CharacterVertex, uv));
-    gl.EnableVertexAttribArray(3);
-    gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
-    attribute(4, 4, offsetof(CharacterVertex, weights));
+    PointAtCharacterVertices(gl, true);
     gl.BindVertexArray(0);
     UploadMorphs(mesh, character.source, gpu);
     AddMorphReach(mesh, inverse_bind);
@@ -379,13 +388,7 @@ void CharacterRenderer::MakeCpuMorphPath(const anim::Mesh& mesh, GpuMesh& gpu) {
                            reinterpret_cast<void*>(location * 3 * sizeof(float)));
   }
   gl.BindBuffer(GL_ARRAY_BUFFER, gpu.vbo.get());
-  const auto stride = static_cast<GLsizei>(sizeof(CharacterVertex));
-  gl.EnableVertexAttribArray(2);
-  gl.VertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, uv)));
-  gl.EnableVertexAttribArray(3);
-  gl.VertexAttribIPointer(3, 4, GL_UNSIGNED_SHORT, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, joints)));
-  gl.EnableVertexAttribArray(4);
-  gl.VertexAttribPointer(4, 4, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offsetof(CharacterVertex, weights)));
+  PointAtCharacterVertices(gl, false);
   gl.BindVertexArray(0);
 }
 
