@@ -40,8 +40,8 @@ void SessionSound::OnUtterance(const speech::Utterance& utterance) {
   incoming_.push_back(std::move(line));
 }
 
-void SessionSound::AddHeardAudio(std::vector<std::int16_t> samples) {
-  if (sink_.HasAudio()) heard_ = std::move(samples);
+void SessionSound::AddHeardAudio(const std::vector<std::int16_t>& samples) {
+  if (sink_.HasAudio()) heard_ = samples;
 }
 
 double SessionSound::SinceStart(Clock::time_point t) const {

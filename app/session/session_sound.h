@@ -74,8 +74,9 @@ class SessionSound {
   // Before the pipeline starts: what the dialogue hears from a WAV (`replay --audio-in`, 16 kHz
   // mono), for the video's audio track, where its sample 0 goes at frame time 0 (the recognizer
   // hears it so) with the lines summed over it: the video then has both sides of the exchange.
-  // Not played live. Nothing without a video track.
-  void AddHeardAudio(std::vector<std::int16_t> samples);
+  // Not played live. Nothing without a video track: the samples are copied only for one (a
+  // minute of speech is 1.9 MB).
+  void AddHeardAudio(const std::vector<std::int16_t>& samples);
   // The sink's thread, after the frame was written (shown).
   void OnFrameShown(const FrameLog& frame, Clock::time_point shown);
   // After the pipeline has ended.
