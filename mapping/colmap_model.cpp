@@ -1,7 +1,5 @@
 #include "mapping/colmap_model.h"
 
-#include <sqlite3.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -279,162 +277,6 @@ std::vector<ColmapPoint> ReadPoints(const fs::path& file, const CancellationToke
   return points;
 }
 
-// COLMAP's pair id: image_id1 * kMaxNumImages + image_id2, image_id1 < image_id2.
-constexpr sqlite3_int64 kMaxNumImages = 2147483647;
-
-// The database, read-only.
-class Database {
- public:
-  explicit Database(const fs::path& path) : path_(path) {
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw map::MapError(path.string() + ": COLMAP database missing");
-    sqlite3* db = nullptr;
-    const int rc = sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
-    db_.reset(db);
-    if (rc != SQLITE_OK) Fail("cannot open");
-  }
-
-  // The descriptors of one image (rows x 128, CV_8U).
-  cv::Mat Descriptors(std::uint32_t image_id) {
-    Statement st(*this, "SELECT rows, cols, data FROM descriptors WHERE image_id = ?");
-    sqlite3_bind_int64(st.get(), 1, image_id);
-    const int rc = sqlite3_step(st.get());
-    if (rc == SQLITE_DONE) Fail("no descriptors for image id " + std::to_string(image_id));
-    if (rc != SQLITE_ROW) Fail("reading descriptors of image id " + std::to_string(image_id));
-    const sqlite3_int64 rows = sqlite3_column_int64(st.get(), 0);
-    const sqlite3_int64 cols = sqlite3_column_int64(st.get(), 1);
-    const void* blob = sqlite3_column_blob(st.get(), 2);
-    const sqlite3_int64 bytes = sqlite3_column_bytes(st.get(), 2);
-    if (cols != kDescriptorSize || rows < 0 || rows > (1 << 24) || bytes != rows * cols || (rows > 0 && !blob)) {
-      Fail("descriptors of image id " + std::to_string(image_id) + " have a wrong shape (" + std::to_string(rows) +
-           " x " + std::to_string(cols) + ", " + std::to_string(bytes) + " bytes; expected uint8 x 128)");
-    }
-    cv::Mat m(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
-    if (rows > 0) std::memcpy(m.data, blob, static_cast<size_t>(bytes));
-    return m;
-  }
-
-  // The verified pairs' essential matrices (two_view_geometries), keyed by COLMAP's image ids.
-  // Nothing when the table or its E column is absent (a database of another COLMAP version): the
-  // map check then skips the comparison.
-  struct PairGeometry {
-    std::uint32_t image_a = 0, image_b = 0;
-    int inliers = 0;
-    int config = 0;  // COLMAP's TwoViewGeometry::ConfigurationType
-    Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();
-    Eigen::Matrix3d fundamental = Eigen::Matrix3d::Zero();  // zero where COLMAP stored none
-  };
-  std::vector<PairGeometry> PairGeometries() {
-    std::vector<PairGeometry> pairs;
-    sqlite3_stmt* raw = nullptr;
-    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F FROM two_view_geometries WHERE rows > 0", -1, &raw,
-                           nullptr) != SQLITE_OK) {
-      sqlite3_finalize(raw);
-      return pairs;
-    }
-    const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> st(raw, sqlite3_finalize);
-    while (sqlite3_step(st.get()) == SQLITE_ROW) {
-      const sqlite3_int64 pair_id = sqlite3_column_int64(st.get(), 0);
-      const void* blob = sqlite3_column_blob(st.get(), 2);
-      if (pair_id < 0 || !blob || sqlite3_column_bytes(st.get(), 2) != 9 * sizeof(double)) continue;
-      PairGeometry g;
-      g.image_a = static_cast<std::uint32_t>(pair_id / kMaxNumImages);
-      g.image_b = static_cast<std::uint32_t>(pair_id % kMaxNumImages);
-      g.inliers = static_cast<int>(std::min<sqlite3_int64>(sqlite3_column_int64(st.get(), 1), 1 << 30));
-      g.config = sqlite3_column_int(st.get(), 3);
-      // COLMAP writes its matrices transposed, i.e. row by row (database.cc); x_b^T E x_a = 0.
-      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> rows_first;
-      std::memcpy(rows_first.data(), blob, 9 * sizeof(double));
-      g.essential = rows_first;
-      const void* f_blob = sqlite3_column_blob(st.get(), 4);
-      if (f_blob && sqlite3_column_bytes(st.get(), 4) == 9 * sizeof(double)) {
-        std::memcpy(rows_first.data(), f_blob, 9 * sizeof(double));
-        g.fundamental = rows_first;
-      }
-      pairs.push_back(g);
-    }
-    return pairs;
-  }
-
-  // Every verified pair with its inlier count, whatever its configuration (the match graph).
-  std::vector<VerifiedPair> VerifiedPairs() {
-    std::vector<VerifiedPair> pairs;
-    Statement st(*this, "SELECT pair_id, rows FROM two_view_geometries WHERE rows > 0");
-    int rc = SQLITE_ROW;
-    while ((rc = sqlite3_step(st.get())) == SQLITE_ROW) {
-      const sqlite3_int64 pair_id = sqlite3_column_int64(st.get(), 0);
-      if (pair_id < 0) Fail("a two-view geometry has the negative pair id " + std::to_string(pair_id));
-      pairs.push_back({static_cast<std::uint32_t>(pair_id / kMaxNumImages),
-                       static_cast<std::uint32_t>(pair_id % kMaxNumImages),
-                       static_cast<int>(std::min<sqlite3_int64>(sqlite3_column_int64(st.get(), 1), 1 << 30))});
-    }
-    if (rc != SQLITE_DONE) Fail("reading two_view_geometries");
-    return pairs;
-  }
-
-  // Every image's id and name, by id.
-  std::vector<std::pair<std::uint32_t, std::string>> Images() {
-    std::vector<std::pair<std::uint32_t, std::string>> images;
-    Statement st(*this, "SELECT image_id, name FROM images ORDER BY image_id");
-    int rc = SQLITE_ROW;
-    while ((rc = sqlite3_step(st.get())) == SQLITE_ROW) {
-      const sqlite3_int64 id = sqlite3_column_int64(st.get(), 0);
-      if (id <= 0 || id > kMaxNumImages) Fail("an image has the id " + std::to_string(id) + ", not one COLMAP gives");
-      const unsigned char* text = sqlite3_column_text(st.get(), 1);
-      images.emplace_back(static_cast<std::uint32_t>(id), text ? reinterpret_cast<const char*>(text) : "");
-    }
-    if (rc != SQLITE_DONE) Fail("reading images");
-    return images;
-  }
-
-  std::uint32_t ImageId(const std::string& name) {
-    Statement st(*this, "SELECT image_id FROM images WHERE name = ?");
-    sqlite3_bind_text(st.get(), 1, name.c_str(), -1, SQLITE_TRANSIENT);
-    const int rc = sqlite3_step(st.get());
-    if (rc == SQLITE_DONE) Fail("no image named " + name);
-    if (rc != SQLITE_ROW) Fail("reading the id of image " + name);
-    const sqlite3_int64 id = sqlite3_column_int64(st.get(), 0);
-    if (id <= 0 || id > 2147483647) Fail("image " + name + " has the id " + std::to_string(id) + ", not one COLMAP gives");
-    return static_cast<std::uint32_t>(id);
-  }
-
-  std::string ImageName(std::uint32_t image_id) {
-    Statement st(*this, "SELECT name FROM images WHERE image_id = ?");
-    sqlite3_bind_int64(st.get(), 1, image_id);
-    const int rc = sqlite3_step(st.get());
-    if (rc == SQLITE_DONE) Fail("no image with id " + std::to_string(image_id) + " (not the model's database?)");
-    if (rc != SQLITE_ROW) Fail("reading image id " + std::to_string(image_id));
-    const unsigned char* text = sqlite3_column_text(st.get(), 0);
-    return text ? reinterpret_cast<const char*>(text) : "";
-  }
-
- private:
-  struct Closer {
-    void operator()(sqlite3* db) const { sqlite3_close(db); }
-  };
-  class Statement {
-   public:
-    Statement(Database& db, const char* sql) {
-      if (sqlite3_prepare_v2(db.db_.get(), sql, -1, &st_, nullptr) != SQLITE_OK) db.Fail("query failed");
-    }
-    ~Statement() { sqlite3_finalize(st_); }
-    Statement(const Statement&) = delete;
-    Statement& operator=(const Statement&) = delete;
-    sqlite3_stmt* get() { return st_; }
-
-   private:
-    sqlite3_stmt* st_ = nullptr;
-  };
-
-  [[noreturn]] void Fail(const std::string& problem) {
-    std::string detail = db_ ? sqlite3_errmsg(db_.get()) : "out of memory";
-    throw map::MapError(path_.string() + ": " + problem + " (SQLite: " + detail + ")");
-  }
-
-  fs::path path_;
-  std::unique_ptr<sqlite3, Closer> db_;
-};
-
 std::uint64_t Key(std::uint32_t image_id, std::uint32_t point2d_idx) {
   return (static_cast<std::uint64_t>(image_id) << 32) | point2d_idx;
 }
@@ -655,7 +497,7 @@ void WriteTransformedModel(const fs::path& from, const fs::path& to, const Sim3&
 
 std::vector<cv::Mat> ReadImageDescriptors(const fs::path& database, const std::vector<std::string>& names,
                                           const CancellationToken& cancel) {
-  Database db(database);
+  ColmapDatabase db(database, ColmapDatabase::Access::kRead);
   std::vector<cv::Mat> descriptors;
   descriptors.reserve(names.size());
   for (const std::string& name : names) {
@@ -669,7 +511,7 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
   std::unordered_map<std::uint32_t, int> keyframe_of_image;
   for (std::size_t k = 0; k < map.keyframes.size(); ++k)
     keyframe_of_image[map.keyframes[k].colmap_image_id] = static_cast<int>(k);
-  Database db(database);
+  ColmapDatabase db(database, ColmapDatabase::Access::kRead);
   std::vector<TwoViewGeometry> result;
   for (const auto& pair : db.PairGeometries()) {
     const auto a = keyframe_of_image.find(pair.image_a), b = keyframe_of_image.find(pair.image_b);
@@ -685,12 +527,15 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
 }
 
 DatabaseMatchGraph ReadMatchGraph(const fs::path& database) {
-  Database db(database);
-  return {db.Images(), db.VerifiedPairs()};
+  ColmapDatabase db(database, ColmapDatabase::Access::kRead);
+  DatabaseMatchGraph graph;
+  for (auto& image : db.Images()) graph.images.emplace_back(image.id, std::move(image.name));
+  graph.pairs = db.VerifiedPairs();
+  return graph;
 }
 
 std::vector<FundamentalPair> ReadFundamentalMatrices(const fs::path& database) {
-  Database db(database);
+  ColmapDatabase db(database, ColmapDatabase::Access::kRead);
   std::vector<FundamentalPair> result;
   for (const auto& pair : db.PairGeometries()) {
     // CALIBRATED (2) and UNCALIBRATED (3) pairs: a general motion, whose F is defined (a
@@ -702,18 +547,7 @@ std::vector<FundamentalPair> ReadFundamentalMatrices(const fs::path& database) {
 }
 
 void SetSingleCameraParams(const fs::path& database, const std::vector<double>& params) {
-  sqlite3* raw = nullptr;
-  const int rc = sqlite3_open_v2(database.c_str(), &raw, SQLITE_OPEN_READWRITE, nullptr);
-  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> db(raw, sqlite3_close);
-  sqlite3_stmt* st = nullptr;
-  const bool ok = rc == SQLITE_OK &&
-                  sqlite3_prepare_v2(raw, "UPDATE cameras SET params = ?", -1, &st, nullptr) == SQLITE_OK &&
-                  sqlite3_bind_blob(st, 1, params.data(), static_cast<int>(params.size() * sizeof(double)),
-                                    SQLITE_TRANSIENT) == SQLITE_OK &&
-                  sqlite3_step(st) == SQLITE_DONE && sqlite3_changes(raw) == 1;
-  const std::string why = raw ? sqlite3_errmsg(raw) : "out of memory";
-  sqlite3_finalize(st);
-  if (!ok) throw map::MapError(database.string() + ": cannot set its camera's parameters (" + why + "; one camera expected)");
+  ColmapDatabase(database, ColmapDatabase::Access::kReadWrite).SetSingleCameraParams(params);
 }
 
 namespace {
@@ -773,7 +607,7 @@ map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, c
 
   RequireTracksReferBack(points, images, keyframe_of_image, points_file, images_file);
 
-  Database db(database);
+  ColmapDatabase db(database, ColmapDatabase::Access::kRead);
   map.descriptors.create(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
   map.descriptor_point.resize(rows);
   map.descriptor_keyframe.resize(rows);

@@ -14,6 +14,7 @@
 
 #include "base/cancellation.h"
 #include "map/map.h"
+#include "mapping/colmap_database.h"
 #include "mapping/map_check.h"
 
 namespace arview::mapping {
@@ -71,11 +72,6 @@ std::vector<cv::Mat> ReadImageDescriptors(const std::filesystem::path& database,
 // a database without the table gives none. Throws MapError when the database cannot be opened.
 std::vector<TwoViewGeometry> ReadTwoViewGeometries(const std::filesystem::path& database, const map::Map& map);
 
-// One pair of images COLMAP verified (two_view_geometries), by COLMAP's image ids.
-struct VerifiedPair {
-  std::uint32_t image_a = 0, image_b = 0;
-  int inliers = 0;
-};
 // Every image of a database (id, name; by id) and every verified pair with inliers, for the match
 // graph (mapping/match_graph.h). Throws MapError when the database cannot be read.
 struct DatabaseMatchGraph {
@@ -84,12 +80,6 @@ struct DatabaseMatchGraph {
 };
 DatabaseMatchGraph ReadMatchGraph(const std::filesystem::path& database);
 
-// A verified pair's fundamental matrix, in COLMAP's pixels (centres at +0.5): x_b^T F x_a = 0.
-struct FundamentalPair {
-  std::uint32_t image_a = 0, image_b = 0;  // COLMAP's image ids
-  int inliers = 0;
-  Eigen::Matrix3d fundamental;
-};
 // Every pair of a general motion (COLMAP's CALIBRATED and UNCALIBRATED configurations) with its
 // F; the planar and pure-turn pairs, whose F is not defined, are left out.
 std::vector<FundamentalPair> ReadFundamentalMatrices(const std::filesystem::path& database);

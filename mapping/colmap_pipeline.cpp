@@ -3,7 +3,6 @@
 #include "base/atomic_file.h"
 #include "base/image_file.h"
 
-#include <sqlite3.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -249,16 +248,8 @@ std::vector<double> ColmapCameraParams(const calib::Camera& c, bool* full_opencv
 }
 
 void ClearMatches(const fs::path& database) {
-  sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr);
-  std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
-  char* error = nullptr;
-  if (rc != SQLITE_OK ||
-      sqlite3_exec(db, "DELETE FROM matches; DELETE FROM two_view_geometries;", nullptr, nullptr, &error) != SQLITE_OK) {
-    const std::string why = error ? error : (db ? sqlite3_errmsg(db) : "cannot open");
-    sqlite3_free(error);
-    throw map::MapError(database.string() + ": cannot clear old matches (" + why + ")");
-  }
+  ColmapDatabase(database, ColmapDatabase::Access::kReadWrite)
+      .Execute("DELETE FROM matches; DELETE FROM two_view_geometries;", "clear old matches");
 }
 
 // The sparse model with the most registered images among <out>/sparse/<n>/.
@@ -655,29 +646,6 @@ void MakeMetric(const KeyframeImages& images, BoardSearchInBackground* board_sea
 }  // namespace
 
 // Stages `arview map extend` runs as well (declared in mapping/colmap_stages.h), used above too.
-
-void RemoveColmapDatabase(const fs::path& database) {
-  std::error_code ec;
-  for (const char* suffix : {"", "-shm", "-wal", "-journal"}) fs::remove(database.string() + suffix, ec);
-}
-
-// A consistent copy of a COLMAP database (VACUUM INTO: whatever its journal holds is in the copy).
-void CopyColmapDatabase(const fs::path& database, const fs::path& copy) {
-  RemoveColmapDatabase(copy);
-  sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
-  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
-  sqlite3_stmt* st = nullptr;
-  const bool ok = rc == SQLITE_OK && sqlite3_prepare_v2(db, "VACUUM INTO ?", -1, &st, nullptr) == SQLITE_OK &&
-                  sqlite3_bind_text(st, 1, copy.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
-                  sqlite3_step(st) == SQLITE_DONE;
-  const std::string why = db ? sqlite3_errmsg(db) : "out of memory";
-  sqlite3_finalize(st);
-  if (!ok) {
-    RemoveColmapDatabase(copy);
-    throw map::MapError(database.string() + ": cannot copy it to " + copy.string() + " for verification (" + why + ")");
-  }
-}
 
 // COLMAP's command lines for the three stages. Each stage's inputs include the previous
 // stage's, so that a change re-runs everything after it.

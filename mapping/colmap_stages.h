@@ -46,9 +46,7 @@ std::vector<std::string> ColmapMapperArgs(const MapBuildOptions& options, const 
 // Whether `arview map` matches this many frames exhaustively (--matcher), else sequentially.
 bool ExhaustiveMatchingWanted(const MapBuildOptions& options, int frames);
 
-// A consistent copy of a COLMAP database (its journal included); removing one with its journal.
-void CopyColmapDatabase(const std::filesystem::path& database, const std::filesystem::path& copy);
-void RemoveColmapDatabase(const std::filesystem::path& database);
+// CopyColmapDatabase and RemoveColmapDatabase: mapping/colmap_database.h.
 
 // The model with the most registered images among <sparse_root>/<n>/ (empty when none).
 std::filesystem::path LargestColmapModel(const std::filesystem::path& sparse_root);

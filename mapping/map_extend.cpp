@@ -1,6 +1,5 @@
 #include "mapping/map_extend.h"
 
-#include <sqlite3.h>
 
 #include <nlohmann/json.hpp>
 
@@ -124,60 +123,22 @@ void RequireSameCamera(const calib::Camera& map_camera, const recordings::Record
     cb.note("the recording's calibration differs from the map's: the new frames are registered with the map's camera");
 }
 
-// A COLMAP database opened for one query or statement.
-class SqliteFile {
- public:
-  SqliteFile(const fs::path& path, int flags) : path_(path) {
-    sqlite3* db = nullptr;
-    const int rc = sqlite3_open_v2(path.c_str(), &db, flags, nullptr);
-    db_.reset(db);
-    if (rc != SQLITE_OK) Fail("cannot open");
-  }
-  void Exec(const char* sql) {
-    char* error = nullptr;
-    if (sqlite3_exec(db_.get(), sql, nullptr, nullptr, &error) != SQLITE_OK) {
-      const std::string why = error ? error : sqlite3_errmsg(db_.get());
-      sqlite3_free(error);
-      Fail(why);
-    }
-  }
-  // Every image's name and camera id.
-  std::vector<std::pair<std::string, std::int64_t>> ImageNames() {
-    sqlite3_stmt* st = nullptr;
-    if (sqlite3_prepare_v2(db_.get(), "SELECT name, camera_id FROM images", -1, &st, nullptr) != SQLITE_OK)
-      Fail(sqlite3_errmsg(db_.get()));
-    const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> guard(st, sqlite3_finalize);
-    std::vector<std::pair<std::string, std::int64_t>> names;
-    while (sqlite3_step(st) == SQLITE_ROW) {
-      const auto* text = reinterpret_cast<const char*>(sqlite3_column_text(st, 0));
-      names.emplace_back(text ? text : "", sqlite3_column_int64(st, 1));
-    }
-    return names;
-  }
-
- private:
-  [[noreturn]] void Fail(const std::string& why) const {
-    throw map::MapError(path_.string() + ": COLMAP database: " + (why.empty() ? "cannot open" : why));
-  }
-  fs::path path_;
-  std::unique_ptr<sqlite3, int (*)(sqlite3*)> db_{nullptr, sqlite3_close};
-};
-
 // Whatever the database's write-ahead log holds moved into the file itself and the log emptied,
 // so that the file alone is the database (renamed over another, or replaced).
 void CheckpointDatabase(const fs::path& database) {
-  SqliteFile(database, SQLITE_OPEN_READWRITE).Exec("PRAGMA wal_checkpoint(TRUNCATE);");
+  ColmapDatabase(database, ColmapDatabase::Access::kReadWrite)
+      .Execute("PRAGMA wal_checkpoint(TRUNCATE);", "move its write-ahead log into the file");
 }
 
 // "session-2" for the first extension: the original session is the first. A name neither the
 // images folder nor the database holds, so that the new frames' names are new to COLMAP.
-std::string NextSessionName(const fs::path& map_dir, const std::vector<std::pair<std::string, std::int64_t>>& names) {
+std::string NextSessionName(const fs::path& map_dir, const std::vector<ColmapDatabase::ImageRow>& names) {
   for (int k = 2;; ++k) {
     const std::string session = "session-" + std::to_string(k);
     std::error_code ec;
     const bool used = fs::exists(map_dir / "images" / session, ec) ||
                       std::any_of(names.begin(), names.end(),
-                                  [&](const auto& n) { return n.first.rfind(session + "/", 0) == 0; });
+                                  [&](const auto& n) { return n.name.rfind(session + "/", 0) == 0; });
     if (!used) return session;
   }
 }
@@ -568,13 +529,13 @@ void MoveIntoFrame(const Sim3& s, map::Map* map) {
 }
 
 // The COLMAP camera id of the map's keyframes, which the new frames share.
-std::int64_t MapCameraId(const OldMap& old, const std::vector<std::pair<std::string, std::int64_t>>& names) {
+std::int64_t MapCameraId(const OldMap& old, const std::vector<ColmapDatabase::ImageRow>& names) {
   const std::string& first = old.map.keyframes.front().name;
-  const auto camera = std::find_if(names.begin(), names.end(), [&](const auto& n) { return n.first == first; });
+  const auto camera = std::find_if(names.begin(), names.end(), [&](const auto& n) { return n.name == first; });
   if (camera == names.end())
     throw map::MapError(old.database.string() + ": does not hold the map's keyframe '" + first +
                         "' (the database of another map?)");
-  return camera->second;
+  return camera->camera_id;
 }
 
 // The new frames' SIFT into the work folder's copy of the map's database, with the map's camera.
@@ -684,7 +645,7 @@ MapExtendResult ExtendMap(const fs::path& map_dir_arg, const recordings::Recordi
   MapExtendOptions options = options_arg;
   if (!options.max_features_set) TakeMapsSiftSettings(map_dir, &options.build);
   const std::optional<Sim3> to_map_file = RequireOwnModel(old.model_dir, old.map, map_dir);
-  const auto names = SqliteFile(old.database, SQLITE_OPEN_READONLY).ImageNames();
+  const auto names = ColmapDatabase(old.database, ColmapDatabase::Access::kRead).Images();
   const std::int64_t camera_id = MapCameraId(old, names);
 
   MapExtendResult result;

@@ -1,6 +1,5 @@
 #include "mapping/pair_matching.h"
 
-#include <sqlite3.h>
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +13,7 @@
 #include "base/atomic_file.h"
 #include "map/descriptor_index.h"
 #include "map/map.h"
+#include "mapping/colmap_database.h"
 
 namespace arview::mapping {
 
@@ -225,48 +225,8 @@ void WriteMatchLists(const std::vector<std::string>& names, const std::vector<Pa
   }
 }
 
-namespace {
-
-// Runs `sql` (one transaction) on `database` with the database `part` attached as "part";
-// `what` names the step for the error ("add the verified pairs of <part>"). `precondition`, when
-// given, is a query run first whose one value must be 1, else `refusal` is the error's reason.
-void RunWithPartAttached(const fs::path& database, const fs::path& part, const char* sql, const std::string& what,
-                         const char* precondition = nullptr, const std::string& refusal = "") {
-  sqlite3* db = nullptr;
-  const int rc = sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READWRITE, nullptr);
-  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> guard(db, sqlite3_close);
-  if (rc != SQLITE_OK) {
-    throw map::MapError(database.string() + ": cannot open to " + what + " (" + (db ? sqlite3_errmsg(db) : "out of memory") +
-                        ")");
-  }
-  sqlite3_busy_timeout(db, 5000);
-  // The part's path is bound, not spliced into the SQL: any file name works.
-  sqlite3_stmt* attach = nullptr;
-  bool attached = sqlite3_prepare_v2(db, "ATTACH DATABASE ? AS part", -1, &attach, nullptr) == SQLITE_OK &&
-                  sqlite3_bind_text(attach, 1, part.c_str(), -1, SQLITE_TRANSIENT) == SQLITE_OK &&
-                  sqlite3_step(attach) == SQLITE_DONE;
-  sqlite3_finalize(attach);
-  if (attached && precondition) {
-    sqlite3_stmt* check = nullptr;
-    const bool holds = sqlite3_prepare_v2(db, precondition, -1, &check, nullptr) == SQLITE_OK &&
-                       sqlite3_step(check) == SQLITE_ROW && sqlite3_column_int(check, 0) == 1;
-    sqlite3_finalize(check);
-    if (!holds) throw map::MapError(database.string() + ": cannot " + what + " (" + refusal + ")");
-  }
-  char* error = nullptr;
-  if (!attached || sqlite3_exec(db, sql, nullptr, nullptr, &error) != SQLITE_OK) {
-    const std::string why = error ? error : sqlite3_errmsg(db);
-    sqlite3_free(error);
-    sqlite3_exec(db, "ROLLBACK", nullptr, nullptr, nullptr);
-    throw map::MapError(database.string() + ": cannot " + what + " (" + why + ")");
-  }
-  sqlite3_exec(db, "DETACH DATABASE part", nullptr, nullptr, nullptr);
-}
-
-}  // namespace
-
 void MergeVerifiedPairs(const fs::path& database, const fs::path& part) {
-  RunWithPartAttached(database, part,
+  ColmapDatabase(database, ColmapDatabase::Access::kReadWrite).ExecuteWithPart(part,
                       "BEGIN; INSERT OR REPLACE INTO main.matches SELECT * FROM part.matches; "
                       "INSERT OR REPLACE INTO main.two_view_geometries SELECT * FROM part.two_view_geometries; COMMIT;",
                       "add the verified pairs of " + part.string());
@@ -277,8 +237,8 @@ void MergeExtractedImages(const fs::path& database, const fs::path& part) {
   // checked to lie in 0 .. 2^31 - 2), so that no two rows of the part ever share one; then its
   // rows are copied. Its camera must be the database's one camera (the same feature_extractor
   // command line).
-  RunWithPartAttached(
-      database, part,
+  ColmapDatabase(database, ColmapDatabase::Access::kReadWrite).ExecuteWithPart(
+      part,
       "BEGIN;"
       "UPDATE part.images SET image_id = image_id + 1073741824, camera_id = (SELECT camera_id FROM main.cameras);"
       "UPDATE part.keypoints SET image_id = image_id + 1073741824;"
