@@ -297,6 +297,7 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // Tracks thinned by someone walking through: the points they hid followed back first.
   if (thinning && from_flow) result->recovered_tracks = RecoverHiddenPoints(pyramid, *from_flow, lk_errors, &c);
   const bool extract_here = !opt.background && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
+  const std::size_t before_search = c.pixels.size();  // the flow tracks and the hidden points followed back
   if (prefetch_due || extract_here) {
     research_trigger_.Searched(frame_counter_);
     const calib::Pose projecting = from_flow.value_or(predicted);
@@ -332,9 +333,9 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
     }
   }
 
-  DropNearMoving(moving, static_cast<std::size_t>(result->flow_tracks), &c, result);
   // Guided matches on clipped windows: keypoints on the edges of the white blobs, not the texture's.
-  DropClippedTracks(gray, static_cast<std::size_t>(result->flow_tracks + result->recovered_tracks), &c, result);
+  DropClippedTracks(gray, before_search, &c, result);
+  DropNearMoving(moving, static_cast<std::size_t>(result->flow_tracks), &c, result);
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short
   // RANSAC, whose pose must stay near the prediction.

@@ -40,6 +40,7 @@ MovingTrackVerdict Tracker::DropMovingTracks(const std::vector<Eigen::Vector2d>&
 }
 
 void Tracker::DropClippedTracks(const cv::Mat& gray, std::size_t from, Correspondences* c, FrameResult* result) const {
+  if (from >= c->pixels.size()) return;
   const std::vector<bool> clipped = MostlyClipped(gray, std::span(c->pixels).subspan(from),
                                                   options_.tracking.lk_window_px, options_.tracking.clipped);
   result->clipped_rejected += KeepCorrespondences(
