@@ -27,6 +27,8 @@
 
 #include "map/map_file.h"
 #include "tracker/brightness_match.h"
+#include "tracker/clipped_windows.h"
+#include "tracker/research_trigger.h"
 #include "tracker/moving_tracks.h"
 #include "recordings/accuracy.h"
 #include "recordings/recording.h"
@@ -159,6 +161,35 @@ static void BM_MovingTrackRejection(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MovingTrackRejection)->Unit(benchmark::kMicrosecond);
+
+// The fourth round's rules switched on (docs/tracker.md, "Fourth round"), per tracked frame at
+// 640x480: the clipped-window test of 300 flow tracks and 300 guided matches (a third of the
+// frame clipped white), and the re-search trigger over 140 tracks with credit kept.
+static void BM_ClippedWindowsAndResearchTrigger(benchmark::State& state) {
+  constexpr int kTracks = 300;
+  cv::Mat frame(480, 640, CV_8U);
+  cv::randu(frame, 30, 220);
+  frame.colRange(0, 213).setTo(255);
+  std::vector<Eigen::Vector2d> tracks(kTracks), guided(kTracks);
+  for (int i = 0; i < kTracks; ++i) {
+    tracks[i] = Eigen::Vector2d(20.0 * (i % 30) + 10, 16.0 * (i / 30) + 8);
+    guided[i] = Eigen::Vector2d((i * 37) % 640, (i * 53) % 480);
+  }
+  ClippedWindowOptions clipped;
+  clipped.max_share = 0.5;
+  ResearchTriggerOptions research;
+  research.occlusion_credit_frames = 30;
+  ResearchTrigger trigger(research, 150);
+  const std::span<const Eigen::Vector2d> followed = std::span(tracks).first(140);
+  std::uint32_t frame_number = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(MostlyClipped(frame, tracks, 11, clipped));
+    benchmark::DoNotOptimize(MostlyClipped(frame, guided, 11, clipped));
+    trigger.Occluded(++frame_number, 6);
+    benchmark::DoNotOptimize(trigger.Due(frame_number, followed, frame.size()));
+  }
+}
+BENCHMARK(BM_ClippedWindowsAndResearchTrigger)->Unit(benchmark::kMicrosecond);
 
 // OpenCV's pipeline on the same input: solvePnPRansac (same threshold, iterations and
 // confidence) then solvePnPRefineLM on its inliers.

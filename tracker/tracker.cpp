@@ -41,7 +41,8 @@ Tracker::Tracker(const map::Map& map, const calib::Camera& camera, const Tracker
       resolution_(camera, options.working_long_side),
       rms_gate_(options.tracking.rms_gate),
       smoother_(options.smoothing),
-      moving_filter_(options.tracking.moving, map.points.size()) {
+      moving_filter_(options.tracking.moving, map.points.size()),
+      research_trigger_(options.tracking.research, options.tracking.replenish_below) {
   CheckTrackable(map, options.min_map_points);
   index_ = options.index_cache_folder.empty()
                ? map::DescriptorIndex(map.descriptors, options.index)
@@ -89,6 +90,7 @@ void Tracker::ForgetPrior() {
   last_light_switch_timestamp_ = -std::numeric_limits<double>::infinity();
   last_inliers_ = {};
   hidden_.Clear();
+  research_trigger_.Clear();
   smoother_.Reset();
 }
 
@@ -241,6 +243,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
     result->flow_lost_in_view = static_cast<int>(std::count(in_view.begin(), in_view.end(), true)) -
                                 followed_in_view;
     moving = DropMovingTracks(predicted_px, lk_errors, &c, result);
+    DropClippedTracks(gray, 0, &c, result);
+    research_trigger_.Occluded(frame_counter_, moving.by_patch);
     for (const std::uint32_t id : c.point_ids) point_stamp_[id] = frame_counter_;
     HideLostTracks(in_view);
     if (!motion_px.empty()) {
@@ -276,11 +280,12 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // motion), or with the prediction and a wider radius when too few tracks survive.
   // A prefetched frame is used `prefetch_lag_frames` after it, or as soon as the tracks thin out.
   // With `background` it is used as soon as it is done, and nothing is extracted here.
+  // Thinning: under replenish_below, less the tracks a walker took that are expected back
+  // (tracker/research_trigger.h).
+  const bool thinning = research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
   const bool prefetch_due =
       prefetch_ && (opt.background ? Ready(prefetch_->extracted)
-                                   : frames_tracked_ - prefetch_->frame >= opt.prefetch_lag_frames ||
-                                         result->flow_tracks < opt.replenish_below);
-  const bool thinning = result->flow_tracks < opt.replenish_below;
+                                   : frames_tracked_ - prefetch_->frame >= opt.prefetch_lag_frames || thinning);
   // The pose the surviving tracks give, when enough survive (what guided matching and the hidden
   // points are projected with).
   std::optional<calib::Pose> from_flow;
@@ -291,9 +296,10 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   }
   // Tracks thinned by someone walking through: the points they hid followed back first.
   if (thinning && from_flow) result->recovered_tracks = RecoverHiddenPoints(pyramid, *from_flow, lk_errors, &c);
-  const bool extract_here =
-      !opt.background && result->flow_tracks + result->recovered_tracks < opt.replenish_below;
+  const bool extract_here = !opt.background && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
+  const std::size_t before_search = c.pixels.size();  // the flow tracks and the hidden points followed back
   if (prefetch_due || extract_here) {
+    research_trigger_.Searched(frame_counter_);
     const calib::Pose projecting = from_flow.value_or(predicted);
     const double radius = from_flow ? opt.guided_radius_px : opt.guided_radius_predicted_px;
     if (prefetch_due) {
@@ -327,6 +333,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
     }
   }
 
+  // Guided matches on clipped windows: keypoints on the edges of the white blobs, not the texture's.
+  DropClippedTracks(gray, before_search, &c, result);
   DropNearMoving(moving, static_cast<std::size_t>(result->flow_tracks), &c, result);
 
   // 3. Refinement from the prediction; when it explains too few correspondences, a short

@@ -21,10 +21,12 @@
 #include "map/descriptor_index.h"
 #include "map/map.h"
 #include "tracker/centre_fitter.h"
+#include "tracker/clipped_windows.h"
 #include "tracker/hidden_points.h"
 #include "tracker/moving_tracks.h"
 #include "tracker/one_euro.h"
 #include "tracker/relocalizer.h"
+#include "tracker/research_trigger.h"
 #include "tracker/residual_gate.h"
 #include "tracker/rotation_aligner.h"
 #include "tracker/tracking_worker.h"
@@ -157,6 +159,12 @@ struct TrackingOptions {
   // Points whose tracks someone walking through took away, followed back when the flow thins
   // out, before guided matching (tracker/hidden_points.h; docs/tracker.md, "People walking through").
   HiddenPointOptions hidden;
+  // Tracks dropped by the patch test counted as expected back before the flow re-searches
+  // (tracker/research_trigger.h; docs/tracker.md, "Fourth round").
+  ResearchTriggerOptions research;
+  // Flow tracks on windows the frame clips white, dropped before the pose
+  // (tracker/clipped_windows.h; docs/tracker.md, "Fourth round").
+  ClippedWindowOptions clipped;
 
   // Throws OptionError naming the first bad field (base/option_check.h; tracker/tracker_options.cpp).
   void Check(const OptionNames& names = {}) const;
@@ -223,6 +231,7 @@ struct FrameResult {
   int moving_rejected = 0; // flow tracks and guided matches rejected as on something moving
   int moving_by_patch = 0;   // of those, flow tracks whose patch changed
   int moving_by_motion = 0;  // of those, flow tracks that moved against the prediction
+  int clipped_rejected = 0;  // flow tracks on windows the frame clips white (TrackingOptions::clipped)
   int recovered_tracks = 0;  // hidden points followed back from the last frame that saw them
   int prefetched_matches = 0;  // of those, matched in a frame extracted ahead and followed by LK
   int wide_matches = 0;    // matches of the wide search (tracking after a motion flow lost)
@@ -374,6 +383,8 @@ class Tracker {
   // number appended.
   int RecoverHiddenPoints(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting,
                           const std::vector<float>& flow_lk_errors, Correspondences* c);
+  // The correspondences c[from, end) whose LK window in `gray` is mostly clipped white, removed.
+  void DropClippedTracks(const cv::Mat& gray, std::size_t from, Correspondences* c, FrameResult* result) const;
   // Correspondences c[from, end) that lie where the verdict rejected tracks, removed.
   void DropNearMoving(const MovingTrackVerdict& verdict, std::size_t from, Correspondences* c, FrameResult* result) const;
   // The pose from a prior: refined from it, and when that explains fewer than
@@ -433,6 +444,7 @@ class Tracker {
   std::uint32_t frame_counter_ = 0;
   MovingTrackFilter moving_filter_;
   HiddenPoints hidden_;
+  ResearchTrigger research_trigger_;
   // Background work (TrackingOptions::background, prefetch_below): its own relocalizer and SIFT,
   // so that no object here but the map and the index is touched by two threads
   // (tracker/tracking_worker.h). Last: destroyed first, so that a running job finishes while

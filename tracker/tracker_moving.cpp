@@ -39,6 +39,14 @@ MovingTrackVerdict Tracker::DropMovingTracks(const std::vector<Eigen::Vector2d>&
   return verdict;
 }
 
+void Tracker::DropClippedTracks(const cv::Mat& gray, std::size_t from, Correspondences* c, FrameResult* result) const {
+  if (from >= c->pixels.size()) return;
+  const std::vector<bool> clipped = MostlyClipped(gray, std::span(c->pixels).subspan(from),
+                                                  options_.tracking.lk_window_px, options_.tracking.clipped);
+  result->clipped_rejected += KeepCorrespondences(
+      from, [&](std::size_t i) { return !clipped[i - from]; }, c->pixels, c->points, c->point_ids);
+}
+
 void Tracker::DropNearMoving(const MovingTrackVerdict& verdict, std::size_t from, Correspondences* c, FrameResult* result) const {
   if (verdict.rejected.empty()) return;
   const double region = options_.tracking.moving.region_px;

@@ -96,6 +96,8 @@ void TrackingOptions::Check(const OptionNames& names) const {
   RequireOption(light_switch_hold_s >= 0, names("light_switch_hold_s"), "0 or more", light_switch_hold_s);
   moving.Check(names.Nested("moving"));
   hidden.Check(names.Nested("hidden"));
+  research.Check(names.Nested("research"));
+  clipped.Check(names.Nested("clipped"));
 }
 
 void TrackerOptions::Check(const OptionNames& names) const {

@@ -78,6 +78,7 @@ nlohmann::ordered_json FrameJson(const FrameRecord& f) {
                               {"moving_rejected", r.moving_rejected},
                               {"moving_by_patch", r.moving_by_patch},
                               {"moving_by_motion", r.moving_by_motion},
+                              {"clipped_rejected", r.clipped_rejected},
                               {"guided_matches", r.guided_matches},
                               {"prefetched_matches", r.prefetched_matches},
                               {"wide_matches", r.wide_matches},
@@ -291,6 +292,19 @@ void AddTrackCommand(CLI::App& app) {
   f.Add(cmd, "--replenish-below", ARVIEW_OPTION_FIELD(o, tracking.replenish_below),
         "Run guided matching when fewer flow tracks survive")
       ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--occlusion-credit", ARVIEW_OPTION_FIELD(o, tracking.research.occlusion_credit_frames),
+        "Flow tracks the patch test dropped (something walked over their points) count toward "
+        "--replenish-below for this many tracked frames, as expected back, while the tracks followed are "
+        "at least half of it and lie in 3 of the frame's 4 quadrants; 0: off (a plain count)")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--research-every", ARVIEW_OPTION_FIELD(o, tracking.research.max_frames_between),
+        "A tracked frame this many frames after the last re-search (guided matching) re-searches whatever "
+        "its flow tracks' count: tracks followed for seconds drift together; 0: never")
+      ->check(CLI::Range(0, 100000));
+  f.Add(cmd, "--clipped-window-share", ARVIEW_OPTION_FIELD(o, tracking.clipped.max_share),
+        "Drop a flow track before the pose when more than this share of its LK window is clipped white "
+        "(grey 250 or more: a lamp switched on under a raised exposure); 1: off")
+      ->check(CLI::Range(0.01, 1.0));
   f.Add(cmd, "--fresh-features-after", ARVIEW_OPTION_FIELD(o, tracking.fresh_features_after_s),
         "A tracked frame that comes more than this many seconds after the last posed one is posed again "
         "from its own SIFT matched against the whole map, as relocalization does, kept when it agrees with "
