@@ -749,6 +749,258 @@ std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, 
   return std::nullopt;
 }
 
+namespace {
+
+// One `arview map` run as the sequence of its stages (BuildMap below): each a method, in the
+// order they run, over the state they hand on (the frames, the database, each stage's inputs).
+// A stage whose recorded inputs match and whose outputs exist is skipped (StageRecord); a stage
+// that fails or is interrupted removes what it left half written.
+class MapBuild {
+ public:
+  using StageWork = std::function<void(std::vector<StageTiming>* steps)>;
+
+  MapBuild(const recordings::Recording& recording, const fs::path& out_dir, const MapBuildOptions& options,
+           const MapBuildCallbacks& cb)
+      : recording_(recording),
+        out_dir_(out_dir),
+        options_(options),
+        cb_(cb),
+        stages_(out_dir),
+        colmap_(options, out_dir, cb),
+        database_(out_dir / "database.db"),
+        sparse_(out_dir / "sparse"),
+        stages_as_jobs_(options.engine == MapEngine::kSlurm && options.slurm_chunk > 0),
+        self_calibrate_(!recording.camera.calibrated),
+        start_camera_(recording.camera) {}
+
+  // The frames COLMAP gets, their list, and the extraction's inputs (its command line and each
+  // frame's identity).
+  void SelectFrames() {
+    t0_ = std::chrono::steady_clock::now();
+    images_ = recording_.IsVideo()
+                  ? PrepareVideoImages(recording_, out_dir_, options_, cb_, stages_, &result_.selected_frames)
+                  : PrepareStillImages(recording_, options_, cb_, &result_.selected_frames);
+    result_.timings.push_back({"select", Seconds(t0_), false});
+    if (images_.names.size() < 2)
+      throw map::MapError("a map needs at least 2 frames (got " + std::to_string(images_.names.size()) + ")");
+    frames_ = static_cast<int>(images_.names.size());
+    const fs::path list = out_dir_ / "image_list.txt";
+    std::string names;
+    for (const auto& name : images_.names) names += name + "\n";
+    WriteFileAtomically(list, names);  // a full disk: "cannot write (<why>)", no empty list left
+    extract_args_ = ColmapExtractArgs(recording_.camera, options_, database_, images_.root, list);
+    // Each stage's inputs include the previous stage's, so that a change re-runs everything after it.
+    inputs_ = Joined(extract_args_);
+    for (const auto& name : images_.names) inputs_ += name + " " + FileIdentity(images_.root / name) + "\n";
+  }
+
+  // SIFT into the database: COLMAP's feature_extractor, or Slurm jobs (--engine slurm
+  // --slurm-chunk N, mapping/job_stages.h; the same database either way, so the stage records do
+  // not say where it was made).
+  void Extract() {
+    const StageWork run = stages_as_jobs_ ? StageWork([this](std::vector<StageTiming>*) {
+      ExtractOnSlurm(recording_.camera, options_, JobFiles(), images_.names, cb_);
+    })
+                                          : ColmapStage("extract", extract_args_);
+    const auto remove_database = [this] { RemoveColmapDatabase(database_); };
+    RunStage("extract", inputs_, remove_database, run, fs::exists(database_), remove_database);
+  }
+
+  // The verified pairs: arview's matcher, COLMAP's, or Slurm jobs.
+  void Match() {
+    const bool arview_wanted = options_.match_engine == MatchEngine::kArview ||
+                               (options_.match_engine == MatchEngine::kAuto && !FramesDoubled(recording_.camera, options_));
+    const bool arview_matches = !stages_as_jobs_ && arview_wanted && NamesFitAMatchList(images_.names);
+    if (arview_wanted && !arview_matches && cb_.note)
+      cb_.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
+    const std::vector<std::string> match_args = MatchArgs(options_, database_, frames_);
+    inputs_ += "--\n" + (stages_as_jobs_  ? SlurmMatchInputs(options_, frames_)
+                         : arview_matches ? ArviewMatchInputs(options_, frames_)
+                                          : Joined(match_args));
+    StageWork run = ColmapStage("match", match_args);
+    if (arview_matches) {
+      run = [this](std::vector<StageTiming>* steps) {
+        MatchWithArview(colmap_, database_, out_dir_, images_.names, options_, cb_, steps);
+      };
+    } else if (stages_as_jobs_) {
+      run = [this](std::vector<StageTiming>*) {
+        MatchOnSlurm(options_, JobFiles(), images_.names, PairsToMatch(options_, frames_), cb_);
+      };
+    }
+    // The mapper's inputs are known now: the map stage's record follows the matches'.
+    const std::string match_inputs = inputs_;
+    mapper_args_ = ColmapMapperArgs(options_, database_, images_.root, sparse_, self_calibrate_);
+    in_leaves_ = options_.leaf_size > 0 && frames_ > options_.leaf_size;  // mapping/leaf_mapping.h
+    inputs_ += "--\n" + Joined(mapper_args_) +
+               (in_leaves_ ? "leaves " + std::to_string(options_.leaf_size) + " " + std::to_string(options_.leaf_overlap) + "\n"
+                           : "");
+    mapper_inputs_ = inputs_;
+    if (self_calibrate_ && cb_.note) {
+      cb_.note("the recording's camera is not calibrated (" + recording_.camera.intrinsics_source +
+               "): COLMAP refines its focal length, principal point and radial distortion");
+    }
+    // Half-written matches stay until the next run clears them (clearing needs room to write).
+    RunStage("match", match_inputs, [this] { ClearMatches(database_); }, run, true, nullptr);
+  }
+
+  // An uncalibrated camera: the focal length COLMAP's adjustment starts from, from the pairs'
+  // fundamental matrices (mapping/self_calibration.h); it is part of the map stage's inputs.
+  void SelfCalibrationStart() {
+    if (!self_calibrate_) return;
+    std::string note;
+    start_camera_ = StartSelfCalibration(database_, recording_.camera, &note);
+    if (cb_.note) cb_.note(note);
+    mapper_inputs_ += "--\nself-calibration " + FormatParams(ColmapRadialParams(start_camera_));
+  }
+
+  // The board is looked for while COLMAP maps, on the CPU time its mapper leaves (a third of two
+  // cores); not when the mapper's stage will be skipped, as its model is then likely made metric.
+  void StartBoardSearch() {
+    if (options_.scale.from != ScaleFrom::kBoard || (fs::is_directory(sparse_) && stages_.Matches("map", mapper_inputs_)))
+      return;
+    board_search_.emplace(
+        images_.names, [root = images_.root](const std::string& name) { return GreyImageOrNone(root / name); },
+        options_.scale.board.inner_corners,
+        options_.threads > 0 ? options_.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  }
+
+  // COLMAP's mapper (or the leaves mapped and merged), `extra_args` appended to its command line
+  // and inputs (a fold retry's start, RetryFoldedMap).
+  void Map(const std::vector<std::string>& extra_args) {
+    if (in_leaves_) {  // sparse/ is replaced only once the leaves are merged
+      const StageWork run = [this](std::vector<StageTiming>* steps) {
+        MapInLeaves(options_, {database_, images_.root, out_dir_}, cb_, steps);
+      };
+      RunStage("map", mapper_inputs_, [] {}, run, fs::is_directory(sparse_), nullptr);
+    } else {
+      std::vector<std::string> args = mapper_args_;
+      args.insert(args.end(), extra_args.begin(), extra_args.end());
+      std::error_code ec;
+      RunStage(
+          "map", extra_args.empty() ? mapper_inputs_ : mapper_inputs_ + Joined(extra_args),
+          [&] {
+            fs::remove_all(sparse_, ec);
+            fs::create_directories(sparse_);
+          },
+          ColmapStage("map", args), fs::is_directory(sparse_), [&] { fs::remove_all(sparse_, ec); });
+    }
+    t0_ = std::chrono::steady_clock::now();  // what follows is timed as the map's writing
+  }
+
+  // The largest model read and looked at as a whole (first, so that a degenerate model is
+  // refused with the reason too).
+  void ReadModel() {
+    result_.model_dir = LargestModel(sparse_, &result_.models, cb_);
+    if (result_.model_dir.empty()) {
+      stages_.Forget("map");
+      throw ColmapStageError("COLMAP mapper registered no images (no model in " + sparse_.string() +
+                                 "): too few matches between the frames? Its output is in " + colmap_.log().string(),
+                             "map", colmap_.log(), {});
+    }
+    options_.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+    std::vector<std::vector<Eigen::Vector2f>> keypoints;
+    result_.map = ReadColmapMap(result_.model_dir, database_, images_.lookup, options_.cancel, &keypoints, false);
+    result_.map.camera.focus = recording_.camera.focus;  // COLMAP's camera has no focus: the calibration's
+    result_.check = CheckMap(result_.map, keypoints, ReadTwoViewGeometries(database_, result_.map));
+  }
+
+  // A folded model: the mapper again from other starts (mapping/fold_retries.h); still folded,
+  // refused with the check's file written, unless --keep-folded.
+  void RetryOrRefuseAFold() {
+    if (Folded(result_.check) && options_.fold_retries > 0 && !in_leaves_) {
+      // The kept model stands for the default command's outcome: a re-run skips the stage.
+      const FoldRetryStages retry_stages{[this](const std::vector<std::string>& extra_args) { Map(extra_args); },
+                                         [this] { ReadModel(); }, [this] { stages_.Forget("map"); },
+                                         [this] { stages_.Save("map", mapper_inputs_); }};
+      RetryFoldedMap(options_.fold_retries, out_dir_, colmap_.log(), cb_, retry_stages, &result_);
+      t0_ = std::chrono::steady_clock::now();
+    }
+    if (Folded(result_.check) && !options_.keep_folded) {
+      WriteMapCheck(result_.check, out_dir_ / kMapCheckFileName);
+      throw map::MapError(FoldRefusal(out_dir_, result_));
+    }
+  }
+
+  // Metric and upright (mapping/metric_frame.h), the refined camera of a self-calibrated map, the
+  // rooms, and the map folder's files.
+  MapBuildResult MakeMetricAndWrite() {
+    const auto read_moved_model = [this] {
+      map::Map moved = ReadColmapMap(result_.model_dir, database_, images_.lookup, options_.cancel, nullptr, false);
+      moved.camera.focus = recording_.camera.focus;
+      return moved;
+    };
+    MakeMetric(KeyframeImagesIn(result_.map, {images_.root}), board_search_ ? &*board_search_ : nullptr, options_, cb_,
+               read_moved_model, &result_);
+    if (self_calibrate_) {
+      if (cb_.note) cb_.note(RefinedCameraNote(start_camera_, result_.map.camera));
+      for (const std::string& problem : ImplausibleIntrinsics(result_.map.camera)) result_.check.warnings.push_back(problem);
+      WriteRefinedCamera(start_camera_, result_.map.camera, out_dir_);
+    }
+    NameRooms(options_.rooms, &result_.map);
+    WriteMapFiles(result_, out_dir_, options_, cb_);
+    result_.timings.push_back({"write", Seconds(t0_), false});
+    return std::move(result_);
+  }
+
+ private:
+  JobStageFiles JobFiles() const { return {database_, images_.root, out_dir_ / "jobs"}; }
+
+  StageWork ColmapStage(const std::string& name, const std::vector<std::string>& args) {
+    return [this, name, args](std::vector<StageTiming>*) { colmap_.Run(name, args, frames_); };
+  }
+
+  // `discard` removes what a failed or interrupted run of the stage left half written (a database
+  // of some of the frames, a partial model), so that nothing unfinished looks like COLMAP's output.
+  // `run` does the stage's work; it may time its own steps into `steps` (else the stage is one).
+  void RunStage(const std::string& name, const std::string& stage_inputs, const std::function<void()>& prepare,
+                const StageWork& run, bool outputs_exist, const std::function<void()>& discard) {
+    t0_ = std::chrono::steady_clock::now();
+    if (outputs_exist && stages_.Matches(name, stage_inputs)) {
+      if (cb_.note) cb_.note(name + ": inputs unchanged since the last run, skipped");
+      result_.timings.push_back({name, 0, true});
+      return;
+    }
+    stages_.Forget(name);
+    prepare();
+    std::vector<StageTiming> steps;
+    try {
+      run(&steps);
+    } catch (const CancelledError& e) {
+      if (discard) discard();
+      throw CancelledError(InterruptedStageMessage(options_.cancel, name, result_.timings), e.signal_number());
+    } catch (const Error&) {
+      if (discard) discard();
+      throw;
+    }
+    stages_.Save(name, stage_inputs);
+    if (steps.empty()) steps.push_back({name, Seconds(t0_), false});
+    result_.timings.insert(result_.timings.end(), steps.begin(), steps.end());
+  }
+
+  const recordings::Recording& recording_;
+  const fs::path out_dir_;
+  const MapBuildOptions& options_;
+  const MapBuildCallbacks& cb_;
+  MapBuildResult result_;
+  StageRecord stages_;
+  ColmapRunner colmap_;
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();  // the current step's start
+
+  const fs::path database_, sparse_;
+  const bool stages_as_jobs_;
+  const bool self_calibrate_;
+  ImageSet images_;
+  int frames_ = 0;
+  std::vector<std::string> extract_args_, mapper_args_;
+  bool in_leaves_ = false;
+  std::string inputs_;         // every stage's inputs so far
+  std::string mapper_inputs_;  // the map stage's (+ the focal length self-calibration starts from)
+  calib::Camera start_camera_;  // what COLMAP's adjustment starts from
+  std::optional<BoardSearchInBackground> board_search_;
+};
+
+}  // namespace
+
 MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& out_dir_arg,
                         const MapBuildOptions& options, const MapBuildCallbacks& cb) {
   // Absolute paths in COLMAP's command lines: the stage records then do not depend on the
@@ -759,186 +1011,16 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec || !fs::is_directory(out_dir)) throw map::MapError(out_dir.string() + ": cannot create the map directory");
-  MapBuildResult result;
-  StageRecord stages(out_dir);
-  ColmapRunner colmap(options, out_dir, cb);
-
-  auto t0 = std::chrono::steady_clock::now();
-  const ImageSet images = recording.IsVideo()
-                              ? PrepareVideoImages(recording, out_dir, options, cb, stages, &result.selected_frames)
-                              : PrepareStillImages(recording, options, cb, &result.selected_frames);
-  result.timings.push_back({"select", Seconds(t0), false});
-  if (images.names.size() < 2) throw map::MapError("a map needs at least 2 frames (got " + std::to_string(images.names.size()) + ")");
-  const int n = static_cast<int>(images.names.size());
-  const fs::path list = out_dir / "image_list.txt";
-  std::string names;
-  for (const auto& name : images.names) names += name + "\n";
-  WriteFileAtomically(list, names);  // a full disk: "cannot write (<why>)", no empty list left
-  const fs::path database = out_dir / "database.db";
-  const fs::path sparse = out_dir / "sparse";
-
-  // Each stage's inputs include the previous stage's, so that a change re-runs everything after it.
-  const std::vector<std::string> extract_args = ColmapExtractArgs(recording.camera, options, database, images.root, list);
-  std::string inputs = Joined(extract_args);
-  for (const auto& name : images.names) inputs += name + " " + FileIdentity(images.root / name) + "\n";
-
-  // `discard` removes what a failed or interrupted run of the stage left half written (a database
-  // of some of the frames, a partial model), so that nothing unfinished looks like COLMAP's output.
-  // `run` does the stage's work; it may time its own steps into `steps` (else the stage is one).
-  auto stage = [&](const std::string& name, const std::string& stage_inputs, const std::function<void()>& prepare,
-                   const std::function<void(std::vector<StageTiming>* steps)>& run, bool outputs_exist,
-                   const std::function<void()>& discard) {
-    t0 = std::chrono::steady_clock::now();
-    if (outputs_exist && stages.Matches(name, stage_inputs)) {
-      if (cb.note) cb.note(name + ": inputs unchanged since the last run, skipped");
-      result.timings.push_back({name, 0, true});
-      return;
-    }
-    stages.Forget(name);
-    prepare();
-    std::vector<StageTiming> steps;
-    try {
-      run(&steps);
-    } catch (const CancelledError& e) {
-      if (discard) discard();
-      throw CancelledError(InterruptedStageMessage(options.cancel, name, result.timings), e.signal_number());
-    } catch (const Error&) {
-      if (discard) discard();
-      throw;
-    }
-    stages.Save(name, stage_inputs);
-    if (steps.empty()) steps.push_back({name, Seconds(t0), false});
-    result.timings.insert(result.timings.end(), steps.begin(), steps.end());
-  };
-  const auto colmap_stage = [&](const std::string& name, const std::vector<std::string>& args) {
-    return [&colmap, name, args, n](std::vector<StageTiming>*) { colmap.Run(name, args, n); };
-  };
-
-  const auto remove_database = [&] { RemoveColmapDatabase(database); };
-  // --engine slurm --slurm-chunk N: extraction and matching as jobs (mapping/job_stages.h). The
-  // same database either way, so the stage records do not say where it was made.
-  const bool stages_as_jobs = options.engine == MapEngine::kSlurm && options.slurm_chunk > 0;
-  const JobStageFiles job_files{database, images.root, out_dir / "jobs"};
-  const std::function<void(std::vector<StageTiming>*)> run_extract =
-      stages_as_jobs ? std::function<void(std::vector<StageTiming>*)>([&](std::vector<StageTiming>*) {
-        ExtractOnSlurm(recording.camera, options, job_files, images.names, cb);
-      })
-                     : colmap_stage("extract", extract_args);
-  stage("extract", inputs, remove_database, run_extract, fs::exists(database), remove_database);
-
-  const bool arview_wanted = options.match_engine == MatchEngine::kArview ||
-                             (options.match_engine == MatchEngine::kAuto && !FramesDoubled(recording.camera, options));
-  const bool arview_matches = !stages_as_jobs && arview_wanted && NamesFitAMatchList(images.names);
-  if (arview_wanted && !arview_matches && cb.note)
-    cb.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
-  const std::vector<std::string> match_args = MatchArgs(options, database, n);
-  inputs += "--\n" + (stages_as_jobs   ? SlurmMatchInputs(options, n)
-                      : arview_matches ? ArviewMatchInputs(options, n)
-                                       : Joined(match_args));
-  const std::string match_inputs = inputs;
-  std::function<void(std::vector<StageTiming>*)> run_match = colmap_stage("match", match_args);
-  if (arview_matches) {
-    run_match = [&](std::vector<StageTiming>* steps) {
-      MatchWithArview(colmap, database, out_dir, images.names, options, cb, steps);
-    };
-  } else if (stages_as_jobs) {
-    run_match = [&](std::vector<StageTiming>*) {
-      MatchOnSlurm(options, job_files, images.names, PairsToMatch(options, n), cb);
-    };
-  }
-  // Half-written matches stay until the next run clears them (clearing needs room to write).
-  const auto match = [&] { stage("match", match_inputs, [&] { ClearMatches(database); }, run_match, true, nullptr); };
-
-  const bool self_calibrate = !recording.camera.calibrated;
-  if (self_calibrate && cb.note) {
-    cb.note("the recording's camera is not calibrated (" + recording.camera.intrinsics_source +
-            "): COLMAP refines its focal length, principal point and radial distortion");
-  }
-  const std::vector<std::string> mapper_args = ColmapMapperArgs(options, database, images.root, sparse, self_calibrate);
-  const bool in_leaves = options.leaf_size > 0 && n > options.leaf_size;  // mapping/leaf_mapping.h
-  inputs += "--\n" + Joined(mapper_args) +
-            (in_leaves ? "leaves " + std::to_string(options.leaf_size) + " " + std::to_string(options.leaf_overlap) + "\n" : "");
-  std::string mapper_inputs = inputs;  // + the focal length self-calibration starts from
-  // `extra_args`: a retry's start (RetryFoldedMap), appended to the command and its inputs.
-  const auto mapper = [&](const std::vector<std::string>& extra_args) {
-    if (in_leaves) {  // sparse/ is replaced only once the leaves are merged
-      const auto run = [&](std::vector<StageTiming>* steps) { MapInLeaves(options, {database, images.root, out_dir}, cb, steps); };
-      return stage("map", mapper_inputs, [] {}, run, fs::is_directory(sparse), nullptr);
-    }
-    std::vector<std::string> args = mapper_args;
-    args.insert(args.end(), extra_args.begin(), extra_args.end());
-    stage(
-        "map", extra_args.empty() ? mapper_inputs : mapper_inputs + Joined(extra_args),
-        [&] {
-          fs::remove_all(sparse, ec);
-          fs::create_directories(sparse);
-        },
-        colmap_stage("map", args), fs::is_directory(sparse), [&] { fs::remove_all(sparse, ec); });
-  };
-  // The largest model read and looked at as a whole (first, so that a degenerate model is
-  // refused with the reason too).
-  const auto read_model = [&] {
-    result.model_dir = LargestModel(sparse, &result.models, cb);
-    if (result.model_dir.empty()) {
-      stages.Forget("map");
-      throw ColmapStageError("COLMAP mapper registered no images (no model in " + sparse.string() +
-                                 "): too few matches between the frames? Its output is in " + colmap.log().string(),
-                             "map", colmap.log(), {});
-    }
-    options.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-    std::vector<std::vector<Eigen::Vector2f>> keypoints;
-    result.map = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, &keypoints, false);
-    result.map.camera.focus = recording.camera.focus;  // COLMAP's camera has no focus: the calibration's
-    result.check = CheckMap(result.map, keypoints, ReadTwoViewGeometries(database, result.map));
-  };
-  match();
-  calib::Camera start_camera = recording.camera;  // what COLMAP's adjustment starts from
-  if (self_calibrate) {
-    std::string note;
-    start_camera = StartSelfCalibration(database, recording.camera, &note);
-    if (cb.note) cb.note(note);
-    mapper_inputs += "--\nself-calibration " + FormatParams(ColmapRadialParams(start_camera));
-  }
-  // The board is looked for while COLMAP maps, on the CPU time its mapper leaves (a third of two
-  // cores); not when the mapper's stage will be skipped, as its model is then likely made metric.
-  std::optional<BoardSearchInBackground> board_search;
-  if (options.scale.from == ScaleFrom::kBoard && !(fs::is_directory(sparse) && stages.Matches("map", mapper_inputs))) {
-    board_search.emplace(
-        images.names,
-        [root = images.root](const std::string& name) { return GreyImageOrNone(root / name); },
-        options.scale.board.inner_corners,
-        options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
-  }
-  mapper({});
-  t0 = std::chrono::steady_clock::now();
-  read_model();
-  if (Folded(result.check) && options.fold_retries > 0 && !in_leaves) {
-    // The kept model stands for the default command's outcome: a re-run skips the stage.
-    const FoldRetryStages retry_stages{mapper, read_model, [&] { stages.Forget("map"); },
-                                       [&] { stages.Save("map", mapper_inputs); }};
-    RetryFoldedMap(options.fold_retries, out_dir, colmap.log(), cb, retry_stages, &result);
-    t0 = std::chrono::steady_clock::now();
-  }
-  if (Folded(result.check) && !options.keep_folded) {
-    WriteMapCheck(result.check, out_dir / kMapCheckFileName);
-    throw map::MapError(FoldRefusal(out_dir, result));
-  }
-  const auto read_moved_model = [&] {
-    map::Map moved = ReadColmapMap(result.model_dir, database, images.lookup, options.cancel, nullptr, false);
-    moved.camera.focus = recording.camera.focus;
-    return moved;
-  };
-  MakeMetric(KeyframeImagesIn(result.map, {images.root}), board_search ? &*board_search : nullptr, options, cb,
-             read_moved_model, &result);
-  if (self_calibrate) {
-    if (cb.note) cb.note(RefinedCameraNote(start_camera, result.map.camera));
-    for (const std::string& problem : ImplausibleIntrinsics(result.map.camera)) result.check.warnings.push_back(problem);
-    WriteRefinedCamera(start_camera, result.map.camera, out_dir);
-  }
-  NameRooms(options.rooms, &result.map);
-  WriteMapFiles(result, out_dir, options, cb);
-  result.timings.push_back({"write", Seconds(t0), false});
-  return result;
+  MapBuild build(recording, out_dir, options, cb);
+  build.SelectFrames();
+  build.Extract();
+  build.Match();
+  build.SelfCalibrationStart();
+  build.StartBoardSearch();
+  build.Map({});
+  build.ReadModel();
+  build.RetryOrRefuseAFold();
+  return build.MakeMetricAndWrite();
 }
 
 map::Map ScaleMapFolder(const fs::path& map_dir, const recordings::Recording* recording, const ScaleRequest& request,
