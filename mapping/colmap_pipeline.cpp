@@ -22,6 +22,7 @@
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
 #include "mapping/fold_retries.h"
+#include "mapping/gap_retry.h"
 #include "mapping/job_stages.h"
 #include "mapping/leaf_mapping.h"
 #include "mapping/self_calibration.h"
@@ -944,10 +945,20 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   mapper({});
   t0 = std::chrono::steady_clock::now();
   read_model();
+  // The kept model stands for the default command's outcome: a re-run skips the stage.
+  std::vector<std::string> kept_args;  // the gap retry's, when its model is kept
+  const FoldRetryStages retry_stages{
+      [&](const std::vector<std::string>& extra_args) {
+        std::vector<std::string> args = kept_args;
+        args.insert(args.end(), extra_args.begin(), extra_args.end());
+        mapper(args);
+      },
+      read_model, [&] { stages.Forget("map"); }, [&] { stages.Save("map", mapper_inputs); }};
+  if (!in_leaves) {
+    kept_args = RetryLeftOutFrames(options, out_dir, cb, retry_stages, &result);
+    t0 = std::chrono::steady_clock::now();
+  }
   if (Folded(result.check) && options.fold_retries > 0 && !in_leaves) {
-    // The kept model stands for the default command's outcome: a re-run skips the stage.
-    const FoldRetryStages retry_stages{mapper, read_model, [&] { stages.Forget("map"); },
-                                       [&] { stages.Save("map", mapper_inputs); }};
     RetryFoldedMap(options.fold_retries, out_dir, colmap.log(), cb, retry_stages, &result);
     t0 = std::chrono::steady_clock::now();
   }
