@@ -69,9 +69,9 @@ std::vector<std::string> RetryLeftOutFrames(const MapBuildOptions& options, cons
   const std::vector<std::string> low_angle = LowAngleMapperArgs(options.gap_retry_angle_deg);
   if (cb.note)
     cb.note("COLMAP registered " + RegisteredText(*result) + " frames and left out " + StretchList(stretches) +
-            " (after a fast turn, a new part of the scene is seen from too short a baseline to triangulate): "
-            "mapping again with triangulation angles down to " + Fixed(options.gap_retry_angle_deg, 1) +
-            " degrees from 1.5");
+            ": mapping again with triangulation angles down to " + Fixed(options.gap_retry_angle_deg, 1) +
+            " degrees from 1.5, which lets COLMAP register frames that see only a part of the scene filmed from "
+            "close together (the walk after a fast turn)");
   const fs::path sparse = out_dir / "sparse";
   const fs::path aside = out_dir / "gap-try";
   std::error_code ec;
