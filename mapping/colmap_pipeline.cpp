@@ -21,6 +21,7 @@
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
 #include "mapping/fold_retries.h"
+#include "mapping/gap_retry.h"
 #include "mapping/job_stages.h"
 #include "mapping/leaf_mapping.h"
 #include "mapping/self_calibration.h"
@@ -904,15 +905,20 @@ class MapBuild {
     result_.check = CheckMap(result_.map, keypoints, ReadTwoViewGeometries(database_, result_.map));
   }
 
+  // A model that leaves a stretch of the walk out (a fast turn): the mapper once more at a lower
+  // triangulation angle (mapping/gap_retry.h); the arguments of the model kept go on with the
+  // fold retries' runs.
+  void RetryLeftOutStretches() {
+    if (in_leaves_) return;
+    kept_mapper_args_ = RetryLeftOutFrames(options_, out_dir_, cb_, RetryStages(), &result_);
+    t0_ = std::chrono::steady_clock::now();
+  }
+
   // A folded model: the mapper again from other starts (mapping/fold_retries.h); still folded,
   // refused with the check's file written, unless --keep-folded.
   void RetryOrRefuseAFold() {
     if (Folded(result_.check) && options_.fold_retries > 0 && !in_leaves_) {
-      // The kept model stands for the default command's outcome: a re-run skips the stage.
-      const FoldRetryStages retry_stages{[this](const std::vector<std::string>& extra_args) { Map(extra_args); },
-                                         [this] { ReadModel(); }, [this] { stages_.Forget("map"); },
-                                         [this] { stages_.Save("map", mapper_inputs_); }};
-      RetryFoldedMap(options_.fold_retries, out_dir_, colmap_.log(), cb_, retry_stages, &result_);
+      RetryFoldedMap(options_.fold_retries, out_dir_, colmap_.log(), cb_, RetryStages(), &result_);
       t0_ = std::chrono::steady_clock::now();
     }
     if (Folded(result_.check) && !options_.keep_folded) {
@@ -944,6 +950,18 @@ class MapBuild {
 
  private:
   JobStageFiles JobFiles() const { return {database_, images_.root, out_dir_ / "jobs"}; }
+
+  // The map stage as the retries run it. The kept model stands for the default command's
+  // outcome: a re-run skips the stage.
+  FoldRetryStages RetryStages() {
+    return {[this](const std::vector<std::string>& extra_args) {
+              std::vector<std::string> args = kept_mapper_args_;
+              args.insert(args.end(), extra_args.begin(), extra_args.end());
+              Map(args);
+            },
+            [this] { ReadModel(); }, [this] { stages_.Forget("map"); },
+            [this] { stages_.Save("map", mapper_inputs_); }};
+  }
 
   StageWork ColmapStage(const std::string& name, const std::vector<std::string>& args) {
     return [this, name, args](std::vector<StageTiming>*) { colmap_.Run(name, args, frames_); };
@@ -992,6 +1010,7 @@ class MapBuild {
   ImageSet images_;
   int frames_ = 0;
   std::vector<std::string> extract_args_, mapper_args_;
+  std::vector<std::string> kept_mapper_args_;  // the gap retry's, when its model is kept
   bool in_leaves_ = false;
   std::string inputs_;         // every stage's inputs so far
   std::string mapper_inputs_;  // the map stage's (+ the focal length self-calibration starts from)
@@ -1019,6 +1038,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   build.StartBoardSearch();
   build.Map({});
   build.ReadModel();
+  build.RetryLeftOutStretches();
   build.RetryOrRefuseAFold();
   return build.MakeMetricAndWrite();
 }

@@ -107,6 +107,13 @@ struct MapBuildOptions {
   // keep_folded: then the least folded model is written, with the warning.
   int fold_retries = 2;
   bool keep_folded = false;
+  // When the model leaves out a stretch of at least gap_retry_min_frames consecutive selected
+  // frames (the walk after a fast turn: mapping/gap_retry.h), COLMAP's mapper runs once more on
+  // the same matches with both triangulation angles (Mapper.tri_min_angle,
+  // filter_min_tri_angle; COLMAP's 1.5) at gap_retry_angle_deg, and the model registering more
+  // frames is kept. 0: no retry. A map that registers every frame never runs it.
+  double gap_retry_angle_deg = 0.5;
+  int gap_retry_min_frames = 3;
   // A venue in parts (mapping/leaf_mapping.h): with more frames than leaf_size, the match graph
   // is cut into leaves of at most leaf_size frames (METIS on the inliers), each grown by
   // leaf_overlap frames most strongly tied to it; each leaf is mapped alone (on `engine`) and

@@ -19,6 +19,10 @@ void MapBuildOptions::Check(const OptionNames& names) const {
   RequireOption(ba_local_max_iterations >= 0, names("ba_local_max_iterations"), "0 or more", ba_local_max_iterations);
   RequireOption(sequential_overlap >= 1, names("sequential_overlap"), "at least 1", sequential_overlap);
   RequireOption(fold_retries >= 0, names("fold_retries"), "0 or more", fold_retries);
+  // COLMAP's mapper triangulates nothing below 0 degrees; above its own 1.5 the retry would lower nothing.
+  RequireOption(gap_retry_angle_deg >= 0 && gap_retry_angle_deg < 1.5, names("gap_retry_angle_deg"),
+                "0 (no retry) to below 1.5 (degrees)", gap_retry_angle_deg);
+  RequireOption(gap_retry_min_frames >= 1, names("gap_retry_min_frames"), "at least 1", gap_retry_min_frames);
   RequireOption(slurm_chunk >= 0, names("slurm_chunk"), "0 (extraction and matching here) or more", slurm_chunk);
   if (colmap.empty()) throw OptionError(names("colmap") + ": an empty name: give the COLMAP executable");
   if (scale.from == ScaleFrom::kBoard) {

@@ -35,6 +35,12 @@ TEST(MapBuildOptionsCheck, ABadValueIsRefusedNamingTheField) {
   o.fold_retries = -1;
   EXPECT_EQ(Refusal(o, OptionNames({{"fold_retries", "--fold-retries"}, {"threads", "--threads"}})), "--fold-retries must be 0 or more (got -1)");
   o = {};
+  o.gap_retry_angle_deg = 1.5;
+  EXPECT_EQ(Refusal(o), "gap_retry_angle_deg must be 0 (no retry) to below 1.5 (degrees) (got 1.5)");
+  o = {};
+  o.gap_retry_min_frames = 0;
+  EXPECT_EQ(Refusal(o), "gap_retry_min_frames must be at least 1 (got 0)");
+  o = {};
   o.colmap = "";
   EXPECT_EQ(Refusal(o), "colmap: an empty name: give the COLMAP executable");
   o = {};

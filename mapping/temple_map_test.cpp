@@ -316,6 +316,10 @@ MapBuildResult BuildFolding(const recordings::Recording& recording, const fs::pa
   options.frames_spec = "0-30:2";
   options.fold_retries = retries;
   options.keep_folded = keep_folded;
+  // COLMAP left 3 of these 16 frames out (6-10) in a run of these tests: the gap retry
+  // (mapping/gap_retry.h, its own tests) would be the wrapper's second mapper run; the fold
+  // retries are tested alone.
+  options.gap_retry_angle_deg = 0;
   options.colmap = ColmapFoldingModels(out.string() + "_colmap", turned).string();
   MapBuildCallbacks cb;
   cb.note = [notes](const std::string& n) { notes->push_back(n); };

@@ -1,6 +1,6 @@
 // arview map <recording> [<recording> ...] --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
-//            [--fold-retries N] [--keep-folded] [--board CxR --square M [--board-off-floor] | --no-metric]
+//            [--fold-retries N] [--keep-folded] [--gap-retry-angle DEG] [--board CxR --square M [--board-off-floor] | --no-metric]
 //            [--leaf-size N [--leaf-overlap N]] [--engine local|slurm [--slurm-chunk N] [--slurm-partition P] [--slurm-cpus N]]
 // arview map info <map-dir>
 // arview map scale <map-dir> [<recording>] (--board CxR --square M [--board-off-floor] | --distance M --from .. --to ..)
@@ -48,6 +48,7 @@ struct MapArgs {
   int max_features = 0;  // 0: the preset's
   int fold_retries = mapping::MapBuildOptions().fold_retries;
   bool keep_folded = mapping::MapBuildOptions().keep_folded;
+  double gap_retry_angle = mapping::MapBuildOptions().gap_retry_angle_deg;
   // A venue in leaves (mapping/leaf_mapping.h).
   int leaf_size = 0;
   int leaf_overlap = mapping::MapBuildOptions().leaf_overlap;
@@ -115,6 +116,7 @@ void RunMap(const MapArgs& args) {
   if (args.max_features > 0) options.max_num_features = args.max_features;
   options.fold_retries = args.fold_retries;
   options.keep_folded = args.keep_folded;
+  options.gap_retry_angle_deg = args.gap_retry_angle;
   options.leaf_size = args.leaf_size;
   options.leaf_overlap = args.leaf_overlap;
   options.slurm.partition = args.slurm_partition;
@@ -333,6 +335,12 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_flag("--keep-folded", args->keep_folded,
                 "Write the map even when it is still folded after --fold-retries (the least folded model, with "
                 "the warning); by default such a map is refused");
+  cmd->add_option("--gap-retry-angle", args->gap_retry_angle,
+                  "When COLMAP leaves out a stretch of 3 or more consecutive frames (the walk after a fast turn), "
+                  "run its mapper again on the same matches with the triangulation angles lowered from 1.5 to this "
+                  "many degrees, and keep the model that registers more frames (0: no retry)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.4));
   cmd->add_option("--leaf-size", args->leaf_size,
                   "Map in parts: with more frames than this, cut the match graph (METIS on the inliers) into leaves "
                   "of at most this many frames, map each alone and merge them (0: one mapper over every frame)")
