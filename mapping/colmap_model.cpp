@@ -323,11 +323,14 @@ class Database {
     int config = 0;  // COLMAP's TwoViewGeometry::ConfigurationType
     Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();
     Eigen::Matrix3d fundamental = Eigen::Matrix3d::Zero();  // zero where COLMAP stored none
+    // The verified matches (keypoint index in image_a, in image_b); empty where the blob is not
+    // `inliers` rows of two uint32 (then the map check compares the rotations alone).
+    std::vector<std::array<std::uint32_t, 2>> matches;
   };
   std::vector<PairGeometry> PairGeometries() {
     std::vector<PairGeometry> pairs;
     sqlite3_stmt* raw = nullptr;
-    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F FROM two_view_geometries WHERE rows > 0", -1, &raw,
+    if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F, cols, data FROM two_view_geometries WHERE rows > 0", -1, &raw,
                            nullptr) != SQLITE_OK) {
       sqlite3_finalize(raw);
       return pairs;
@@ -351,7 +354,14 @@ class Database {
         std::memcpy(rows_first.data(), f_blob, 9 * sizeof(double));
         g.fundamental = rows_first;
       }
-      pairs.push_back(g);
+      const void* match_blob = sqlite3_column_blob(st.get(), 6);
+      const sqlite3_int64 match_bytes = sqlite3_column_bytes(st.get(), 6);
+      if (match_blob && sqlite3_column_int64(st.get(), 5) == 2 &&
+          match_bytes == static_cast<sqlite3_int64>(g.inliers) * 2 * static_cast<sqlite3_int64>(sizeof(std::uint32_t))) {
+        g.matches.resize(static_cast<std::size_t>(g.inliers));
+        std::memcpy(g.matches.data(), match_blob, static_cast<std::size_t>(match_bytes));
+      }
+      pairs.push_back(std::move(g));
     }
     return pairs;
   }
@@ -679,7 +689,7 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
     // matrix better than any essential one; their E is not the pair's motion (phone-fox: 8.7
     // degrees where the frames turned 57).
     if (pair.config != 2 && pair.config != 6) continue;
-    result.push_back({a->second, b->second, pair.inliers, pair.essential});
+    result.push_back({a->second, b->second, pair.inliers, pair.essential, pair.matches});
   }
   return result;
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A venue of rendered rooms joined by doors (`arview synth venue`, docs/render.md) mapped as one
 # venue from one recording per room, each room also mapped alone, and a walk through the first
-# door tracked on the venue's map (docs/mapping.md, "A venue of rendered rooms joined by doors").
+# door tracked on the venue's map (docs/mapping.md, "A venue of rendered rooms joined by doors"),
+# the rooms alone last (the longest part).
 #
 #   bash scripts/venue-rooms.sh [/tmp/arview-venue-rooms]
 #
@@ -31,10 +32,9 @@ done
 first_door=$(grep -v '^#' plan/rooms.txt | awk -v r="${rooms[1]}" '$2 == r { print int($1 * 30 + 0.5); exit }')
 [ -d walk ] || synth --out walk --subset "$((first_door - 60))-$((first_door + 60))"
 
-# --keep-folded: the self-check takes this walk's turns for a fold where the map is right
-# (docs/mapping.md); the ground truth below is the judge here.
+# --max-frames 0: every frame given (a venue of more than 300 frames is otherwise thinned evenly).
 echo "== the venue, ${#rooms[@]} rooms as one map"
-/usr/bin/time -f "venue map: %e s wall" "$arview" map "${rooms[@]}" --out venue --preset fast --matcher sequential --keep-folded
+/usr/bin/time -f "venue map: %e s wall" "$arview" map "${rooms[@]}" --out venue --preset fast --matcher sequential --max-frames 0
 "$arview" map info venue | sed -n '/^rooms/,/^[a-z]/p'
 "$arview" eval venue/keyframes.txt plan/groundtruth.txt
 for room in "${rooms[@]}"; do
@@ -43,9 +43,6 @@ for room in "${rooms[@]}"; do
   awk 'NR == FNR { t[sprintf("%.4f", $1)] = 1; next } /^#/ || t[sprintf("%.4f", $1)]' "$room.times" venue/keyframes.txt > "venue-$room.txt"
   echo "== $room in the venue's map"
   "$arview" eval "venue-$room.txt" plan/groundtruth.txt
-  echo "== $room alone"
-  /usr/bin/time -f "$room alone: %e s wall" "$arview" map "$room" --out "alone-$room" --preset fast --keep-folded
-  "$arview" eval "alone-$room/keyframes.txt" plan/groundtruth.txt
 done
 echo "== the walk through the first door, tracked on the venue's map"
 "$arview" track walk --map venue --out walk-track.txt --stats walk-stats.json
@@ -57,3 +54,8 @@ rooms = [f.get("room", "lost") for f in frames]
 changes = [(frames[i]["index"], rooms[i - 1], rooms[i]) for i in range(1, len(rooms)) if rooms[i] != rooms[i - 1]]
 print(f"walk: {len(frames)} frames, {rooms.count('lost')} lost; room changes: {changes}")
 PY
+for room in "${rooms[@]}"; do
+  echo "== $room alone"
+  /usr/bin/time -f "$room alone: %e s wall" "$arview" map "$room" --out "alone-$room" --preset fast --max-frames 0
+  "$arview" eval "alone-$room/keyframes.txt" plan/groundtruth.txt
+done
