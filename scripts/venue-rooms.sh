@@ -6,14 +6,16 @@
 #
 #   bash scripts/venue-rooms.sh [/tmp/arview-venue-rooms]
 #
-# VENUE_FRAMES (720): the whole walk's frames; VENUE_STEP (8): every how many frames a room's
-# recording takes; VENUE_ROOMS (3). A re-run keeps the recordings and re-uses the maps' finished
-# stages (arview map's stage records).
+# VENUE_FRAMES (600): the whole walk's frames; VENUE_STEP (2): every how many frames a room's
+# recording takes (the walk turns up to 4.8 degrees a frame at 600 frames: at 2, 9.6 degrees from
+# one frame to the next, and every frame registered; at 8 frames of 720, 24-32 degrees, a room's
+# turn was lost, docs/mapping.md); VENUE_ROOMS (3). A re-run keeps the recordings and re-uses
+# the maps' finished stages (arview map's stage records).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 arview="$(pwd)/${ARVIEW:-build/release/app/arview}"
 out="${1:-/tmp/arview-venue-rooms}"
-frames="${VENUE_FRAMES:-720}" step="${VENUE_STEP:-8}" rooms_count="${VENUE_ROOMS:-3}"
+frames="${VENUE_FRAMES:-600}" step="${VENUE_STEP:-2}" rooms_count="${VENUE_ROOMS:-3}"
 mkdir -p "$out"
 cd "$out"
 
@@ -28,7 +30,7 @@ frame_list() {  # the walk's frame indices of room $1 in plan/
 for room in "${rooms[@]}"; do
   [ -d "$room" ] || synth --out "$room" --subset "$(frame_list "$room")"
 done
-# Every frame from 2 s before the first door to 2 s after it (the walk crosses it ~7 s in at 720 frames).
+# Every frame from 2 s before the first door to 2 s after it (the walk crosses it ~6 s in at 600 frames).
 first_door=$(grep -v '^#' plan/rooms.txt | awk -v r="${rooms[1]}" '$2 == r { print int($1 * 30 + 0.5); exit }')
 [ -d walk ] || synth --out walk --subset "$((first_door - 60))-$((first_door + 60))"
 
