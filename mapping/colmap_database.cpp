@@ -125,7 +125,7 @@ cv::Mat ColmapDatabase::Descriptors(std::uint32_t image_id) {
 std::vector<ColmapDatabase::PairGeometry> ColmapDatabase::PairGeometries() {
   std::vector<PairGeometry> pairs;
   sqlite3_stmt* raw = nullptr;
-  if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F FROM two_view_geometries WHERE rows > 0", -1, &raw,
+  if (sqlite3_prepare_v2(db_.get(), "SELECT pair_id, rows, E, config, F, cols, data FROM two_view_geometries WHERE rows > 0", -1, &raw,
                          nullptr) != SQLITE_OK) {
     sqlite3_finalize(raw);
     return pairs;
@@ -149,7 +149,14 @@ std::vector<ColmapDatabase::PairGeometry> ColmapDatabase::PairGeometries() {
       std::memcpy(rows_first.data(), f_blob, 9 * sizeof(double));
       g.fundamental = rows_first;
     }
-    pairs.push_back(g);
+    const void* match_blob = sqlite3_column_blob(st.get(), 6);
+    const sqlite3_int64 match_bytes = sqlite3_column_bytes(st.get(), 6);
+    if (match_blob && sqlite3_column_int64(st.get(), 5) == 2 &&
+        match_bytes == static_cast<sqlite3_int64>(g.inliers) * 2 * static_cast<sqlite3_int64>(sizeof(std::uint32_t))) {
+      g.matches.resize(static_cast<std::size_t>(g.inliers));
+      std::memcpy(g.matches.data(), match_blob, static_cast<std::size_t>(match_bytes));
+    }
+    pairs.push_back(std::move(g));
   }
   return pairs;
 }

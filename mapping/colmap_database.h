@@ -5,6 +5,7 @@
 // matched, the camera of a self-calibrated map, a consistent copy). Every failure is a
 // map::MapError naming the file, what was being done and SQLite's reason.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -69,6 +70,9 @@ class ColmapDatabase {
     int config = 0;  // COLMAP's TwoViewGeometry::ConfigurationType
     Eigen::Matrix3d essential = Eigen::Matrix3d::Zero();
     Eigen::Matrix3d fundamental = Eigen::Matrix3d::Zero();  // zero where COLMAP stored none
+    // The verified matches (keypoint index in image_a, in image_b); empty where the blob is not
+    // `inliers` rows of two uint32 (then the map check compares the rotations alone).
+    std::vector<std::array<std::uint32_t, 2>> matches;
   };
   // Nothing when the table or its E column is absent (a database of another COLMAP version): the
   // map check then skips the comparison.

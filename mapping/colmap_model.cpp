@@ -521,7 +521,7 @@ std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, con
     // matrix better than any essential one; their E is not the pair's motion (phone-fox: 8.7
     // degrees where the frames turned 57).
     if (pair.config != 2 && pair.config != 6) continue;
-    result.push_back({a->second, b->second, pair.inliers, pair.essential});
+    result.push_back({a->second, b->second, pair.inliers, pair.essential, pair.matches});
   }
   return result;
 }

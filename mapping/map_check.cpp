@@ -130,12 +130,54 @@ double SceneDepth(const map::Map& map) {
 struct PairDisagreement {
   int a = 0, b = 0;  // indices into Map::keyframes
   double deg = 0;
+  bool fitted = false;  // the map's relative pose fits the pair's matches (MapCheckLimits::two_view_fit_px)
 };
 
+// The median Sampson distance of matched normalised points under `essential`, in pixels of focal
+// length `focal_px` (the first-order distance of each match from its epipolar lines). Nothing for a
+// zero matrix (two keyframes at one place) or no matches.
+std::optional<double> MedianSampsonPx(const Eigen::Matrix3d& essential, const std::vector<Eigen::Vector3d>& in_a,
+                                      const std::vector<Eigen::Vector3d>& in_b, double focal_px) {
+  if (in_a.empty() || essential.norm() < 1e-12) return std::nullopt;
+  std::vector<double> distances;
+  distances.reserve(in_a.size());
+  for (std::size_t i = 0; i < in_a.size(); ++i) {
+    const Eigen::Vector3d line_b = essential * in_a[i], line_a = essential.transpose() * in_b[i];
+    const double gradient = line_b.head<2>().squaredNorm() + line_a.head<2>().squaredNorm();
+    if (gradient <= 0) continue;
+    distances.push_back(std::abs(in_b[i].dot(line_b)) / std::sqrt(gradient) * focal_px);
+  }
+  if (distances.empty()) return std::nullopt;
+  return Median(distances);
+}
+
+// Whether the map's relative pose of the pair fits its verified matches as well as the pair's own
+// essential matrix does, or within limits.two_view_fit_px (MapCheckLimits). False when the matches,
+// the keypoints or the camera are not known.
+bool MapPoseFitsTheMatches(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
+                           const TwoViewGeometry& g, const MapCheckLimits& limits) {
+  const auto a = static_cast<std::size_t>(g.keyframe_a), b = static_cast<std::size_t>(g.keyframe_b);
+  if (g.matches.empty() || map.camera.fx <= 0 || map.camera.fy <= 0 || a >= keypoints.size() || b >= keypoints.size())
+    return false;
+  std::vector<Eigen::Vector3d> in_a, in_b;
+  in_a.reserve(g.matches.size());
+  in_b.reserve(g.matches.size());
+  for (const auto& [index_a, index_b] : g.matches) {
+    if (index_a >= keypoints[a].size() || index_b >= keypoints[b].size()) return false;  // not this model's keypoints
+    in_a.push_back(map.camera.PixelToNormalized(keypoints[a][index_a].cast<double>()).homogeneous());
+    in_b.push_back(map.camera.PixelToNormalized(keypoints[b][index_b].cast<double>()).homogeneous());
+  }
+  const double focal_px = 0.5 * (map.camera.fx + map.camera.fy);
+  const std::optional<double> map_fit =
+      MedianSampsonPx(EssentialBetween(map.keyframes[a].pose, map.keyframes[b].pose), in_a, in_b, focal_px);
+  const std::optional<double> own_fit = MedianSampsonPx(g.essential, in_a, in_b, focal_px);
+  return map_fit && *map_fit <= std::max(limits.two_view_fit_px, own_fit.value_or(0));
+}
+
 // The pairs matched well enough to be compared (limits.two_view_min_inliers), with their
-// disagreement in degrees.
-std::vector<PairDisagreement> ComparablePairs(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
-                                              const MapCheckLimits& limits) {
+// disagreement in degrees and whether the map's pose fits their matches.
+std::vector<PairDisagreement> ComparablePairs(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
+                                              const std::vector<TwoViewGeometry>& two_view, const MapCheckLimits& limits) {
   const int n = static_cast<int>(map.keyframes.size());
   std::vector<PairDisagreement> pairs;
   for (const TwoViewGeometry& g : two_view) {
@@ -144,25 +186,29 @@ std::vector<PairDisagreement> ComparablePairs(const map::Map& map, const std::ve
       continue;
     const Eigen::Matrix3d rotation_ab = map.keyframes[g.keyframe_b].pose.R() * map.keyframes[g.keyframe_a].pose.R().transpose();
     if (const std::optional<double> off_deg = RotationDisagreementDeg(g.essential, rotation_ab))
-      pairs.push_back({g.keyframe_a, g.keyframe_b, *off_deg});
+      pairs.push_back({g.keyframe_a, g.keyframe_b, *off_deg, MapPoseFitsTheMatches(map, keypoints, g, limits)});
   }
   return pairs;
 }
 
 // The map's camera rotations against the pairs' two-view geometry (map_check.h): the fraction of
 // pairs that disagree by more than two_view_max_disagreement_deg, and the keyframes whose own
-// pairs disagree by more than the map's typical pair does.
-void CompareTwoViewRotations(const map::Map& map, const std::vector<TwoViewGeometry>& two_view,
-                             const MapCheckLimits& limits, MapCheck& c) {
-  const std::vector<PairDisagreement> pairs = ComparablePairs(map, two_view, limits);
+// pairs disagree by more than the map's typical pair does. A pair whose matches the map's pose fits
+// counts as agreeing (0 degrees) in both; the map's median pair, which sets the keyframes' limit,
+// stays the essential matrices' own.
+void CompareTwoViewRotations(const map::Map& map, const std::vector<std::vector<Eigen::Vector2f>>& keypoints,
+                             const std::vector<TwoViewGeometry>& two_view, const MapCheckLimits& limits, MapCheck& c) {
+  const std::vector<PairDisagreement> pairs = ComparablePairs(map, keypoints, two_view, limits);
   std::vector<std::vector<double>> per_keyframe(map.keyframes.size());
   std::vector<double> all;
   int disagree = 0;
   for (const PairDisagreement& p : pairs) {
-    disagree += p.deg > limits.two_view_max_disagreement_deg;
+    const double judged_deg = p.fitted ? 0.0 : p.deg;
+    c.fitted_pairs += p.fitted;
+    disagree += judged_deg > limits.two_view_max_disagreement_deg;
     all.push_back(p.deg);
-    per_keyframe[p.a].push_back(p.deg);
-    per_keyframe[p.b].push_back(p.deg);
+    per_keyframe[p.a].push_back(judged_deg);
+    per_keyframe[p.b].push_back(judged_deg);
   }
   c.two_view_pairs = static_cast<int>(pairs.size());
   c.disagreeing_fraction = pairs.empty() ? 0 : static_cast<double>(disagree) / static_cast<double>(pairs.size());
@@ -261,6 +307,14 @@ std::optional<int> KeyframeToStartFrom(const map::Map& map, const MapCheck& chec
   return best;
 }
 
+Eigen::Matrix3d EssentialBetween(const calib::Pose& a, const calib::Pose& b) {
+  const Eigen::Matrix3d r = b.R() * a.R().transpose();
+  const Eigen::Vector3d t = b.t_cw - r * a.t_cw;
+  Eigen::Matrix3d tx;
+  tx << 0, -t.z(), t.y(), t.z(), 0, -t.x(), -t.y(), t.x(), 0;
+  return tx * r;
+}
+
 std::optional<double> RotationDisagreementDeg(const Eigen::Matrix3d& essential, const Eigen::Matrix3d& rotation_ab) {
   if (!essential.allFinite() || essential.norm() < 1e-12) return std::nullopt;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(essential, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -306,7 +360,7 @@ MapCheck CheckMap(const map::Map& map, const std::vector<std::vector<Eigen::Vect
   }
   c.moving_pairs = static_cast<int>(still.size());
   c.still_fraction = Median(still);
-  CompareTwoViewRotations(map, two_view, limits, c);
+  CompareTwoViewRotations(map, keypoints, two_view, limits, c);
   AddWarnings(c, limits);
   return c;
 }
@@ -318,7 +372,8 @@ std::string DescribeMapCheck(const MapCheck& c) {
          " (median of " + std::to_string(c.moving_pairs) + " keyframe pairs)" +
          (c.two_view_pairs > 0 ? "; rotations disagree with the two-view geometry in " + Percent(c.disagreeing_fraction) +
                                      " of " + std::to_string(c.two_view_pairs) + " pairs (median pair " +
-                                     Fixed(c.median_disagreement_deg, 2) + " deg; keyframes off: " +
+                                     Fixed(c.median_disagreement_deg, 2) + " deg; " + std::to_string(c.fitted_pairs) +
+                                     " fitted by the map's poses; keyframes off: " +
                                      std::to_string(c.disagreeing_frames.size()) + ")"
                                : std::string());
 }
@@ -336,6 +391,7 @@ void WriteMapCheck(const MapCheck& c, const fs::path& file) {
                   {"disagreeing_fraction", c.disagreeing_fraction},
                   {"median_disagreement_deg", c.median_disagreement_deg},
                   {"keyframe_off_deg", c.keyframe_off_deg},
+                  {"fitted_pairs", c.fitted_pairs},
                   {"off_neighbours", c.off_neighbours},
                   {"disagreeing_frames", c.disagreeing_frames},
                   {"flagged", c.flagged()},
@@ -370,6 +426,8 @@ std::optional<MapCheck> ReadMapCheckFile(const fs::path& file) {
     c.median_disagreement_deg = j.value("median_disagreement_deg", 0.0);
     c.keyframe_off_deg = j.value("keyframe_off_deg", 0.0);
     c.off_neighbours = j.value("off_neighbours", 0);
+    // Absent from check files written before pairs were fitted with the map's poses (2026-12-06).
+    c.fitted_pairs = j.value("fitted_pairs", 0);
     c.disagreeing_frames = j.value("disagreeing_frames", std::vector<int>{});
     c.warnings = j.at("warnings").get<std::vector<std::string>>();
     return c;
