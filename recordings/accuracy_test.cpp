@@ -262,6 +262,37 @@ TEST(Tum, WriteThenReadRoundTrips) {
   }
 }
 
+std::string FileText(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A live session streams its poses (app/session): the file must be the one WriteTum would write,
+// and only once finished.
+TEST(TumFileWriter, WritesWhatWriteTumWritesAndOnlyOnceFinished) {
+  const Trajectory gt = Orbit(9, 1.3e9, 0.033);
+  const fs::path dir = fs::temp_directory_path() / ("arview_tumw_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  WriteTum(gt, dir / "whole.txt", "test");
+  {
+    TumFileWriter writer(dir / "streamed.txt", "test");
+    for (const StampedPose& p : gt) writer.Add(p);
+    EXPECT_EQ(writer.poses(), gt.size());
+    EXPECT_FALSE(fs::exists(dir / "streamed.txt"));  // not before Finish
+    writer.Finish();
+  }
+  EXPECT_EQ(FileText(dir / "streamed.txt"), FileText(dir / "whole.txt"));
+  {
+    TumFileWriter unfinished(dir / "cut.txt");
+    unfinished.Add(gt.front());
+  }
+  for (const auto& entry : fs::directory_iterator(dir))
+    EXPECT_EQ(entry.path().filename().string().find("cut"), std::string::npos) << entry.path();
+  EXPECT_THROW(TumFileWriter(dir, "test"), RecordingError);  // a folder
+  EXPECT_THROW(TumFileWriter(dir / "no-such-folder" / "t.txt"), RecordingError);
+  fs::remove_all(dir);
+}
+
 TEST(Tum, MalformedLinesAreNamedWithFileAndLine) {
   const fs::path file = fs::temp_directory_path() / ("arview_tum_bad_" + std::to_string(::getpid()) + ".txt");
   auto error_for = [&](const std::string& text) {

@@ -6,7 +6,11 @@
 #include "base/input_guard.h"
 #include "base/point_spread.h"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -83,20 +87,71 @@ Trajectory ReadTum(const std::filesystem::path& path) {
   return NamingInput<RecordingError>(path.string(), [&] { return ReadTumFile(path); });
 }
 
+namespace {
+
+std::string TumHeader(const std::string& header_comment) {
+  std::string header = header_comment.empty() ? "" : "# " + header_comment + "\n";
+  return header + "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
+}
+
+std::string TumLine(const StampedPose& p) {
+  const Eigen::Vector3d c = p.pose.Center();
+  const Eigen::Quaterniond q = p.pose.CameraToWorldRotation();
+  std::ostringstream out;
+  out << std::setprecision(9) << std::fixed << p.timestamp << std::defaultfloat << std::setprecision(17) << ' '
+      << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w()
+      << '\n';
+  return out.str();
+}
+
+}  // namespace
+
 void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
               const std::string& header_comment) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    if (!header_comment.empty()) out << "# " << header_comment << "\n";
-    out << "# timestamp tx ty tz qx qy qz qw (camera-to-world)\n";
-    out << std::setprecision(17);
-    for (const StampedPose& p : trajectory) {
-      const Eigen::Vector3d c = p.pose.Center();
-      const Eigen::Quaterniond q = p.pose.CameraToWorldRotation();
-      out << std::setprecision(9) << std::fixed << p.timestamp << std::defaultfloat << std::setprecision(17)
-          << ' ' << c.x() << ' ' << c.y() << ' ' << c.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z()
-          << ' ' << q.w() << '\n';
-    }
+    out << TumHeader(header_comment);
+    for (const StampedPose& p : trajectory) out << TumLine(p);
   });
+}
+
+TumFileWriter::TumFileWriter(const std::filesystem::path& path, const std::string& header_comment)
+    : pending_(path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(pending_.final_path(), ec)) {
+    throw RecordingError(pending_.final_path().string() + ": is a folder, not a file for the trajectory");
+  }
+  file_ = std::fopen(pending_.partial().c_str(), "w");
+  if (file_ == nullptr) {
+    throw RecordingError(pending_.final_path().string() + ": cannot write here (" + std::strerror(errno) + ")");
+  }
+  Write(TumHeader(header_comment));
+}
+
+TumFileWriter::~TumFileWriter() {
+  if (file_ != nullptr) std::fclose(file_);  // unfinished: PendingOutput removes the partial file
+}
+
+void TumFileWriter::Write(const std::string& text) {
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0) {
+    throw RecordingError(pending_.final_path().string() + ": cannot write (" + std::strerror(errno) + ")");
+  }
+}
+
+void TumFileWriter::Add(const StampedPose& pose) {
+  Write(TumLine(pose));
+  ++poses_;
+}
+
+void TumFileWriter::Finish() {
+  const bool synced = ::fsync(::fileno(file_)) == 0;
+  const int sync_error = errno;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!synced || !closed) {
+    throw RecordingError(pending_.final_path().string() + ": cannot write (" +
+                         std::strerror(synced ? errno : sync_error) + ")");
+  }
+  pending_.Commit();
 }
 
 }  // namespace arview::recordings

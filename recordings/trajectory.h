@@ -1,11 +1,13 @@
 #pragma once
 // TUM trajectory files: one line per pose, "timestamp tx ty tz qx qy qz qw", camera-to-world.
 
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "base/atomic_file.h"
 #include "base/error.h"
 #include "calib/pose.h"
 
@@ -32,5 +34,32 @@ std::string ReadRecordingText(const std::filesystem::path& file);
 Trajectory ReadTum(const std::filesystem::path& path);
 void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
               const std::string& header_comment = "");
+
+// A TUM file written pose by pose as a long session runs, so that its poses are on disk and not
+// held in memory (a live session's would grow by 80 bytes a frame, 7.5 MiB an hour at 26 Hz:
+// docs/reliability.md). Written under a partial name (base/atomic_file.h, PendingOutput), renamed
+// into place by Finish(); removed when destroyed unfinished, so that an interrupted run never
+// leaves a file that looks complete. The same text as WriteTum for the same poses.
+class TumFileWriter {
+ public:
+  // Throws RecordingError naming `path` when it cannot be written or is a folder.
+  TumFileWriter(const std::filesystem::path& path, const std::string& header_comment = "");
+  ~TumFileWriter();
+  TumFileWriter(const TumFileWriter&) = delete;
+  TumFileWriter& operator=(const TumFileWriter&) = delete;
+
+  // One pose's line, flushed to the kernel. From one thread at a time.
+  void Add(const StampedPose& pose);
+  // On disk (fsync), then renamed into place. Throws RecordingError naming the file.
+  void Finish();
+  std::size_t poses() const { return poses_; }
+
+ private:
+  void Write(const std::string& text);
+
+  PendingOutput pending_;
+  std::FILE* file_ = nullptr;
+  std::size_t poses_ = 0;
+};
 
 }  // namespace arview::recordings

@@ -77,10 +77,10 @@ void AddReplayCommand(CLI::App& app) {
     SessionOptions o;
     ApplySessionFlags(a->session, /*live_source=*/a->paced, o);
     ApplyDialogueFlags(a->dialogue, video::IsWindowTarget(a->out), o);
-    // No per-frame record kept (--stats streams them to disk) and the trajectory only for
-    // --trajectory: a long run's memory stays flat.
+    // No per-frame record and no pose kept (--stats and --trajectory stream them to disk): a
+    // long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;
-    o.pipeline.keep_trajectory = !o.trajectory_out.empty();
+    o.pipeline.keep_trajectory = false;
     o.pipeline.drop_frames = a->paced;
     o.expected_frames = expected;
     o.sink_fps = MedianFrameRate(recording.frames);

@@ -72,10 +72,10 @@ void AddRunCommand(CLI::App& app) {
     o.command_start = Clock::now();
     ApplySessionFlags(a->session, /*live_source=*/true, o);
     ApplyDialogueFlags(a->dialogue, video::IsWindowTarget(a->out), o);
-    // No per-frame record kept (--stats streams them to disk) and the trajectory only for
-    // --trajectory: a long run's memory stays flat.
+    // No per-frame record and no pose kept (--stats and --trajectory stream them to disk): a
+    // long run's memory stays flat.
     o.pipeline.keep_frame_logs = false;
-    o.pipeline.keep_trajectory = !o.trajectory_out.empty();
+    o.pipeline.keep_trajectory = false;
     o.sink = a->out;
     o.pipeline.drop_frames = true;  // live: never fall behind the camera
     // An unplugged or stalled camera ends the session with what it has: the video, the

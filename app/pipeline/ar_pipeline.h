@@ -72,15 +72,19 @@ struct PipelineOptions {
   // recovers.
   std::function<void(const std::string&)> on_source_note;
   // Per-frame records kept in the report: `frames` (about 300 bytes a frame, for the demo's
-  // figures) and `trajectory` (80 bytes a localized frame, for --trajectory). `replay` and `run`
-  // keep no frames (--stats streams them through `on_frame_log`) and the trajectory only for
-  // --trajectory, so that their memory stays flat (the soak test, docs/reliability.md). What the
-  // summaries need is kept in constant memory whatever these say.
+  // figures) and `trajectory` (80 bytes a localized frame, for the demo's accuracy). `replay` and
+  // `run` keep neither (--stats and --trajectory stream them through `on_frame_log` and
+  // `on_localized_pose`), so that their memory stays flat (the soak test, docs/reliability.md).
+  // What the summaries need is kept in constant memory whatever these say.
   bool keep_frame_logs = true;
   bool keep_trajectory = true;
   // Called on the sink's thread with each frame's record as the frame reaches the sink: --stats
   // writes it to disk then (pipeline_report.h, StatsFileWriter), so that it is not kept.
   std::function<void(const FrameLog&)> on_frame_log;
+  // Called on the render thread with each localized frame's raw pose, whether or not the frame
+  // then reaches the sink (a frame dropped before the sink was still tracked): --trajectory
+  // writes it to disk then (recordings/trajectory.h, TumFileWriter).
+  std::function<void(const recordings::StampedPose&)> on_localized_pose;
   // Gives each lost frame its cause (on the track thread, in its `track` time: 1.8 ms a 640x480
   // frame, 3.4 ms a 1920x1080 one): the HUD shows it, the report counts the causes. Null: lost
   // frames have no cause.

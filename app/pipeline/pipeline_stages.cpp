@@ -127,6 +127,7 @@ RenderStage::RenderStage(std::span<LayeredAnimator* const> animators, FrameCompo
       compositor_(compositor),
       keep_trajectory_(options.keep_trajectory),
       on_first_localized_(options.on_first_localized),
+      on_localized_pose_(options.on_localized_pose),
       in_(in),
       out_(out) {}
 
@@ -148,8 +149,10 @@ void RenderStage::Run(std::stop_token stop) {
     item->log.timeline.render_end = item->MsSinceCapture();
     // The pose is kept whether or not the frame is shown: a frame dropped before the sink was
     // still tracked.
-    if (keep_trajectory_ && item->track.status != tracker::TrackStatus::kLost) {
-      trajectory_.push_back({item->frame.timestamp, item->track.pose});
+    if (item->track.status != tracker::TrackStatus::kLost) {
+      const recordings::StampedPose pose{item->frame.timestamp, item->track.pose};
+      if (keep_trajectory_) trajectory_.push_back(pose);
+      if (on_localized_pose_) on_localized_pose_(pose);
     }
     if (!out_.Push(std::move(*item))) break;
   }

@@ -196,6 +196,7 @@ class RenderStage {
   FrameCompositor& compositor_;
   const bool keep_trajectory_;
   const std::function<void(const tracker::FrameResult&)> on_first_localized_;  // PipelineOptions'
+  const std::function<void(const recordings::StampedPose&)> on_localized_pose_;  // PipelineOptions'
   bool localized_before_ = false;
   FrameQueue& in_;
   FrameQueue& out_;

@@ -4,6 +4,7 @@
 #include "anim_authoring/character_builder.h"
 #include "app/session/character_setup.h"
 #include "app/session/keyframe_appearance.h"
+#include "recordings/trajectory.h"
 #include "base/stats.h"
 
 #include <cstdio>
@@ -119,6 +120,12 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
   if (!o.stats_out.empty()) {
     stats.emplace(o.stats_out);
     pipeline.on_frame_log = [&stats](const FrameLog& frame) { stats->Add(frame); };
+  }
+  // --trajectory: each localized frame's pose goes to disk as it comes (recordings/trajectory.h).
+  std::optional<recordings::TumFileWriter> trajectory;
+  if (!o.trajectory_out.empty()) {
+    trajectory.emplace(o.trajectory_out, "arview: raw refined poses of localized frames");
+    pipeline.on_localized_pose = [&trajectory](const recordings::StampedPose& pose) { trajectory->Add(pose); };
   }
   if (sound.active()) {
     pipeline.on_frame_log = [stats_log = std::move(pipeline.on_frame_log), &sound](const FrameLog& frame) {
@@ -280,9 +287,7 @@ SessionResult RunSession(recordings::FrameSource& source, cv::Size source_size, 
           std::chrono::duration<double>(*result.report.first_localized_output - command_start).count();
     }
   }
-  if (!o.trajectory_out.empty()) {
-    recordings::WriteTum(result.report.trajectory, o.trajectory_out, "arview: raw refined poses of localized frames");
-  }
+  if (trajectory) trajectory->Finish();
   result.sound = sound.Finish();
   if (stats) {
     stats->Finish(result.report, result.renderer, result.renderer_info,
