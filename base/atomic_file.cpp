@@ -121,6 +121,40 @@ void PendingOutput::Commit() {
   committed_ = true;
 }
 
+StreamedFile::StreamedFile(const fs::path& file, std::string_view role) : pending_(file) {
+  std::error_code ec;
+  if (fs::is_directory(pending_.final_path(), ec)) {
+    throw Error(pending_.final_path().string() + ": is a folder, not a file for " + std::string(role) +
+                " (give a file path)");
+  }
+  file_ = std::fopen(pending_.partial().c_str(), "w");
+  if (file_ == nullptr) throw Error(pending_.final_path().string() + ": cannot write here (" + std::strerror(errno) + ")");
+}
+
+StreamedFile::~StreamedFile() {
+  if (file_ != nullptr) std::fclose(file_);  // unfinished: PendingOutput removes the partial file
+}
+
+void StreamedFile::Write(std::string_view text) {
+  if (file_ == nullptr) throw Error(pending_.final_path().string() + ": cannot write (already finished)");
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0) {
+    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(errno) + ")");
+  }
+}
+
+void StreamedFile::Finish() {
+  if (file_ == nullptr) throw Error(pending_.final_path().string() + ": cannot write (already finished)");
+  // On disk before the rename makes it the file (as WriteFileAtomically).
+  const bool synced = ::fsync(::fileno(file_)) == 0;
+  const int sync_error = errno;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!synced || !closed) {
+    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(synced ? errno : sync_error) + ")");
+  }
+  pending_.Commit();
+}
+
 std::string NoRoomToWrite(const std::filesystem::path& folder) {
   const std::filesystem::path probe = folder / (".arview-space-probe." + std::to_string(::getpid()));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);

@@ -6,6 +6,7 @@
 // an arview::Error naming the final file: an interrupted or failed run never leaves a file that
 // looks finished, and never destroys the previous good copy.
 
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
@@ -54,6 +55,29 @@ class PendingOutput {
   std::filesystem::path final_, partial_;
   bool folder_ = false;
   bool committed_ = false;
+};
+
+// A file written piece by piece as a long run goes (a session's --stats and --trajectory), so
+// that what it holds is on disk and not in memory: under PendingOutput's partial name, each
+// piece flushed to the kernel (a run killed outright leaves it readable in the partial file),
+// fsync'ed and renamed into place by Finish(); removed if destroyed unfinished. From one thread
+// at a time.
+class StreamedFile {
+ public:
+  // Throws arview::Error naming `file` when it is a folder (`role`: what the file is for, as
+  // "--stats") or cannot be written.
+  StreamedFile(const std::filesystem::path& file, std::string_view role);
+  ~StreamedFile();
+  StreamedFile(const StreamedFile&) = delete;
+  StreamedFile& operator=(const StreamedFile&) = delete;
+
+  // Throws arview::Error naming the file when the write fails.
+  void Write(std::string_view text);
+  void Finish();
+
+ private:
+  PendingOutput pending_;
+  std::FILE* file_ = nullptr;
 };
 
 }  // namespace arview

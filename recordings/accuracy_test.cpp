@@ -288,8 +288,8 @@ TEST(TumFileWriter, WritesWhatWriteTumWritesAndOnlyOnceFinished) {
   }
   for (const auto& entry : fs::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find("cut"), std::string::npos) << entry.path();
-  EXPECT_THROW(TumFileWriter(dir, "test"), RecordingError);  // a folder
-  EXPECT_THROW(TumFileWriter(dir / "no-such-folder" / "t.txt"), RecordingError);
+  EXPECT_THROW(TumFileWriter(dir, "test"), arview::Error);  // a folder
+  EXPECT_THROW(TumFileWriter(dir / "no-such-folder" / "t.txt"), arview::Error);
   fs::remove_all(dir);
 }
 

@@ -6,11 +6,7 @@
 #include "base/input_guard.h"
 #include "base/point_spread.h"
 
-#include <unistd.h>
-
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -115,43 +111,13 @@ void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
 }
 
 TumFileWriter::TumFileWriter(const std::filesystem::path& path, const std::string& header_comment)
-    : pending_(path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(pending_.final_path(), ec)) {
-    throw RecordingError(pending_.final_path().string() + ": is a folder, not a file for the trajectory");
-  }
-  file_ = std::fopen(pending_.partial().c_str(), "w");
-  if (file_ == nullptr) {
-    throw RecordingError(pending_.final_path().string() + ": cannot write here (" + std::strerror(errno) + ")");
-  }
-  Write(TumHeader(header_comment));
-}
-
-TumFileWriter::~TumFileWriter() {
-  if (file_ != nullptr) std::fclose(file_);  // unfinished: PendingOutput removes the partial file
-}
-
-void TumFileWriter::Write(const std::string& text) {
-  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0) {
-    throw RecordingError(pending_.final_path().string() + ": cannot write (" + std::strerror(errno) + ")");
-  }
+    : file_(path, "the trajectory") {
+  file_.Write(TumHeader(header_comment));
 }
 
 void TumFileWriter::Add(const StampedPose& pose) {
-  Write(TumLine(pose));
+  file_.Write(TumLine(pose));
   ++poses_;
-}
-
-void TumFileWriter::Finish() {
-  const bool synced = ::fsync(::fileno(file_)) == 0;
-  const int sync_error = errno;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!synced || !closed) {
-    throw RecordingError(pending_.final_path().string() + ": cannot write (" +
-                         std::strerror(synced ? errno : sync_error) + ")");
-  }
-  pending_.Commit();
 }
 
 }  // namespace arview::recordings

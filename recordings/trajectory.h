@@ -1,7 +1,6 @@
 #pragma once
 // TUM trajectory files: one line per pose, "timestamp tx ty tz qx qy qz qw", camera-to-world.
 
-#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -42,23 +41,17 @@ void WriteTum(const Trajectory& trajectory, const std::filesystem::path& path,
 // leaves a file that looks complete. The same text as WriteTum for the same poses.
 class TumFileWriter {
  public:
-  // Throws RecordingError naming `path` when it cannot be written or is a folder.
+  // Throws arview::Error naming `path` when it cannot be written or is a folder.
   TumFileWriter(const std::filesystem::path& path, const std::string& header_comment = "");
-  ~TumFileWriter();
-  TumFileWriter(const TumFileWriter&) = delete;
-  TumFileWriter& operator=(const TumFileWriter&) = delete;
 
   // One pose's line, flushed to the kernel. From one thread at a time.
   void Add(const StampedPose& pose);
-  // On disk (fsync), then renamed into place. Throws RecordingError naming the file.
-  void Finish();
+  // On disk (fsync), then renamed into place. Throws arview::Error naming the file.
+  void Finish() { file_.Finish(); }
   std::size_t poses() const { return poses_; }
 
  private:
-  void Write(const std::string& text);
-
-  PendingOutput pending_;
-  std::FILE* file_ = nullptr;
+  StreamedFile file_;
   std::size_t poses_ = 0;
 };
 

@@ -155,30 +155,12 @@ nlohmann::ordered_json FrameLogJson(const FrameLog& f) {
   return frame;
 }
 
-StatsFileWriter::StatsFileWriter(const std::filesystem::path& file) : pending_(file) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(pending_.final_path(), ec)) {
-    throw Error(pending_.final_path().string() + ": is a folder, not a file for --stats (give a file path)");
-  }
-  file_ = std::fopen(pending_.partial().c_str(), "w");
-  if (file_ == nullptr) {
-    throw Error(pending_.final_path().string() + ": cannot write here (" + std::strerror(errno) + ")");
-  }
-  Write("{\n  \"frames\": [");
-}
-
-StatsFileWriter::~StatsFileWriter() {
-  if (file_ != nullptr) std::fclose(file_);  // not finished: PendingOutput removes the partial file
-}
-
-void StatsFileWriter::Write(const std::string& text) {
-  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || std::fflush(file_) != 0) {
-    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(errno) + ")");
-  }
+StatsFileWriter::StatsFileWriter(const std::filesystem::path& file) : file_(file, "--stats") {
+  file_.Write("{\n  \"frames\": [");
 }
 
 void StatsFileWriter::Add(const FrameLog& frame) {
-  Write((frames_ == 0 ? "\n    " : ",\n    ") + FrameLogJson(frame).dump());
+  file_.Write((frames_ == 0 ? "\n    " : ",\n    ") + FrameLogJson(frame).dump());
   ++frames_;
 }
 
@@ -189,16 +171,8 @@ void StatsFileWriter::Finish(const PipelineReport& report, const std::string& gl
     for (const auto& [key, value] : more.items()) summary_json[key] = value;
   // The summary's own braces dropped: its keys follow "frames" in the one object.
   const std::string summary = summary_json.dump(2);
-  Write("\n  ]," + summary.substr(1) + "\n");
-  // On disk before the rename makes it the file (as WriteFileAtomically).
-  const bool synced = ::fsync(::fileno(file_)) == 0;
-  const int sync_error = errno;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!synced || !closed) {
-    throw Error(pending_.final_path().string() + ": cannot write (" + std::strerror(synced ? errno : sync_error) + ")");
-  }
-  pending_.Commit();
+  file_.Write("\n  ]," + summary.substr(1) + "\n");
+  file_.Finish();
 }
 
 std::string PipelineReportText(const PipelineReport& r) {

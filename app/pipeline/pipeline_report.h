@@ -62,7 +62,6 @@ class StatsFileWriter {
  public:
   // Throws arview::Error naming `file` when it cannot be written (before the session starts).
   explicit StatsFileWriter(const std::filesystem::path& file);
-  ~StatsFileWriter();
   StatsFileWriter(const StatsFileWriter&) = delete;
   StatsFileWriter& operator=(const StatsFileWriter&) = delete;
 
@@ -77,10 +76,7 @@ class StatsFileWriter {
   std::size_t frames() const { return frames_; }
 
  private:
-  void Write(const std::string& text);
-
-  PendingOutput pending_;
-  std::FILE* file_ = nullptr;
+  StreamedFile file_;
   std::size_t frames_ = 0;
 };
 
