@@ -60,6 +60,9 @@ TEST(TempleStagesOnSlurm, ExtractionAndMatchingAsJobsGiveTheDatabaseAndMapOfTheL
   options.engine = MapEngine::kSlurm;
   options.slurm_chunk = 2;
   options.slurm.poll = std::chrono::milliseconds(300);
+  // Each job takes seconds: one whose COLMAP hangs is ended and submitted again, rather than holding
+  // the one-node cluster past the test's own time limit (and every later Slurm test with it).
+  options.slurm.time_limit_minutes = 3;
   std::vector<std::string> notes;
   MapBuildCallbacks cb;
   cb.note = [&](const std::string& note) { notes.push_back(note); };

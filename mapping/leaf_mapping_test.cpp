@@ -218,6 +218,30 @@ TEST_F(SlurmJobs, AFailedTaskCancelsTheRestAndSaysWhy) {
   EXPECT_FALSE(fs::exists(dir / "never"));
 }
 
+// --slurm-time-limit: a job that would run on (a hung COLMAP) is ended by Slurm, TIMEOUT, and the
+// run fails naming the limit instead of waiting for it. Slurm looks at the limits about every
+// 30 s and then gives the job KillWait (30 s) to end: about a minute and a half in all.
+TEST_F(SlurmJobs, AJobPastItsTimeLimitEndsAndIsNamedAsSuch) {
+  SlurmJobPlan plan = ShellPlan(dir, {"sleep 600"}, "touch never");
+  plan.retries = 0;
+  SlurmOptions options = QuickPolls();
+  options.time_limit_minutes = 1;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    RunSlurmJobs(plan, options, 1, {}, {});
+    FAIL() << "the job past its limit went unnoticed";
+  } catch (const SlurmError& e) {
+    EXPECT_NE(std::string(e.what()).find("task 0 failed on Slurm (job "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("TIMEOUT: ran past its time limit (--slurm-time-limit"), std::string::npos)
+        << e.what();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << "ended " << seconds << " s after submitting\n";
+  EXPECT_LT(seconds, 300) << "ended by its limit, long before the task itself would have";
+  EXPECT_TRUE(QueuedAfterCancelling(plan.job_name).empty());
+  EXPECT_FALSE(fs::exists(dir / "never"));
+}
+
 TEST_F(SlurmJobs, AFinalCommandPrintingTheFailureMarkerFailsTheJob) {
   const SlurmJobPlan plan = ShellPlan(dir, {"true"}, "echo '=> Merge failed'; exit 0");
   try {
@@ -266,6 +290,7 @@ TEST(TempleLeavesOnSlurm, TwoLeavesMergeIntoTheSingleMapperMapAndAFailedLeafChan
   options.leaf_overlap = 6;
   options.engine = MapEngine::kSlurm;
   options.slurm.poll = std::chrono::milliseconds(300);
+  options.slurm.time_limit_minutes = 3;  // a hung COLMAP ends (job_stages_test.cpp says why)
   std::vector<std::string> notes;
   MapBuildCallbacks cb;
   cb.note = [&](const std::string& note) { notes.push_back(note); };

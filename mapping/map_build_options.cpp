@@ -24,6 +24,8 @@ void MapBuildOptions::Check(const OptionNames& names) const {
                 "0 (no retry) to below 1.5 (degrees)", gap_retry_angle_deg);
   RequireOption(gap_retry_min_frames >= 1, names("gap_retry_min_frames"), "at least 1", gap_retry_min_frames);
   RequireOption(slurm_chunk >= 0, names("slurm_chunk"), "0 (extraction and matching here) or more", slurm_chunk);
+  RequireOption(slurm.time_limit_minutes >= 0, names("slurm.time_limit_minutes"), "0 (the partition's) or more (minutes)",
+                slurm.time_limit_minutes);
   if (colmap.empty()) throw OptionError(names("colmap") + ": an empty name: give the COLMAP executable");
   if (scale.from == ScaleFrom::kBoard) {
     RequireOption(scale.board.square > 0, names("scale.board.square"), "above 0 (metres)", scale.board.square);

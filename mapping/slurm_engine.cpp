@@ -150,6 +150,7 @@ class SubmittedJobs {
     Command argv{options_.sbatch, "--parsable", "--no-requeue", "--chdir", plan_.work_dir.string(), "--cpus-per-task",
                  std::to_string(cpus_)};
     if (!options_.partition.empty()) argv.insert(argv.end(), {"--partition", options_.partition});
+    if (options_.time_limit_minutes > 0) argv.push_back("--time=" + std::to_string(options_.time_limit_minutes));
     if (retry) argv.push_back("--open-mode=append");
     return argv;
   }
@@ -189,6 +190,8 @@ std::string Failure(const std::string& name, const std::vector<JobTry>& tries, c
 // How a job ended, for messages: its state and why (`why`, else the last line of its log).
 std::string Ended(const std::string& state, const std::string& why, const fs::path& log) {
   const std::string said = why.empty() ? LastLine(log) : why;
+  // Slurm's own last line then is "*** JOB ... CANCELLED ... DUE TO TIME LIMIT ***": say it plainly.
+  if (state == "TIMEOUT") return state + ": ran past its time limit (--slurm-time-limit, or the partition's)";
   return state + (said.empty() ? "" : ": " + said);
 }
 

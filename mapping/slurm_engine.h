@@ -33,6 +33,11 @@ struct SlurmOptions {
   std::string sbatch = "sbatch", squeue = "squeue", scancel = "scancel";
   std::string partition;  // --slurm-partition; empty: the cluster's default
   int cpus_per_task = 0;  // --slurm-cpus; 0: the command's --threads (1 when --threads is -1)
+  // --slurm-time-limit: each job's wall-time limit in minutes (sbatch --time); 0: the partition's
+  // default. A job that runs past it (a COLMAP that hangs: feature_extractor was once seen
+  // deadlocked after its last image) ends TIMEOUT and is submitted once more like a failed one,
+  // instead of holding its node until someone cancels it.
+  int time_limit_minutes = 0;
   std::chrono::milliseconds poll{1000};
   // squeue failing (slurmctld down, unreachable) for this long fails the run.
   std::chrono::seconds unanswered_limit{60};

@@ -654,6 +654,12 @@ TEST_F(Round4BadInputs, MapEngineFlagsThatDoNotGoTogetherAreRefused) {
                 2);
   ExpectRefused({"map", At("rec"), "--out", At("venue"), "--slurm-chunk", "8"},
                 "map: --slurm-chunk makes Slurm jobs: it needs --engine slurm", 2);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--slurm-time-limit", "30"},
+                "map: --slurm-time-limit sets the Slurm jobs: it needs --engine slurm", 2);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--slurm-cpus", "2"},
+                "map: --slurm-cpus sets the Slurm jobs: it needs --engine slurm", 2);
+  ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "slurm", "--slurm-chunk", "8", "--slurm-time-limit", "-1"},
+                "--slurm-time-limit", kFlagCheck);
   ExpectRefused({"map", At("rec"), At("rec"), "--out", At("venue")}, At("rec") + ": the same recording given twice", 1);
   ExpectRefused({"map", At("rec"), "--out", At("venue"), "--engine", "cloud", "--leaf-size", "10"},
                 "--engine: cloud not in {local,slurm}", kFlagCheck);

@@ -1,7 +1,7 @@
 // arview map <recording> [<recording> ...] --out <map-dir> [--frames <spec>] [--matcher auto|sequential|exhaustive] [--match-engine auto|arview|colmap]
 //            [--max-frames N] [--refine-intrinsics] [--threads N] [--colmap <path>] [--max-features N] [--preset quality|fast]
 //            [--fold-retries N] [--keep-folded] [--gap-retry-angle DEG] [--board CxR --square M [--board-off-floor] | --no-metric]
-//            [--leaf-size N [--leaf-overlap N]] [--engine local|slurm [--slurm-chunk N] [--slurm-partition P] [--slurm-cpus N]]
+//            [--leaf-size N [--leaf-overlap N]] [--engine local|slurm [--slurm-chunk N] [--slurm-partition P] [--slurm-cpus N] [--slurm-time-limit MIN]]
 // arview map info <map-dir>
 // arview map scale <map-dir> [<recording>] (--board CxR --square M [--board-off-floor] | --distance M --from .. --to ..)
 
@@ -55,6 +55,7 @@ struct MapArgs {
   std::string engine = "local";
   std::string slurm_partition;
   int slurm_cpus = 0;
+  int slurm_time_limit = 0;
   int slurm_chunk = 0;
   std::string info_dir;
   bool info_recheck = false;
@@ -121,12 +122,20 @@ void RunMap(const MapArgs& args) {
   options.leaf_overlap = args.leaf_overlap;
   options.slurm.partition = args.slurm_partition;
   options.slurm.cpus_per_task = args.slurm_cpus;
+  options.slurm.time_limit_minutes = args.slurm_time_limit;
   options.slurm_chunk = args.slurm_chunk;
   if (args.engine == "slurm" && args.leaf_size == 0 && args.slurm_chunk == 0)
     throw CommandError("map: --engine slurm runs stages as jobs: give --leaf-size (the mapping in leaves) or "
                        "--slurm-chunk (extraction and matching), or both", 2);
   if (args.slurm_chunk > 0 && args.engine != "slurm")
     throw CommandError("map: --slurm-chunk makes Slurm jobs: it needs --engine slurm", 2);
+  // The jobs' settings mean nothing without jobs: refused rather than ignored.
+  for (const auto& [flag, given] : {std::pair{"--slurm-partition", !args.slurm_partition.empty()},
+                                    std::pair{"--slurm-cpus", args.slurm_cpus > 0},
+                                    std::pair{"--slurm-time-limit", args.slurm_time_limit > 0}}) {
+    if (given && args.engine != "slurm")
+      throw CommandError(std::string("map: ") + flag + " sets the Slurm jobs: it needs --engine slurm", 2);
+  }
   if (!args.board.empty()) {
     if (args.no_metric) throw CommandError("map: --board and --no-metric exclude each other", 2);
     options.scale.from = mapping::ScaleFrom::kBoard;
@@ -365,6 +374,11 @@ void AddMapCommand(CLI::App& app) {
   cmd->add_option("--slurm-cpus", args->slurm_cpus, "CPUs each Slurm job asks for (0: --threads)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  cmd->add_option("--slurm-time-limit", args->slurm_time_limit,
+                  "Each Slurm job's wall-time limit in minutes (sbatch --time): a job past it (a hung COLMAP) ends and "
+                  "is submitted once more (0: the partition's default)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 525600));
 
   auto* info = cmd->add_subcommand("info", "Describe a map: frames, points, track length, reprojection error, load time");
   info->add_option("map-dir", args->info_dir, "Map directory (or its map.arvmap)")->required();
