@@ -1,4 +1,5 @@
 #include "map/descriptor_index.h"
+#include "map/descriptor_size.h"
 
 // OpenCV's copy of FLANN (cvflann), not libflann: libflann 1.9.2 shuffles the points before
 // building each kd-tree with a std::random_device (flann/algorithms/kdtree_index.h), so its
@@ -29,7 +30,6 @@ namespace arview::map {
 
 namespace {
 
-constexpr int kDescriptorSize = 128;
 // cvflann's L2 for bytes: the same squared distance as cvflann::L2<unsigned char>, bit for bit
 // (every partial sum is an integer below 2^24, exact in a float), computed 16 bytes at a time.
 // cvflann's own converts each byte to float and tests for an early exit every 4 bytes, which

@@ -1,4 +1,5 @@
 #include "map/map_file.h"
+#include "map/descriptor_size.h"
 
 #include "base/atomic_file.h"
 #include "base/point_spread.h"
@@ -24,7 +25,6 @@ namespace {
 
 constexpr char kMagic[8] = {'A', 'R', 'V', 'M', 'A', 'P', '\r', '\n'};
 constexpr std::size_t kHeaderSize = 8 + 4 + 4 + 8 + 8;
-constexpr int kDescriptorSize = 128;
 
 std::uint64_t Checksum(const char* data, std::size_t n) {
   std::uint64_t h = 0xcbf29ce484222325ULL;

@@ -1,4 +1,5 @@
 #include "mapping/colmap_database.h"
+#include "map/descriptor_size.h"
 
 #include <sqlite3.h>
 #include <sys/stat.h>
@@ -14,8 +15,6 @@ namespace arview::mapping {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr int kDescriptorSize = 128;
 
 // How long a write waits for another process's lock (a job merging its part) before failing.
 constexpr int kBusyTimeoutMs = 5000;
@@ -113,11 +112,11 @@ cv::Mat ColmapDatabase::Descriptors(std::uint32_t image_id) {
   const sqlite3_int64 cols = sqlite3_column_int64(st.get(), 1);
   const void* blob = sqlite3_column_blob(st.get(), 2);
   const sqlite3_int64 bytes = sqlite3_column_bytes(st.get(), 2);
-  if (cols != kDescriptorSize || rows < 0 || rows > (1 << 24) || bytes != rows * cols || (rows > 0 && !blob)) {
+  if (cols != map::kDescriptorSize || rows < 0 || rows > (1 << 24) || bytes != rows * cols || (rows > 0 && !blob)) {
     Fail("descriptors of image id " + std::to_string(image_id) + " have a wrong shape (" + std::to_string(rows) + " x " +
          std::to_string(cols) + ", " + std::to_string(bytes) + " bytes; expected uint8 x 128)");
   }
-  cv::Mat m(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
+  cv::Mat m(static_cast<int>(rows), map::kDescriptorSize, CV_8UC1);
   if (rows > 0) std::memcpy(m.data, blob, static_cast<size_t>(bytes));
   return m;
 }

@@ -1,4 +1,5 @@
 #include "mapping/colmap_model.h"
+#include "map/descriptor_size.h"
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +24,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr std::uint64_t kInvalidPoint3D = std::numeric_limits<std::uint64_t>::max();
-constexpr int kDescriptorSize = 128;
 
 // A whole file in memory with bounds-checked little-endian reads.
 class BinaryReader {
@@ -608,7 +608,7 @@ map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, c
   RequireTracksReferBack(points, images, keyframe_of_image, points_file, images_file);
 
   ColmapDatabase db(database, ColmapDatabase::Access::kRead);
-  map.descriptors.create(static_cast<int>(rows), kDescriptorSize, CV_8UC1);
+  map.descriptors.create(static_cast<int>(rows), map::kDescriptorSize, CV_8UC1);
   map.descriptor_point.resize(rows);
   map.descriptor_keyframe.resize(rows);
   map.points.resize(points.size());
