@@ -7,8 +7,9 @@
 //      from its size; when it lies on the floor, up from its normal and the origin at its centre.
 //   2. a known distance between two scene points, each given as its pixel in two or more
 //      keyframes: scale from the distance, up and origin from the floor.
-//   3. an estimate: the floor (the dominant plane of the points, below the cameras) and a typical
-//      hand-held camera height over it. Stated as an estimate, with its likely error.
+//   3. an estimate: the floor (the lowest dense plane of the points, below the cameras) and a
+//      typical hand-held camera height over it. Stated as an estimate, with its likely error, or
+//      refused when the floor found cannot be trusted.
 //
 //   std::vector<BoardSighting> seen = FindBoard(map, images, {9, 6});
 //   MetricFit fit = FitFromBoard(map, TriangulateBoard(map, seen, {9, 6}), {{9, 6}, 0.025});
@@ -138,7 +139,12 @@ MetricFit FitFromDistance(const map::Map& map, const TriangulatedPoint& a, const
 inline constexpr double kTypicalCameraHeight = 1.45;
 inline constexpr double kCameraHeightRelativeError = 0.17;
 
-// The floor's estimate. Throws map::MapError when the points hold no floor below the cameras.
+// The floor's estimate: the floor the lowest dense plane of the points, the cameras' median height
+// over it kTypicalCameraHeight. Its scale_error is kCameraHeightRelativeError, or half the 10-90 %
+// range of the cameras' own heights over the floor where that is wider (its `how` then says
+// "doubtful"). Throws map::MapError when the points hold no floor below the cameras, or the floor
+// found cannot be trusted (more than 1 % of the points below it, the cameras' heights over it
+// varying by more than +-35 %): the scale could then be off by any factor.
 MetricFit FitFromCameraHeight(const map::Map& map);
 
 // The keyframes' poses and the points moved into the metric frame, and map->frame set from the

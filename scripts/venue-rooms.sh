@@ -31,7 +31,9 @@ for room in "${rooms[@]}"; do
   [ -d "$room" ] || synth --out "$room" --subset "$(frame_list "$room")"
 done
 # Every frame from 2 s before the first door to 2 s after it (the walk crosses it ~6 s in at 600 frames).
-first_door=$(grep -v '^#' plan/rooms.txt | awk -v r="${rooms[1]}" '$2 == r { print int($1 * 30 + 0.5); exit }')
+# (awk reads the file itself: its early exit would otherwise end grep with SIGPIPE, which pipefail
+# turns into the script's exit 141.)
+first_door=$(awk -v r="${rooms[1]}" '!/^#/ && $2 == r { print int($1 * 30 + 0.5); exit }' plan/rooms.txt)
 [ -d walk ] || synth --out walk --subset "$((first_door - 60))-$((first_door + 60))"
 
 # --max-frames 0: every frame given (a venue of more than 300 frames is otherwise thinned evenly).
