@@ -1,12 +1,8 @@
 #include "app/pipeline/pipeline_report.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <thread>
-
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 

@@ -1,7 +1,6 @@
 #pragma once
 // stats.json and the console summary of a pipeline run.
 
-#include <cstdio>
 #include <filesystem>
 #include <string>
 
