@@ -1,5 +1,5 @@
 #pragma once
-// The parts of `arview map` (mapping/colmap_pipeline.cpp) that `arview map extend`
+// The parts of `arview map` (mapping/colmap_stages.cpp, map_folder.cpp) that `arview map extend`
 // (mapping/map_extend.h) runs as well: frame selection, COLMAP's command lines and child
 // processes, the database copy, and the map folder's files. Internal to mapping/.
 

@@ -16,7 +16,7 @@
 //   ApplyMetricFit(fit, &map);   // the keyframes, the points and map.frame
 //
 // The COLMAP model on disk is moved with it (colmap_model.h's WriteTransformedModel, from
-// colmap_pipeline.cpp).
+// map_folder.cpp).
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
