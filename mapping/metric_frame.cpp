@@ -21,9 +21,9 @@
 #include <thread>
 #include <unordered_map>
 
-#include "base/plane_fit.h"
 #include "base/stats.h"
 #include "calib/calibration.h"
+#include "mapping/floor_search.h"
 
 namespace arview::mapping {
 namespace {
@@ -184,147 +184,17 @@ double WidestAngleDeg(const map::Map& map, const std::vector<const BoardSighting
   return WidestRayAngleDeg(poses, rays);
 }
 
-Eigen::Vector3d Mean(const std::vector<Eigen::Vector3d>& points) {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const auto& p : points) sum += p;
-  return sum / std::max<std::size_t>(points.size(), 1);
-}
-
-std::vector<Eigen::Vector3d> Centres(const map::Map& map) {
-  std::vector<Eigen::Vector3d> centres;
-  for (const map::Keyframe& k : map.keyframes) centres.push_back(k.pose.Center());
-  return centres;
-}
-
 std::string Format(const char* format, double a, double b = 0, double c = 0, double d = 0) {
   char text[256];
   std::snprintf(text, sizeof text, format, a, b, c, d);
   return text;
 }
 
-// The floor is the lowest plane the points hold: below it there are only points matched wrongly,
-// too few or too scattered to hold a plane of this share of the points. A horizontal slice through
-// densely textured walls holds as many points as a sparsely textured floor (the rendered venue's
-// rooms: 452 points in a slice at 1.3 m against the floor's 54 near the cloud's middle), but
-// has the walls' lower part and the floor below it.
-constexpr double kFloorShareOfPoints = 0.01;
-constexpr int kFloorLeastPoints = 30;
-// A room has a few such slices (the walls' panels, a table) above its floor.
-constexpr int kFloorRounds = 12;
 // The estimate's checks of the floor it stands on (FitFromCameraHeight), set from the maps in
 // docs/mapping.md, "The floor under the estimate": right floors had at most 0.2 % of the points
 // below them and the cameras within a few % of one height over them; wrong ones 1.4 % and more.
 constexpr double kMostPointsBelowFloor = 0.01;
 constexpr double kMostCameraHeightSpread = 0.35;
-// Below the first plane, one nearly perpendicular to up (the camera centres' plane gives up to a
-// fraction of a degree): a plane tilted across the walls holds many of their points. Where up is
-// further off, no lower plane is found, and the first one is checked as the floor.
-constexpr double kLowerFloorMaxTiltDeg = 5;
-
-int PointsWithin(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double distance) {
-  int within = 0;
-  for (const Eigen::Vector3d& p : points) within += std::abs(plane.Distance(p)) < distance;
-  return within;
-}
-
-// Whether `plane`'s normal is within `max_tilt_deg` of `up` either way. FitDominantPlane's
-// least-squares refit on its inliers can turn a plane that passed the tilt limit upright (a strip
-// of points along a wall's foot).
-bool Upright(const Plane& plane, const Eigen::Vector3d& up, double max_tilt_deg) {
-  return std::abs(plane.normal.dot(up)) >= std::cos(max_tilt_deg * kDeg);
-}
-
-// `plane` with its normal along `up`.
-Plane FacingUp(Plane plane, const Eigen::Vector3d& up) {
-  if (plane.normal.dot(up) < 0) {
-    plane.normal = -plane.normal;
-    plane.offset = -plane.offset;
-  }
-  return plane;
-}
-
-// The floor: a plane near-perpendicular to the cameras' up, its normal turned towards the cameras.
-// The dominant plane of all the points first; then, while the points below the plane found
-// (along up) hold another plane of at least kFloorShareOfPoints of the points, that one, so that
-// the search goes down to the lowest dense plane. `below` receives the fraction of the points
-// more than three inlier distances under the floor returned.
-Plane FindFloor(const map::Map& map, double* below = nullptr) {
-  std::vector<Eigen::Vector3d> points, up_axes;
-  for (const map::MapPoint& p : map.points) points.push_back(p.xyz);
-  for (const map::Keyframe& k : map.keyframes) up_axes.push_back(-(k.pose.q_cw.conjugate() * Eigen::Vector3d::UnitY()));
-  PlaneFitOptions options;
-  // The first fit's inlier distance (1 % of the cloud's extent) for every fit: a subset's own
-  // extent is smaller.
-  options.inlier_distance = 0.01 * 2 * MedianDistance(points, ComponentMedian(points));
-  const int least = std::max(kFloorLeastPoints, static_cast<int>(kFloorShareOfPoints * points.size()));
-  Plane floor;
-  Eigen::Vector3d up;
-  PlaneFitOptions lower_options = options;  // below the first plane: see kLowerFloorMaxTiltDeg
-  try {
-    floor = FitFloorUnderCameras(points, Centres(map), up_axes, options, &up);
-    lower_options.up_prior = up;
-    lower_options.max_tilt_deg = kLowerFloorMaxTiltDeg;
-    lower_options.iterations = 2000;
-    if (!Upright(floor, up, options.max_tilt_deg)) floor = FitFloorUnderCameras(points, Centres(map), up_axes, lower_options);
-  } catch (const Error& e) {
-    throw map::MapError(std::string("no floor found in the map's points: ") + e.what());
-  }
-  if (!Upright(floor, up, options.max_tilt_deg)) {
-    throw map::MapError("no floor found in the map's points: the planes near-perpendicular to the cameras' up hold too "
-                        "few of them");
-  }
-  std::vector<Eigen::Vector3d> candidates = points;
-  for (int round = 0; round < kFloorRounds; ++round) {
-    const Plane facing_up = FacingUp(floor, up);
-    std::vector<Eigen::Vector3d> under;  // of the points below the planes before (a plane tilted
-    for (const Eigen::Vector3d& p : candidates)  // across a large room would lift the search again)
-      if (facing_up.Distance(p) < -options.inlier_distance) under.push_back(p);
-    if (static_cast<int>(under.size()) < least) break;
-    Plane lower;
-    try {
-      lower = FitFloorUnderCameras(under, Centres(map), up_axes, lower_options);
-    } catch (const Error&) {
-      break;  // nothing below holds a plane
-    }
-    if (!Upright(lower, up, 2 * kLowerFloorMaxTiltDeg) || PointsWithin(lower, points, options.inlier_distance) < least) break;
-    floor = lower;
-    candidates = std::move(under);
-  }
-  if (below) {
-    const Plane facing_up = FacingUp(floor, up);
-    std::size_t count = 0;
-    for (const Eigen::Vector3d& p : points) count += facing_up.Distance(p) < -3 * options.inlier_distance;
-    *below = static_cast<double>(count) / std::max<std::size_t>(points.size(), 1);
-  }
-  return floor;
-}
-
-// The frame standing on `floor`: z its normal, the origin below the cameras' mean centre, x the
-// first keyframe's viewing direction along the floor; `scale` map units → metres.
-Sim3 FloorFrame(const map::Map& map, const Plane& floor, double scale) {
-  const Eigen::Vector3d z = floor.normal.normalized();
-  Eigen::Vector3d x = map.keyframes.front().pose.q_cw.conjugate() * Eigen::Vector3d::UnitZ();
-  x -= x.dot(z) * z;
-  if (x.norm() < 1e-6) x = z.unitOrthogonal();
-  x.normalize();
-  Eigen::Matrix3d axes;  // rows: the new frame's axes in map coordinates
-  axes.row(0) = x;
-  axes.row(1) = z.cross(x);
-  axes.row(2) = z;
-  const Eigen::Vector3d centre = Mean(Centres(map));
-  const Eigen::Vector3d origin = centre - floor.Distance(centre) * z;
-  Sim3 s;
-  s.scale = scale;
-  s.R = axes;
-  s.t = -scale * (axes * origin);
-  return s;
-}
-
-double MedianHeightOverFloor(const map::Map& map, const Plane& floor) {
-  std::vector<double> heights;
-  for (const Eigen::Vector3d& c : Centres(map)) heights.push_back(floor.Distance(c));
-  return Median(heights);
-}
 
 }  // namespace
 

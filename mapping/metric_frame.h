@@ -16,7 +16,7 @@
 //   ApplyMetricFit(fit, &map);   // the keyframes, the points and map.frame
 //
 // The COLMAP model on disk is moved with it (colmap_model.h's WriteTransformedModel, from
-// map_folder.cpp).
+// map_folder.cpp). The floor the estimate stands on: mapping/floor_search.h.
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
