@@ -1,7 +1,8 @@
 #pragma once
 // Reading COLMAP's output directly: the binary sparse model (cameras.bin, images.bin,
 // points3D.bin) and the SQLite feature database (descriptors). Every size and id is validated:
-// a truncated or corrupted file throws MapError naming the file and what is wrong.
+// a truncated or corrupted file throws MapError naming the file and what is wrong. Writing a
+// model moved by a similarity (WriteTransformedModel) is in mapping/colmap_model_writer.cpp.
 
 #include <cstdint>
 #include <filesystem>
@@ -54,9 +55,6 @@ std::vector<map::Keyframe> ReadColmapCameraPath(const std::filesystem::path& spa
 // (`arview map extend`, whose COLMAP stages would otherwise end in COLMAP's stack trace).
 void RequireReadableModel(const std::filesystem::path& sparse_dir, const CancellationToken& cancel = {});
 
-// The SIFT descriptors COLMAP extracted for the named images (one rows x 128 CV_8U matrix each,
-// in the order of `names`). Throws MapError naming the database and the image that is missing
-// or malformed.
 // The binary sparse model in `from` moved by `transform` (every image's pose and every point;
 // cameras.bin as it is) written into the folder `to` (created), otherwise byte for byte as
 // COLMAP wrote it. Each file is written atomically; a file that cannot be written is a MapError
@@ -64,6 +62,9 @@ void RequireReadableModel(const std::filesystem::path& sparse_dir, const Cancell
 // model_transformer ignores write errors and leaves a truncated model looking complete.
 void WriteTransformedModel(const std::filesystem::path& from, const std::filesystem::path& to, const Sim3& transform);
 
+// The SIFT descriptors COLMAP extracted for the named images (one rows x 128 CV_8U matrix each,
+// in the order of `names`). Throws MapError naming the database and the image that is missing
+// or malformed.
 std::vector<cv::Mat> ReadImageDescriptors(const std::filesystem::path& database, const std::vector<std::string>& names,
                                           const CancellationToken& cancel = {});
 
