@@ -614,16 +614,10 @@ void Camera::Preload() {
   constexpr size_t kBatch = 16;
   for (size_t first = 0; first < cache_.size(); first += kBatch) {
     std::vector<std::vector<uint8_t>> made(std::min(kBatch, cache_.size() - first));
-    // TBB hands the payloads back with its own atomics, compiled without TSan, so TSan saw the
-    // producer's copies race the workers' writes (docs/reliability.md). Each worker's release and
-    // this thread's acquire order them where TSan can see it; the producer starts after.
-    std::atomic<size_t> made_count{0};
     cv::parallel_for_(cv::Range(0, static_cast<int>(made.size())),
                       [&](const cv::Range& r) {
                         for (int i = r.start; i < r.end; ++i) made[i] = MakePayload(first + i);
-                        made_count.fetch_add(static_cast<size_t>(r.end - r.start), std::memory_order_release);
                       });
-    if (made_count.load(std::memory_order_acquire) != made.size()) return;  // cannot happen: parallel_for_ ran every index
     for (size_t i = 0; i < made.size(); ++i) {
       if (!Cache(first + i, made[i])) return;
     }
