@@ -126,9 +126,13 @@ class LocalizeOnly : public ::testing::Test {
       EXPECT_NE(r.out.find("too dark (e.g. brightness"), std::string::npos) << args[0] << ": " << r.out;
     }
     const Snapshot before = Take(map);
+    // Relocalized in line, not on the tracker's worker: the worker runs at nice +10, and on a
+    // loaded machine (load 7 in release, and under TSan) its first relocalization had not
+    // finished when the run was stopped, so nothing was localized. What is checked here is the
+    // map folder, which neither way writes.
     const CommandResult live = testing::RunWithEmulatedCamera(
         {"run", "--device", testing::kEmulatedCamera, "--map", map.string(), "--out", "null", "--stats",
-         (out / "run.json").string()},
+         (out / "run.json").string(), "--tracking-worker", "off"},
         {{"ARVIEW_FAKE_CAMERA_RECORDING", views.string()}}, out, {0, 0}, 4.0 * testing::kSanitizerSlowdown);
     EXPECT_EQ(live.exit_code, 0) << label << " run: " << live.err;
     EXPECT_EQ(Differences(before, Take(map)), "") << label << " run changed the map folder";

@@ -11,6 +11,7 @@
 #include <random>
 #include <thread>
 
+#include "tests/support/sanitizer_slowdown.h"
 #include "tests/support/test_data.h"
 #include "tracker/test_planar_scene.h"
 #include "tracker/test_scene.h"
@@ -416,8 +417,11 @@ TEST_F(PlanarTrackerTest, InTheBackgroundNoFrameWaitsForSiftOrRelocalization) {
   options.tracking.background = true;
   options.tracking.prefetch_below = 100000;  // every tracked frame without one pending starts one
   Tracker tracker(*map_, options);
-  auto at_camera_rate = [next = std::chrono::steady_clock::now()]() mutable {
-    next += std::chrono::microseconds(33333);
+  // 30 fps, slower by as much as a sanitizer slows the worker: what is checked is the order of
+  // the frames and the worker's results, which a 5x slower worker at full rate would not reach.
+  const auto frame_interval = std::chrono::microseconds(static_cast<long>(33333 * arview::testing::kSanitizerSlowdown));
+  auto at_camera_rate = [next = std::chrono::steady_clock::now(), frame_interval]() mutable {
+    next += frame_interval;
     std::this_thread::sleep_until(next);
   };
   const cv::Mat still = world_->Render(PathPose(0));
@@ -452,7 +456,8 @@ TEST_F(PlanarTrackerTest, InTheBackgroundNoFrameWaitsForSiftOrRelocalization) {
 }
 
 // Frames of a scene the map does not hold, in the background: each is lost at once while the
-// worker tries; the tracker is destroyed with a relocalization running.
+// worker tries; the tracker is destroyed with a relocalization running. Two seconds of frames
+// (longer under a sanitizer: the worker's relocalization runs as much slower as the rest).
 TEST_F(PlanarTrackerTest, InTheBackgroundAnUnknownSceneIsLostWithoutWaiting) {
   TrackerOptions options;
   options.tracking.background = true;
@@ -461,16 +466,17 @@ TEST_F(PlanarTrackerTest, InTheBackgroundAnUnknownSceneIsLostWithoutWaiting) {
   cv::Mat noise(map_->camera.Size(), CV_8U);
   cv::randu(noise, 0, 255);
   cv::GaussianBlur(noise, noise, cv::Size(5, 5), 1.5);
+  const int frames = static_cast<int>(60 * arview::testing::kSanitizerSlowdown);
   bool a_relocalization_failed = false;
-  for (int i = 0; i < 60; ++i) {
+  for (int i = 0; i < frames; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(33));
     const FrameResult r = tracker->Track(noise, i / 30.0);
     ASSERT_EQ(r.status, TrackStatus::kLost) << "frame " << i;
     EXPECT_EQ(r.keypoints > 0, r.relocalization_failure != PoseFailure::kNone) << "frame " << i << ": " << r.reason;
     if (r.relocalization_failure != PoseFailure::kNone) a_relocalization_failed = true;
   }
-  EXPECT_TRUE(a_relocalization_failed) << "no relocalization finished in 2 s";
-  tracker->Track(noise, 2.0);  // starts another
+  EXPECT_TRUE(a_relocalization_failed) << "no relocalization finished in " << frames / 30 << " s";
+  tracker->Track(noise, frames / 30.0);  // starts another
   tracker.reset();
 }
 
