@@ -15,7 +15,8 @@
 // 408 MB, flat over repeated loops), it is only no longer returned between frames.
 //
 // Called once at the start of the programs that process frames (app/cli/main.cpp, the frame
-// benchmarks). Under AddressSanitizer, whose allocator ignores mallopt, it does nothing.
+// benchmarks). Under AddressSanitizer or ThreadSanitizer, whose allocators ignore mallopt, it does
+// nothing and says so.
 
 #include <cstddef>
 

@@ -17,8 +17,10 @@
 
 #include "calib/camera.h"
 #include "tests/support/emulated_camera.h"
+#include "tests/support/probe_video.h"
 #include "tests/support/random_map.h"
 #include "tests/support/run_command.h"
+#include "tests/support/sanitizer_slowdown.h"
 
 namespace arview {
 namespace {
@@ -57,20 +59,8 @@ class LiveFaults : public ::testing::Test {
     if (!fault.empty()) {
       EXPECT_NE(stats.value("source_fault", std::string()).find(fault), std::string::npos) << stats.dump(1).substr(0, 400);
     }
-    EXPECT_EQ(DecodedFrames(Video()), shown) << "the video holds every frame shown";
+    EXPECT_EQ(testing::DecodedVideoFrames(Video(), dir_), shown) << "the video holds every frame shown";
     EXPECT_TRUE(fs::exists(dir_ / "trajectory.txt"));
-  }
-
-  // The frames ffprobe decodes from `video` to its end (-1: ffprobe could not read it). Decoded
-  // in a process of its own: libavcodec's frame threads hand frames over with atomics of their
-  // own, compiled without TSan, so decoding in the test's process gave TSan reports in FFmpeg.
-  int DecodedFrames(const fs::path& video) const {
-    const fs::path count = dir_ / "decoded_frames.txt";
-    const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
-                            "-of csv=p=0 " + testing::ShellQuote(video.string()) + " >" + testing::ShellQuote(count.string());
-    if (std::system(cmd.c_str()) != 0) return -1;
-    const std::string text = ReadWholeFile(count.string());
-    return text.empty() ? -1 : std::stoi(text);
   }
 
   fs::path dir_;
@@ -104,11 +94,18 @@ TEST_F(LiveFaults, ACameraThatStopsDeliveringEndsTheSessionWithItsOutputs) {
   ExpectOutputsComplete("no frame within");
 }
 
+// Ctrl-C ends the session; how many frames came before it depends on the start-up (1.3-1.7 s
+// of the 3 s under TSan beside the tsan label: 45 frames, 4 of them corrupt), so the check is
+// the share: every tenth frame the camera sent is skipped and counted, whatever their number.
 TEST_F(LiveFaults, CorruptFramesAreSkippedAndCounted) {
-  const CommandResult r = Run({{"ARVIEW_FAKE_CAMERA_CORRUPT_EVERY", "10"}}, 3.0);
+  const CommandResult r = Run({{"ARVIEW_FAKE_CAMERA_CORRUPT_EVERY", "10"}}, 3.0 * testing::kSanitizerSlowdown);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json stats = nlohmann::json::parse(ReadWholeFile(Stats().string()));
-  EXPECT_GE(stats["source"]["corrupt_skipped"].get<int>(), 5) << stats["source"];
+  const int corrupt = stats["source"]["corrupt_skipped"].get<int>();
+  const int sent = stats["frames_read"].get<int>() + corrupt + stats["source"]["driver_dropped"].get<int>() +
+                   stats["source"]["stale_skipped"].get<int>();
+  EXPECT_GE(corrupt, 2) << stats["source"];
+  EXPECT_NEAR(corrupt, sent / 10.0, 1.0) << sent << " frames sent: " << stats["source"];
   EXPECT_TRUE(std::regex_search(r.out, std::regex(R"(camera: \d+ dropped by the driver, [1-9]\d* corrupt)"))) << r.out;
   ExpectOutputsComplete("");
 }

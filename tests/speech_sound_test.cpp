@@ -27,6 +27,7 @@
 #include "tests/support/emulated_camera.h"
 #include "tests/support/emulated_sound.h"
 #include "tests/support/graffiti_map.h"
+#include "tests/support/probe_video.h"
 #include "tests/support/run_command.h"
 #include "tests/support/test_data.h"
 #include "tracker/test_planar_scene.h"
@@ -37,6 +38,7 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CommandResult;
 using testing::ShellQuote;
+using testing::StreamDuration;
 
 constexpr int kRate = 16000;
 
@@ -57,17 +59,6 @@ std::vector<std::int16_t> DecodeAudio(const fs::path& video, const fs::path& dir
   std::vector<std::int16_t> samples(bytes.size() / 2);
   std::memcpy(samples.data(), bytes.data(), samples.size() * 2);
   return samples;
-}
-
-// ffprobe's duration of the file's first stream of `type` (video, audio); < 0: none.
-double StreamDuration(const fs::path& video, const std::string& type, const fs::path& dir) {
-  const fs::path out = dir / ("probe_" + type + ".txt");
-  const std::string cmd = "ffprobe -v error -select_streams " + type.substr(0, 1) +
-                          ":0 -show_entries stream=duration -of csv=p=0 " + ShellQuote(video.string()) + " >" +
-                          ShellQuote(out.string());
-  if (std::system(cmd.c_str()) != 0) return -1;
-  const std::string text = testing::ReadWholeFile(out.string());
-  return text.empty() ? -1 : std::stod(text);
 }
 
 // The audio's RMS over one frame's length centred at `t` seconds.

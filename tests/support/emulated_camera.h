@@ -21,12 +21,15 @@ inline constexpr const char* kEmulatedCamera = "/dev/video-arview-fake";
 
 // `env`: the emulated camera's settings (ARVIEW_FAKE_CAMERA_*). `pause` (seconds after the
 // start, for how long): the process is stopped in between (SIGSTOP), as a reader that falls
-// behind the camera. `interrupt_after` > 0: Ctrl-C (SIGINT) after that many seconds, as a user
+// behind the camera. With `pause_after_file`, the seconds count from when that file appears
+// (e.g. a recording's fifth frame: the camera streams, however long the start-up took under a
+// sanitizer; 60 s at most). `interrupt_after` > 0: Ctrl-C (SIGINT) after that many seconds, as a user
 // ends `run`. Its stdout, stderr and exit status go through files in `dir`.
 inline CommandResult RunWithEmulatedCamera(const std::vector<std::string>& args,
                                            const std::map<std::string, std::string>& env,
                                            const std::filesystem::path& dir, std::pair<double, double> pause = {0, 0},
-                                           double interrupt_after = 0) {
+                                           double interrupt_after = 0,
+                                           const std::filesystem::path& pause_after_file = {}) {
   const char* bin = std::getenv("ARVIEW_BIN");
   std::string cmd = "LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
                     " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\"";
@@ -40,7 +43,11 @@ inline CommandResult RunWithEmulatedCamera(const std::vector<std::string>& args,
   const std::filesystem::path out = dir / "cmd.out", err = dir / "cmd.err", code = dir / "cmd.code";
   cmd += " >" + ShellQuote(out.string()) + " 2>" + ShellQuote(err.string()) + " </dev/null";
   if (pause.second > 0) {
-    cmd = "{ " + cmd + " & pid=$!; sleep " + std::to_string(pause.first) + "; kill -STOP $pid; sleep " +
+    const std::string wait_for_file =
+        pause_after_file.empty()
+            ? ""
+            : "for i in $(seq 600); do [ -e " + ShellQuote(pause_after_file.string()) + " ] && break; sleep 0.1; done; ";
+    cmd = "{ " + cmd + " & pid=$!; " + wait_for_file + "sleep " + std::to_string(pause.first) + "; kill -STOP $pid; sleep " +
           std::to_string(pause.second) + "; kill -CONT $pid; wait $pid; echo $? >" + ShellQuote(code.string()) + "; }";
   } else {
     cmd = "{ " + cmd + "; echo $? >" + ShellQuote(code.string()) + "; }";

@@ -609,15 +609,23 @@ void Camera::StopProducer() {
 }
 
 // Every picture's payload into the cache, in playing order, 16 at a time on all cores, until
-// the cache is full.
+// the cache is full. The batch's threads are this library's own, joined before the payloads are
+// read: with cv::parallel_for_, TBB's workers handed them over by synchronization that TSan does
+// not see (libtbb is not instrumented), and the producer's copy was reported as a race.
 void Camera::Preload() {
   constexpr size_t kBatch = 16;
+  const size_t threads = std::max(1u, std::thread::hardware_concurrency());
   for (size_t first = 0; first < cache_.size(); first += kBatch) {
     std::vector<std::vector<uint8_t>> made(std::min(kBatch, cache_.size() - first));
-    cv::parallel_for_(cv::Range(0, static_cast<int>(made.size())),
-                      [&](const cv::Range& r) {
-                        for (int i = r.start; i < r.end; ++i) made[i] = MakePayload(first + i);
-                      });
+    std::atomic<size_t> next{0};
+    {
+      std::vector<std::jthread> makers;
+      for (size_t t = 0; t < std::min(threads, made.size()); ++t) {
+        makers.emplace_back([&] {
+          for (size_t i = next++; i < made.size(); i = next++) made[i] = MakePayload(first + i);
+        });
+      }
+    }  // joined
     for (size_t i = 0; i < made.size(); ++i) {
       if (!Cache(first + i, made[i])) return;
     }
