@@ -1,3 +1,10 @@
+// Tracker (tracker.h): construction, the per-frame Track() and the steps it runs in line (the
+// prior from flow and guided matching, the wide search, image alignment, relocalization, the
+// refinement on the full camera). Apart from it: the hand-off to the worker in
+// tracker_background.cpp, the flow in tracker_flow.cpp, guided matching's search in
+// guided_matching.cpp, the hidden points and the moving-track filter in tracker_hidden.cpp and
+// tracker_moving.cpp.
+
 #include "tracker/tracker.h"
 
 #include "tracker/brightness_match.h"
@@ -6,7 +13,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <future>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -66,6 +72,8 @@ Tracker::Tracker(const map::Map& map, const calib::Camera& camera, const Tracker
       point_keyframes_[obs.point].push_back(static_cast<std::uint32_t>(k));
 }
 
+Tracker::~Tracker() = default;  // worker_, destroyed first, finishes a running job
+
 void Tracker::WarmUp() {
   const cv::Mat blank(resolution_.work().Size(), CV_8U, cv::Scalar(0));
   const RelocalizationResult nothing = relocalizer_->Relocalize(blank);  // its own SIFT size
@@ -108,90 +116,6 @@ Tracker::PriorPose Tracker::PoseFromPrior(const Correspondences& c, AbsolutePose
     out.prior_dropped = true;
   }
   return out;
-}
-
-// A frame's guided features being extracted on a worker thread, with what matching them and
-// following them into a later frame needs of it.
-struct Tracker::Prefetch {
-  std::future<TrackingWorker::Extracted> extracted;  // run by worker_
-  std::int64_t frame = 0;  // frames_tracked_ of the frame
-  calib::Pose pose;        // its pose (working camera)
-  std::vector<cv::Mat> pyramid;
-  std::vector<std::uint32_t> tracked_points;  // its followed inliers' map points (covisibility)
-};
-
-// A relocalization running on the worker (TrackingOptions::background), and the frame it works on.
-struct Tracker::Recovery {
-  std::future<TrackingWorker::Relocalized> outcome;  // run by worker_
-  std::int64_t frame = 0;        // frames_tracked_ of the frame
-};
-
-namespace {
-template <typename T>
-bool Ready(const std::future<T>& future) {
-  return future.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
-}
-}  // namespace
-
-Tracker::~Tracker() = default;  // worker_, destroyed first, finishes a running job
-
-void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
-  const TrackingOptions& opt = options_.tracking;
-  if (opt.prefetch_below <= 0 || prefetch_ || recovery_ || result.status == TrackStatus::kLost) return;
-  // After a relocalization always: its inliers are relocalization's keypoints, which flow
-  // follows less exactly (relocalization_keypoints_followed_), and it may be followed only thinly.
-  const bool fresh_tracks_wanted = opt.background && result.status == TrackStatus::kRelocalized;
-  if (result.status != TrackStatus::kTracking && !fresh_tracks_wanted) return;
-  if (!fresh_tracks_wanted && static_cast<int>(last_inliers_.pixels.size()) >= opt.prefetch_below) return;
-  if (last_pyramid_.empty()) return;
-  auto prefetch = std::make_unique<Prefetch>();
-  prefetch->frame = frames_tracked_;
-  prefetch->pose = result.pose;
-  prefetch->pyramid = last_pyramid_;  // shares the images: the next frame builds its own
-  prefetch->tracked_points = last_inliers_.points;
-  prefetch->extracted = worker_->ExtractAhead(gray);
-  prefetch_ = std::move(prefetch);
-}
-
-int Tracker::UsePrefetch(const std::vector<cv::Mat>& pyramid, const calib::Pose& projecting, FrameResult* result,
-                         Correspondences* correspondences) {
-  const TrackingOptions& opt = options_.tracking;
-  const calib::Camera& camera = resolution_.work();
-  const std::unique_ptr<Prefetch> prefetch = std::move(prefetch_);
-  const TrackingWorker::Extracted extracted = prefetch->extracted.get();
-  result->keypoints = static_cast<int>(extracted.features.keypoints.size());
-  result->times.extract_ms += extracted.cpu_ms;
-  result->times.cpu_ms += extracted.cpu_ms;  // Track() adds its own thread's
-  const auto match_start = std::chrono::steady_clock::now();
-  // The map points the prefetched frame's neighbours see, projected with its own pose.
-  const std::vector<GuidedCandidate> candidates = GuidedCandidates(prefetch->pose, prefetch->tracked_points);
-  const auto matches = MatchGuided(extracted.features, candidates, map_, opt.guided_radius_px, opt.guided_ratio,
-                                     camera.Size());
-  // Followed from the prefetched frame into this one, started where this frame's pose puts them;
-  // only as many, spread over the picture, as the flow follows (LK costs ~10 us a point).
-  Track2D3D matched;
-  for (const auto& m : matches) {
-    matched.pixels.push_back(extracted.features.keypoints[m.keypoint].pt);
-    matched.points.push_back(m.point);
-  }
-  matched = SpreadTracks(matched, opt.max_flow_tracks, opt.flow_grid_cell_px, camera.Size());
-  std::vector<cv::Point2f> to;
-  std::vector<Eigen::Vector2d> expected;
-  for (size_t i = 0; i < matched.pixels.size(); ++i) {
-    const Eigen::Vector3d pc = projecting.ToCamera(map_.points[matched.points[i]].xyz);
-    const Eigen::Vector2d px = pc.z() > 0 ? camera.Project(pc) : Eigen::Vector2d(-1, -1);
-    expected.push_back(px);
-    to.push_back(camera.InImage(px) ? cv::Point2f(px.x(), px.y()) : matched.pixels[i]);
-  }
-  // A track that ends far from where the pose puts its point slid onto something else.
-  const int added = FollowIntoFrame(prefetch->pyramid, pyramid, matched.pixels, matched.points, std::move(to),
-                                    correspondences, [&](std::size_t i, const Eigen::Vector2d& px) {
-                                      return (px - expected[i]).norm() <= opt.guided_radius_predicted_px;
-                                    });
-  result->prefetched_matches = added;
-  result->guided_matches += added;
-  result->times.match_ms += MillisecondsSince(match_start);
-  return added;  // (the LK above is counted with the matching)
 }
 
 calib::Pose Tracker::Predict(double timestamp) const {
@@ -579,98 +503,6 @@ void Tracker::Remember(const FrameResult& result, double timestamp, const Track2
   has_pose_ = true;
   const TrackingOptions& opt = options_.tracking;
   last_inliers_ = SpreadTracks(DropDriftedTracks(inliers, result.pose), opt.max_flow_tracks, opt.flow_grid_cell_px, resolution_.work().Size());
-}
-
-Track2D3D Tracker::TrackWithoutWaiting(const cv::Mat& gray, double timestamp, FrameResult* result) {
-  Track2D3D inliers;
-  // 1. A relocalization the worker finished, followed into this frame.
-  if (recovery_ && Ready(recovery_->outcome)) {
-    if (FinishRecovery(gray, result, &inliers)) {
-      result->status = TrackStatus::kRelocalized;
-      return inliers;
-    }
-    inliers = {};
-  }
-  // 2. The prior: flow, and the guided matches extracted ahead when they are done.
-  if (has_pose_) {
-    const std::vector<cv::Mat> reference_pyramid = last_pyramid_;  // the last posed frame's (shared)
-    std::optional<Features> none;  // nothing is extracted on this thread
-    if (TrackWithPrior(gray, timestamp, result, &none, &inliers)) {
-      result->status = TrackStatus::kTracking;
-      result->reason.clear();
-      return inliers;
-    }
-    inliers = {};
-    // 3. A whip-pan: the rotation by image alignment while the worker relocalises.
-    if (TrackByAlignment(reference_pyramid, gray, timestamp, result)) {
-      result->status = TrackStatus::kTracking;
-      result->inliers = 0;
-      result->rms_px = 0;
-      StartRecovery(gray);
-      return inliers;
-    }
-  }
-  // 4. Lost: relocalised on the worker; this frame is not waited for.
-  StartRecovery(gray);
-  result->status = TrackStatus::kLost;
-  result->inliers = 0;
-  result->awaiting_relocalization = result->relocalization_failure == PoseFailure::kNone;
-  std::ostringstream msg;
-  msg << (result->reason.empty() ? "" : "; ") << "relocalization running in the background since "
-      << frames_tracked_ - recovery_->frame << " frame(s) ago";
-  result->reason += msg.str();
-  return inliers;
-}
-
-void Tracker::StartRecovery(const cv::Mat& gray) {
-  if (recovery_) return;
-  prefetch_.reset();  // its features would come after the relocalization's
-  auto recovery = std::make_unique<Recovery>();
-  recovery->frame = frames_tracked_;
-  recovery->outcome = worker_->Relocalize(gray);
-  recovery_ = std::move(recovery);
-}
-
-bool Tracker::FinishRecovery(const cv::Mat& gray, FrameResult* result, Track2D3D* inliers) {
-  const std::unique_ptr<Recovery> recovery = std::move(recovery_);
-  const TrackingWorker::Relocalized outcome = recovery->outcome.get();
-  const RelocalizationResult& reloc = outcome.relocalization;
-  result->keypoints = reloc.keypoints;
-  result->matches = reloc.matches;
-  result->times.extract_ms += reloc.extract_ms;  // the worker's
-  result->times.cpu_ms += outcome.cpu_ms;
-  result->relocalized_frames_ago = static_cast<int>(frames_tracked_ - recovery->frame);
-  if (!reloc.pose.ok) {
-    result->reason = "relocalization failed: " + reloc.pose.reason;
-    result->relocalization_failure = reloc.pose.failure;
-    return false;
-  }
-  // The relocalization's inliers followed from its frame into this one, started where they were:
-  // the camera moved little in the frames it took.
-  const auto flow_start = std::chrono::steady_clock::now();
-  std::vector<cv::Mat> pyramid = FlowPyramid(gray);
-  Correspondences c;
-  FollowIntoFrame(outcome.pyramid, pyramid, reloc.inliers.pixels, reloc.inliers.points, reloc.inliers.pixels, &c);
-  result->flow_tracks = static_cast<int>(c.pixels.size());
-  result->times.flow_ms += MillisecondsSince(flow_start);
-  AbsolutePoseOptions pose_options = TrackedPoseOptions(options_.tracking.ransac_max_iterations);
-  pose_options.max_rms_px = options_.relocalization.pose.max_rms_px;  // no recent tracked frames to gate by
-  pose_options.prior = reloc.pose.pose;
-  const AbsolutePoseResult pose = PoseFromPrior(c, pose_options, result).pose;
-  if (!pose.ok) {
-    std::ostringstream msg;
-    msg << "relocalised " << result->relocalized_frames_ago << " frame(s) before, its " << reloc.inliers.pixels.size()
-        << " inliers followed into this frame: " << pose.reason;
-    result->reason = msg.str();
-    return false;
-  }
-  result->pose = pose.pose;
-  for (int i : pose.inliers) {
-    inliers->pixels.emplace_back(c.pixels[i].x(), c.pixels[i].y());
-    inliers->points.push_back(c.point_ids[i]);
-  }
-  last_pyramid_ = std::move(pyramid);
-  return true;
 }
 
 void Tracker::NameRoom(FrameResult* result) const {
