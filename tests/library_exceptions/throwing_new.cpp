@@ -15,8 +15,11 @@
 extern "C" const char* __asan_default_options() { return "allocator_may_return_null=1"; }
 
 namespace {
+// ASan's malloc: null when the heap cannot meet the request. At least a byte: every new gives a
+// distinct address.
+void* TryAllocate(std::size_t bytes) noexcept { return std::malloc(bytes == 0 ? 1 : bytes); }
 void* Allocate(std::size_t bytes) {
-  if (void* block = std::malloc(bytes == 0 ? 1 : bytes)) return block;
+  if (void* block = TryAllocate(bytes)) return block;
   throw std::bad_alloc();
 }
 }  // namespace
@@ -24,8 +27,8 @@ void* Allocate(std::size_t bytes) {
 // The unaligned forms; the aligned ones (std::align_val_t) stay ASan's, new and delete alike.
 void* operator new(std::size_t bytes) { return Allocate(bytes); }
 void* operator new[](std::size_t bytes) { return Allocate(bytes); }
-void* operator new(std::size_t bytes, const std::nothrow_t&) noexcept { return std::malloc(bytes == 0 ? 1 : bytes); }
-void* operator new[](std::size_t bytes, const std::nothrow_t&) noexcept { return std::malloc(bytes == 0 ? 1 : bytes); }
+void* operator new(std::size_t bytes, const std::nothrow_t&) noexcept { return TryAllocate(bytes); }
+void* operator new[](std::size_t bytes, const std::nothrow_t&) noexcept { return TryAllocate(bytes); }
 void operator delete(void* block) noexcept { std::free(block); }
 void operator delete[](void* block) noexcept { std::free(block); }
 void operator delete(void* block, std::size_t) noexcept { std::free(block); }

@@ -5,10 +5,11 @@
 namespace arview::testing {
 
 // Under AddressSanitizer (the asan preset) arview runs several times slower: `run` had not shown
-// its first frame 3 s after its start, and a reader paused 1 s after its start was paused before
-// its camera streamed. Under ThreadSanitizer (the tsan preset) as much or more: Flite synthesized
-// a session dialogue's reply over 1 s late at load 16 (docs/reliability.md, "TSan on this
-// round's threads"). Tests that time a whole command scale their waits by this, or skip.
+// its first frame 3 s after its start. Under ThreadSanitizer (the tsan preset) as much or more:
+// Flite synthesized a session dialogue's reply over 1 s late at load 16 (docs/reliability.md,
+// "TSan on this round's threads"). Tests that time a whole command scale their waits by this;
+// where an event must fall at a point of the run, they wait for that point instead (a file it
+// writes: RunWithEmulatedCamera's pause_after_file).
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 inline constexpr double kSanitizerSlowdown = 5;
 #else
