@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "base/geometry.h"
-#include "base/plane_fit.h"
+#include "base/lowest_floor.h"
 #include "map/map.h"
 
 namespace arview::mapping {
@@ -18,11 +18,10 @@ namespace arview::mapping {
 // The keyframes' camera centres, in keyframe order.
 std::vector<Eigen::Vector3d> Centres(const map::Map& map);
 
-// The floor: a plane near-perpendicular to the cameras' up, its normal turned towards the cameras.
-// The dominant plane of all the points first; then, while the points below the plane found
-// (along up) hold another plane of at least kFloorShareOfPoints of the points, that one, so that
-// the search goes down to the lowest dense plane. `below` receives the fraction of the points
-// more than three inlier distances under the floor returned.
+// The floor: base/lowest_floor.h's FindLowestFloor on the map's points and keyframes (the lowest
+// dense plane near-perpendicular to the cameras' up, its normal turned towards them). `below`
+// receives the fraction of the points more than three inlier distances under it. Throws
+// map::MapError ("no floor found in the map's points: ...").
 Plane FindFloor(const map::Map& map, double* below = nullptr);
 
 // The frame standing on `floor`: z its normal, the origin below the cameras' mean centre, x the

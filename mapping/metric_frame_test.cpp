@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "base/plane_fit.h"
+#include "tests/support/textured_room.h"
 
 namespace arview::mapping {
 namespace {
@@ -215,36 +216,25 @@ TEST(MetricFrame, TheCameraHeightEstimateIsStatedWithItsError) {
   EXPECT_THROW(FitFromCameraHeight(no_floor), map::MapError);
 }
 
-// A room of 5 x 4 m as the rendered venue's (docs/mapping.md, "Metric scale and up"): walls
-// textured densely from 0.55 to 2.45 m, a floor with few points, the camera turning round the
-// room at `heights` (one keyframe each, in turn) on a ring of 0.6 m, looking at the walls. Moved
-// into COLMAP's arbitrary frame as MakeScene's.
+// tests/support/textured_room.h's room as a map, moved into COLMAP's arbitrary frame as
+// MakeScene's.
 Scene MakeTexturedRoom(const std::vector<double>& heights, int floor_points = 120) {
+  const testing::TexturedRoom room = testing::MakeTexturedRoom(heights, floor_points);
   Scene s = MakeScene();
   s.map.keyframes.clear();
   s.map.points.clear();
-  for (std::size_t k = 0; k < 24; ++k) {
-    const double a = 2 * M_PI * static_cast<double>(k) / 24;
-    const Eigen::Vector3d centre(0.6 * std::cos(a), 0.6 * std::sin(a), heights[k % heights.size()]);
+  for (std::size_t k = 0; k < room.camera_centres.size(); ++k) {
     map::Keyframe kf;
     kf.name = "frames/" + std::to_string(k) + ".png";
-    const calib::Pose metric = LookAt(centre, centre + Eigen::Vector3d(std::cos(a), std::sin(a), -0.1));
+    const calib::Pose metric = LookAt(room.camera_centres[k], room.camera_targets[k]);
     kf.pose = calib::Pose::FromRigid(s.colmap_frame.TransformPose(metric.ToRigid()));
     s.map.keyframes.push_back(kf);
   }
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> x(-2.5, 2.5), y(-2, 2), z(0.55, 2.45), side(0, 1);
-  auto add = [&](const Eigen::Vector3d& metric) {
+  for (const Eigen::Vector3d& metric : room.points) {
     map::MapPoint p;
     p.xyz = s.colmap_frame(metric);
     s.map.points.push_back(p);
-  };
-  for (int i = 0; i < 6000; ++i) {
-    const bool long_wall = side(rng) < 5.0 / 9;
-    const double sign = side(rng) < 0.5 ? -1 : 1;
-    add(long_wall ? Eigen::Vector3d(x(rng), 2 * sign, z(rng)) : Eigen::Vector3d(2.5 * sign, y(rng), z(rng)));
   }
-  for (int i = 0; i < floor_points; ++i) add(Eigen::Vector3d(x(rng), y(rng), 0));
   return s;
 }
 

@@ -46,7 +46,7 @@ ScenePlacement PlaceCharacter(const map::Map& map, const std::filesystem::path& 
   placed.name = authoring::IsBuiltinAsset(asset) ? asset.string().substr(std::string(authoring::kBuiltinAssetPrefix).size())
                                             : asset.stem().string();
   placed.asset = asset;
-  placed.anchor = o.anchor ? *o.anchor : PlaceOnDominantPlane(points, centres, up_axes, height, options);
+  placed.anchor = o.anchor ? *o.anchor : PlaceOnFloor(points, centres, up_axes, height, options);
   // A metric map says how tall in metres; otherwise the fraction of the viewing distance stands.
   if (!o.anchor && map.frame.metric()) placed.anchor.scale = MetricHeight(o, height) / height;
   placed.rest_height = height;

@@ -1,6 +1,6 @@
 #pragma once
 // `arview place` as a function (the demo calls it too): a character from an asset, standing on
-// the dominant plane of a map, with look-at keys around it.
+// the floor of a map (its lowest dense plane), with look-at keys around it.
 
 #include <cstdint>
 #include <filesystem>
@@ -29,7 +29,7 @@ struct PlaceCharacterOptions {
   std::optional<double> key_elevation_deg;  // empty: the median elevation of the map's cameras
   std::uint64_t seed = 1;
   // Given: the character stands here (position, rotation and scale in map units) instead of on
-  // the dominant plane, e.g. where the demo's walk circles; the keys are still fitted to the
+  // the floor found, e.g. where the demo's walk circles; the keys are still fitted to the
   // map's cameras.
   std::optional<Anchor> anchor;
   // Given: the character then moves on its floor to stand where `stand_at` (map units) falls on

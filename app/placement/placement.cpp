@@ -23,20 +23,23 @@ Eigen::Quaterniond UprightFacing(const Eigen::Vector3d& up, const Eigen::Vector3
 
 }  // namespace
 
-Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
+Anchor PlaceOnFloor(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_centres,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
                             const PlacementOptions& o) {
   if (camera_centres.empty()) throw PlacementError("the map has no registered cameras");
   if (!(character_height > 0)) throw PlacementError("the character has no height (empty or flat bind pose)");
-  Eigen::Vector3d camera_up;
-  const Plane plane = [&] {
+  // The lowest dense plane, not the densest: a slice through densely textured walls, or a table,
+  // can hold more points than the floor.
+  const LowestFloor found = [&] {
     try {
-      return FitFloorUnderCameras(points, camera_centres, camera_up_axes, o.plane, &camera_up);
+      return FindLowestFloor(points, camera_centres, camera_up_axes, o.plane);
     } catch (const Error& e) {  // the map's points, said as a placement error (the caller names the map)
       throw PlacementError(e.what());
     }
   }();
+  const Plane& plane = found.floor;
+  const Eigen::Vector3d& camera_up = found.up;
 
   // Stand at the median of the plane's inliers near the middle, projected onto the plane.
   const Eigen::Vector3d middle = ComponentMedian(points);

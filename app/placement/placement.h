@@ -1,7 +1,7 @@
 #pragma once
-// Where a character stands in a map: the dominant plane of the map's points near the middle of
-// the scene (RANSAC), the character's up along the plane normal towards the cameras, facing the
-// first keyframe, scaled to the scene.
+// Where a character stands in a map: on the floor under the cameras (the lowest dense plane of the
+// map's points, base/lowest_floor.h), the character's up along the plane normal towards the
+// cameras, facing the first keyframe, scaled to the scene.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -10,6 +10,7 @@
 
 #include "base/error.h"
 #include "base/geometry.h"
+#include "base/lowest_floor.h"
 #include "base/plane_fit.h"
 
 namespace arview::app {
@@ -30,8 +31,9 @@ struct PlacementOptions {
 
 // Character frame convention (glTF): +Y up, +Z forward (the direction the character faces).
 // `character_height` is the height of the character's bind pose in its own units. The floor is
-// the dominant plane among those within options.plane.max_tilt_deg of UpFromCameras().
-Anchor PlaceOnDominantPlane(const std::vector<Eigen::Vector3d>& points,
+// FindLowestFloor's: the lowest dense plane within options.plane.max_tilt_deg of
+// UpFromCameras().
+Anchor PlaceOnFloor(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& camera_centres,
                             const std::vector<Eigen::Vector3d>& camera_up_axes, double character_height,
                             const PlacementOptions& options);

@@ -2,6 +2,7 @@
 #include "app/placement/place_character.h"
 #include "figure/humanoid.h"
 #include "tests/support/test_data.h"
+#include "tests/support/textured_room.h"
 
 #include <gtest/gtest.h>
 
@@ -42,7 +43,7 @@ TEST(Placement, FindsTheDominantPlaneDespiteClutter) {
 TEST(Placement, UpPointsTowardsTheCamerasAndFacesTheFirstOne) {
   for (bool below : {false, true}) {
     const Scene s = MakeScene(below);
-    const Anchor a = PlaceOnDominantPlane(s.points, s.cameras, {}, 1.8, {});
+    const Anchor a = PlaceOnFloor(s.points, s.cameras, {}, 1.8, {});
     const Eigen::Matrix3d r = a.rotation.toRotationMatrix();
     const Eigen::Vector3d up = r.col(1);
     EXPECT_GT(up.dot(below ? -s.normal : s.normal), 0.999);
@@ -63,7 +64,7 @@ TEST(Placement, TheCamerasRingTellsTheFloorFromAWall) {
   std::uniform_real_distribution<double> u(-1, 1);
   const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
   for (int i = 0; i < 2500; ++i) s.points.push_back(tilt * Eigen::Vector3d(0.3, u(rng), 1 + u(rng)) + Eigen::Vector3d(5, 0, 0));
-  const Anchor a = PlaceOnDominantPlane(s.points, s.cameras, {}, 1.8, {});
+  const Anchor a = PlaceOnFloor(s.points, s.cameras, {}, 1.8, {});
   EXPECT_GT((a.rotation * Eigen::Vector3d::UnitY()).dot(s.normal), 0.99);
   EXPECT_GT(UpFromCameras(s.cameras, {}).cwiseAbs().dot(s.normal.cwiseAbs()), 0.99);
 }
@@ -73,7 +74,7 @@ TEST(Placement, DegenerateInputsAreClearErrors) {
   std::vector<Eigen::Vector3d> line;
   for (int i = 0; i < 50; ++i) line.emplace_back(i, 0, 0);
   EXPECT_THROW(FitDominantPlane(line, {}), arview::Error);
-  EXPECT_THROW(PlaceOnDominantPlane(MakeScene(false).points, {}, {}, 1.0, {}), PlacementError);
+  EXPECT_THROW(PlaceOnFloor(MakeScene(false).points, {}, {}, 1.0, {}), PlacementError);
 }
 
 }  // namespace
@@ -195,6 +196,25 @@ TEST(PlaceCharacterAt, IsTheFloorsPlacementMovedOnTheFloor) {
   Eigen::Vector3d to_facing = *o.facing - at.anchor.position;
   to_facing -= to_facing.dot(up) * up;
   EXPECT_NEAR((at.anchor.rotation * Eigen::Vector3d::UnitZ()).dot(to_facing.normalized()), 1, 1e-9);
+}
+
+}  // namespace
+}  // namespace arview::app
+
+namespace arview::app {
+namespace {
+
+// A room whose walls are textured densely and whose floor is plain (the rendered venue's): the
+// character stands on the floor, not on the slice through the walls that is the dominant plane
+// near-perpendicular to up (base/lowest_floor.h).
+TEST(Placement, StandsOnThePlainFloorOfARoomWithDenselyTexturedWalls) {
+  const testing::TexturedRoom room = testing::MakeTexturedRoom({1.5});
+  const Anchor a = PlaceOnFloor(room.points, room.camera_centres, room.camera_up_axes, 1.8, {});
+  EXPECT_NEAR(a.position.z(), 0, 0.02) << "stood at " << a.position.transpose();
+  EXPECT_GT((a.rotation * Eigen::Vector3d::UnitY()).z(), 0.999);
+  // Inside the room, on its floor.
+  EXPECT_LT(std::abs(a.position.x()), 2.5);
+  EXPECT_LT(std::abs(a.position.y()), 2.0);
 }
 
 }  // namespace
