@@ -24,12 +24,16 @@ inline constexpr const char* kEmulatedCamera = "/dev/video-arview-fake";
 // behind the camera. With `pause_after_file`, the seconds count from when that file appears
 // (e.g. a recording's fifth frame: the camera streams, however long the start-up took under a
 // sanitizer; 60 s at most). `interrupt_after` > 0: Ctrl-C (SIGINT) after that many seconds, as a user
-// ends `run`. Its stdout, stderr and exit status go through files in `dir`.
+// ends `run`; with `interrupt_after_text`, the seconds count from when the command's stderr first
+// holds that text (the first localized view's line: the session reached its point however slowly
+// a loaded machine started it; 60 s at most). Its stdout, stderr and exit status go through
+// files in `dir`.
 inline CommandResult RunWithEmulatedCamera(const std::vector<std::string>& args,
                                            const std::map<std::string, std::string>& env,
                                            const std::filesystem::path& dir, std::pair<double, double> pause = {0, 0},
                                            double interrupt_after = 0,
-                                           const std::filesystem::path& pause_after_file = {}) {
+                                           const std::filesystem::path& pause_after_file = {},
+                                           const std::string& interrupt_after_text = {}) {
   const char* bin = std::getenv("ARVIEW_BIN");
   std::string cmd = "LD_PRELOAD=" + ShellQuote(ARVIEW_FAKE_V4L2_LIBRARY) +
                     " ASAN_OPTIONS=\"$ASAN_OPTIONS:verify_asan_link_order=0\"";
@@ -37,12 +41,19 @@ inline CommandResult RunWithEmulatedCamera(const std::vector<std::string>& args,
   // --preserve-status: the exit status is arview's, not timeout's 124. --foreground: the signal
   // goes to arview alone; without it timeout signals its whole process group too, and arview,
   // getting SIGINT twice, takes the second for a user's second Ctrl-C and dies at once.
-  if (interrupt_after > 0) cmd += " timeout --foreground --preserve-status -s INT " + std::to_string(interrupt_after);
+  const bool interrupt_after_text_seen = interrupt_after > 0 && !interrupt_after_text.empty();
+  if (interrupt_after > 0 && !interrupt_after_text_seen)
+    cmd += " timeout --foreground --preserve-status -s INT " + std::to_string(interrupt_after);
   cmd += " " + ShellQuote(bin ? bin : "arview");
   for (const std::string& a : args) cmd += " " + ShellQuote(a);
   const std::filesystem::path out = dir / "cmd.out", err = dir / "cmd.err", code = dir / "cmd.code";
   cmd += " >" + ShellQuote(out.string()) + " 2>" + ShellQuote(err.string()) + " </dev/null";
-  if (pause.second > 0) {
+  if (interrupt_after_text_seen) {
+    // SIGINT to arview alone (its pid: the job is the one simple command), as timeout --foreground.
+    cmd = "{ " + cmd + " & pid=$!; for i in $(seq 600); do grep -qF -- " + ShellQuote(interrupt_after_text) + " " +
+          ShellQuote(err.string()) + " && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done; sleep " +
+          std::to_string(interrupt_after) + "; kill -INT $pid 2>/dev/null; wait $pid; echo $? >" + ShellQuote(code.string()) + "; }";
+  } else if (pause.second > 0) {
     const std::string wait_for_file =
         pause_after_file.empty()
             ? ""
