@@ -25,13 +25,7 @@
 #include <cstddef>
 #include <memory>
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define ARVIEW_SANITIZED_ALLOCATOR 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define ARVIEW_SANITIZED_ALLOCATOR 1
-#endif
-#endif
+#include "base/sanitizer_build.h"  // ARVIEW_SANITIZED_ALLOCATOR: whether malloc is counted through the sanitizer's hooks
 
 namespace {
 std::atomic<long> g_allocations{0};

@@ -6,14 +6,10 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "base/sanitizer_build.h"
+
 namespace arview {
 namespace {
-
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizedAllocator = true;
-#else
-constexpr bool kSanitizedAllocator = false;
-#endif
 
 // A block of the size of SIFT's scale-space images and of a full-HD frame comes from the heap
 // and, freed, stays in it for the next frame. With glibc's defaults (in a fresh process) it is

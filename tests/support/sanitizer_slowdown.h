@@ -2,6 +2,8 @@
 // How much slower the code under test runs in a sanitizer build, for tests that time a whole
 // command or pace frames against a thread of the code's own.
 
+#include "base/sanitizer_build.h"
+
 namespace arview::testing {
 
 // Under AddressSanitizer (the asan preset) arview runs several times slower: `run` had not shown
@@ -10,10 +12,6 @@ namespace arview::testing {
 // "TSan on this round's threads"). Tests that time a whole command scale their waits by this;
 // where an event must fall at a point of the run, they wait for that point instead (a file it
 // writes: RunWithEmulatedCamera's pause_after_file).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-inline constexpr double kSanitizerSlowdown = 5;
-#else
-inline constexpr double kSanitizerSlowdown = 1;
-#endif
+inline constexpr double kSanitizerSlowdown = kSanitizedAllocator ? 5 : 1;
 
 }  // namespace arview::testing
