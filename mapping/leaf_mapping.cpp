@@ -54,8 +54,12 @@ Command TriangulateCommand(const MapBuildOptions& options, const LeafMappingPath
   const std::string refine = RefineFlag(options);
   return {"point_triangulator", "--database_path", paths.database.string(), "--image_path",
           paths.image_root.string(), "--input_path", in.string(), "--output_path", out.string(),
-          // Tracks from the database's matches again: the leaves' tracks of a shared image disagree.
-          "--clear_points", "1", "--Mapper.num_threads", std::to_string(options.threads),
+          // The leaves' own points kept (model_merger joined their tracks in the shared frames)
+          // and completed from the database's matches: re-triangulated from the matches instead,
+          // then adjusted, templeRing's keyframes came out 10-25 % further from the ground truth,
+          // and the single mapper's own model as far (docs/mapping.md, "The merge keeps the
+          // leaves' points").
+          "--clear_points", "0", "--Mapper.num_threads", std::to_string(options.threads),
           "--Mapper.ba_refine_focal_length", refine, "--Mapper.ba_refine_principal_point", refine,
           "--Mapper.ba_refine_extra_params", refine};
 }
