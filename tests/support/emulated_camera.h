@@ -41,14 +41,14 @@ inline CommandResult RunWithEmulatedCamera(const std::vector<std::string>& args,
   // --preserve-status: the exit status is arview's, not timeout's 124. --foreground: the signal
   // goes to arview alone; without it timeout signals its whole process group too, and arview,
   // getting SIGINT twice, takes the second for a user's second Ctrl-C and dies at once.
-  const bool interrupt_after_text_seen = interrupt_after > 0 && !interrupt_after_text.empty();
-  if (interrupt_after > 0 && !interrupt_after_text_seen)
+  const bool interrupt_counts_from_text = interrupt_after > 0 && !interrupt_after_text.empty();
+  if (interrupt_after > 0 && !interrupt_counts_from_text)
     cmd += " timeout --foreground --preserve-status -s INT " + std::to_string(interrupt_after);
   cmd += " " + ShellQuote(bin ? bin : "arview");
   for (const std::string& a : args) cmd += " " + ShellQuote(a);
   const std::filesystem::path out = dir / "cmd.out", err = dir / "cmd.err", code = dir / "cmd.code";
   cmd += " >" + ShellQuote(out.string()) + " 2>" + ShellQuote(err.string()) + " </dev/null";
-  if (interrupt_after_text_seen) {
+  if (interrupt_counts_from_text) {
     // SIGINT to arview alone (its pid: the job is the one simple command), as timeout --foreground.
     cmd = "{ " + cmd + " & pid=$!; for i in $(seq 600); do grep -qF -- " + ShellQuote(interrupt_after_text) + " " +
           ShellQuote(err.string()) + " && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done; sleep " +
