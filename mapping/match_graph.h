@@ -46,7 +46,8 @@ struct Partition {
 };
 
 // Recursive bisection with METIS (edge weights = inliers) until every leaf holds at most
-// options.leaf_size vertices, then the overlap. A graph of at most leaf_size vertices is one leaf.
+// options.leaf_size vertices, each connected part of a subgraph bisected apart (a part of fewer
+// than 10 vertices goes with the largest), then the overlap. A graph of at most leaf_size vertices is one leaf.
 // Deterministic (METIS's seed is fixed). Throws MapError when METIS fails or the options are
 // out of range.
 Partition PartitionMatchGraph(const MatchGraph& graph, const PartitionOptions& options);

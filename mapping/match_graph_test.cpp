@@ -87,6 +87,43 @@ TEST(MatchGraph, AGraphWithoutEdgesIsStillSplit) {
   }
 }
 
+// Rooms recorded apart that never matched each other: chains of frames, each matched with its
+// next two.
+MatchGraph UnmatchedChains(const std::vector<int>& sizes) {
+  MatchGraph g;
+  int first = 0;
+  for (const int size : sizes) {
+    for (int v = first; v < first + size; ++v) {
+      g.names.push_back("frame_" + std::to_string(v) + ".png");
+      for (int next = v + 1; next <= v + 2 && next < first + size; ++next) g.edges.push_back({v, next, 200});
+    }
+    first += size;
+  }
+  return g;
+}
+
+TEST(MatchGraph, ALeafNeverHoldsFramesThatShareNoMatch) {
+  // Balanced halves of 100 would put 20 frames of the 40-chain with each 30-chain.
+  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 30, 40}), {50, 0});
+  ASSERT_EQ(p.leaves.size(), 3u);
+  ExpectEveryVertexInOneCore(p, 100);
+  std::multiset<std::size_t> sizes;
+  for (const auto& leaf : p.leaves) {
+    sizes.insert(leaf.core.size());
+    const auto [low, high] = std::minmax_element(leaf.core.begin(), leaf.core.end());
+    EXPECT_EQ(static_cast<std::size_t>(*high - *low + 1), leaf.core.size()) << "a leaf of two chains";
+  }
+  EXPECT_EQ(sizes, (std::multiset<std::size_t>{30, 30, 40}));
+  EXPECT_EQ(p.cut_weight, 0);
+}
+
+TEST(MatchGraph, APartTooSmallToMapAloneGoesWithTheLargest) {
+  // 4 frames that matched nothing else: alone, COLMAP's mapper would keep no model of them.
+  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 4}), {40, 0});
+  ASSERT_EQ(p.leaves.size(), 1u);
+  EXPECT_EQ(p.leaves[0].core.size(), 34u);
+}
+
 TEST(MatchGraph, RefusesALeafOfOneImage) {
   try {
     PartitionMatchGraph(InterleavedCliques(3), {1, 0});
