@@ -43,10 +43,15 @@ struct Track2D3D {
   std::vector<std::uint32_t> points;
 };
 
-// AbsolutePoseOptions with relocalization's RANSAC threshold (RelocalizerOptions::pose).
+// AbsolutePoseOptions with relocalization's RANSAC threshold and refinement (RelocalizerOptions::pose).
 inline AbsolutePoseOptions RelocalizationPoseOptions() {
   AbsolutePoseOptions options;
   options.ransac_threshold_px = 2.0;
+  // The Cauchy loss bends at 1 px, as in COLMAP's image registration: a relocalised pose has no
+  // flow behind it, and on still photos (Herz-Jesus-P25, three maps) the median centre error
+  // fell 9.12 -> 8.51 mm against 2 px, phone-fox's and templeRing's too (docs/tracker.md,
+  // "Herz-Jesus-P25"). Tracked frames keep TrackingOptions::refine_loss_scale_px.
+  options.refinement.loss_scale_px = 1.0;
   return options;
 }
 

@@ -333,6 +333,7 @@ AbsolutePoseOptions Tracker::TrackedPoseOptions(int ransac_iterations) const {
   AbsolutePoseOptions pose_options = options_.relocalization.pose;
   pose_options.ransac_max_iterations = ransac_iterations;
   pose_options.ransac_threshold_px = opt.ransac_threshold_px;
+  pose_options.refinement.loss_scale_px = opt.refine_loss_scale_px;
   pose_options.min_inliers = opt.min_inliers;
   pose_options.max_rms_px = rms_gate_.Gate();
   pose_options.seed += frame_counter_;
@@ -455,8 +456,10 @@ void Tracker::RefineOnFullCamera(const Track2D3D& inliers, FrameResult* result) 
     pixels.push_back(resolution_.ToFull({inliers.pixels[i].x, inliers.pixels[i].y}));
     points.push_back(map_.points[inliers.points[i]].xyz);
   }
+  // The loss of the step that posed the frame, in full-resolution pixels.
   RefineOptions refine = options_.relocalization.pose.refinement;
-  refine.loss_scale_px *= resolution_.full_per_work();  // the same loss, in full-resolution pixels
+  if (result->status == TrackStatus::kTracking) refine.loss_scale_px = options_.tracking.refine_loss_scale_px;
+  refine.loss_scale_px *= resolution_.full_per_work();
   const RefineResult refined = RefinePose(resolution_.full(), pixels, points, result->pose, refine);
   if (refined.ok) result->pose = refined.pose;
   result->times.refine_ms += MillisecondsSince(start);

@@ -101,6 +101,9 @@ struct TrackingOptions {
   // RANSAC's inlier threshold when tracking and in the wide search (relocalization has its own):
   // the correspondences come from flow and guided matching on a moving, often blurred camera.
   double ransac_threshold_px = 4.0;
+  // Where the Cauchy loss of a tracked frame's refinement bends (relocalization has its own,
+  // RelocalizerOptions::pose.refinement): flow and guided matches on a moving camera.
+  double refine_loss_scale_px = 2.0;
   // A RANSAC pose turned further than this from the prediction is refused (a P3P solution
   // mirrored on a nearly planar patch explains the points almost as well as the true one).
   double max_rotation_from_prediction_deg = 20;

@@ -40,6 +40,7 @@ void AbsolutePoseOptions::Check(const OptionNames& names) const {
                 "in (0, 1)", ransac_success_probability);
   RequireOption(prior_loss_scale_px > 0, names("prior_loss_scale_px"), "above 0", prior_loss_scale_px);
   RequireOption(inlier_threshold_px > 0, names("inlier_threshold_px"), "above 0", inlier_threshold_px);
+  RequireOption(refinement.loss_scale_px > 0, names("refinement.loss_scale_px"), "above 0", refinement.loss_scale_px);
   // Six degrees of freedom, two residuals a point.
   RequireOption(min_inliers >= 3, names("min_inliers"), "at least 3", min_inliers);
   RequireOption(max_rms_px > 0, names("max_rms_px"), "above 0", max_rms_px);
@@ -83,6 +84,7 @@ void TrackingOptions::Check(const OptionNames& names) const {
   }
   RequireOption(ransac_max_iterations >= 1, names("ransac_max_iterations"), "at least 1", ransac_max_iterations);
   RequireOption(ransac_threshold_px > 0, names("ransac_threshold_px"), "above 0", ransac_threshold_px);
+  RequireOption(refine_loss_scale_px > 0, names("refine_loss_scale_px"), "above 0", refine_loss_scale_px);
   RequireOption(min_inliers >= 3, names("min_inliers"), "at least 3", min_inliers);
   RequireOption(wide_radius_fraction >= 0, names("wide_radius_fraction"), "0 (off) or more", wide_radius_fraction);
   RequireRatio(wide_ratio, names("wide_ratio"));

@@ -278,6 +278,13 @@ void AddTrackCommand(CLI::App& app) {
   f.Add(cmd, "--inlier-threshold", ARVIEW_OPTION_FIELD(o, relocalization.pose.inlier_threshold_px),
         "Inlier threshold after refinement (the inliers counted, followed and gated), working pixels")
       ->check(CLI::Range(0.1, 50.0));
+  f.Add(cmd, "--refine-loss-scale", ARVIEW_OPTION_FIELD(o, relocalization.pose.refinement.loss_scale_px),
+        "Where the Cauchy loss of a relocalization's refinement bends, working pixels (COLMAP's image "
+        "registration's; 2 until 2026-12-07, what tracked frames keep: --tracking-refine-loss-scale)")
+      ->check(CLI::Range(0.1, 50.0));
+  f.Add(cmd, "--tracking-refine-loss-scale", ARVIEW_OPTION_FIELD(o, tracking.refine_loss_scale_px),
+        "Where the Cauchy loss of a tracked frame's refinement bends, working pixels")
+      ->check(CLI::Range(0.1, 50.0));
   f.Add(cmd, "--ransac-iterations", ARVIEW_OPTION_FIELD(o, relocalization.pose.ransac_max_iterations),
         "RANSAC iterations when relocalising")
       ->check(CLI::Range(1, 1000000));
