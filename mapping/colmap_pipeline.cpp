@@ -245,7 +245,7 @@ class MapBuild {
                read_moved_model, &result_);
     if (self_calibrate_) {
       if (cb_.note) cb_.note(RefinedCameraNote(start_camera_, result_.map.camera));
-      for (const std::string& problem : ImplausibleIntrinsics(result_.map.camera)) result_.check.warnings.push_back(problem);
+      for (const std::string& problem : ImplausibleIntrinsics(result_.map.camera)) result_.check.warnings.push_back("is self-calibrated implausibly: " + problem);
       WriteRefinedCamera(start_camera_, result_.map.camera, out_dir_);
     }
     NameRooms(options_.rooms, &result_.map);

@@ -255,16 +255,21 @@ void AddWarnings(MapCheck& c, const MapCheckLimits& limits) {
         " px) while the map's points move between the frames, so the camera path is the object's motion, not the "
         "camera's. Record again moving the camera through a still scene, with moving things out of view");
   if (c.extent_ratio < limits.min_extent_ratio)
-    c.warnings.push_back("the camera path spans " + Percent(c.extent_ratio) +
+    c.warnings.push_back("has a camera path spanning " + Percent(c.extent_ratio) +
                          " of the scene's depth: looks like a still camera, or one that only turned, and the map's "
                          "depth is guessed. Record again moving the camera sideways by a tenth of its distance to "
                          "the scene or more");
+  if (c.extent_ratio > limits.max_extent_ratio)
+    c.warnings.push_back("has a camera path spanning " + Fixed(c.extent_ratio, 0) +
+                         " times the scene's depth: its points sit next to the cameras that see them, a model "
+                         "COLMAP let collapse, whose poses are wrong. Map again with --matcher exhaustive, or the "
+                         "recording in shorter parts (--frames)");
   if (c.median_triangulation_deg < limits.min_triangulation_deg)
-    c.warnings.push_back("the map's points are triangulated from rays a median " + Fixed(c.median_triangulation_deg, 2) +
+    c.warnings.push_back("has its points triangulated from rays a median " + Fixed(c.median_triangulation_deg, 2) +
                          " degrees apart: their depth is poorly determined. Move the camera further between the "
                          "frames (or give COLMAP more widely spaced frames with --frames)");
   if (c.explained_fraction < limits.min_explained_fraction)
-    c.warnings.push_back("the map explains only " + Percent(c.explained_fraction) +
+    c.warnings.push_back("explains only " + Percent(c.explained_fraction) +
                          " of the frames' features: the scene changed while it was filmed, or most of what was "
                          "filmed moved. Record a still scene");
   if (Folded(c, limits)) c.warnings.push_back(FoldWarning(c, limits));

@@ -106,16 +106,27 @@ TEST(MapCheck, ACameraThatNeverMovedIsFlagged) {
   // 2 mm of travel at 5 units' depth (COLMAP's model of a tripod shot fits noise).
   const Scene s = MovingCameraScene(SidewaysPath(12, 0.002), 400, 400);
   const MapCheck c = CheckMap(s.map, s.keypoints);
-  EXPECT_TRUE(HasWarning(c, "the camera path spans")) << DescribeMapCheck(c);
+  EXPECT_TRUE(HasWarning(c, "has a camera path spanning")) << DescribeMapCheck(c);
   EXPECT_TRUE(HasWarning(c, "triangulated from rays a median")) << DescribeMapCheck(c);
   EXPECT_LT(c.extent_ratio, 0.001);
   EXPECT_EQ(c.moving_pairs, 0) << "no pair moves its points by 2 px";
 }
 
+TEST(MapCheck, AModelWhosePointsSitNextToItsCamerasIsFlagged) {
+  // 10,000 units of path over points 5 units from the cameras: 2,000 x the scene's depth.
+  const Scene s = MovingCameraScene(SidewaysPath(12, 10000), 400, 400);
+  const MapCheck c = CheckMap(s.map, s.keypoints);
+  EXPECT_GT(c.extent_ratio, 1000);
+  EXPECT_TRUE(HasWarning(c, "times the scene's depth: its points sit next to the cameras")) << DescribeMapCheck(c);
+  // A long walk past its scene is not: 100 units over 5 (a corridor).
+  const MapCheck corridor = CheckMap(MovingCameraScene(SidewaysPath(12, 100), 400, 400).map, {});
+  EXPECT_FALSE(HasWarning(corridor, "times the scene's depth")) << DescribeMapCheck(corridor);
+}
+
 TEST(MapCheck, AMapThatExplainsLittleOfTheFramesIsFlagged) {
   const Scene s = MovingCameraScene(SidewaysPath(12, 1.5), 50, 2000);
   const MapCheck c = CheckMap(s.map, s.keypoints);
-  EXPECT_TRUE(HasWarning(c, "the map explains only 2.4% of the frames' features")) << DescribeMapCheck(c);
+  EXPECT_TRUE(HasWarning(c, "explains only 2.4% of the frames' features")) << DescribeMapCheck(c);
 }
 
 TEST(MapCheck, TheCheckFileRoundTripsAndAnAbsentOneIsNothing) {

@@ -242,7 +242,7 @@ MapCheck RecheckMap(const fs::path& map_dir) {
   // A map made without a calibration keeps the warning on its refined intrinsics.
   std::error_code ec;
   if (fs::exists(map_dir / "camera.yaml", ec) && !calib::LoadCamera(map_dir / "camera.yaml").calibrated) {
-    for (const std::string& problem : ImplausibleIntrinsics(built.camera)) check.warnings.push_back(problem);
+    for (const std::string& problem : ImplausibleIntrinsics(built.camera)) check.warnings.push_back("is self-calibrated implausibly: " + problem);
   }
   WriteMapCheck(check, map_dir / kMapCheckFileName);
   return check;
