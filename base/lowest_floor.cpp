@@ -58,6 +58,7 @@ LowestFloor FindLowestFloor(const std::vector<Eigen::Vector3d>& points, const st
   if (!(options.inlier_distance > 0)) options.inlier_distance = 0.01 * 2 * MedianDistance(points, ComponentMedian(points));
   const int least = std::max(kFloorLeastPoints, static_cast<int>(kFloorShareOfPoints * points.size()));
   LowestFloor found;
+  found.inlier_distance = options.inlier_distance;
   found.floor = FitFloorUnderCameras(points, camera_centres, camera_up_axes, options, &found.up);
   PlaneFitOptions lower_options = options;  // below the first plane: see kLowerFloorMaxTiltDeg
   lower_options.up_prior = found.up;

@@ -16,6 +16,7 @@ struct LowestFloor {
   Plane floor;                                  // its normal as FitFloorUnderCameras turns it: towards the cameras
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the cameras' up the search went down along
   double below_share = 0;                       // the points more than three inlier distances under it
+  double inlier_distance = 0;                   // a point this close to a plane lies on it (every fit's)
 };
 
 // The dominant plane of `points` under the cameras (FitFloorUnderCameras, within

@@ -42,13 +42,11 @@ Anchor PlaceOnFloor(const std::vector<Eigen::Vector3d>& points,
   const Eigen::Vector3d& camera_up = found.up;
 
   // Stand at the median of the plane's inliers near the middle, projected onto the plane.
-  const Eigen::Vector3d middle = ComponentMedian(points);
-  const double limit = o.plane.inlier_distance > 0 ? o.plane.inlier_distance : 0.01 * 2 * MedianDistance(points, middle);
   std::vector<Eigen::Vector3d> on_plane;
   for (const auto& p : points) {
-    if (std::abs(plane.Distance(p)) < limit) on_plane.push_back(p);
+    if (std::abs(plane.Distance(p)) < found.inlier_distance) on_plane.push_back(p);
   }
-  Eigen::Vector3d position = on_plane.empty() ? middle : ComponentMedian(on_plane);
+  Eigen::Vector3d position = on_plane.empty() ? ComponentMedian(points) : ComponentMedian(on_plane);
   position -= plane.Distance(position) * plane.normal;
 
   // Face the first keyframe. Stand upright in the viewers' world: up is the cameras' up (signed
