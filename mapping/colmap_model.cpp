@@ -22,8 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr std::uint64_t kInvalidPoint3D = std::numeric_limits<std::uint64_t>::max();
-
 // A whole file in memory with bounds-checked little-endian reads.
 class BinaryReader {
  public:
@@ -184,15 +182,6 @@ std::unordered_map<std::uint32_t, calib::Camera> ReadCameras(const fs::path& fil
   return cameras;
 }
 
-struct ColmapImage {
-  std::uint32_t id = 0;
-  std::uint32_t camera_id = 0;
-  std::string name;
-  calib::Pose pose;
-  std::vector<Eigen::Vector2d> xy;          // COLMAP convention
-  std::vector<std::uint64_t> point3d_ids;   // kInvalidPoint3D when none
-};
-
 std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToken& cancel) {
   BinaryReader r(file, cancel);
   const auto n = r.ReadCount("registered image count", 4 + 7 * 8 + 4 + 1 + 8);
@@ -235,17 +224,6 @@ std::vector<ColmapImage> ReadImages(const fs::path& file, const CancellationToke
   r.ExpectEnd();
   return images;
 }
-
-struct TrackElement {
-  std::uint32_t image_id;
-  std::uint32_t point2d_idx;
-};
-
-struct ColmapPoint {
-  std::uint64_t id = 0;
-  map::MapPoint point;
-  std::vector<TrackElement> track;
-};
 
 std::vector<ColmapPoint> ReadPoints(const fs::path& file, const CancellationToken& cancel) {
   BinaryReader r(file, cancel);
@@ -452,6 +430,33 @@ ModelFiles ReadModelFiles(const fs::path& sparse_dir, const CancellationToken& c
   model.camera = TheOneCamera(cameras, model.images, cameras_file, images_file);
   return model;
 }
+
+}  // namespace
+
+SparseModel ReadSparseModel(const fs::path& sparse_dir, const CancellationToken& cancel) {
+  ModelFiles files = ReadModelFiles(sparse_dir, cancel);
+  const fs::path images_file = sparse_dir / "images.bin";
+  std::unordered_map<std::uint32_t, std::uint32_t> index_of_image;
+  for (const auto& im : files.images) {
+    if (!index_of_image.emplace(im.id, static_cast<std::uint32_t>(index_of_image.size())).second) {
+      throw map::MapError(images_file.string() + ": image id " + std::to_string(im.id) + " appears twice");
+    }
+  }
+  RequireTracksReferBack(files.points, files.images, index_of_image, sparse_dir / "points3D.bin", images_file);
+  SparseModel model;
+  try {
+    const fs::path cameras_file = sparse_dir / "cameras.bin";
+    model.cameras_bin = NamingInput<map::MapError>(cameras_file.string(), [&] { return ReadFileUpTo(cameras_file, kMaxBinaryFileBytes, cancel); });
+  } catch (const InputError& e) {
+    throw map::MapError(e.what());
+  }
+  model.camera = files.camera;
+  model.images = std::move(files.images);
+  model.points = std::move(files.points);
+  return model;
+}
+
+namespace {
 
 map::Map ReadColmapModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
                   const CancellationToken& cancel, std::vector<std::vector<Eigen::Vector2f>>* keypoints,

@@ -14,6 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include "base/cancellation.h"
+#include "calib/camera.h"
+#include "calib/pose.h"
 #include "map/map.h"
 #include "mapping/colmap_database.h"
 #include "mapping/map_check.h"
@@ -26,6 +28,46 @@ struct FrameInfo {
   double timestamp = 0;
 };
 using FrameLookup = std::map<std::string, FrameInfo>;
+
+constexpr std::uint64_t kInvalidPoint3D = ~std::uint64_t{0};  // a 2D point without a 3D point
+
+// One registered image of a binary sparse model (images.bin), as COLMAP wrote it.
+struct ColmapImage {
+  std::uint32_t id = 0;
+  std::uint32_t camera_id = 0;
+  std::string name;
+  calib::Pose pose;
+  std::vector<Eigen::Vector2d> xy;          // COLMAP convention (OpenCV's pixel + 0.5)
+  std::vector<std::uint64_t> point3d_ids;   // kInvalidPoint3D when none
+};
+
+struct TrackElement {
+  std::uint32_t image_id;
+  std::uint32_t point2d_idx;
+};
+
+// One 3D point of points3D.bin.
+struct ColmapPoint {
+  std::uint64_t id = 0;
+  map::MapPoint point;
+  std::vector<TrackElement> track;
+};
+
+// A whole binary sparse model, for the leaves' merge (mapping/leaf_merge.h).
+struct SparseModel {
+  std::string cameras_bin;  // cameras.bin's bytes, written back as they are
+  calib::Camera camera;     // its one camera (arview maps have one)
+  std::vector<ColmapImage> images;
+  std::vector<ColmapPoint> points;
+};
+
+// Reads cameras.bin, images.bin and points3D.bin whole, validated as ReadColmapMap validates
+// them (every track refers back to its 2D points). Throws MapError naming the file.
+SparseModel ReadSparseModel(const std::filesystem::path& sparse_dir, const CancellationToken& cancel = {});
+
+// Writes `model` as a binary sparse model into the folder `to` (created), each file atomically;
+// MapError naming the file that cannot be written.
+void WriteSparseModel(const SparseModel& model, const std::filesystem::path& to);
 
 // The number of registered images in a sparse model folder (reads only images.bin's header);
 // used to pick the largest of several models. Throws MapError when images.bin is unreadable.

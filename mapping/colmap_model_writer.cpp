@@ -2,6 +2,7 @@
 // model moved by a similarity (WriteTransformedModel, declared in mapping/colmap_model.h), each
 // pose and point patched where it lies and every other byte kept as COLMAP wrote it. The metric
 // step (mapping/map_folder.cpp) and `arview map extend` (mapping/map_extend.cpp) move models.
+// WriteSparseModel writes a whole model held in memory (the leaves' merge, mapping/leaf_merge.h).
 
 #include "mapping/colmap_model.h"
 
@@ -110,6 +111,72 @@ std::string TransformedPoints(const fs::path& file, const Sim3& transform) {
   return f.bytes();
 }
 
+// Little-endian values appended as COLMAP's binary model files hold them.
+class BinaryWriter {
+ public:
+  template <typename T>
+  void Put(T value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* bytes = reinterpret_cast<const char*>(&value);
+    data_.append(bytes, sizeof(T));
+  }
+  void PutCString(const std::string& text) { data_.append(text.c_str(), text.size() + 1); }
+  const std::string& bytes() const { return data_; }
+
+ private:
+  std::string data_;
+};
+
+std::string ImagesBin(const std::vector<ColmapImage>& images) {
+  BinaryWriter w;
+  w.Put<std::uint64_t>(images.size());
+  for (const ColmapImage& im : images) {
+    w.Put(im.id);
+    const Eigen::Quaterniond& q = im.pose.q_cw;
+    for (const double v : {q.w(), q.x(), q.y(), q.z()}) w.Put(v);
+    for (int k = 0; k < 3; ++k) w.Put(im.pose.t_cw[k]);
+    w.Put(im.camera_id);
+    w.PutCString(im.name);
+    w.Put<std::uint64_t>(im.xy.size());
+    for (std::size_t k = 0; k < im.xy.size(); ++k) {
+      w.Put(im.xy[k].x());
+      w.Put(im.xy[k].y());
+      w.Put(im.point3d_ids[k]);
+    }
+  }
+  return w.bytes();
+}
+
+std::string PointsBin(const std::vector<ColmapPoint>& points) {
+  BinaryWriter w;
+  w.Put<std::uint64_t>(points.size());
+  for (const ColmapPoint& p : points) {
+    w.Put(p.id);
+    for (int k = 0; k < 3; ++k) w.Put(p.point.xyz[k]);
+    for (const std::uint8_t c : p.point.rgb) w.Put(c);
+    w.Put(p.point.reprojection_error);
+    w.Put<std::uint64_t>(p.track.size());
+    for (const TrackElement& e : p.track) {
+      w.Put(e.image_id);
+      w.Put(e.point2d_idx);
+    }
+  }
+  return w.bytes();
+}
+
+void WriteModelFiles(const fs::path& to, const std::string& cameras, const std::string& images, const std::string& points) {
+  std::error_code ec;
+  fs::create_directories(to, ec);
+  if (ec) throw map::MapError(to.string() + ": cannot create the folder (" + ec.message() + ")");
+  try {
+    WriteFileAtomically(to / "cameras.bin", cameras);
+    WriteFileAtomically(to / "images.bin", images);
+    WriteFileAtomically(to / "points3D.bin", points);
+  } catch (const Error& e) {
+    throw map::MapError(e.what());
+  }
+}
+
 }  // namespace
 
 void WriteTransformedModel(const fs::path& from, const fs::path& to, const Sim3& transform) {
@@ -121,16 +188,11 @@ void WriteTransformedModel(const fs::path& from, const fs::path& to, const Sim3&
   } catch (const InputError& e) {
     throw map::MapError(e.what());
   }
-  std::error_code ec;
-  fs::create_directories(to, ec);
-  if (ec) throw map::MapError(to.string() + ": cannot create the folder (" + ec.message() + ")");
-  try {
-    WriteFileAtomically(to / "cameras.bin", cameras);
-    WriteFileAtomically(to / "images.bin", images);
-    WriteFileAtomically(to / "points3D.bin", points);
-  } catch (const Error& e) {
-    throw map::MapError(e.what());
-  }
+  WriteModelFiles(to, cameras, images, points);
+}
+
+void WriteSparseModel(const SparseModel& model, const fs::path& to) {
+  WriteModelFiles(to, model.cameras_bin, ImagesBin(model.images), PointsBin(model.points));
 }
 
 }  // namespace arview::mapping

@@ -117,7 +117,7 @@ struct MapBuildOptions {
   // A venue in parts (mapping/leaf_mapping.h): with more frames than leaf_size, the match graph
   // is cut into leaves of at most leaf_size frames (METIS on the inliers), each grown by
   // leaf_overlap frames most strongly tied to it; each leaf is mapped alone (on `engine`) and
-  // the leaves merged (COLMAP's model_merger, point_triangulator, bundle_adjuster). The fold
+  // the leaves merged (mapping/leaf_merge.h, then point_triangulator, bundle_adjuster). The fold
   // retries do not apply to a merged map. 0: one mapper over every frame (today's path).
   int leaf_size = 0;
   int leaf_overlap = 10;

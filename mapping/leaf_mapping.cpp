@@ -7,6 +7,7 @@
 #include "base/process.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
+#include "mapping/leaf_merge.h"
 
 namespace arview::mapping {
 
@@ -15,8 +16,6 @@ namespace fs = std::filesystem;
 MapEngine ParseMapEngine(const std::string& text) { return ParseEnum<MapEngine, map::MapError>(text, "--engine"); }
 
 namespace {
-
-constexpr const char* kMergeFailed = "=> Merge failed";  // model_merger's line when it could not merge
 
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -28,11 +27,10 @@ struct LeafPlan {
   std::vector<std::vector<std::string>> leaf_images;  // each leaf's image names (core, then overlap)
   std::vector<Command> leaf_commands;     // COLMAP argument lists, without the executable
   std::vector<int> merge_order;
-  std::vector<Command> merge_commands;    // model_merger per leaf after the first, triangulator, adjuster
-  fs::path merged_last, adjusted;
+  Command triangulate, adjust;            // over the merged leaves, after the merge
+  fs::path merged, adjusted;
 
   fs::path LeafModel(int leaf) const { return work / std::to_string(leaf) / "sparse" / "0"; }
-  fs::path Merged(int step) const { return work / ("merged_" + std::to_string(step)); }
   std::string LeafName(int leaf) const {
     return "leaf " + std::to_string(leaf) + " (" + std::to_string(leaf_images[leaf].size()) + " frames)";
   }
@@ -40,21 +38,12 @@ struct LeafPlan {
 
 std::string RefineFlag(const MapBuildOptions& options) { return options.refine_intrinsics ? "1" : "0"; }
 
-// The merge's alignment counts an observation as agreeing within 4 px (the mapper's own
-// filter_max_reproj_error), not model_merger's default 64 px: with 64, templeRing's leaves were
-// merged 1.5 degrees apart, a misalignment too large for the triangulation's 4 px filter to keep
-// any track across it, so the bundle adjustment after could not close it (docs/mapping.md).
-Command MergeCommand(const fs::path& a, const fs::path& b, const fs::path& out) {
-  return {"model_merger", "--input_path1", a.string(), "--input_path2", b.string(), "--output_path", out.string(),
-          "--max_reproj_error", "4"};
-}
-
 Command TriangulateCommand(const MapBuildOptions& options, const LeafMappingPaths& paths, const fs::path& in,
                            const fs::path& out) {
   const std::string refine = RefineFlag(options);
   return {"point_triangulator", "--database_path", paths.database.string(), "--image_path",
           paths.image_root.string(), "--input_path", in.string(), "--output_path", out.string(),
-          // The leaves' own points kept (model_merger joined their tracks in the shared frames)
+          // The leaves' own points kept (the merge joined their tracks in the shared frames)
           // and completed from the database's matches: re-triangulated from the matches instead,
           // then adjusted, templeRing's keyframes came out 10-25 % further from the ground truth,
           // and the single mapper's own model as far (docs/mapping.md, "The merge keeps the
@@ -99,19 +88,13 @@ LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& path
     sizes += (sizes.empty() ? "" : ", ") + std::to_string(leaf.core.size()) + "+" + std::to_string(leaf.overlap.size());
   }
   plan.merge_order = MergeOrder(partition);
-  fs::path merged = plan.LeafModel(plan.merge_order.front());
-  for (std::size_t step = 1; step < plan.merge_order.size(); ++step) {
-    fs::create_directories(plan.Merged(static_cast<int>(step)));
-    plan.merge_commands.push_back(MergeCommand(merged, plan.LeafModel(plan.merge_order[step]), plan.Merged(static_cast<int>(step))));
-    merged = plan.Merged(static_cast<int>(step));
-  }
-  plan.merged_last = merged;
+  plan.merged = plan.work / "merged";
   const fs::path triangulated = plan.work / "triangulated";
   plan.adjusted = plan.work / "adjusted";
   fs::create_directories(triangulated);
   fs::create_directories(plan.adjusted);
-  plan.merge_commands.push_back(TriangulateCommand(options, paths, merged, triangulated));
-  plan.merge_commands.push_back(AdjustCommand(options, triangulated, plan.adjusted));
+  plan.triangulate = TriangulateCommand(options, paths, plan.merged, triangulated);
+  plan.adjust = AdjustCommand(options, triangulated, plan.adjusted);
   if (cb.note) {
     cb.note(std::to_string(graph.names.size()) + " frames mapped as " + std::to_string(partition.leaves.size()) +
             " leaves of at most " + std::to_string(options.leaf_size) + " (frames + overlap: " + sizes +
@@ -132,30 +115,33 @@ std::set<std::uint32_t> RegisteredIds(const fs::path& model, const std::string& 
   return ids;
 }
 
-// model_merger exits 0 when it cannot merge, leaving the first model as it was: each step's
-// output must hold every image the leaves merged so far registered.
-void CheckMerges(const LeafPlan& plan, const std::vector<fs::path>& leaf_logs, int steps_done, const fs::path& merge_log) {
-  std::set<std::uint32_t> expected = RegisteredIds(plan.LeafModel(plan.merge_order[0]), plan.LeafName(plan.merge_order[0]),
-                                                   leaf_logs[plan.merge_order[0]]);
-  for (int step = 1; step <= steps_done; ++step) {
+// The leaves' models joined one by one in the merge order into <work>/merged (mapping/leaf_merge.h).
+// A leaf that cannot be merged is a MapError naming it and why.
+void MergeLeaves(const LeafPlan& plan, const std::vector<fs::path>& leaf_logs, const MapBuildCallbacks& cb) {
+  const auto read_leaf = [&](int leaf) {
+    RegisteredIds(plan.LeafModel(leaf), plan.LeafName(leaf), leaf_logs[static_cast<std::size_t>(leaf)]);
+    return ReadSparseModel(plan.LeafModel(leaf));
+  };
+  SparseModel merged = read_leaf(plan.merge_order.front());
+  for (std::size_t step = 1; step < plan.merge_order.size(); ++step) {
     const int leaf = plan.merge_order[step];
-    const std::set<std::uint32_t> ids = RegisteredIds(plan.LeafModel(leaf), plan.LeafName(leaf), leaf_logs[leaf]);
-    int shared = 0;
-    for (const auto id : ids) shared += static_cast<int>(expected.count(id));
-    expected.insert(ids.begin(), ids.end());
-    const std::uint64_t merged = fs::exists(plan.Merged(step) / "images.bin") ? CountRegisteredImages(plan.Merged(step)) : 0;
-    if (merged != expected.size()) {
-      throw map::MapError("COLMAP model_merger could not merge " + plan.LeafName(leaf) + " into the leaves before it (" +
-                          std::to_string(merged) + " of " + std::to_string(expected.size()) +
-                          " registered images in its output; the leaves share " + std::to_string(shared) +
-                          " registered images, a merge needs 3 that agree): a larger --leaf-overlap may help; its output "
-                          "is in " + merge_log.string());
+    const SparseModel model = read_leaf(leaf);
+    LeafAlignment alignment = AlignLeaf(merged, model);
+    if (!alignment.problem.empty()) {
+      throw map::MapError("could not merge " + plan.LeafName(leaf) + ", of which its mapper registered " +
+                          std::to_string(model.images.size()) + ", into the leaves before it: " + alignment.problem +
+                          "; a larger --leaf-overlap may help (the leaves' models are in " + plan.work.string() + ")");
     }
+    JoinLeaf(&merged, model, &alignment);
+    if (cb.note) cb.note("merged " + plan.LeafName(leaf) + ": " + alignment.report.Describe());
   }
+  std::error_code ec;
+  fs::remove_all(plan.merged, ec);
+  WriteSparseModel(merged, plan.merged);
 }
 
 void CheckAdjusted(const LeafPlan& plan, const fs::path& log) {
-  const std::uint64_t merged = CountRegisteredImages(plan.merged_last);
+  const std::uint64_t merged = CountRegisteredImages(plan.merged);
   const std::uint64_t adjusted = fs::exists(plan.adjusted / "images.bin") ? CountRegisteredImages(plan.adjusted) : 0;
   if (adjusted != merged) {
     throw map::MapError("the merged leaves' triangulation and bundle adjustment left " + std::to_string(adjusted) +
@@ -196,57 +182,62 @@ void RunLocally(const MapBuildOptions& options, const LeafMappingPaths& paths, c
   }
   steps->push_back({"map leaves", SecondsSince(t0), false});
   t0 = std::chrono::steady_clock::now();
-  const std::vector<fs::path> leaf_logs(plan.leaf_commands.size(), log);
-  const int merges = static_cast<int>(plan.merge_order.size()) - 1;
-  for (int step = 1; step <= merges; ++step) {
-    RunColmap(options, paths.out_dir, "merge", plan.merge_commands[step - 1], 0, cb);
-    CheckMerges(plan, leaf_logs, step, log);
-  }
-  for (std::size_t c = merges; c < plan.merge_commands.size(); ++c) RunColmap(options, paths.out_dir, "merge", plan.merge_commands[c], 0, cb);
+  MergeLeaves(plan, std::vector<fs::path>(plan.leaf_commands.size(), log), cb);
+  RunColmap(options, paths.out_dir, "merge", plan.triangulate, 0, cb);
+  RunColmap(options, paths.out_dir, "merge", plan.adjust, 0, cb);
   CheckAdjusted(plan, log);
   steps->push_back({"merge", SecondsSince(t0), false});
 }
 
-// The leaves as one Slurm job array and the merge as one job after it.
+SlurmCallbacks SlurmProgressAs(const std::string& stage, const std::string& what, const MapBuildCallbacks& cb) {
+  SlurmCallbacks slurm;
+  slurm.progress = [&cb, stage, what](const SlurmProgress& p) {
+    if (cb.progress) cb.progress(stage, p.done, p.total);
+    if (cb.note && p.done < p.total) cb.note(what + " on Slurm: " + p.Describe());
+  };
+  slurm.note = cb.note;
+  return slurm;
+}
+
+// The leaves as one Slurm job array; their merge here (the models read, aligned and joined: a
+// few seconds); then the global triangulation as a job and the bundle adjustment as the job after it.
 void RunOnSlurm(const MapBuildOptions& options, const LeafPlan& plan, const MapBuildCallbacks& cb,
                 std::vector<StageTiming>* steps) {
   const std::string colmap = FindExecutable(options.colmap);
   if (colmap.empty()) throw map::MapError("COLMAP not found: '" + options.colmap + "' (the Slurm jobs run it)");
-  SlurmJobPlan jobs;
-  jobs.work_dir = plan.work;
-  jobs.job_name = "arview-map-leaves";
-  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) {
-    jobs.tasks.push_back(WithExecutable(colmap, plan.leaf_commands[i]));
-    jobs.task_names.push_back(plan.LeafName(static_cast<int>(i)));
-    jobs.task_outputs.push_back(plan.LeafModel(static_cast<int>(i)));
-  }
-  for (const auto& command : plan.merge_commands) jobs.final_commands.push_back(WithExecutable(colmap, command));
-  jobs.final_name = "the merge of the leaves";
-  jobs.final_failure_marker = kMergeFailed;
   const int cpus = options.slurm.cpus_per_task > 0 ? options.slurm.cpus_per_task : std::max(1, options.threads);
+  SlurmJobPlan leaves;
+  leaves.work_dir = plan.work;
+  leaves.job_name = "arview-map-leaves";
+  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) {
+    leaves.tasks.push_back(WithExecutable(colmap, plan.leaf_commands[i]));
+    leaves.task_names.push_back(plan.LeafName(static_cast<int>(i)));
+    leaves.task_outputs.push_back(plan.LeafModel(static_cast<int>(i)));
+  }
   // Each leaf's model is read as soon as its job completes: one that is missing or damaged fails
   // the leaf (and is mapped once more) before the merge takes it.
-  jobs.check_task = [&plan](int leaf) { return LeafModelProblem(plan.LeafModel(leaf)); };
-  const auto t0 = std::chrono::steady_clock::now();
-  SlurmCallbacks slurm;
-  slurm.progress = [&](const SlurmProgress& p) {
-    if (cb.progress) cb.progress("map", p.done, p.total);
-    if (cb.note && p.done < p.total) cb.note("leaves on Slurm: " + p.Describe());
-  };
-  slurm.note = cb.note;
+  leaves.check_task = [&plan](int leaf) { return LeafModelProblem(plan.LeafModel(leaf)); };
+  auto t0 = std::chrono::steady_clock::now();
+  RunSlurmJobs(leaves, options.slurm, cpus, options.cancel, SlurmProgressAs("map", "leaves", cb));
+  steps->push_back({"map leaves (slurm)", SecondsSince(t0), false});
+
+  t0 = std::chrono::steady_clock::now();
   std::vector<fs::path> leaf_logs;
-  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) leaf_logs.push_back(TaskLog(jobs, static_cast<int>(i)));
-  try {
-    RunSlurmJobs(jobs, options.slurm, cpus, options.cancel, slurm);
-  } catch (const SlurmError& e) {
-    // The merge job fails when a leaf could not be merged: say which.
-    if (std::string(e.what()).rfind(jobs.final_name, 0) == 0 && fs::exists(FinalLog(jobs)))
-      CheckMerges(plan, leaf_logs, static_cast<int>(plan.merge_order.size()) - 1, FinalLog(jobs));
-    throw;
-  }
-  CheckMerges(plan, leaf_logs, static_cast<int>(plan.merge_order.size()) - 1, FinalLog(jobs));
-  CheckAdjusted(plan, FinalLog(jobs));
-  steps->push_back({"map leaves + merge (slurm)", SecondsSince(t0), false});
+  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) leaf_logs.push_back(TaskLog(leaves, static_cast<int>(i)));
+  MergeLeaves(plan, leaf_logs, cb);
+  steps->push_back({"merge", SecondsSince(t0), false});
+
+  t0 = std::chrono::steady_clock::now();
+  SlurmJobPlan global;
+  global.work_dir = plan.work / "global";
+  global.job_name = "arview-map-merge";
+  global.tasks = {WithExecutable(colmap, plan.triangulate)};
+  global.task_names = {"the triangulation of the merged leaves"};
+  global.final_commands = {WithExecutable(colmap, plan.adjust)};
+  global.final_name = "the bundle adjustment of the merged leaves";
+  RunSlurmJobs(global, options.slurm, cpus, options.cancel, SlurmProgressAs("merge", "the merged leaves' adjustment", cb));
+  CheckAdjusted(plan, FinalLog(global));
+  steps->push_back({"triangulate + adjust (slurm)", SecondsSince(t0), false});
 }
 
 }  // namespace

@@ -7,11 +7,12 @@
 //   partition   the database's match graph cut with METIS (mapping/match_graph.h)
 //   leaves      <out>/leaves/<i>/images.txt, COLMAP mapper on those images (one model:
 //               --Mapper.multiple_models 0) ─► <out>/leaves/<i>/sparse/0
-//   merge       model_merger leaf by leaf (each next the leaf sharing the most images with those
-//               merged), then point_triangulator (tracks from the database's matches again)
-//               and bundle_adjuster over everything ─► <out>/leaves/adjusted
-//   check       every image some leaf registered is in each merge's output (model_merger exits 0
-//               when it cannot merge); then <out>/sparse is replaced by the adjusted model
+//   merge       leaf by leaf (each next the leaf sharing the most images with those merged), on
+//               the shared frames' 3D points (mapping/leaf_merge.h), in this process ─►
+//               <out>/leaves/merged; then point_triangulator (the leaves' points kept and
+//               completed from the database's matches) and bundle_adjuster over everything
+//               (on `engine`: with slurm, a job and the job after it) ─► <out>/leaves/adjusted
+//   check       the adjusted model holds every merged image; then <out>/sparse is replaced by it
 //
 // On any failure <out>/sparse is left as it was; the logs stay in <out>/leaves.
 
