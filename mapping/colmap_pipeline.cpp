@@ -176,7 +176,7 @@ class MapBuild {
   void Map(const std::vector<std::string>& extra_args) {
     if (in_leaves_) {  // sparse/ is replaced only once the leaves are merged
       const StageWork run = [this](std::vector<StageTiming>* steps) {
-        MapInLeaves(options_, {database_, images_.root, out_dir_}, cb_, steps);
+        MapInLeaves(options_, {database_, images_.root, out_dir_, images_.lookup}, cb_, steps);
       };
       RunStage("map", mapper_inputs_, [] {}, run, fs::is_directory(sparse_), nullptr);
     } else {

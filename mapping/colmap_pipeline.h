@@ -118,7 +118,7 @@ struct MapBuildOptions {
   // is cut into leaves of at most leaf_size frames (METIS on the inliers), each grown by
   // leaf_overlap frames most strongly tied to it; each leaf is mapped alone (on `engine`) and
   // the leaves merged (mapping/leaf_merge.h, then point_triangulator, bundle_adjuster). The fold
-  // retries do not apply to a merged map. 0: one mapper over every frame (today's path).
+  // retries apply to each leaf, not to the merged map. 0: one mapper over every frame (today's path).
   int leaf_size = 0;
   int leaf_overlap = 10;
   MapEngine engine = MapEngine::kLocal;

@@ -1,12 +1,16 @@
 #include "mapping/leaf_mapping.h"
 
 #include <chrono>
+#include <fstream>
+#include <functional>
 #include <set>
 
 #include "base/atomic_file.h"
 #include "base/process.h"
 #include "mapping/colmap_model.h"
 #include "mapping/colmap_stages.h"
+#include "mapping/fold_retries.h"
+#include "mapping/map_check.h"
 #include "mapping/leaf_merge.h"
 
 namespace arview::mapping {
@@ -19,6 +23,14 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// `from`'s bytes appended to `to` (a log gathered from a job's; a missing `from` adds nothing).
+void AppendFile(const fs::path& from, const fs::path& to) {
+  std::ifstream in(from, std::ios::binary);
+  if (!in) return;
+  std::ofstream out(to, std::ios::binary | std::ios::app);
+  out << in.rdbuf();
 }
 
 // What is run, where, for one map built in leaves.
@@ -115,6 +127,41 @@ std::set<std::uint32_t> RegisteredIds(const fs::path& model, const std::string& 
   return ids;
 }
 
+// Why a leaf's model cannot be merged (missing, empty, a file damaged), or empty when it can.
+std::string LeafModelProblem(const fs::path& model) {
+  if (!fs::exists(model / "images.bin"))
+    return "COLMAP mapper registered no images (no model in " + model.string() + "): too few matches between its frames?";
+  try {
+    RequireReadableModel(model);
+  } catch (const Error& e) {
+    return std::string("its model is damaged: ") + e.what();
+  }
+  if (CountRegisteredImages(model) == 0) return "its model in " + model.string() + " holds no registered image";
+  return "";
+}
+
+// A leaf's model read and looked at as BuildMap looks at a map (mapping/map_check.h); false
+// when it has no model to look at (the merge says why).
+bool ReadAndCheckLeaf(const LeafMappingPaths& paths, const LeafPlan& plan, int leaf, MapBuildResult* result) {
+  if (!LeafModelProblem(plan.LeafModel(leaf)).empty()) return false;
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  result->map = ReadColmapMap(plan.LeafModel(leaf), paths.database, paths.frames, {}, &keypoints, false);
+  result->check = CheckMap(result->map, keypoints, ReadTwoViewGeometries(paths.database, result->map));
+  return true;
+}
+
+std::vector<fs::path> LeafDirs(const LeafPlan& plan) {
+  std::vector<fs::path> dirs;
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) dirs.push_back(plan.work / std::to_string(i));
+  return dirs;
+}
+
+std::vector<std::string> LeafNames(const LeafPlan& plan) {
+  std::vector<std::string> names;
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) names.push_back(plan.LeafName(i));
+  return names;
+}
+
 // The leaves' models joined one by one in the merge order into <work>/merged (mapping/leaf_merge.h).
 // A leaf that cannot be merged is a MapError naming it and why.
 void MergeLeaves(const LeafPlan& plan, const std::vector<fs::path>& leaf_logs, const MapBuildCallbacks& cb) {
@@ -149,19 +196,6 @@ void CheckAdjusted(const LeafPlan& plan, const fs::path& log) {
   }
 }
 
-// Why a leaf's model cannot be merged (missing, empty, a file damaged), or empty when it can.
-std::string LeafModelProblem(const fs::path& model) {
-  if (!fs::exists(model / "images.bin"))
-    return "COLMAP mapper registered no images (no model in " + model.string() + "): too few matches between its frames?";
-  try {
-    RequireReadableModel(model);
-  } catch (const Error& e) {
-    return std::string("its model is damaged: ") + e.what();
-  }
-  if (CountRegisteredImages(model) == 0) return "its model in " + model.string() + " holds no registered image";
-  return "";
-}
-
 Command WithExecutable(const std::string& colmap, Command args) {
   args.insert(args.begin(), colmap);
   return args;
@@ -171,18 +205,31 @@ Command WithExecutable(const std::string& colmap, Command args) {
 void RunLocally(const MapBuildOptions& options, const LeafMappingPaths& paths, const LeafPlan& plan,
                 const MapBuildCallbacks& cb, std::vector<StageTiming>* steps) {
   const fs::path log = paths.out_dir / "colmap.log";
-  auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) {
-    if (cb.note) cb.note("mapping " + plan.LeafName(static_cast<int>(i)) + " of " + std::to_string(plan.leaf_commands.size()));
+  // Each leaf's mapper writes its own log (<out>/leaves/<i>/colmap.log): its fold retries read the
+  // initial pair of its last run there.
+  const auto leaf_dir = [&plan](int leaf) { return plan.work / std::to_string(leaf); };
+  const auto map_leaf = [&](int leaf, const Command& extra) {
+    Command command = plan.leaf_commands[static_cast<std::size_t>(leaf)];
+    command.insert(command.end(), extra.begin(), extra.end());
     try {
-      RunColmap(options, paths.out_dir, "map", plan.leaf_commands[i], static_cast<int>(plan.leaf_images[i].size()), cb);
+      RunColmap(options, leaf_dir(leaf), "map", command, static_cast<int>(plan.leaf_images[leaf].size()), cb);
     } catch (const ColmapStageError& e) {
-      throw ColmapStageError(plan.LeafName(static_cast<int>(i)) + ": " + e.what(), e.stage, e.log, e.log_tail);
+      throw ColmapStageError(plan.LeafName(leaf) + ": " + e.what(), e.stage, e.log, e.log_tail);
     }
+  };
+  auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) {
+    if (cb.note) cb.note("mapping " + plan.LeafName(i) + " of " + std::to_string(plan.leaf_commands.size()));
+    map_leaf(i, {});
   }
+  const auto leaf_log = [&](int leaf) { return leaf_dir(leaf) / "colmap.log"; };
+  RetryFoldedLeaves(options, LeafNames(plan), LeafDirs(plan), cb,
+                    {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_leaf, leaf_log});
   steps->push_back({"map leaves", SecondsSince(t0), false});
   t0 = std::chrono::steady_clock::now();
-  MergeLeaves(plan, std::vector<fs::path>(plan.leaf_commands.size(), log), cb);
+  std::vector<fs::path> leaf_logs;
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) leaf_logs.push_back(leaf_log(i));
+  MergeLeaves(plan, leaf_logs, cb);
   RunColmap(options, paths.out_dir, "merge", plan.triangulate, 0, cb);
   RunColmap(options, paths.out_dir, "merge", plan.adjust, 0, cb);
   CheckAdjusted(plan, log);
@@ -201,8 +248,8 @@ SlurmCallbacks SlurmProgressAs(const std::string& stage, const std::string& what
 
 // The leaves as one Slurm job array; their merge here (the models read, aligned and joined: a
 // few seconds); then the global triangulation as a job and the bundle adjustment as the job after it.
-void RunOnSlurm(const MapBuildOptions& options, const LeafPlan& plan, const MapBuildCallbacks& cb,
-                std::vector<StageTiming>* steps) {
+void RunOnSlurm(const MapBuildOptions& options, const LeafMappingPaths& paths, const LeafPlan& plan,
+                const MapBuildCallbacks& cb, std::vector<StageTiming>* steps) {
   const std::string colmap = FindExecutable(options.colmap);
   if (colmap.empty()) throw map::MapError("COLMAP not found: '" + options.colmap + "' (the Slurm jobs run it)");
   const int cpus = options.slurm.cpus_per_task > 0 ? options.slurm.cpus_per_task : std::max(1, options.threads);
@@ -219,11 +266,34 @@ void RunOnSlurm(const MapBuildOptions& options, const LeafPlan& plan, const MapB
   leaves.check_task = [&plan](int leaf) { return LeafModelProblem(plan.LeafModel(leaf)); };
   auto t0 = std::chrono::steady_clock::now();
   RunSlurmJobs(leaves, options.slurm, cpus, options.cancel, SlurmProgressAs("map", "leaves", cb));
+  // A folded leaf is mapped again as a job of its own; its runs' output gathered in
+  // <out>/leaves/<i>/mapper.log, where its fold retries read each run's initial pair.
+  const auto leaf_log = [&plan](int leaf) { return plan.work / std::to_string(leaf) / "mapper.log"; };
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) AppendFile(TaskLog(leaves, i), leaf_log(i));
+  int reruns = 0;
+  const auto map_again = [&](int leaf, const Command& extra) {
+    SlurmJobPlan again = leaves;
+    again.work_dir = plan.work / ("again_" + std::to_string(reruns++));
+    again.tasks = {leaves.tasks[static_cast<std::size_t>(leaf)]};
+    again.tasks.front().insert(again.tasks.front().end(), extra.begin(), extra.end());
+    again.task_names = {plan.LeafName(leaf) + ", mapped again"};
+    again.task_outputs.clear();
+    again.check_task = [&plan, leaf](int) { return LeafModelProblem(plan.LeafModel(leaf)); };
+    try {
+      RunSlurmJobs(again, options.slurm, cpus, options.cancel, SlurmProgressAs("map", plan.LeafName(leaf), cb));
+    } catch (...) {
+      AppendFile(TaskLog(again, 0), leaf_log(leaf));
+      throw;
+    }
+    AppendFile(TaskLog(again, 0), leaf_log(leaf));
+  };
+  RetryFoldedLeaves(options, LeafNames(plan), LeafDirs(plan), cb,
+                    {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_again, leaf_log});
   steps->push_back({"map leaves (slurm)", SecondsSince(t0), false});
 
   t0 = std::chrono::steady_clock::now();
   std::vector<fs::path> leaf_logs;
-  for (std::size_t i = 0; i < plan.leaf_commands.size(); ++i) leaf_logs.push_back(TaskLog(leaves, static_cast<int>(i)));
+  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) leaf_logs.push_back(leaf_log(i));
   MergeLeaves(plan, leaf_logs, cb);
   steps->push_back({"merge", SecondsSince(t0), false});
 
@@ -268,11 +338,39 @@ std::vector<int> MergeOrder(const Partition& partition) {
   return order;
 }
 
+void RetryFoldedLeaves(const MapBuildOptions& options, const std::vector<std::string>& leaf_names,
+                       const std::vector<fs::path>& leaf_dirs, const MapBuildCallbacks& cb, const FoldedLeafStages& stages) {
+  for (int leaf = 0; leaf < static_cast<int>(leaf_dirs.size()); ++leaf) {
+    MapBuildResult result;
+    if (!stages.read_and_check(leaf, &result) || !Folded(result.check)) continue;
+    const fs::path& leaf_dir = leaf_dirs[static_cast<std::size_t>(leaf)];
+    const std::string& name = leaf_names[static_cast<std::size_t>(leaf)];
+    MapBuildCallbacks leaf_cb = cb;
+    leaf_cb.note = [&](const std::string& note) {
+      if (cb.note) cb.note(name + ": " + note);
+    };
+    FoldRetryStages retry;
+    retry.map = [&](const std::vector<std::string>& extra) {
+      fs::create_directories(leaf_dir / "sparse");
+      stages.map_again(leaf, extra);
+    };
+    retry.read_model = [&] {
+      if (!stages.read_and_check(leaf, &result)) throw map::MapError(name + ": the mapper left no model");
+    };
+    retry.forget_map = retry.remember_map = [] {};
+    RetryFoldedMap(options.fold_retries, leaf_dir, stages.log_of(leaf), leaf_cb, retry, &result);
+    if (Folded(result.check) && !options.keep_folded) {
+      WriteMapCheck(result.check, leaf_dir / kMapCheckFileName);
+      throw map::MapError(name + ": " + FoldRefusal(leaf_dir, result));
+    }
+  }
+}
+
 void MapInLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb,
                  std::vector<StageTiming>* steps) {
   const LeafPlan plan = PlanLeaves(options, paths, cb);
   if (options.engine == MapEngine::kSlurm) {
-    RunOnSlurm(options, plan, cb, steps);
+    RunOnSlurm(options, paths, plan, cb, steps);
   } else {
     RunLocally(options, paths, plan, cb, steps);
   }

@@ -17,6 +17,7 @@
 
 #include "base/process.h"
 #include "mapping/leaf_mapping.h"
+#include "mapping/map_check.h"
 #include "mapping/slurm_engine.h"
 #include "mapping/test_slurm.h"
 #include "mapping/test_temple_map.h"
@@ -48,6 +49,106 @@ TEST(SlurmEngine, ReadsSqueuesStatesOfArrayTasksAndJobs) {
   EXPECT_FALSE(SlurmStateFailed("COMPLETED"));
   EXPECT_TRUE(SlurmStateCompleted("COMPLETED"));
   EXPECT_FALSE(SlurmStateCompleted("COMPLETING"));
+}
+
+// A leaf's model as the fold retries see it: six keyframes (COLMAP ids 11-16, frames 0-5) and
+// a check made by the test, folded (frames 0 and 1 off, half the pairs disagreeing; keyframe 4,
+// id 15, agrees in the most pairs) or not.
+MapBuildResult LeafCheck(bool folded) {
+  MapBuildResult result;
+  for (int k = 0; k < 6; ++k) {
+    map::Keyframe kf;
+    kf.colmap_image_id = static_cast<std::uint32_t>(11 + k);
+    kf.frame_index = k;
+    result.map.keyframes.push_back(kf);
+  }
+  result.check.two_view_pairs = 10;
+  result.check.keyframe_agreeing_pairs = {0, 0, 3, 4, 5, 2};
+  if (folded) {
+    result.check.disagreeing_fraction = 0.5;
+    result.check.disagreeing_frames = {0, 1};
+    result.check.off_neighbours = 1;
+  }
+  return result;
+}
+
+// Two leaf folders, each with a model folder and a log whose mapper started from ids 11 and 12.
+std::vector<fs::path> LeafFolders(const fs::path& root) {
+  fs::remove_all(root);
+  std::vector<fs::path> dirs = {root / "0", root / "1"};
+  for (const auto& d : dirs) {
+    fs::create_directories(d / "sparse" / "0");
+    std::ofstream(d / "colmap.log") << "Initializing with image pair #11 and #12\n";
+  }
+  return dirs;
+}
+
+TEST(LeafMapping, AFoldedLeafIsMappedAgainFromAKeyframeTheCheckFoundRight) {
+  const fs::path root = fs::temp_directory_path() / ("arview_folded_leaf_" + std::to_string(::getpid()));
+  const std::vector<fs::path> dirs = LeafFolders(root);
+  std::vector<std::pair<int, std::vector<std::string>>> runs;
+  FoldedLeafStages stages;
+  stages.read_and_check = [&](int leaf, MapBuildResult* result) {
+    const MapBuildResult made = LeafCheck(leaf == 1 && runs.empty());  // leaf 1 folded until mapped again
+    result->map = made.map;
+    result->check = made.check;
+    return true;
+  };
+  stages.map_again = [&](int leaf, const std::vector<std::string>& extra) {
+    runs.emplace_back(leaf, extra);
+    fs::create_directories(dirs[leaf] / "sparse" / "0");
+  };
+  stages.log_of = [&](int leaf) { return dirs[leaf] / "colmap.log"; };
+  std::vector<std::string> notes;
+  MapBuildCallbacks cb;
+  cb.note = [&](const std::string& note) { notes.push_back(note); };
+  MapBuildOptions options;
+  RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, cb, stages);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0].first, 1);
+  EXPECT_EQ(runs[0].second, (std::vector<std::string>{"--Mapper.init_image_id1", "15"}));
+  ASSERT_FALSE(notes.empty());
+  EXPECT_EQ(notes.front().rfind("leaf 1 (6 frames): the model looks folded", 0), 0u) << notes.front();
+  EXPECT_NE(notes.front().find("mapping again from frame 4, try 1 of 2"), std::string::npos) << notes.front();
+  EXPECT_TRUE(fs::exists(dirs[1] / "sparse" / "0")) << "the new model in place";
+  fs::remove_all(root);
+}
+
+TEST(LeafMapping, ALeafStillFoldedAfterItsRetriesIsRefusedNamingItUnlessKept) {
+  const fs::path root = fs::temp_directory_path() / ("arview_folded_leaf_" + std::to_string(::getpid()));
+  const std::vector<fs::path> dirs = LeafFolders(root);
+  std::vector<std::vector<std::string>> runs;
+  FoldedLeafStages stages;
+  stages.read_and_check = [&](int leaf, MapBuildResult* result) {
+    const MapBuildResult made = LeafCheck(leaf == 0);
+    result->map = made.map;
+    result->check = made.check;
+    return true;
+  };
+  stages.map_again = [&](int, const std::vector<std::string>& extra) {
+    runs.push_back(extra);
+    fs::create_directories(dirs[0] / "sparse" / "0");
+  };
+  stages.log_of = [&](int leaf) { return dirs[leaf] / "colmap.log"; };
+  MapBuildOptions options;
+  try {
+    RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, {}, stages);
+    FAIL() << "a leaf still folded went through";
+  } catch (const map::MapError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("leaf 0 (6 frames): ", 0), 0u) << what;
+    EXPECT_NE(what.find("the map is folded and was not written"), std::string::npos) << what;
+    EXPECT_NE(what.find("in the least folded of 3 models"), std::string::npos) << what;
+  }
+  // Two retries, each from another start (the second never from the first's).
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0], (std::vector<std::string>{"--Mapper.init_image_id1", "15"}));
+  EXPECT_EQ(runs[1], (std::vector<std::string>{"--Mapper.init_image_id1", "14"}));
+  EXPECT_TRUE(fs::exists(dirs[0] / kMapCheckFileName));
+  fs::create_directories(dirs[0] / "sparse" / "0");
+  options.keep_folded = true;
+  EXPECT_NO_THROW(RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, {}, stages));
+  fs::remove_all(root);
 }
 
 TEST(LeafMapping, MergesEachNextTheLeafSharingTheMostImages) {
