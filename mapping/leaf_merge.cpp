@@ -8,6 +8,7 @@
 #include <unordered_set>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 #include "base/error.h"
 
@@ -90,13 +91,51 @@ bool SimilarityOfThree(const std::vector<PointPair>& pairs, const int (&pick)[3]
   return true;
 }
 
-Sim3 FitToInliers(const std::vector<PointPair>& pairs, const std::vector<int>& inliers) {
-  std::vector<Eigen::Vector3d> from, to;
-  for (const int i : inliers) {
-    from.push_back(pairs[static_cast<std::size_t>(i)].leaf);
-    to.push_back(pairs[static_cast<std::size_t>(i)].merged);
+// The similarity minimising the pairs' squared distances (Umeyama's closed form), `weighted`: each
+// divided by its distance from the camera that sees it (weights 1/depth^2, depths under half the
+// median's taken as half the median's), an angle, as the agreement is judged, so that the far
+// points, whose positions the leaves know least, do not outweigh the near.
+Sim3 FitToInliers(const std::vector<PointPair>& pairs, const std::vector<int>& inliers, bool weighted) {
+  std::vector<double> depths;
+  for (const int i : inliers)
+    depths.push_back((pairs[static_cast<std::size_t>(i)].merged - pairs[static_cast<std::size_t>(i)].camera_centre).norm());
+  std::vector<double> sorted = depths;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  // A point far nearer than the others (one of the leaf's at 0.1 of the median's depth) would
+  // otherwise weigh hundreds of times as much as the rest and decide the rotation alone.
+  const double nearest = std::max(0.5 * sorted[sorted.size() / 2], 1e-9);
+  double total = 0;
+  Eigen::Vector3d mean_leaf = Eigen::Vector3d::Zero(), mean_merged = Eigen::Vector3d::Zero();
+  std::vector<double> weights;
+  for (std::size_t k = 0; k < inliers.size(); ++k) {
+    const PointPair& p = pairs[static_cast<std::size_t>(inliers[k])];
+    const double depth = std::max(depths[k], nearest);
+    weights.push_back(weighted ? 1 / (depth * depth) : 1.0);
+    total += weights.back();
+    mean_leaf += weights.back() * p.leaf;
+    mean_merged += weights.back() * p.merged;
   }
-  return EstimateSim3(from, to, true, "the leaf's agreeing points");
+  mean_leaf /= total;
+  mean_merged /= total;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double leaf_variance = 0;
+  for (std::size_t k = 0; k < inliers.size(); ++k) {
+    const PointPair& p = pairs[static_cast<std::size_t>(inliers[k])];
+    const Eigen::Vector3d a = p.leaf - mean_leaf, b = p.merged - mean_merged;
+    covariance += weights[k] * b * a.transpose();
+    leaf_variance += weights[k] * a.squaredNorm();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Vector3d singular = svd.singularValues();
+  if (!(singular(1) > 1e-12 * singular(0)) || !(leaf_variance > 0))
+    throw Error("the leaf's agreeing points lie on one line: no rotation is determined by them");
+  Eigen::Matrix3d sign = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) sign(2, 2) = -1;
+  Sim3 fit;
+  fit.R = svd.matrixU() * sign * svd.matrixV().transpose();
+  fit.scale = (singular.asDiagonal() * sign).trace() / leaf_variance;
+  fit.t = mean_merged - fit.scale * fit.R * mean_leaf;
+  return fit;
 }
 
 // COLMAP's convention for 2D points is OpenCV's pixel + 0.5.
@@ -165,19 +204,31 @@ LeafAlignment AlignLeaf(const SparseModel& merged, const SparseModel& leaf, cons
     Sim3 candidate;
     if (pick[0] == pick[1] || pick[0] == pick[2] || pick[1] == pick[2] || !SimilarityOfThree(pairs, pick, &candidate)) continue;
     std::vector<int> inliers = InlierIndices(pairs, candidate, max_angle);
-    if (inliers.size() > best.size()) best = std::move(inliers);
-  }
-  // Refitted to all agreeing pairs until the set settles (a few rounds).
-  for (int round = 0; round < 5 && best.size() >= 3; ++round) {
-    try {
-      report.leaf_to_merged = FitToInliers(pairs, best);
-    } catch (const Error& e) {
-      result.problem = e.what();
-      return result;
+    if (inliers.size() > best.size()) {
+      best = std::move(inliers);
+      report.leaf_to_merged = candidate;
     }
-    std::vector<int> inliers = InlierIndices(pairs, report.leaf_to_merged, max_angle);
-    if (inliers == best) break;
-    best = std::move(inliers);
+  }
+  // Refitted to the agreeing pairs, in 3D and weighted by depth (FitToInliers), the fit that more
+  // pairs agree with kept, while that number grows: neither fit wins on every leaf (the rendered
+  // venue's leaves: one gained 356 agreeing pairs weighted, another lost 375).
+  for (int round = 0; round < 5 && best.size() >= 3; ++round) {
+    bool grew = false;
+    for (const bool weighted : {false, true}) {
+      Sim3 fit;
+      try {
+        fit = FitToInliers(pairs, best, weighted);
+      } catch (const Error&) {
+        continue;  // the agreeing points on one line: the fit before stays
+      }
+      std::vector<int> inliers = InlierIndices(pairs, fit, max_angle);
+      if (inliers.size() > best.size()) {
+        best = std::move(inliers);
+        report.leaf_to_merged = fit;
+        grew = true;
+      }
+    }
+    if (!grew) break;
   }
   report.inliers = static_cast<int>(best.size());
   if (report.inliers < least) {
