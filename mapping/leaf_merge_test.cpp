@@ -223,18 +223,3 @@ TEST(SparseModelFiles, AModelReadAndWrittenBackIsByteForByteAsCOLMAPWroteIt) {
 
 }  // namespace
 }  // namespace arview::mapping
-#include "mapping/map_check.h"
-namespace arview::mapping {
-TEST(TmpLeafCheck, Try) {
-  if (!getenv("TRY_LEAVES")) GTEST_SKIP();
-  const fs::path w = "/work/venue6/run600/venue-leaves/leaves";
-  const fs::path db = "/work/venue6/run600/venue-leaves/database.db";
-  for (int l = 0; l < 7; ++l) {
-    std::vector<std::vector<Eigen::Vector2f>> keypoints;
-    const map::Map m = ReadColmapMap(w / std::to_string(l) / "sparse/0", db, {}, {}, &keypoints, false);
-    const MapCheck c = CheckMap(m, keypoints, ReadTwoViewGeometries(db, m));
-    std::cout << "leaf " << l << " kf " << m.keyframes.size() << " folded " << Folded(c) << " : " << DescribeMapCheck(c) << "\n";
-    for (const auto& wr : c.warnings) std::cout << "   " << wr << "\n";
-  }
-}
-}
