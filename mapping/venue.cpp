@@ -1,5 +1,7 @@
 #include "mapping/venue.h"
 
+#include "map/map_rooms.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -143,6 +145,7 @@ std::string DescribeRoom(const VenueRoom& room) {
 
 std::vector<std::string> DescribeMapRooms(const map::Map& map, const std::vector<VenueRoom>& venue) {
   std::vector<std::string> lines;
+  const std::vector<std::vector<int>> neighbours = map::RoomNeighbours(map);
   for (std::size_t r = 0; r < map.rooms.size(); ++r) {
     const auto keyframes = std::count_if(map.keyframes.begin(), map.keyframes.end(),
                                          [&](const map::Keyframe& k) { return k.room == static_cast<int>(r); });
@@ -151,6 +154,9 @@ std::vector<std::string> DescribeMapRooms(const map::Map& map, const std::vector
     if (named != venue.end())
       line += " of " + std::to_string(named->frames) + " frames (" + std::to_string(named->first_frame) + "-" +
               std::to_string(named->first_frame + named->frames - 1) + ")";
+    std::string next;
+    for (const int n : neighbours[r]) next += (next.empty() ? "" : ", ") + map.rooms[static_cast<std::size_t>(n)];
+    line += next.empty() ? "; next to no other room" : "; next to " + next;
     lines.push_back(line);
   }
   return lines;

@@ -52,7 +52,8 @@ std::optional<std::vector<VenueRoom>> ReadVenueFile(const std::filesystem::path&
 std::string DescribeRoom(const VenueRoom& room);
 
 // One line per room of the map file (map::Map::rooms): "hall: 24 keyframes", and with the room of
-// that name in `venue` (venue.json) its frames: "hall: 24 keyframes of 24 frames (0-23)".
+// that name in `venue` (venue.json) its frames: "hall: 24 keyframes of 24 frames (0-23)"; then
+// the rooms next to it (map/map_rooms.h, what `--room` loads with it): "; next to office".
 std::vector<std::string> DescribeMapRooms(const map::Map& map, const std::vector<VenueRoom>& venue);
 
 }  // namespace arview::mapping

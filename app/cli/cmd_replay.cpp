@@ -103,7 +103,7 @@ void AddReplayCommand(CLI::App& app) {
     }
     o.recording = &recording;
     recordings::RecordingSource source(recording, replay);
-    const map::Map map = map::LoadMap(a->map_dir);
+    const map::Map map = LoadSessionMap(a->map_dir, a->session.room);
     o.frame_camera = RecordingTrackingCamera(map.camera, recording.camera);
     if (o.scene_file.empty() && !a->session.no_figure) o.first_view = FirstRunFigure(map, a->map_dir);
     // The scene's lines into a video file's audio track, and played live (--audio-out) when the

@@ -92,7 +92,7 @@ void AddRunCommand(CLI::App& app) {
     recordings::V4l2Options v4l2;
     ApplyCameraFlags(a->camera, v4l2);
     v4l2.cancel = signals.token();
-    const map::Map map = map::LoadMap(a->map_dir);
+    const map::Map map = LoadSessionMap(a->map_dir, a->session.room);
     const bool own_camera = !a->camera_file.empty();
     const calib::Camera calibration = own_camera ? calib::LoadCamera(a->camera_file) : map.camera;
     const std::string whose = own_camera ? "--camera's calibration" : "the map's camera";

@@ -39,6 +39,7 @@ namespace {
 struct TrackArgs {
   std::string recording;
   std::string map;
+  std::string room;  // --room: a venue's room, loaded with its neighbours only
   std::string out;
   std::string frames;
   std::string stats;
@@ -148,7 +149,7 @@ void RunTrack(const TrackArgs& args) {
     replay.frames = recordings::ParseFrameSpec(args.frames, static_cast<int>(rec.frames.size()));
   const size_t frame_count = replay.frames.empty() ? rec.frames.size() : replay.frames.size();
   map::Map map;
-  map = map::LoadMap(args.map);
+  map = LoadSessionMap(args.map, args.room);
   const std::optional<calib::Camera> own_camera = RecordingTrackingCamera(map.camera, rec.camera);
   const calib::Camera camera = own_camera.value_or(map.camera);
   if (camera.Size() != rec.camera.Size()) {
@@ -240,6 +241,7 @@ void AddTrackCommand(CLI::App& app) {
   OptionFlags& f = a->flags;
   cmd->add_option("recording", a->recording, "Recording folder")->required();
   cmd->add_option("--map", a->map, "Map directory (or its map.arvmap)")->required();
+  AddRoomOption(cmd, a->room);
   cmd->add_option("--out", a->out, "TUM trajectory to write (localised frames only)")
       ->required()
       ->check(OutputFileCheck());

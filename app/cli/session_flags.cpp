@@ -2,6 +2,8 @@
 
 #include "app/cli/output_flags.h"
 #include "app/placement/scene_lighting.h"
+#include "map/map_file.h"
+#include "map/map_rooms.h"
 #include "base/cache_folder.h"
 #include "render/hmd.h"
 #include "render/offscreen.h"
@@ -33,11 +35,39 @@ void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds) {
       ->check(CLI::Range(0.0, 10.0));
 }
 
+void AddRoomOption(CLI::App* cmd, std::string& room) {
+  cmd->add_option("--room", room,
+                  "Of a venue's map (several recordings mapped as one, 'arview map info' lists its rooms): load "
+                  "only this room and the rooms next to it (those whose keyframes see 2 % of its points, as 'arview map "
+                  "info' lists them), "
+                  "not the whole venue");
+}
+
+map::Map LoadSessionMap(const std::string& map_dir, const std::string& room) {
+  map::Map map = map::LoadMap(map_dir);
+  if (room.empty()) return map;
+  int index = -1;
+  try {
+    index = map::RoomIndex(map, room);
+  } catch (const map::MapError& e) {
+    throw CommandError("--room " + room + ": " + map_dir + ": " + e.what(), 2);
+  }
+  const std::vector<int> rooms = map::RoomWithNeighbours(map, index);
+  map::Map part = map::RoomsPart(map, rooms);
+  std::string names;
+  for (const int r : rooms) names += (names.empty() ? "" : r == rooms.back() ? " and " : ", ") + map.rooms[r];
+  std::fprintf(stderr, "note: --room %s: loaded %s: %zu of the map's %zu keyframes, %zu of its %zu points\n",
+               room.c_str(), names.c_str(), part.keyframes.size(), map.keyframes.size(), part.points.size(),
+               map.points.size());
+  return part;
+}
+
 void AddSessionFlags(CLI::App* cmd, SessionFlags& f) {
   cmd->add_option("--scene", f.scene,
                   "Scene file (see 'arview place'); without it the built-in figure stands on the map's floor in front "
                   "of the first localized view, and the line saying where gives the 'arview place' command that keeps it");
   cmd->add_flag("--no-figure", f.no_figure, "Without --scene: no character, only the video tracked");
+  AddRoomOption(cmd, f.room);
   cmd->add_option("--trajectory", f.trajectory, "Also write the tracked poses (TUM, camera-to-world)")
       ->check(OutputFileCheck());
   cmd->add_option("--stats", f.stats, "Also write per-stage timings and per-frame tracking as JSON")

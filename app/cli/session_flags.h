@@ -24,9 +24,16 @@ struct SessionFlags {
   int prefetch_below = -1;
   std::string tracking_worker = "auto";  // auto (on for a live source), on, off
   double align_max_seconds = tracker::TrackingOptions{}.align_max_seconds;
+  std::string room;  // --room: a venue's room, loaded with its neighbours only
 };
 
 void AddSessionFlags(CLI::App* cmd, SessionFlags& flags);
+// --room NAME (`track`, `replay`, `run`): of a venue's map, load that room and the rooms next to it only.
+void AddRoomOption(CLI::App* cmd, std::string& room);
+// The map in `map_dir`; with `room` (--room) that room and its neighbours only (map/map_rooms.h),
+// a note on stderr saying which rooms and how much of the map. An unknown room is a
+// CommandError naming the rooms there are.
+map::Map LoadSessionMap(const std::string& map_dir, const std::string& room);
 // --align-max-seconds (tracker::TrackingOptions::align_max_seconds), shared with `arview track`.
 void AddAlignMaxSecondsOption(CLI::App* cmd, double& seconds);
 // Fills the session options these flags control and checks them (SessionOptions::Check: an
