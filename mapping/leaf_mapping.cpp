@@ -3,6 +3,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <set>
 
 #include "base/atomic_file.h"
@@ -37,6 +38,7 @@ void AppendFile(const fs::path& from, const fs::path& to) {
 struct LeafPlan {
   fs::path work;                          // <out>/leaves
   std::vector<std::vector<std::string>> leaf_images;  // each leaf's image names (core, then overlap)
+  std::vector<LeafToRetry> retry;         // each leaf as its model's retries see it
   std::vector<Command> leaf_commands;     // COLMAP argument lists, without the executable
   std::vector<int> merge_order;
   Command triangulate, adjust;            // over the merged leaves, after the merge
@@ -72,8 +74,28 @@ Command AdjustCommand(const MapBuildOptions& options, const fs::path& in, const 
           "--BundleAdjustment.refine_extra_params", refine};
 }
 
+// A leaf's frames (COLMAP image id, name), those with the most inliers to the leaf's other frames
+// first: where a new mapper run best starts.
+std::vector<std::pair<std::uint32_t, std::string>> BestMatchedFirst(const MatchGraph& graph, const DatabaseMatchGraph& database,
+                                                                    const Leaf& leaf) {
+  const std::vector<int> all = leaf.All();
+  std::set<int> in_leaf(all.begin(), all.end());
+  std::map<int, long long> weight;
+  for (const GraphEdge& e : graph.edges) {
+    if (!in_leaf.count(e.a) || !in_leaf.count(e.b)) continue;
+    weight[e.a] += e.weight;
+    weight[e.b] += e.weight;
+  }
+  std::vector<int> order = all;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return weight[a] > weight[b]; });
+  std::vector<std::pair<std::uint32_t, std::string>> starts;
+  for (const int v : order) starts.emplace_back(database.images[static_cast<std::size_t>(v)].first, graph.names[v]);
+  return starts;
+}
+
 LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb) {
-  const MatchGraph graph = BuildMatchGraph(ReadMatchGraph(paths.database));
+  const DatabaseMatchGraph database = ReadMatchGraph(paths.database);
+  const MatchGraph graph = BuildMatchGraph(database);
   const Partition partition = PartitionMatchGraph(graph, {options.leaf_size, options.leaf_overlap});
   LeafPlan plan;
   plan.work = paths.out_dir / "leaves";
@@ -97,8 +119,10 @@ LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& path
     mapper.insert(mapper.end(), {"--image_list_path", (dir / "images.txt").string(), "--Mapper.multiple_models", "0"});
     plan.leaf_commands.push_back(std::move(mapper));
     plan.leaf_images.push_back(std::move(names));
+    plan.retry.push_back(LeafToRetry{"", dir, static_cast<int>(leaf.All().size()), BestMatchedFirst(graph, database, leaf)});
     sizes += (sizes.empty() ? "" : ", ") + std::to_string(leaf.core.size()) + "+" + std::to_string(leaf.overlap.size());
   }
+  for (std::size_t i = 0; i < plan.retry.size(); ++i) plan.retry[i].name = plan.LeafName(static_cast<int>(i));
   plan.merge_order = MergeOrder(partition);
   plan.merged = plan.work / "merged";
   const fs::path triangulated = plan.work / "triangulated";
@@ -148,18 +172,6 @@ bool ReadAndCheckLeaf(const LeafMappingPaths& paths, const LeafPlan& plan, int l
   result->map = ReadColmapMap(plan.LeafModel(leaf), paths.database, paths.frames, {}, &keypoints, false);
   result->check = CheckMap(result->map, keypoints, ReadTwoViewGeometries(paths.database, result->map));
   return true;
-}
-
-std::vector<fs::path> LeafDirs(const LeafPlan& plan) {
-  std::vector<fs::path> dirs;
-  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) dirs.push_back(plan.work / std::to_string(i));
-  return dirs;
-}
-
-std::vector<std::string> LeafNames(const LeafPlan& plan) {
-  std::vector<std::string> names;
-  for (int i = 0; i < static_cast<int>(plan.leaf_commands.size()); ++i) names.push_back(plan.LeafName(i));
-  return names;
 }
 
 // The leaves' models joined one by one in the merge order into <work>/merged (mapping/leaf_merge.h).
@@ -223,8 +235,8 @@ void RunLocally(const MapBuildOptions& options, const LeafMappingPaths& paths, c
     map_leaf(i, {});
   }
   const auto leaf_log = [&](int leaf) { return leaf_dir(leaf) / "colmap.log"; };
-  RetryFoldedLeaves(options, LeafNames(plan), LeafDirs(plan), cb,
-                    {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_leaf, leaf_log});
+  RetryLeafModels(options, plan.retry, cb,
+                  {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_leaf, leaf_log});
   steps->push_back({"map leaves", SecondsSince(t0), false});
   t0 = std::chrono::steady_clock::now();
   std::vector<fs::path> leaf_logs;
@@ -287,8 +299,8 @@ void RunOnSlurm(const MapBuildOptions& options, const LeafMappingPaths& paths, c
     }
     AppendFile(TaskLog(again, 0), leaf_log(leaf));
   };
-  RetryFoldedLeaves(options, LeafNames(plan), LeafDirs(plan), cb,
-                    {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_again, leaf_log});
+  RetryLeafModels(options, plan.retry, cb,
+                  {[&](int leaf, MapBuildResult* r) { return ReadAndCheckLeaf(paths, plan, leaf, r); }, map_again, leaf_log});
   steps->push_back({"map leaves (slurm)", SecondsSince(t0), false});
 
   t0 = std::chrono::steady_clock::now();
@@ -338,31 +350,96 @@ std::vector<int> MergeOrder(const Partition& partition) {
   return order;
 }
 
-void RetryFoldedLeaves(const MapBuildOptions& options, const std::vector<std::string>& leaf_names,
-                       const std::vector<fs::path>& leaf_dirs, const MapBuildCallbacks& cb, const FoldedLeafStages& stages) {
-  for (int leaf = 0; leaf < static_cast<int>(leaf_dirs.size()); ++leaf) {
-    MapBuildResult result;
-    if (!stages.read_and_check(leaf, &result) || !Folded(result.check)) continue;
-    const fs::path& leaf_dir = leaf_dirs[static_cast<std::size_t>(leaf)];
-    const std::string& name = leaf_names[static_cast<std::size_t>(leaf)];
-    MapBuildCallbacks leaf_cb = cb;
-    leaf_cb.note = [&](const std::string& note) {
-      if (cb.note) cb.note(name + ": " + note);
-    };
-    FoldRetryStages retry;
-    retry.map = [&](const std::vector<std::string>& extra) {
-      fs::create_directories(leaf_dir / "sparse");
-      stages.map_again(leaf, extra);
-    };
-    retry.read_model = [&] {
-      if (!stages.read_and_check(leaf, &result)) throw map::MapError(name + ": the mapper left no model");
-    };
-    retry.forget_map = retry.remember_map = [] {};
-    RetryFoldedMap(options.fold_retries, leaf_dir, stages.log_of(leaf), leaf_cb, retry, &result);
-    if (Folded(result.check) && !options.keep_folded) {
-      WriteMapCheck(result.check, leaf_dir / kMapCheckFileName);
-      throw map::MapError(name + ": " + FoldRefusal(leaf_dir, result));
+namespace {
+
+// A model that registered under half its leaf's frames, mapped again from the best-matched frame
+// it left out; the model registering most is left in place and read into `result`.
+void RetrySmallLeafModel(const MapBuildOptions& options, const LeafToRetry& leaf, int index, const MapBuildCallbacks& cb,
+                         const LeafRetryStages& stages, MapBuildResult* result) {
+  const auto registered = [&] { return static_cast<int>(result->map.keyframes.size()); };
+  if (2 * registered() >= leaf.frames || options.fold_retries <= 0) return;
+  const fs::path tries = leaf.dir / "small-tries";
+  std::error_code ec;
+  fs::remove_all(tries, ec);
+  fs::create_directories(tries / "0");
+  fs::rename(leaf.dir / "sparse", tries / "0" / "sparse");
+  int best = 0, best_count = registered();
+  MapBuildResult best_result = *result;
+  const auto put_back_best = [&] {
+    fs::remove_all(leaf.dir / "sparse", ec);
+    fs::rename(tries / std::to_string(best) / "sparse", leaf.dir / "sparse");
+    fs::remove_all(tries, ec);
+    *result = best_result;
+  };
+  std::set<std::uint32_t> tried;
+  for (int t = 1; t <= options.fold_retries && 2 * best_count < leaf.frames; ++t) {
+    std::set<std::uint32_t> in_model;
+    for (const map::Keyframe& k : best_result.map.keyframes) in_model.insert(k.colmap_image_id);
+    const auto start = std::find_if(leaf.starts.begin(), leaf.starts.end(),
+                                    [&](const auto& s) { return !in_model.count(s.first) && !tried.count(s.first); });
+    if (start == leaf.starts.end()) break;
+    tried.insert(start->first);
+    if (cb.note)
+      cb.note(leaf.name + ": COLMAP registered " + std::to_string(best_count) + " of its " + std::to_string(leaf.frames) +
+              " frames: mapping again from " + start->second + ", try " + std::to_string(t) + " of " +
+              std::to_string(options.fold_retries));
+    fs::create_directories(leaf.dir / "sparse");
+    int count = 0;
+    try {
+      stages.map_again(index, {"--Mapper.init_image_id1", std::to_string(start->first)});
+      if (stages.read_and_check(index, result)) count = registered();
+    } catch (const CancelledError&) {
+      put_back_best();
+      throw;
+    } catch (const Error& e) {
+      if (cb.note) cb.note(leaf.name + ": try " + std::to_string(t) + " failed: " + e.what());
     }
+    fs::create_directories(tries / std::to_string(t));
+    if (fs::exists(leaf.dir / "sparse")) fs::rename(leaf.dir / "sparse", tries / std::to_string(t) / "sparse");
+    if (count > best_count) {
+      best = t;
+      best_count = count;
+      best_result = *result;
+    }
+  }
+  put_back_best();
+  if (cb.note)
+    cb.note(leaf.name + ": kept " + (best == 0 ? std::string("the first model") : "the model of try " + std::to_string(best)) +
+            ", " + std::to_string(best_count) + " of " + std::to_string(leaf.frames) + " frames registered");
+}
+
+void RetryFoldedLeafModel(const MapBuildOptions& options, const LeafToRetry& leaf, int index, const MapBuildCallbacks& cb,
+                          const LeafRetryStages& stages, MapBuildResult* result) {
+  if (!Folded(result->check)) return;
+  MapBuildCallbacks leaf_cb = cb;
+  leaf_cb.note = [&](const std::string& note) {
+    if (cb.note) cb.note(leaf.name + ": " + note);
+  };
+  FoldRetryStages retry;
+  retry.map = [&](const std::vector<std::string>& extra) {
+    fs::create_directories(leaf.dir / "sparse");
+    stages.map_again(index, extra);
+  };
+  retry.read_model = [&] {
+    if (!stages.read_and_check(index, result)) throw map::MapError(leaf.name + ": the mapper left no model");
+  };
+  retry.forget_map = retry.remember_map = [] {};
+  RetryFoldedMap(options.fold_retries, leaf.dir, stages.log_of(index), leaf_cb, retry, result);
+  if (Folded(result->check) && !options.keep_folded) {
+    WriteMapCheck(result->check, leaf.dir / kMapCheckFileName);
+    throw map::MapError(leaf.name + ": " + FoldRefusal(leaf.dir, *result));
+  }
+}
+
+}  // namespace
+
+void RetryLeafModels(const MapBuildOptions& options, const std::vector<LeafToRetry>& leaves, const MapBuildCallbacks& cb,
+                     const LeafRetryStages& stages) {
+  for (int i = 0; i < static_cast<int>(leaves.size()); ++i) {
+    MapBuildResult result;
+    if (!stages.read_and_check(i, &result)) continue;
+    RetrySmallLeafModel(options, leaves[static_cast<std::size_t>(i)], i, cb, stages, &result);
+    RetryFoldedLeafModel(options, leaves[static_cast<std::size_t>(i)], i, cb, stages, &result);
   }
 }
 

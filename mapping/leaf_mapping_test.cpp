@@ -83,11 +83,84 @@ std::vector<fs::path> LeafFolders(const fs::path& root) {
   return dirs;
 }
 
+std::vector<LeafToRetry> SixFrameLeaves(const std::vector<fs::path>& dirs) {
+  return {{"leaf 0 (6 frames)", dirs[0], 6, {}}, {"leaf 1 (6 frames)", dirs[1], 6, {}}};
+}
+
+// A model of `count` registered keyframes, COLMAP ids 1.. count, not folded.
+MapBuildResult Registered(int count) {
+  MapBuildResult result;
+  for (int k = 0; k < count; ++k) {
+    map::Keyframe kf;
+    kf.colmap_image_id = static_cast<std::uint32_t>(k + 1);
+    kf.frame_index = k;
+    result.map.keyframes.push_back(kf);
+  }
+  return result;
+}
+
+TEST(LeafMapping, ALeafModelOfUnderHalfItsFramesIsMappedAgainFromAFrameItLeftOut) {
+  const fs::path root = fs::temp_directory_path() / ("arview_small_leaf_" + std::to_string(::getpid()));
+  const std::vector<fs::path> dirs = LeafFolders(root);
+  std::ofstream(dirs[0] / "sparse" / "0" / "first") << "the first model";
+  // 20 frames, ids 1-20, best matched first: 3, 1, 7, 20, ...; the first run registered 1-4, the
+  // first rerun 2 frames, the second 15.
+  std::vector<std::pair<std::uint32_t, std::string>> starts = {{3, "f3"}, {1, "f1"}, {7, "f7"}, {20, "f20"}};
+  const std::vector<LeafToRetry> leaves = {{"leaf 0 (20 frames)", dirs[0], 20, starts}};
+  std::vector<std::vector<std::string>> runs;
+  const int counts[] = {4, 2, 15};
+  LeafRetryStages stages;
+  stages.read_and_check = [&](int, MapBuildResult* result) {
+    const MapBuildResult made = Registered(counts[runs.size()]);
+    result->map = made.map;
+    result->check = made.check;
+    return true;
+  };
+  stages.map_again = [&](int, const std::vector<std::string>& extra) {
+    runs.push_back(extra);
+    fs::create_directories(dirs[0] / "sparse" / "0");
+    std::ofstream(dirs[0] / "sparse" / "0" / ("try" + std::to_string(runs.size()))) << "x";
+  };
+  stages.log_of = [&](int leaf) { return dirs[leaf] / "colmap.log"; };
+  std::vector<std::string> notes;
+  MapBuildCallbacks cb;
+  cb.note = [&](const std::string& note) { notes.push_back(note); };
+  MapBuildOptions options;  // 2 retries
+  RetryLeafModels(options, leaves, cb, stages);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(runs[0], (std::vector<std::string>{"--Mapper.init_image_id1", "7"})) << "3 and 1 were in the model";
+  EXPECT_EQ(runs[1], (std::vector<std::string>{"--Mapper.init_image_id1", "20"}));
+  EXPECT_TRUE(fs::exists(dirs[0] / "sparse" / "0" / "try2")) << "the model of 15 frames in place";
+  EXPECT_FALSE(fs::exists(dirs[0] / "small-tries"));
+  ASSERT_FALSE(notes.empty());
+  EXPECT_EQ(notes.front(), "leaf 0 (20 frames): COLMAP registered 4 of its 20 frames: mapping again from f7, try 1 of 2");
+  EXPECT_EQ(notes.back(), "leaf 0 (20 frames): kept the model of try 2, 15 of 20 frames registered");
+
+  // Reruns that register fewer: the first model back in place.
+  fs::remove_all(root);
+  const std::vector<fs::path> again = LeafFolders(root);
+  std::ofstream(again[0] / "sparse" / "0" / "first") << "the first model";
+  runs.clear();
+  const int fewer[] = {4, 2, 3};
+  stages.read_and_check = [&](int, MapBuildResult* result) {
+    result->map = Registered(fewer[runs.size()]).map;
+    return true;
+  };
+  stages.map_again = [&](int, const std::vector<std::string>& extra) {
+    runs.push_back(extra);
+    fs::create_directories(again[0] / "sparse" / "0");
+  };
+  RetryLeafModels(options, {{"leaf 0 (20 frames)", again[0], 20, starts}}, {}, stages);
+  EXPECT_EQ(runs.size(), 2u);
+  EXPECT_TRUE(fs::exists(again[0] / "sparse" / "0" / "first"));
+  fs::remove_all(root);
+}
+
 TEST(LeafMapping, AFoldedLeafIsMappedAgainFromAKeyframeTheCheckFoundRight) {
   const fs::path root = fs::temp_directory_path() / ("arview_folded_leaf_" + std::to_string(::getpid()));
   const std::vector<fs::path> dirs = LeafFolders(root);
   std::vector<std::pair<int, std::vector<std::string>>> runs;
-  FoldedLeafStages stages;
+  LeafRetryStages stages;
   stages.read_and_check = [&](int leaf, MapBuildResult* result) {
     const MapBuildResult made = LeafCheck(leaf == 1 && runs.empty());  // leaf 1 folded until mapped again
     result->map = made.map;
@@ -103,7 +176,7 @@ TEST(LeafMapping, AFoldedLeafIsMappedAgainFromAKeyframeTheCheckFoundRight) {
   MapBuildCallbacks cb;
   cb.note = [&](const std::string& note) { notes.push_back(note); };
   MapBuildOptions options;
-  RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, cb, stages);
+  RetryLeafModels(options, SixFrameLeaves(dirs), cb, stages);
   ASSERT_EQ(runs.size(), 1u);
   EXPECT_EQ(runs[0].first, 1);
   EXPECT_EQ(runs[0].second, (std::vector<std::string>{"--Mapper.init_image_id1", "15"}));
@@ -118,7 +191,7 @@ TEST(LeafMapping, ALeafStillFoldedAfterItsRetriesIsRefusedNamingItUnlessKept) {
   const fs::path root = fs::temp_directory_path() / ("arview_folded_leaf_" + std::to_string(::getpid()));
   const std::vector<fs::path> dirs = LeafFolders(root);
   std::vector<std::vector<std::string>> runs;
-  FoldedLeafStages stages;
+  LeafRetryStages stages;
   stages.read_and_check = [&](int leaf, MapBuildResult* result) {
     const MapBuildResult made = LeafCheck(leaf == 0);
     result->map = made.map;
@@ -132,7 +205,7 @@ TEST(LeafMapping, ALeafStillFoldedAfterItsRetriesIsRefusedNamingItUnlessKept) {
   stages.log_of = [&](int leaf) { return dirs[leaf] / "colmap.log"; };
   MapBuildOptions options;
   try {
-    RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, {}, stages);
+    RetryLeafModels(options, SixFrameLeaves(dirs), {}, stages);
     FAIL() << "a leaf still folded went through";
   } catch (const map::MapError& e) {
     const std::string what = e.what();
@@ -147,7 +220,7 @@ TEST(LeafMapping, ALeafStillFoldedAfterItsRetriesIsRefusedNamingItUnlessKept) {
   EXPECT_TRUE(fs::exists(dirs[0] / kMapCheckFileName));
   fs::create_directories(dirs[0] / "sparse" / "0");
   options.keep_folded = true;
-  EXPECT_NO_THROW(RetryFoldedLeaves(options, {"leaf 0 (6 frames)", "leaf 1 (6 frames)"}, dirs, {}, stages));
+  EXPECT_NO_THROW(RetryLeafModels(options, SixFrameLeaves(dirs), {}, stages));
   fs::remove_all(root);
 }
 
