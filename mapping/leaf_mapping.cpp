@@ -375,6 +375,7 @@ void RetrySmallLeafModel(const MapBuildOptions& options, const LeafToRetry& leaf
   std::error_code ec;
   fs::remove_all(tries, ec);
   fs::create_directories(tries / "0");
+  fs::create_directories(leaf.dir / "sparse");  // a mapper that registered nothing may have left none
   fs::rename(leaf.dir / "sparse", tries / "0" / "sparse");
   int best = 0, best_count = registered();
   MapBuildResult best_result = *result;
@@ -450,7 +451,7 @@ void RetryLeafModels(const MapBuildOptions& options, const std::vector<LeafToRet
                      const LeafRetryStages& stages) {
   for (int i = 0; i < static_cast<int>(leaves.size()); ++i) {
     MapBuildResult result;
-    if (!stages.read_and_check(i, &result)) continue;
+    stages.read_and_check(i, &result);  // no model: none of its frames registered
     RetrySmallLeafModel(options, leaves[static_cast<std::size_t>(i)], i, cb, stages, &result);
     RetryFoldedLeafModel(options, leaves[static_cast<std::size_t>(i)], i, cb, stages, &result);
   }

@@ -64,8 +64,8 @@ struct LeafToRetry {
 };
 
 // Each leaf's model looked at, as BuildMap looks at one mapper's:
-//  - a model that registered under half the leaf's frames (COLMAP's mapper stopped early: the
-//    rendered venue's leaf 6 once kept 7 of its 161) is mapped again from the best-matched frame
+//  - a model that registered under half the leaf's frames, or no model (COLMAP's mapper stopped
+//    early: the rendered venue's leaf 6 once kept 7 of its 161), is mapped again from the best-matched frame
 //    it left out (--Mapper.init_image_id1), up to options.fold_retries times, the model
 //    registering most kept;
 //  - a folded model (mapping/map_check.h) is mapped again from other starts

@@ -153,6 +153,17 @@ TEST(LeafMapping, ALeafModelOfUnderHalfItsFramesIsMappedAgainFromAFrameItLeftOut
   RetryLeafModels(options, {{"leaf 0 (20 frames)", again[0], 20, starts}}, {}, stages);
   EXPECT_EQ(runs.size(), 2u);
   EXPECT_TRUE(fs::exists(again[0] / "sparse" / "0" / "first"));
+
+  // No model at all (the mapper registered nothing): mapped again from the best-matched frame.
+  runs.clear();
+  stages.read_and_check = [&](int, MapBuildResult* result) {
+    if (runs.empty()) return false;
+    result->map = Registered(15).map;
+    return true;
+  };
+  RetryLeafModels(options, {{"leaf 0 (20 frames)", again[0], 20, starts}}, {}, stages);
+  ASSERT_EQ(runs.size(), 1u);
+  EXPECT_EQ(runs[0], (std::vector<std::string>{"--Mapper.init_image_id1", "3"}));
   fs::remove_all(root);
 }
 
