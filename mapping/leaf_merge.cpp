@@ -50,10 +50,11 @@ std::vector<PointPair> SharedPointPairs(const SparseModel& merged, const SparseM
     const ColmapImage& merged_image = merged.images[found->second];
     const std::size_t n = std::min(merged_image.point3d_ids.size(), leaf_image.point3d_ids.size());
     for (std::size_t k = 0; k < n; ++k) {
-      const std::uint64_t a = merged_image.point3d_ids[k], b = leaf_image.point3d_ids[k];
-      if (a == kInvalidPoint3D || b == kInvalidPoint3D || !seen.emplace(a, b).second) continue;
-      pairs.push_back({merged.points[merged_points.at(a)].point.xyz, leaf.points[leaf_points.at(b)].point.xyz,
-                       merged_image.pose.Center()});
+      const auto a = merged_points.find(merged_image.point3d_ids[k]);
+      const auto b = leaf_points.find(leaf_image.point3d_ids[k]);
+      // A 2D point without a 3D point in either model (or naming one the model lacks) pairs nothing.
+      if (a == merged_points.end() || b == leaf_points.end() || !seen.emplace(a->first, b->first).second) continue;
+      pairs.push_back({merged.points[a->second].point.xyz, leaf.points[b->second].point.xyz, merged_image.pose.Center()});
     }
   }
   return pairs;
@@ -266,7 +267,7 @@ void JoinLeaf(SparseModel* merged, const SparseModel& leaf, LeafAlignment* align
     for (const TrackElement& e : point.track) {
       const ColmapImage& image = merged->images[image_of.at(e.image_id)];
       const std::uint64_t there = added.count(e.image_id) ? kInvalidPoint3D : image.point3d_ids[e.point2d_idx];
-      if (there == kInvalidPoint3D) {
+      if (there == kInvalidPoint3D || !point_of.count(there)) {
         fresh.push_back(e);
       } else {
         existing.insert(there);
