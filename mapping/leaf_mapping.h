@@ -12,8 +12,8 @@
 //   merge       leaf by leaf (each next the leaf sharing the most images with those merged), on
 //               the shared frames' 3D points (mapping/leaf_merge.h), in this process ─►
 //               <out>/leaves/merged; then point_triangulator (the leaves' points kept and
-//               completed from the database's matches) and bundle_adjuster over everything
-//               (on `engine`: with slurm, a job and the job after it) ─► <out>/leaves/adjusted
+//               completed from the database's matches) and bundle_adjuster over everything,
+//               twice (on `engine`: with slurm, a job and the job after it) ─► <out>/leaves/adjusted
 //   check       the adjusted model holds every merged image; then <out>/sparse is replaced by it
 //
 // On any failure <out>/sparse is left as it was; the logs stay in <out>/leaves.
