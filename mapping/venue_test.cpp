@@ -146,7 +146,8 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   EXPECT_EQ(saved.rooms, (std::vector<std::string>{"east", "west"}));
   for (const map::Keyframe& k : saved.keyframes) EXPECT_EQ(k.room, k.frame_index < 3 ? 0 : 1) << k.name;
   EXPECT_EQ(DescribeMapRooms(saved, rooms),
-            (std::vector<std::string>{"east: 3 keyframes of 3 frames (0-2)", "west: 3 keyframes of 3 frames (3-5)"}));
+            (std::vector<std::string>{"east: 3 keyframes of 3 frames (0-2); next to west",
+                                      "west: 3 keyframes of 3 frames (3-5); next to east"}));
   const auto read = ReadVenueFile(dir / "venue");
   ASSERT_TRUE(read.has_value());
   ASSERT_EQ(read->size(), 2u);
