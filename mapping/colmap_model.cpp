@@ -365,6 +365,15 @@ std::vector<cv::Mat> ReadImageDescriptors(const fs::path& database, const std::v
   return descriptors;
 }
 
+CheckedModel ReadCheckedModel(const fs::path& sparse_dir, const fs::path& database, const FrameLookup& frames,
+                              const CancellationToken& cancel) {
+  std::vector<std::vector<Eigen::Vector2f>> keypoints;
+  CheckedModel model;
+  model.map = ReadColmapMap(sparse_dir, database, frames, cancel, &keypoints, false);
+  model.check = CheckMap(model.map, keypoints, ReadTwoViewGeometries(database, model.map));
+  return model;
+}
+
 std::vector<TwoViewGeometry> ReadTwoViewGeometries(const fs::path& database, const map::Map& map) {
   std::unordered_map<std::uint32_t, int> keyframe_of_image;
   for (std::size_t k = 0; k < map.keyframes.size(); ++k)

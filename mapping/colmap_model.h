@@ -87,6 +87,17 @@ map::Map ReadColmapMap(const std::filesystem::path& sparse_dir, const std::files
                   const FrameLookup& frames = {}, const CancellationToken& cancel = {},
                   std::vector<std::vector<Eigen::Vector2f>>* keypoints = nullptr, bool check_values = true);
 
+// A sparse model read as ReadColmapMap reads it (`check_values` false: the caller runs
+// RequireModelValuesInRange) and looked at as a whole (CheckMap with every keyframe's keypoints
+// and the database's two-view geometries): how BuildMap judges the mapper's model, and
+// `arview map --leaf-size` each leaf's (mapping/leaf_mapping.h).
+struct CheckedModel {
+  map::Map map;
+  MapCheck check;
+};
+CheckedModel ReadCheckedModel(const std::filesystem::path& sparse_dir, const std::filesystem::path& database,
+                              const FrameLookup& frames = {}, const CancellationToken& cancel = {});
+
 // The registered images of a sparse model as keyframes without observations (images.bin alone,
 // ordered as ReadColmapMap orders them): for looking at a model's camera path when its database
 // is gone. Throws MapError as ReadColmapMap does.

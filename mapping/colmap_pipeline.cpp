@@ -205,10 +205,10 @@ class MapBuild {
                              "map", colmap_.log(), {});
     }
     options_.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-    std::vector<std::vector<Eigen::Vector2f>> keypoints;
-    result_.map = ReadColmapMap(result_.model_dir, database_, images_.lookup, options_.cancel, &keypoints, false);
+    CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
+    result_.map = std::move(model.map);
     result_.map.camera.focus = recording_.camera.focus;  // COLMAP's camera has no focus: the calibration's
-    result_.check = CheckMap(result_.map, keypoints, ReadTwoViewGeometries(database_, result_.map));
+    result_.check = std::move(model.check);
   }
 
   // A model that leaves a stretch of the walk out (a fast turn): the mapper once more at a lower

@@ -153,15 +153,12 @@ LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& path
   return plan;
 }
 
-// The COLMAP image ids a model registered; a leaf without a model is a MapError naming it.
-std::set<std::uint32_t> RegisteredIds(const fs::path& model, const std::string& what, const fs::path& log) {
+// A leaf without a model is a MapError naming it and its mapper's output (ReadSparseModel reads the model after).
+void RequireLeafModel(const fs::path& model, const std::string& what, const fs::path& log) {
   if (!fs::exists(model / "images.bin")) {
     throw map::MapError(what + ": COLMAP mapper registered no images (no model in " + model.string() +
                         "): too few matches between its frames? Its output is in " + log.string());
   }
-  std::set<std::uint32_t> ids;
-  for (const auto& keyframe : ReadColmapCameraPath(model)) ids.insert(keyframe.colmap_image_id);
-  return ids;
 }
 
 // Why a leaf's model cannot be merged (missing, empty, a file damaged), or empty when it can.
@@ -181,9 +178,9 @@ std::string LeafModelProblem(const fs::path& model) {
 // when it has no model to look at (the merge says why).
 bool ReadAndCheckLeaf(const LeafMappingPaths& paths, const LeafPlan& plan, int leaf, MapBuildResult* result) {
   if (!LeafModelProblem(plan.LeafModel(leaf)).empty()) return false;
-  std::vector<std::vector<Eigen::Vector2f>> keypoints;
-  result->map = ReadColmapMap(plan.LeafModel(leaf), paths.database, paths.frames, {}, &keypoints, false);
-  result->check = CheckMap(result->map, keypoints, ReadTwoViewGeometries(paths.database, result->map));
+  CheckedModel model = ReadCheckedModel(plan.LeafModel(leaf), paths.database, paths.frames);
+  result->map = std::move(model.map);
+  result->check = std::move(model.check);
   return true;
 }
 
@@ -191,7 +188,7 @@ bool ReadAndCheckLeaf(const LeafMappingPaths& paths, const LeafPlan& plan, int l
 // A leaf that cannot be merged is a MapError naming it and why.
 void MergeLeaves(const LeafPlan& plan, const std::vector<fs::path>& leaf_logs, const MapBuildCallbacks& cb) {
   const auto read_leaf = [&](int leaf) {
-    RegisteredIds(plan.LeafModel(leaf), plan.LeafName(leaf), leaf_logs[static_cast<std::size_t>(leaf)]);
+    RequireLeafModel(plan.LeafModel(leaf), plan.LeafName(leaf), leaf_logs[static_cast<std::size_t>(leaf)]);
     return ReadSparseModel(plan.LeafModel(leaf));
   };
   SparseModel merged = read_leaf(plan.merge_order.front());

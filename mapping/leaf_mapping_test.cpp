@@ -72,6 +72,14 @@ MapBuildResult LeafCheck(bool folded) {
   return result;
 }
 
+// What read_and_check gives: the model `made` read into `result` (its map and check only, as the
+// real reading leaves the rest of the result, fold_retries among it, as it was).
+bool ReadAs(const MapBuildResult& made, MapBuildResult* result) {
+  result->map = made.map;
+  result->check = made.check;
+  return true;
+}
+
 // Two leaf folders, each with a model folder and a log whose mapper started from ids 11 and 12.
 std::vector<fs::path> LeafFolders(const fs::path& root) {
   fs::remove_all(root);
@@ -111,10 +119,7 @@ TEST(LeafMapping, ALeafModelOfUnderHalfItsFramesIsMappedAgainFromAFrameItLeftOut
   const int counts[] = {4, 2, 15};
   LeafRetryStages stages;
   stages.read_and_check = [&](int, MapBuildResult* result) {
-    const MapBuildResult made = Registered(counts[runs.size()]);
-    result->map = made.map;
-    result->check = made.check;
-    return true;
+    return ReadAs(Registered(counts[runs.size()]), result);
   };
   stages.map_again = [&](int, const std::vector<std::string>& extra) {
     runs.push_back(extra);
@@ -143,8 +148,7 @@ TEST(LeafMapping, ALeafModelOfUnderHalfItsFramesIsMappedAgainFromAFrameItLeftOut
   runs.clear();
   const int fewer[] = {4, 2, 3};
   stages.read_and_check = [&](int, MapBuildResult* result) {
-    result->map = Registered(fewer[runs.size()]).map;
-    return true;
+    return ReadAs(Registered(fewer[runs.size()]), result);
   };
   stages.map_again = [&](int, const std::vector<std::string>& extra) {
     runs.push_back(extra);
@@ -157,9 +161,7 @@ TEST(LeafMapping, ALeafModelOfUnderHalfItsFramesIsMappedAgainFromAFrameItLeftOut
   // No model at all (the mapper registered nothing): mapped again from the best-matched frame.
   runs.clear();
   stages.read_and_check = [&](int, MapBuildResult* result) {
-    if (runs.empty()) return false;
-    result->map = Registered(15).map;
-    return true;
+    return !runs.empty() && ReadAs(Registered(15), result);
   };
   RetryLeafModels(options, {{"leaf 0 (20 frames)", again[0], 20, starts}}, {}, stages);
   ASSERT_EQ(runs.size(), 1u);
@@ -173,10 +175,7 @@ TEST(LeafMapping, AFoldedLeafIsMappedAgainFromAKeyframeTheCheckFoundRight) {
   std::vector<std::pair<int, std::vector<std::string>>> runs;
   LeafRetryStages stages;
   stages.read_and_check = [&](int leaf, MapBuildResult* result) {
-    const MapBuildResult made = LeafCheck(leaf == 1 && runs.empty());  // leaf 1 folded until mapped again
-    result->map = made.map;
-    result->check = made.check;
-    return true;
+    return ReadAs(LeafCheck(leaf == 1 && runs.empty()), result);  // leaf 1 folded until mapped again
   };
   stages.map_again = [&](int leaf, const std::vector<std::string>& extra) {
     runs.emplace_back(leaf, extra);
@@ -204,10 +203,7 @@ TEST(LeafMapping, ALeafStillFoldedAfterItsRetriesIsRefusedNamingItUnlessKept) {
   std::vector<std::vector<std::string>> runs;
   LeafRetryStages stages;
   stages.read_and_check = [&](int leaf, MapBuildResult* result) {
-    const MapBuildResult made = LeafCheck(leaf == 0);
-    result->map = made.map;
-    result->check = made.check;
-    return true;
+    return ReadAs(LeafCheck(leaf == 0), result);
   };
   stages.map_again = [&](int, const std::vector<std::string>& extra) {
     runs.push_back(extra);
