@@ -120,18 +120,27 @@ class MapBuild {
     const bool arview_matches = !stages_as_jobs_ && arview_wanted && NamesFitAMatchList(images_.names);
     if (arview_wanted && !arview_matches && cb_.note)
       cb_.note("a frame's file name holds a space: COLMAP matches the frames itself (--match-engine colmap)");
+    // A venue's pairs (within rooms, across them from the descriptor index) where COLMAP matches.
+    const bool listed_pairs = !stages_as_jobs_ && !arview_matches && VenuePairsWanted(options_, frames_) &&
+                              NamesFitAMatchList(images_.names);
     const std::vector<std::string> match_args = MatchArgs(options_, database_, frames_);
     inputs_ += "--\n" + (stages_as_jobs_  ? SlurmMatchInputs(options_, frames_)
                          : arview_matches ? ArviewMatchInputs(options_, frames_)
+                         : listed_pairs   ? ListedPairsMatchInputs(options_, frames_)
                                           : Joined(match_args));
     StageWork run = ColmapStage("match", match_args);
     if (arview_matches) {
       run = [this](std::vector<StageTiming>* steps) {
-        MatchWithArview(colmap_, database_, out_dir_, images_.names, options_, cb_, steps);
+        MatchWithArview(colmap_, database_, out_dir_, images_.names, images_.lookup, options_, cb_, steps);
       };
     } else if (stages_as_jobs_) {
       run = [this](std::vector<StageTiming>*) {
-        MatchOnSlurm(options_, JobFiles(), images_.names, PairsToMatch(options_, frames_), cb_);
+        MatchOnSlurm(options_, JobFiles(), images_.names,
+                     PairsToMatch(options_, images_.names, images_.lookup, database_, cb_), cb_);
+      };
+    } else if (listed_pairs) {
+      run = [this](std::vector<StageTiming>*) {
+        MatchListedPairsWithColmap(colmap_, database_, out_dir_, images_.names, images_.lookup, options_, cb_);
       };
     }
     // The mapper's inputs are known now: the map stage's record follows the matches'.

@@ -24,6 +24,7 @@
 #include "mapping/pair_matching.h"
 #include "mapping/slurm_engine.h"
 #include "mapping/venue.h"
+#include "mapping/venue_pairs.h"
 #include "recordings/recording.h"
 
 namespace arview::mapping {
@@ -133,6 +134,10 @@ struct MapBuildOptions {
   // A venue's rooms (mapping/venue.h, VenueRecording): the map file names each keyframe's room.
   // Empty for one recording.
   std::vector<VenueRoom> rooms;
+  // A venue matched sequentially: each room's frames among themselves, and each frame with the
+  // frames of other rooms that share most of its descriptors (mapping/venue_pairs.h; its threads
+  // are `threads`).
+  CrossRoomOptions cross_rooms;
 
   // `arview map --preset fast`: 850 features and one orientation per keypoint, fewer bundle
   // adjustments (chosen on templeRing: a third less CPU, about twice the tracking error).

@@ -324,6 +324,7 @@ std::optional<std::pair<int, int>> ParseColmapProgress(const std::string& line, 
   if (std::sscanf(text, "Matching block [%d/%d, %d/%d]", &a, &na, &b, &nb) == 4) {
     return std::make_pair((a - 1) * nb + b, na * nb);
   }
+  if (std::sscanf(text, "Matching block [%d/%d]", &a, &na) == 2) return std::make_pair(a, na);  // listed pairs
   if (std::sscanf(text, "Registering image #%d (%d)", &b, &a) == 2) return std::make_pair(a, total_images);
   if (line.rfind("Initializing with image pair", 0) == 0) return std::make_pair(0, total_images);
   return std::nullopt;

@@ -18,6 +18,7 @@ void MapBuildOptions::Check(const OptionNames& names) const {
   RequireOption(ba_global_max_iterations >= 1, names("ba_global_max_iterations"), "at least 1", ba_global_max_iterations);
   RequireOption(ba_local_max_iterations >= 0, names("ba_local_max_iterations"), "0 or more", ba_local_max_iterations);
   RequireOption(sequential_overlap >= 1, names("sequential_overlap"), "at least 1", sequential_overlap);
+  cross_rooms.Check(names.Nested("cross_rooms"));
   RequireOption(fold_retries >= 0, names("fold_retries"), "0 or more", fold_retries);
   // COLMAP's mapper triangulates nothing below 0 degrees; above its own 1.5 the retry would lower nothing.
   RequireOption(gap_retry_angle_deg >= 0 && gap_retry_angle_deg < 1.5, names("gap_retry_angle_deg"),

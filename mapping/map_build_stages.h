@@ -94,19 +94,35 @@ std::vector<std::string> MatchArgs(const MapBuildOptions& options, const std::fi
 // matches_importer splits a pair's line at the first space.
 bool NamesFitAMatchList(const std::vector<std::string>& names);
 
-// The pairs `arview map` matches: exhaustive or sequential, as COLMAP's matcher would.
-std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, int frames);
+// Whether a venue's frames are paired room by room and across rooms from a descriptor index
+// (mapping/venue_pairs.h): two rooms or more, sequential matching, cross_rooms.neighbours > 0.
+bool VenuePairsWanted(const MapBuildOptions& options, int frames);
+
+// The pairs `arview map` matches: exhaustive or sequential, as COLMAP's matcher would; a venue's
+// (VenuePairsWanted) so within each room, and across rooms from the images' `descriptors` (read
+// from `database` when not given). `names` are the images in their order, `lookup` their frames,
+// whose room options.rooms says. The venue's pairs are described in a note (cb.note).
+std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, const std::vector<std::string>& names,
+                                    const FrameLookup& lookup, const std::filesystem::path& database,
+                                    const MapBuildCallbacks& cb, const std::vector<cv::Mat>* descriptors = nullptr);
+
+// COLMAP's matcher on listed pairs (matches_importer --match_type pairs, one process): a venue's
+// pairs where COLMAP matches (--match-engine colmap, or frames it doubles).
+void MatchListedPairsWithColmap(ColmapRunner& colmap, const std::filesystem::path& database,
+                                const std::filesystem::path& out_dir, const std::vector<std::string>& names,
+                                const FrameLookup& lookup, const MapBuildOptions& options, const MapBuildCallbacks& cb);
 
 // What decides arview's matches, and the Slurm jobs' (matches_importer on pairs), for the stage
 // record.
 std::string ArviewMatchInputs(const MapBuildOptions& options, int frames);
 std::string SlurmMatchInputs(const MapBuildOptions& options, int frames);
+std::string ListedPairsMatchInputs(const MapBuildOptions& options, int frames);  // MatchListedPairsWithColmap's
 
 // arview's matching: the pairs matched with a kd-tree per frame, then verified by COLMAP.
 // `timings` gets the two steps.
 void MatchWithArview(ColmapRunner& colmap, const std::filesystem::path& database, const std::filesystem::path& out_dir,
-                     const std::vector<std::string>& names, const MapBuildOptions& options, const MapBuildCallbacks& cb,
-                     std::vector<StageTiming>* timings);
+                     const std::vector<std::string>& names, const FrameLookup& lookup, const MapBuildOptions& options,
+                     const MapBuildCallbacks& cb, std::vector<StageTiming>* timings);
 
 // --- mapping/map_folder.cpp ---
 

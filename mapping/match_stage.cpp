@@ -14,6 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include "base/atomic_file.h"
+#include "map/map.h"
 #include "mapping/colmap_model.h"
 
 namespace arview::mapping {
@@ -26,10 +28,56 @@ bool NamesFitAMatchList(const std::vector<std::string>& names) {
   });
 }
 
-std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, int frames) {
-  return ExhaustiveMatchingWanted(options, frames)
-             ? ExhaustivePairs(frames)
-             : SequentialPairs(frames, options.sequential_overlap, options.quadratic_overlap);
+bool VenuePairsWanted(const MapBuildOptions& options, int frames) {
+  return options.rooms.size() >= 2 && options.cross_rooms.neighbours > 0 && !ExhaustiveMatchingWanted(options, frames);
+}
+
+namespace {
+
+// Each image's room: the room of options.rooms holding its frame.
+std::vector<int> RoomOfEachImage(const MapBuildOptions& options, const std::vector<std::string>& names,
+                                 const FrameLookup& lookup) {
+  std::vector<int> room_of;
+  for (const std::string& name : names) {
+    const auto frame = lookup.find(name);
+    const int index = frame == lookup.end() ? -1 : frame->second.frame_index;
+    const auto room = std::find_if(options.rooms.begin(), options.rooms.end(),
+                                   [&](const VenueRoom& r) { return r.Holds(index); });
+    if (room == options.rooms.end()) throw map::MapError("venue: image " + name + " is in none of its rooms");
+    room_of.push_back(static_cast<int>(room - options.rooms.begin()));
+  }
+  return room_of;
+}
+
+}  // namespace
+
+std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, const std::vector<std::string>& names,
+                                    const FrameLookup& lookup, const fs::path& database, const MapBuildCallbacks& cb,
+                                    const std::vector<cv::Mat>* descriptors) {
+  const int frames = static_cast<int>(names.size());
+  if (!VenuePairsWanted(options, frames)) {
+    return ExhaustiveMatchingWanted(options, frames)
+               ? ExhaustivePairs(frames)
+               : SequentialPairs(frames, options.sequential_overlap, options.quadratic_overlap);
+  }
+  std::vector<cv::Mat> read;
+  if (descriptors == nullptr) {
+    read = ReadImageDescriptors(database, names, options.cancel);
+    descriptors = &read;
+  }
+  CrossRoomOptions cross = options.cross_rooms;
+  cross.threads = options.threads;
+  const VenuePairs pairs = PairVenueFrames(
+      RoomOfEachImage(options, names, lookup), *descriptors,
+      [&](int n) { return SequentialPairs(n, options.sequential_overlap, options.quadratic_overlap); }, cross,
+      [&](int done, int total) {
+        if (cb.progress) cb.progress("pair rooms", done, total);
+      },
+      options.cancel);
+  std::vector<std::string> room_names;
+  for (const VenueRoom& r : options.rooms) room_names.push_back(r.name);
+  if (cb.note) cb.note("venue: " + pairs.Describe(room_names));
+  return pairs.pairs;
 }
 
 namespace {
@@ -39,11 +87,17 @@ int VerifyingProcesses(const MapBuildOptions& options) {
   return std::max(1, options.threads <= 0 ? cores : options.threads);
 }
 
-// "exhaustive" or "sequential 10 quadratic": which pairs are matched, for the stage records.
+// "exhaustive" or "sequential 10 quadratic": which pairs are matched, for the stage records; a
+// venue's rooms and its pairs across them too.
 std::string PairsWanted(const MapBuildOptions& options, int frames) {
-  return ExhaustiveMatchingWanted(options, frames)
-             ? "exhaustive"
-             : "sequential " + std::to_string(options.sequential_overlap) + (options.quadratic_overlap ? " quadratic" : "");
+  if (ExhaustiveMatchingWanted(options, frames)) return "exhaustive";
+  std::string wanted = "sequential " + std::to_string(options.sequential_overlap) + (options.quadratic_overlap ? " quadratic" : "");
+  if (!VenuePairsWanted(options, frames)) return wanted;
+  const CrossRoomOptions& c = options.cross_rooms;
+  wanted += " within rooms";
+  for (const VenueRoom& r : options.rooms) wanted += " " + std::to_string(r.first_frame) + "+" + std::to_string(r.frames);
+  return wanted + "; across " + std::to_string(c.neighbours) + " neighbours, " + std::to_string(c.descriptors_per_frame) +
+         " descriptors, " + std::to_string(c.min_votes) + " votes, ratio " + FormatParams({c.max_ratio});
 }
 
 }  // namespace
@@ -54,6 +108,11 @@ std::string ArviewMatchInputs(const MapBuildOptions& options, int frames) {
   ss << "arview pair matching\n" << PairsWanted(options, frames) << "\nratio " << m.max_ratio << " distance " << m.max_distance << " cross " << m.cross_check << " trees "
      << m.trees << " checks " << m.checks << " at least " << m.min_matches << "\nmatches_importer raw\n";
   return ss.str();
+}
+
+std::string ListedPairsMatchInputs(const MapBuildOptions& options, int frames) {
+  return "COLMAP matches_importer on listed pairs\n" + PairsWanted(options, frames) + "\nthreads " +
+         std::to_string(options.threads) + "\n";
 }
 
 std::string SlurmMatchInputs(const MapBuildOptions& options, int frames) {
@@ -131,11 +190,11 @@ void VerifyMatches(ColmapRunner& colmap, const fs::path& database, const std::ve
 }  // namespace
 
 void MatchWithArview(ColmapRunner& colmap, const fs::path& database, const fs::path& out_dir,
-                     const std::vector<std::string>& names, const MapBuildOptions& options, const MapBuildCallbacks& cb,
-                     std::vector<StageTiming>* timings) {
+                     const std::vector<std::string>& names, const FrameLookup& lookup, const MapBuildOptions& options,
+                     const MapBuildCallbacks& cb, std::vector<StageTiming>* timings) {
   auto t0 = std::chrono::steady_clock::now();
   const std::vector<cv::Mat> descriptors = ReadImageDescriptors(database, names, options.cancel);
-  const std::vector<ImagePair> pairs = PairsToMatch(options, static_cast<int>(names.size()));
+  const std::vector<ImagePair> pairs = PairsToMatch(options, names, lookup, database, cb, &descriptors);
   PairMatchingOptions matching = options.pair_matching;
   matching.threads = options.threads;
   const std::vector<PairMatches> matches = MatchImagePairs(
@@ -164,6 +223,32 @@ void MatchWithArview(ColmapRunner& colmap, const fs::path& database, const fs::p
   }
   remove_lists();
   timings->push_back({"verify", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), false});
+}
+
+void MatchListedPairsWithColmap(ColmapRunner& colmap, const fs::path& database, const fs::path& out_dir,
+                                const std::vector<std::string>& names, const FrameLookup& lookup,
+                                const MapBuildOptions& options, const MapBuildCallbacks& cb) {
+  const std::vector<ImagePair> pairs = PairsToMatch(options, names, lookup, database, cb);
+  std::string text;
+  for (const ImagePair& p : pairs)
+    text += names.at(static_cast<std::size_t>(p.first)) + " " + names.at(static_cast<std::size_t>(p.second)) + "\n";
+  const fs::path list = out_dir / "venue-pairs.txt";
+  WriteFileAtomically(list, text);
+  // Progress: COLMAP prints "Matching block [i/N]" every 1,225 pairs (matches_importer has no
+  // option for the block's size).
+  try {
+    colmap.Run("match",
+               {"matches_importer", "--database_path", database.string(), "--match_list_path", list.string(),
+                "--match_type", "pairs", "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
+                std::to_string(options.threads)},
+               static_cast<int>(names.size()));
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(list, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::remove(list, ec);
 }
 
 }  // namespace arview::mapping

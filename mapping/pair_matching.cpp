@@ -109,14 +109,14 @@ PairMatches MatchPair(const std::vector<cv::Mat>& descriptors, const std::vector
   return out;
 }
 
+}  // namespace
+
 int Workers(int threads, size_t jobs) {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int wanted = threads <= 0 ? cores : threads;
   return std::max(1, std::min<int>(wanted, static_cast<int>(std::max<size_t>(1, jobs))));
 }
 
-// Runs job(i) for i in [0, count) on `workers` threads; the calling thread reports progress and
-// looks at `cancel`. The first exception of a job is rethrown after every worker has stopped.
 void ForEachInParallel(size_t count, int workers, const std::function<void(size_t)>& job,
                        const std::function<void(int, int)>& progress, const CancellationToken& cancel,
                        const std::string& what) {
@@ -162,8 +162,6 @@ void ForEachInParallel(size_t count, int workers, const std::function<void(size_
   if (failure) std::rethrow_exception(failure);
   cancel.ThrowIfCancelled(what);
 }
-
-}  // namespace
 
 std::vector<PairMatches> MatchImagePairs(const std::vector<cv::Mat>& descriptors, const std::vector<ImagePair>& pairs,
                                          const PairMatchingOptions& options,

@@ -36,6 +36,16 @@ std::vector<ImagePair> ExhaustivePairs(int images);
 // loops along a video). Each pair once, in order.
 std::vector<ImagePair> SequentialPairs(int images, int overlap, bool quadratic);
 
+// Worker threads for `jobs` jobs: `threads`, or every core when `threads` <= 0, at most one a job.
+int Workers(int threads, size_t jobs);
+
+// Runs job(i) for i in [0, count) on `workers` threads; the calling thread reports
+// progress(done, count) and looks at `cancel` (then CancelledError "interrupted: <what>"). The
+// first exception of a job is rethrown after every worker has stopped.
+void ForEachInParallel(size_t count, int workers, const std::function<void(size_t)>& job,
+                       const std::function<void(int, int)>& progress, const CancellationToken& cancel,
+                       const std::string& what);
+
 struct PairMatchingOptions {
   // COLMAP's SiftMatching defaults: the best neighbour's distance at most max_ratio of the
   // second's, at most max_distance (on unit descriptors; COLMAP stores them x512 as bytes), and

@@ -115,6 +115,7 @@ TEST_F(TempleMapTest, ProgressFollowsEveryStageToItsEnd) {
     }
   }
   EXPECT_EQ(ParseColmapProgress("Matching block [2/3, 1/3] in 1.2s", 0), std::make_pair(4, 9));
+  EXPECT_EQ(ParseColmapProgress("Matching block [3/20] in 0.8s", 0), std::make_pair(3, 20));
   EXPECT_EQ(ParseColmapProgress("Matching image [5/40] in 0.5s", 0), std::make_pair(5, 40));
   EXPECT_EQ(ParseColmapProgress("Processed file [3/24]", 0), std::make_pair(3, 24));
   EXPECT_EQ(ParseColmapProgress("Registering image #4 (7)", 24), std::make_pair(7, 24));

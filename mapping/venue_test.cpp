@@ -204,6 +204,47 @@ TEST_F(TwoRooms, MappedAsOneVenueTheyGiveTheMapOfOneRecordingAndNameTheirRooms) 
   EXPECT_LT(centre, 1e-5 * extent);
 }
 
+// Two rooms given in the order nobody walked them (west, frames 9-11, then east, 6-8) and matched
+// sequentially with an overlap of 1: a sequence over the venue's frames would pair west's last
+// frame (11) with east's first (6), and never frames 8 and 9, which stand next to each other on
+// the ring. Matched room by room and across rooms from the descriptor index, 8 and 9 are a
+// verified pair and the venue maps whole.
+TEST_F(TwoRooms, FramesOfOtherRoomsArePairedByTheirDescriptorsNotByTheOrderOfTheRooms) {
+  // arview's matcher, and COLMAP's on the listed pairs (matches_importer --match_type pairs).
+  for (const MatchEngine engine : {MatchEngine::kArview, MatchEngine::kColmap}) {
+    SCOPED_TRACE(ToString(engine));
+    MapBuildOptions options;
+    options.UseFastPreset();
+    options.match_engine = engine;
+    options.matcher = MatcherKind::kSequential;
+    options.sequential_overlap = 1;
+    options.quadratic_overlap = false;
+    options.cross_rooms.neighbours = 1;
+    options.keep_folded = true;  // six frames: the fold check's pairs are few (as above)
+    const fs::path out = dir / ("venue-" + ToString(engine));
+    std::vector<VenueRoom> rooms;
+    const recordings::Recording venue = VenueRecording({dir / "west", dir / "east"}, out, &rooms);
+    options.rooms = rooms;
+    std::vector<std::string> notes;
+    MapBuildCallbacks cb;
+    cb.note = [&](const std::string& line) { notes.push_back(line); };
+    const MapBuildResult result = BuildMap(venue, out, options, cb);
+    const auto venue_note =
+        std::find_if(notes.begin(), notes.end(), [](const std::string& n) { return n.rfind("venue: ", 0) == 0; });
+    ASSERT_NE(venue_note, notes.end()) << "the venue's pairs are described";
+    EXPECT_NE(venue_note->find("4 pairs within rooms"), std::string::npos) << *venue_note;
+    EXPECT_NE(venue_note->find("across: west and east"), std::string::npos) << *venue_note;
+    const auto pairs = VerifiedInliers(out / "database.db", WithoutRoom);
+    const auto pair_8_9 = pairs.find(std::minmax(temple.frames[8].path, temple.frames[9].path));
+    ASSERT_NE(pair_8_9, pairs.end()) << "frames 8 and 9 were not matched";
+    EXPECT_GT(pair_8_9->second, 100) << "inliers of frames 8 and 9";
+    EXPECT_EQ(pairs.count(std::minmax(temple.frames[11].path, temple.frames[6].path)), 0u)
+        << "the rooms' order paired west's last frame with east's first";
+    EXPECT_EQ(result.map.keyframes.size(), 6u);
+    EXPECT_FALSE(fs::exists(out / "venue-pairs.txt")) << "the pair list is removed once matched";
+  }
+}
+
 TEST(VenueFile, ANonVenueFileIsOneClearError) {
   const fs::path dir = fs::temp_directory_path() / ("arview_venue_file_" + std::to_string(::getpid()));
   fs::create_directories(dir);

@@ -52,6 +52,7 @@ struct MapArgs {
   // A venue in leaves (mapping/leaf_mapping.h).
   int leaf_size = 0;
   int leaf_overlap = mapping::MapBuildOptions().leaf_overlap;
+  int cross_room_neighbours = mapping::MapBuildOptions().cross_rooms.neighbours;
   std::string engine = "local";
   std::string slurm_partition;
   int slurm_cpus = 0;
@@ -120,6 +121,7 @@ void RunMap(const MapArgs& args) {
   options.gap_retry_angle_deg = args.gap_retry_angle;
   options.leaf_size = args.leaf_size;
   options.leaf_overlap = args.leaf_overlap;
+  options.cross_rooms.neighbours = args.cross_room_neighbours;
   options.slurm.partition = args.slurm_partition;
   options.slurm.cpus_per_task = args.slurm_cpus;
   options.slurm.time_limit_minutes = args.slurm_time_limit;
@@ -350,6 +352,12 @@ void AddMapCommand(CLI::App& app) {
                   "many degrees, and keep the model that registers more frames (0: no retry)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.4));
+  cmd->add_option("--cross-room-neighbours", args->cross_room_neighbours,
+                  "A venue matched sequentially: each room's frames among themselves, and each frame with this many "
+                  "frames of the other rooms that share most of its SIFT descriptors (0: the rooms' frames as one "
+                  "sequence, room after room, for recordings walked one into the next)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--leaf-size", args->leaf_size,
                   "Map in parts: with more frames than this, cut the match graph (METIS on the inliers) into leaves "
                   "of at most this many frames, map each alone and merge them (0: one mapper over every frame)")
