@@ -13,6 +13,7 @@
 #include "mapping/fold_retries.h"
 #include "mapping/map_check.h"
 #include "mapping/leaf_merge.h"
+#include "mapping/map_build_stages.h"
 
 namespace arview::mapping {
 
@@ -104,7 +105,7 @@ std::vector<std::pair<std::uint32_t, std::string>> BestMatchedFirst(const MatchG
 LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb) {
   const DatabaseMatchGraph database = ReadMatchGraph(paths.database);
   const MatchGraph graph = BuildMatchGraph(database);
-  const Partition partition = PartitionMatchGraph(graph, {options.leaf_size, options.leaf_overlap});
+  const Partition partition = PartitionMatchGraph(graph, {options.leaf_size, options.leaf_overlap, RoomOfEachImage(options, graph.names, paths.frames)});
   LeafPlan plan;
   plan.work = paths.out_dir / "leaves";
   std::error_code ec;
@@ -146,7 +147,8 @@ LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& path
   }
   if (cb.note) {
     cb.note(std::to_string(graph.names.size()) + " frames mapped as " + std::to_string(partition.leaves.size()) +
-            " leaves of at most " + std::to_string(options.leaf_size) + " (frames + overlap: " + sizes +
+            " leaves of at most " + std::to_string(options.leaf_size) + (options.rooms.size() >= 2 ? ", cut within rooms" : "") +
+            " (frames + overlap: " + sizes +
             "); the cut between them holds " + std::to_string(partition.cut_weight) + " of " +
             std::to_string(total_weight) + " inliers");
   }

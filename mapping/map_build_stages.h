@@ -94,6 +94,11 @@ std::vector<std::string> MatchArgs(const MapBuildOptions& options, const std::fi
 // matches_importer splits a pair's line at the first space.
 bool NamesFitAMatchList(const std::vector<std::string>& names);
 
+// Each image's room (the index in options.rooms of the room holding its frame, -1: none), or
+// nothing when options.rooms holds fewer than two rooms.
+std::vector<int> RoomOfEachImage(const MapBuildOptions& options, const std::vector<std::string>& names,
+                                 const FrameLookup& lookup);
+
 // Whether a venue's frames are paired room by room and across rooms from a descriptor index
 // (mapping/venue_pairs.h): two rooms or more, sequential matching, cross_rooms.neighbours > 0.
 bool VenuePairsWanted(const MapBuildOptions& options, int frames);

@@ -163,6 +163,49 @@ MatchGraph BuildMatchGraph(const DatabaseMatchGraph& database, int min_inliers) 
   return graph;
 }
 
+namespace {
+
+// The vertices of each room (room_of per vertex), a room of fewer than kLeastFramesOfALeaf (or
+// leaf_size) vertices put into the room it shares most edge weight with, smallest rooms first.
+std::vector<std::vector<int>> RoomsLargeEnough(const std::vector<std::vector<std::pair<int, int>>>& adjacency,
+                                               const std::vector<int>& room_of, int leaf_size) {
+  std::vector<int> room = room_of;
+  const int rooms = room.empty() ? 0 : *std::max_element(room.begin(), room.end()) + 1;
+  const std::size_t least = static_cast<std::size_t>(std::min(kLeastFramesOfALeaf, leaf_size));
+  const auto members = [&] {
+    std::vector<std::vector<int>> m(static_cast<std::size_t>(std::max(rooms, 0)));
+    for (std::size_t v = 0; v < room.size(); ++v)
+      if (room[v] >= 0) m[static_cast<std::size_t>(room[v])].push_back(static_cast<int>(v));
+    return m;
+  };
+  for (bool moved = true; moved;) {
+    moved = false;
+    std::vector<std::vector<int>> m = members();
+    std::size_t smallest = m.size();
+    for (std::size_t r = 0; r < m.size(); ++r)
+      if (!m[r].empty() && m[r].size() < least && (smallest == m.size() || m[r].size() < m[smallest].size())) smallest = r;
+    if (smallest == m.size()) break;
+    std::vector<long long> tie(m.size(), 0);
+    for (const int v : m[smallest])
+      for (const auto& [u, weight] : adjacency[v])
+        if (room[u] >= 0 && room[u] != static_cast<int>(smallest)) tie[static_cast<std::size_t>(room[u])] += weight;
+    const auto strongest = std::max_element(tie.begin(), tie.end());
+    if (*strongest == 0) break;  // tied to no other room: it stays a part of its own
+    for (const int v : m[smallest]) room[v] = static_cast<int>(strongest - tie.begin());
+    moved = true;
+  }
+  std::vector<std::vector<int>> grouped;
+  for (std::vector<int>& r : members())
+    if (!r.empty()) grouped.push_back(std::move(r));
+  std::vector<int> outside;  // vertices in no room: a part of their own
+  for (std::size_t v = 0; v < room.size(); ++v)
+    if (room[v] < 0) outside.push_back(static_cast<int>(v));
+  if (!outside.empty()) grouped.push_back(std::move(outside));
+  return grouped;
+}
+
+}  // namespace
+
 Partition PartitionMatchGraph(const MatchGraph& graph, const PartitionOptions& options) {
   if (options.leaf_size < 2) throw map::MapError("a leaf must hold at least 2 images (leaf size " + std::to_string(options.leaf_size) + ")");
   if (options.overlap < 0) throw map::MapError("the leaves' overlap cannot be negative (" + std::to_string(options.overlap) + ")");
@@ -174,7 +217,15 @@ Partition PartitionMatchGraph(const MatchGraph& graph, const PartitionOptions& o
   std::vector<int> all(graph.names.size());
   std::iota(all.begin(), all.end(), 0);
   Partition partition;
-  SplitUntilSmall(adjacency, all, options.leaf_size, &partition.leaves);
+  if (options.room_of.empty()) {
+    SplitUntilSmall(adjacency, all, options.leaf_size, &partition.leaves);
+  } else {
+    if (options.room_of.size() != graph.names.size())
+      throw map::MapError("the leaves' rooms: " + std::to_string(options.room_of.size()) + " given for " +
+                          std::to_string(graph.names.size()) + " images");
+    for (const std::vector<int>& room : RoomsLargeEnough(adjacency, options.room_of, options.leaf_size))
+      SplitUntilSmall(adjacency, room, options.leaf_size, &partition.leaves);
+  }
   std::vector<int> group(graph.names.size(), 0);
   for (std::size_t l = 0; l < partition.leaves.size(); ++l) {
     for (const int v : partition.leaves[l].core) group[v] = static_cast<int>(l);

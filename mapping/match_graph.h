@@ -32,6 +32,10 @@ MatchGraph BuildMatchGraph(const DatabaseMatchGraph& database, int min_inliers =
 struct PartitionOptions {
   int leaf_size = 0;   // at most this many images in a leaf before the overlap (> 1)
   int overlap = 10;    // outside images added to each leaf, the most strongly tied first
+  // A venue's rooms: each vertex's room (empty: none). Leaves are then cut within rooms, never
+  // across one's walls: each room is partitioned on its own, and a room too small to map alone
+  // (under 10 images) goes with the room it shares most inliers with.
+  std::vector<int> room_of;
 };
 
 struct Leaf {
@@ -45,8 +49,8 @@ struct Partition {
   long long cut_weight = 0;  // the inliers of the edges between different leaves' cores
 };
 
-// Recursive bisection with METIS (edge weights = inliers) until every leaf holds at most
-// options.leaf_size vertices, each connected part of a subgraph bisected apart (a part of fewer
+// Recursive bisection with METIS (edge weights = inliers), within each room when rooms are
+// given, until every leaf holds at most options.leaf_size vertices, each connected part of a subgraph bisected apart (a part of fewer
 // than 10 vertices goes with the largest), then the overlap. A graph of at most leaf_size vertices is one leaf.
 // Deterministic (METIS's seed is fixed). Throws MapError when METIS fails or the options are
 // out of range.

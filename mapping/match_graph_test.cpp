@@ -36,7 +36,7 @@ void ExpectEveryVertexInOneCore(const Partition& p, int vertices) {
 
 TEST(MatchGraph, CutsBetweenTheCliquesNotByIndex) {
   const MatchGraph g = InterleavedCliques(10);
-  const Partition p = PartitionMatchGraph(g, {10, 0});
+  const Partition p = PartitionMatchGraph(g, {10, 0, {}});
   ASSERT_EQ(p.leaves.size(), 2u);
   ExpectEveryVertexInOneCore(p, 20);
   for (const auto& leaf : p.leaves) {
@@ -49,7 +49,7 @@ TEST(MatchGraph, CutsBetweenTheCliquesNotByIndex) {
 
 TEST(MatchGraph, SplitsUntilEveryLeafFits) {
   const MatchGraph g = InterleavedCliques(10);
-  const Partition p = PartitionMatchGraph(g, {4, 0});
+  const Partition p = PartitionMatchGraph(g, {4, 0, {}});
   EXPECT_GE(p.leaves.size(), 5u);
   ExpectEveryVertexInOneCore(p, 20);
   for (const auto& leaf : p.leaves) EXPECT_LE(leaf.core.size(), 4u);
@@ -60,7 +60,7 @@ TEST(MatchGraph, OverlapTakesTheMostStronglyTiedOutsideImages) {
   // Vertex 1 (odd clique) tied to the even clique more strongly than vertex 3.
   g.edges.push_back({1, 2, 150});
   g.edges.push_back({3, 4, 60});
-  const Partition p = PartitionMatchGraph(g, {6, 2});
+  const Partition p = PartitionMatchGraph(g, {6, 2, {}});
   ASSERT_EQ(p.leaves.size(), 2u);
   const Leaf& even = p.leaves[0].core.front() % 2 == 0 ? p.leaves[0] : p.leaves[1];
   EXPECT_EQ(even.overlap, (std::vector<int>{1, 3}));
@@ -69,7 +69,7 @@ TEST(MatchGraph, OverlapTakesTheMostStronglyTiedOutsideImages) {
 }
 
 TEST(MatchGraph, ASmallGraphIsOneLeafWithoutOverlap) {
-  const Partition p = PartitionMatchGraph(InterleavedCliques(3), {6, 5});
+  const Partition p = PartitionMatchGraph(InterleavedCliques(3), {6, 5, {}});
   ASSERT_EQ(p.leaves.size(), 1u);
   EXPECT_EQ(p.leaves[0].core.size(), 6u);
   EXPECT_TRUE(p.leaves[0].overlap.empty());
@@ -79,7 +79,7 @@ TEST(MatchGraph, ASmallGraphIsOneLeafWithoutOverlap) {
 TEST(MatchGraph, AGraphWithoutEdgesIsStillSplit) {
   MatchGraph g;
   for (int v = 0; v < 9; ++v) g.names.push_back(std::to_string(v));
-  const Partition p = PartitionMatchGraph(g, {3, 1});
+  const Partition p = PartitionMatchGraph(g, {3, 1, {}});
   ExpectEveryVertexInOneCore(p, 9);
   for (const auto& leaf : p.leaves) {
     EXPECT_LE(leaf.core.size(), 3u);
@@ -104,7 +104,7 @@ MatchGraph UnmatchedChains(const std::vector<int>& sizes) {
 
 TEST(MatchGraph, ALeafNeverHoldsFramesThatShareNoMatch) {
   // Balanced halves of 100 would put 20 frames of the 40-chain with each 30-chain.
-  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 30, 40}), {50, 0});
+  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 30, 40}), {50, 0, {}});
   ASSERT_EQ(p.leaves.size(), 3u);
   ExpectEveryVertexInOneCore(p, 100);
   std::multiset<std::size_t> sizes;
@@ -119,14 +119,47 @@ TEST(MatchGraph, ALeafNeverHoldsFramesThatShareNoMatch) {
 
 TEST(MatchGraph, APartTooSmallToMapAloneGoesWithTheLargest) {
   // 4 frames that matched nothing else: alone, COLMAP's mapper would keep no model of them.
-  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 4}), {40, 0});
+  const Partition p = PartitionMatchGraph(UnmatchedChains({30, 4}), {40, 0, {}});
   ASSERT_EQ(p.leaves.size(), 1u);
   EXPECT_EQ(p.leaves[0].core.size(), 34u);
 }
 
+// One chain of 60 frames walked through three rooms (frames 0-19, 20-49, 50-59) and matched
+// across the doors as within rooms: METIS alone would cut two balanced leaves of 30, each across a
+// door; with the rooms given each leaf stays within a room (the 30-frame room split no further:
+// it fits), and a room of 5 frames, too small to map alone, goes with the room it matched most.
+TEST(MatchGraph, WithRoomsGivenLeavesAreCutWithinRooms) {
+  const MatchGraph g = UnmatchedChains({60});
+  std::vector<int> room_of(60);
+  for (int v = 0; v < 60; ++v) room_of[v] = v < 20 ? 0 : v < 50 ? 1 : 2;
+  const Partition p = PartitionMatchGraph(g, {30, 2, room_of});
+  ExpectEveryVertexInOneCore(p, 60);
+  std::multiset<std::size_t> sizes;
+  for (const auto& leaf : p.leaves) {
+    sizes.insert(leaf.core.size());
+    for (const int v : leaf.core) EXPECT_EQ(room_of[v], room_of[leaf.core.front()]) << "vertex " << v << " crosses a room";
+    EXPECT_EQ(leaf.overlap.size(), 2u) << "the overlap still comes from the next room";
+  }
+  EXPECT_EQ(sizes, (std::multiset<std::size_t>{20, 30, 10}));
+
+  // The walk ends 5 frames into the third room (frames 50-54): they go with the second room's.
+  const MatchGraph shorter = UnmatchedChains({55});
+  const std::vector<int> short_rooms(room_of.begin(), room_of.begin() + 55);
+  const Partition q = PartitionMatchGraph(shorter, {40, 0, short_rooms});
+  ExpectEveryVertexInOneCore(q, 55);
+  std::multiset<std::size_t> q_sizes;
+  for (const auto& leaf : q.leaves) {
+    q_sizes.insert(leaf.core.size());
+    const bool first_room = room_of[leaf.core.front()] == 0;
+    for (const int v : leaf.core) EXPECT_EQ(room_of[v] == 0, first_room) << "vertex " << v;
+  }
+  EXPECT_EQ(q_sizes, (std::multiset<std::size_t>{20, 35})) << "frames 50-54 join frames 20-49";
+  EXPECT_THROW(PartitionMatchGraph(g, {30, 0, {0, 1}}), map::MapError) << "two rooms given for 60 frames";
+}
+
 TEST(MatchGraph, RefusesALeafOfOneImage) {
   try {
-    PartitionMatchGraph(InterleavedCliques(3), {1, 0});
+    PartitionMatchGraph(InterleavedCliques(3), {1, 0, {}});
     FAIL() << "a leaf size of 1 was accepted";
   } catch (const map::MapError& e) {
     EXPECT_NE(std::string(e.what()).find("leaf size 1"), std::string::npos) << e.what();
@@ -155,7 +188,7 @@ TEST(TempleMatchGraph, LeavesOfTheRingCutWhereTheMatchesAreFewest) {
   const MatchGraph g = BuildMatchGraph(ReadMatchGraph(testing::TempleMapRoot() / "map" / "database.db"));
   ASSERT_EQ(g.names.size(), 24u);
   ASSERT_GT(g.edges.size(), 24u);
-  const Partition p = PartitionMatchGraph(g, {8, 4});
+  const Partition p = PartitionMatchGraph(g, {8, 4, {}});
   ASSERT_EQ(p.leaves.size(), 4u);  // 24 → 12 + 12 → four of 6
   ExpectEveryVertexInOneCore(p, 24);
   std::vector<int> by_index(24);

@@ -32,24 +32,19 @@ bool VenuePairsWanted(const MapBuildOptions& options, int frames) {
   return options.rooms.size() >= 2 && options.cross_rooms.neighbours > 0 && !ExhaustiveMatchingWanted(options, frames);
 }
 
-namespace {
-
-// Each image's room: the room of options.rooms holding its frame.
 std::vector<int> RoomOfEachImage(const MapBuildOptions& options, const std::vector<std::string>& names,
                                  const FrameLookup& lookup) {
+  if (options.rooms.size() < 2) return {};
   std::vector<int> room_of;
   for (const std::string& name : names) {
     const auto frame = lookup.find(name);
     const int index = frame == lookup.end() ? -1 : frame->second.frame_index;
     const auto room = std::find_if(options.rooms.begin(), options.rooms.end(),
                                    [&](const VenueRoom& r) { return r.Holds(index); });
-    if (room == options.rooms.end()) throw map::MapError("venue: image " + name + " is in none of its rooms");
-    room_of.push_back(static_cast<int>(room - options.rooms.begin()));
+    room_of.push_back(room == options.rooms.end() ? -1 : static_cast<int>(room - options.rooms.begin()));
   }
   return room_of;
 }
-
-}  // namespace
 
 std::vector<ImagePair> PairsToMatch(const MapBuildOptions& options, const std::vector<std::string>& names,
                                     const FrameLookup& lookup, const fs::path& database, const MapBuildCallbacks& cb,
