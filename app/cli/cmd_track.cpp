@@ -298,6 +298,9 @@ void AddTrackCommand(CLI::App& app) {
       ->check(CLI::Range(0.01, 50.0));
   f.Add(cmd, "--tracking-min-inliers", ARVIEW_OPTION_FIELD(o, tracking.min_inliers), "Inliers needed to keep tracking")
       ->check(CLI::Range(6, 100000));
+  f.Add(cmd, "--max-flow-tracks", ARVIEW_OPTION_FIELD(o, tracking.max_flow_tracks),
+        "At most this many inliers are followed into the next frame by optical flow, spread over the image")
+      ->check(CLI::Range(1, 100000));
   f.Add(cmd, "--replenish-below", ARVIEW_OPTION_FIELD(o, tracking.replenish_below),
         "Run guided matching when fewer flow tracks survive")
       ->check(CLI::Range(0, 100000));
