@@ -122,6 +122,10 @@ struct MapBuildOptions {
   // retries apply to each leaf, not to the merged map. 0: one mapper over every frame (today's path).
   int leaf_size = 0;
   int leaf_overlap = 10;
+  // A venue's leaves cut within its rooms (PartitionOptions::room_of); off: METIS over every
+  // frame, the rooms unknown to it (on the rendered venue one run each way, within rooms was
+  // not the better: docs/mapping.md, "Leaves within rooms").
+  bool leaves_within_rooms = false;
   MapEngine engine = MapEngine::kLocal;
   SlurmOptions slurm;
   // With engine kSlurm: feature extraction and matching as Slurm jobs of about this many frames

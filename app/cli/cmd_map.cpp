@@ -53,6 +53,7 @@ struct MapArgs {
   int leaf_size = 0;
   int leaf_overlap = mapping::MapBuildOptions().leaf_overlap;
   int cross_room_neighbours = mapping::MapBuildOptions().cross_rooms.neighbours;
+  bool leaves_within_rooms = false;
   std::string engine = "local";
   std::string slurm_partition;
   int slurm_cpus = 0;
@@ -122,6 +123,7 @@ void RunMap(const MapArgs& args) {
   options.leaf_size = args.leaf_size;
   options.leaf_overlap = args.leaf_overlap;
   options.cross_rooms.neighbours = args.cross_room_neighbours;
+  options.leaves_within_rooms = args.leaves_within_rooms;
   options.slurm.partition = args.slurm_partition;
   options.slurm.cpus_per_task = args.slurm_cpus;
   options.slurm.time_limit_minutes = args.slurm_time_limit;
@@ -367,6 +369,9 @@ void AddMapCommand(CLI::App& app) {
                   "Frames added to each leaf from its neighbours, the most strongly matched first, for the merge")
       ->capture_default_str()
       ->check(CLI::Range(0, 100000));
+  cmd->add_flag("--leaves-within-rooms", args->leaves_within_rooms,
+                "A venue mapped in leaves: cut the leaves within each room (a room under 10 frames goes with the room "
+                "it matched most), not by the match graph alone");
   cmd->add_option("--engine", args->engine,
                   "Where the leaves are mapped (and with --slurm-chunk, extraction and matching run): local (one after "
                   "another here) or slurm (job arrays and a merge job through sbatch, a failed job submitted once "
