@@ -14,12 +14,15 @@
 #include <opencv2/flann.hpp>
 
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
 #include "map/descriptor_index.h"
 #include "map/map_file.h"
+#include "mapping/colmap_model.h"
 #include "mapping/colmap_pipeline.h"
+#include "mapping/venue_pairs.h"
 #include "recordings/importers.h"
 #include "tests/support/test_data.h"
 
@@ -78,6 +81,50 @@ void BM_LoadMap(benchmark::State& state) {
   state.counters["file_MiB"] = static_cast<double>(fs::file_size(d.map_dir / map::kMapFileName)) / (1 << 20);
 }
 BENCHMARK(BM_LoadMap)->Unit(benchmark::kMillisecond);
+
+// A venue's pairs across rooms (mapping/venue_pairs.h): templeRing's even and odd frames as two
+// rooms, two sessions of one place, each frame's SIFT from its map's database (the quality
+// preset's, up to 8,192 a frame); within rooms sequential (10), across from the descriptor index
+// with the defaults (400 descriptors a frame, 5 neighbours). `across` counts the pairs found
+// across; every odd frame's true neighbours are the even frames either side of it.
+void BM_PairVenueFrames(benchmark::State& state) {
+  const BenchData& d = Data();
+  std::vector<cv::Mat> descriptors;
+  std::vector<int> room_of;
+  std::vector<int> frame_of;  // templeRing's frame number, from the image's name
+  for (const auto& [folder, room] : {std::pair{"even", 0}, std::pair{"odd", 1}}) {
+    std::ifstream list(BenchDir() / folder / "image_list.txt");
+    std::vector<std::string> names;
+    for (std::string name; std::getline(list, name);)
+      if (!name.empty()) names.push_back(name);
+    std::vector<cv::Mat> read = mapping::ReadImageDescriptors(BenchDir() / folder / "database.db", names);
+    for (std::size_t i = 0; i < read.size(); ++i) {
+      descriptors.push_back(std::move(read[i]));
+      room_of.push_back(room);
+      frame_of.push_back(std::stoi(fs::path(names[i]).stem().string()));
+    }
+  }
+  mapping::CrossRoomOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  mapping::VenuePairs pairs;
+  for (auto _ : state) {
+    pairs = mapping::PairVenueFrames(room_of, descriptors, [](int n) { return mapping::SequentialPairs(n, 10, false); },
+                                     options);
+    benchmark::DoNotOptimize(pairs.pairs.data());
+  }
+  state.counters["frames"] = static_cast<double>(descriptors.size());
+  state.counters["across"] = static_cast<double>(pairs.pairs.size()) - pairs.within;
+  // Of them, pairs of frames at most 4 apart on the ring of 47 (the views that overlap most).
+  int near = 0;
+  for (std::size_t k = static_cast<std::size_t>(pairs.within); k < pairs.pairs.size(); ++k) {
+    const int gap = std::abs(frame_of[pairs.pairs[k].first] - frame_of[pairs.pairs[k].second]);
+    near += std::min(gap, 47 - gap) <= 4;
+  }
+  state.counters["across_near"] = near;
+  benchmark::DoNotOptimize(d.map.descriptors.rows);
+}
+// Wall time: the work is on the worker threads, the calling thread waits.
+BENCHMARK(BM_PairVenueFrames)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 map::IndexParams Params(const benchmark::State& state) {
   map::IndexParams p;
