@@ -105,7 +105,9 @@ std::vector<std::pair<std::uint32_t, std::string>> BestMatchedFirst(const MatchG
 LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb) {
   const DatabaseMatchGraph database = ReadMatchGraph(paths.database);
   const MatchGraph graph = BuildMatchGraph(database);
-  const Partition partition = PartitionMatchGraph(graph, {options.leaf_size, options.leaf_overlap, options.leaves_within_rooms ? RoomOfEachImage(options, graph.names, paths.frames) : std::vector<int>{}});
+  const bool by_room = options.leaves_within_rooms && options.rooms.size() >= 2;
+  const Partition partition = PartitionMatchGraph(
+      graph, {options.leaf_size, options.leaf_overlap, by_room ? RoomOfEachImage(options, graph.names, paths.frames) : std::vector<int>{}});
   LeafPlan plan;
   plan.work = paths.out_dir / "leaves";
   std::error_code ec;
@@ -147,7 +149,7 @@ LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& path
   }
   if (cb.note) {
     cb.note(std::to_string(graph.names.size()) + " frames mapped as " + std::to_string(partition.leaves.size()) +
-            " leaves of at most " + std::to_string(options.leaf_size) + (options.leaves_within_rooms && options.rooms.size() >= 2 ? ", cut within rooms" : "") +
+            " leaves of at most " + std::to_string(options.leaf_size) + (by_room ? ", cut within rooms" : "") +
             " (frames + overlap: " + sizes +
             "); the cut between them holds " + std::to_string(partition.cut_weight) + " of " +
             std::to_string(total_weight) + " inliers");
