@@ -11,6 +11,7 @@
 
 #include "base/atomic_file.h"
 #include "mapping/colmap_model.h"
+#include "mapping/outlying_poses.h"
 #include "mapping/fold_retries.h"
 #include "mapping/gap_retry.h"
 #include "mapping/job_stages.h"
@@ -215,6 +216,9 @@ class MapBuild {
                              "map", colmap_.log(), {});
     }
     options_.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+    // A frame the adjustment left in a local minimum, posed again on its points (mapping/outlying_poses.h).
+    for (const RePosedImage& image : RePoseOutlyingImagesIn(result_.model_dir))
+      if (cb_.note) cb_.note(Describe(image));
     CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
     result_.map = std::move(model.map);
     result_.map.camera.focus = recording_.camera.focus;  // COLMAP's camera has no focus: the calibration's
