@@ -216,12 +216,24 @@ class MapBuild {
                              "map", colmap_.log(), {});
     }
     options_.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
-    // A frame the adjustment left in a local minimum, posed again on its points (mapping/outlying_poses.h).
-    for (const RePosedImage& image : RePoseOutlyingImagesIn(result_.model_dir))
-      if (cb_.note) cb_.note(Describe(image));
     CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
     result_.map = std::move(model.map);
     result_.map.camera.focus = recording_.camera.focus;  // COLMAP's camera has no focus: the calibration's
+    result_.check = std::move(model.check);
+  }
+
+  // A frame the adjustment left in a local minimum, posed again on its points with them held
+  // (mapping/outlying_poses.h), and the model read again. Not in a folded model (one kept with
+  // --keep-folded): a fold is a stretch of the path turned together, for the fold retries.
+  void RePoseOutlyingFrames() {
+    if (Folded(result_.check)) return;
+    const std::vector<RePosedImage> re_posed = RePoseOutlyingImagesIn(result_.model_dir);
+    for (const RePosedImage& image : re_posed)
+      if (cb_.note) cb_.note(Describe(image));
+    if (std::none_of(re_posed.begin(), re_posed.end(), [](const RePosedImage& r) { return r.kept; })) return;
+    CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
+    result_.map = std::move(model.map);
+    result_.map.camera.focus = recording_.camera.focus;
     result_.check = std::move(model.check);
   }
 
@@ -360,6 +372,7 @@ MapBuildResult BuildMap(const recordings::Recording& recording, const fs::path& 
   build.ReadModel();
   build.RetryLeftOutStretches();
   build.RetryOrRefuseAFold();
+  build.RePoseOutlyingFrames();
   return build.MakeMetricAndWrite();
 }
 
