@@ -1,13 +1,14 @@
 #include "mapping/outlying_poses.h"
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <unordered_map>
+
+#include "base/stats.h"
 
 namespace arview::mapping {
 
@@ -20,12 +21,6 @@ void OutlyingPoseOptions::Check(const OptionNames& names) const {
 }
 
 namespace {
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 // An image's observations: its 2D points in OpenCV's pixel convention and their 3D points.
 struct Observations {
@@ -74,13 +69,7 @@ std::optional<calib::Pose> PoseAgain(const calib::Camera& camera, const Observat
     in_pixels.push_back(o.pixels[static_cast<std::size_t>(i)]);
   }
   cv::solvePnPRefineLM(in_points, in_pixels, K, camera.DistCoeffs(), rvec, tvec);
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d Re;
-  Eigen::Vector3d te;
-  cv::cv2eigen(R, Re);
-  cv::cv2eigen(tvec, te);
-  return calib::Pose::FromRt(Re, te);
+  return calib::PoseFromOpenCv(rvec, tvec);
 }
 
 }  // namespace
