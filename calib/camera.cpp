@@ -1,6 +1,8 @@
 #include "calib/camera.h"
 
 #include <Eigen/Dense>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 #include <charconv>
 #include <climits>
@@ -42,6 +44,16 @@ Eigen::Matrix3d Camera::KEigen() const {
   Eigen::Matrix3d k;
   k << fx, 0, cx, 0, fy, cy, 0, 0, 1;
   return k;
+}
+
+Pose PoseFromOpenCv(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  cv::cv2eigen(R, rotation);
+  cv::cv2eigen(tvec, translation);
+  return Pose::FromRt(rotation, translation);
 }
 
 cv::Mat Camera::DistCoeffs() const {

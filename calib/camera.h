@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "base/error.h"
+#include "calib/pose.h"
 
 #include <array>
 #include <cstdint>
@@ -95,5 +96,9 @@ double GuessedFocal(int width, int height);
 // OpenCV FileStorage YAML with the names of OpenCV's calibration sample.
 Camera LoadCamera(const std::filesystem::path& path);
 void SaveCamera(const Camera& camera, const std::filesystem::path& path);
+
+// The pose OpenCV's solvePnP family gives: a Rodrigues rotation vector and a translation, world
+// to camera (3x1 CV_64F each).
+Pose PoseFromOpenCv(const cv::Mat& rvec, const cv::Mat& tvec);
 
 }  // namespace arview::calib

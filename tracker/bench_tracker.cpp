@@ -12,7 +12,6 @@
 #include <Eigen/Core>
 #include <benchmark/benchmark.h>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
@@ -215,13 +214,7 @@ bool OpenCvPose(const calib::Camera& camera, const std::vector<Eigen::Vector2d>&
     in_object.push_back(object[k]);
   }
   cv::solvePnPRefineLM(in_object, in_image, K, dist, rvec, tvec);
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d Re;
-  Eigen::Vector3d te;
-  cv::cv2eigen(R, Re);
-  cv::cv2eigen(tvec, te);
-  *pose = calib::Pose::FromRt(Re, te);
+  *pose = calib::PoseFromOpenCv(rvec, tvec);
   *n_inliers = static_cast<int>(inliers.size());
   return true;
 }
