@@ -265,4 +265,13 @@ std::vector<Neighbor> DescriptorIndex::Knn(const std::uint8_t* descriptor, int k
   return Knn(row, k).front();
 }
 
+std::vector<int> NearestNeighbourVotes(const DescriptorIndex& index, const std::vector<std::uint32_t>& owner_of_row,
+                                       std::size_t owners, const cv::Mat& queries, double max_ratio) {
+  std::vector<int> votes(owners, 0);
+  if (queries.empty() || index.empty()) return votes;
+  for (const auto& n : index.Knn(queries, 2))
+    if (n.size() == 2 && n[0].distance < max_ratio * n[1].distance) ++votes[owner_of_row[n[0].row]];
+  return votes;
+}
+
 }  // namespace arview::map

@@ -86,4 +86,11 @@ class DescriptorIndex {
   IndexParams params_;
 };
 
+// For each owner 0 .. owners-1 of the indexed rows (`owner_of_row`: a row's frame or keyframe),
+// how many rows of `queries` have their nearest indexed row owned by it and pass the ratio test
+// (nearest distance under `max_ratio` of the second nearest): the votes by which a frame finds
+// the frames it looks most like (`map extend`'s old keyframes, a venue's frames of other rooms).
+std::vector<int> NearestNeighbourVotes(const DescriptorIndex& index, const std::vector<std::uint32_t>& owner_of_row,
+                                       std::size_t owners, const cv::Mat& queries, double max_ratio);
+
 }  // namespace arview::map

@@ -228,11 +228,8 @@ std::vector<std::vector<int>> OldKeyframesNearest(const map::Map& old, const std
   std::vector<std::vector<int>> nearest;
   for (const cv::Mat& descriptors : new_descriptors) {
     cancel.ThrowIfCancelled("stopped choosing the keyframes to match");
-    std::vector<int> votes(static_cast<std::size_t>(keyframes), 0);
-    if (!descriptors.empty()) {
-      for (const auto& n : index.Knn(descriptors, 2))
-        if (n.size() == 2 && n[0].distance < 0.8f * n[1].distance) ++votes[old.descriptor_keyframe[n[0].row]];
-    }
+    const std::vector<int> votes =
+        map::NearestNeighbourVotes(index, old.descriptor_keyframe, static_cast<std::size_t>(keyframes), descriptors, 0.8f);
     std::vector<int> order = all;
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return votes[static_cast<std::size_t>(a)] > votes[static_cast<std::size_t>(b)]; });
     order.resize(static_cast<std::size_t>(wanted));

@@ -50,7 +50,7 @@ cv::Mat EvenRows(const cv::Mat& descriptors, int count) {
 // One room's sampled descriptors in one index, each row's image beside it.
 struct RoomIndex {
   cv::Mat rows;
-  std::vector<int> image_of_row;
+  std::vector<std::uint32_t> image_of_row;
   map::DescriptorIndex index;
 };
 
@@ -60,7 +60,7 @@ RoomIndex IndexRoom(const std::vector<int>& images, const std::vector<cv::Mat>& 
     const cv::Mat& s = samples[static_cast<std::size_t>(i)];
     if (s.empty()) continue;
     room.rows.push_back(s);
-    room.image_of_row.insert(room.image_of_row.end(), static_cast<std::size_t>(s.rows), i);
+    room.image_of_row.insert(room.image_of_row.end(), static_cast<std::size_t>(s.rows), static_cast<std::uint32_t>(i));
   }
   if (!room.rows.empty()) room.index = map::DescriptorIndex(room.rows);
   return room;
@@ -74,9 +74,8 @@ std::vector<int> NearestOtherFrames(int i, const std::vector<int>& room_of, cons
   if (query.empty()) return {};
   for (std::size_t r = 0; r < rooms.size(); ++r) {
     if (static_cast<int>(r) == room_of[static_cast<std::size_t>(i)] || rooms[r].rows.empty()) continue;
-    std::vector<int> count(room_of.size(), 0);
-    for (const auto& n : rooms[r].index.Knn(query, 2))
-      if (n.size() == 2 && n[0].distance < options.max_ratio * n[1].distance) ++count[static_cast<std::size_t>(rooms[r].image_of_row[n[0].row])];
+    const std::vector<int> count = map::NearestNeighbourVotes(rooms[r].index, rooms[r].image_of_row, room_of.size(), query,
+                                                              options.max_ratio);
     for (std::size_t j = 0; j < count.size(); ++j)
       if (count[j] >= options.min_votes) votes.emplace_back(count[j], static_cast<int>(j));
   }
