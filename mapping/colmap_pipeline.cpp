@@ -150,7 +150,7 @@ class MapBuild {
     in_leaves_ = options_.leaf_size > 0 && frames_ > options_.leaf_size;  // mapping/leaf_mapping.h
     inputs_ += "--\n" + Joined(mapper_args_) +
                (in_leaves_ ? "leaves " + std::to_string(options_.leaf_size) + " " + std::to_string(options_.leaf_overlap) +
-                                 (options_.leaves_within_rooms && options_.rooms.size() >= 2 ? " within rooms" : "") + "\n"
+                                 (options_.LeavesCutWithinRooms() ? " within rooms" : "") + "\n"
                            : "");
     mapper_inputs_ = inputs_;
     if (self_calibrate_ && cb_.note) {

@@ -126,6 +126,8 @@ struct MapBuildOptions {
   // frame, the rooms unknown to it (on the rendered venue one run each way, within rooms was
   // not the better: docs/mapping.md, "Leaves within rooms").
   bool leaves_within_rooms = false;
+  // Whether the leaves are cut within rooms: asked for, and a venue of two rooms or more.
+  bool LeavesCutWithinRooms() const { return leaves_within_rooms && rooms.size() >= 2; }
   MapEngine engine = MapEngine::kLocal;
   SlurmOptions slurm;
   // With engine kSlurm: feature extraction and matching as Slurm jobs of about this many frames

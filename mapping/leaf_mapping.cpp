@@ -105,7 +105,7 @@ std::vector<std::pair<std::uint32_t, std::string>> BestMatchedFirst(const MatchG
 LeafPlan PlanLeaves(const MapBuildOptions& options, const LeafMappingPaths& paths, const MapBuildCallbacks& cb) {
   const DatabaseMatchGraph database = ReadMatchGraph(paths.database);
   const MatchGraph graph = BuildMatchGraph(database);
-  const bool by_room = options.leaves_within_rooms && options.rooms.size() >= 2;
+  const bool by_room = options.LeavesCutWithinRooms();
   const Partition partition = PartitionMatchGraph(
       graph, {options.leaf_size, options.leaf_overlap, by_room ? RoomOfEachImage(options, graph.names, paths.frames) : std::vector<int>{}});
   LeafPlan plan;
