@@ -34,11 +34,16 @@ struct Features {
 // x512, round, clamp to 255, uint8.
 cv::Mat ToColmapDescriptors(const cv::Mat& sift);
 
+// Where OpenCV's SIFT (4.6, and later ones without `enable_precise_upscale`) puts a keypoint,
+// right of and below where it is, in pixels of the image given to it; Extract() takes it off.
+inline constexpr float kOpenCvSiftOffsetPx = 0.25f;
+
 // Reuses one cv::SIFT detector across frames.
 class SiftExtractor {
  public:
   explicit SiftExtractor(const FeatureOptions& options = {});
   // image: 8-bit grey or BGR. An empty or tiny image gives no features (never throws).
+  // Keypoints where they are in `image` (OpenCV's quarter-pixel offset taken off).
   Features Extract(const cv::Mat& image) const;
   const FeatureOptions& options() const { return options_; }
 
