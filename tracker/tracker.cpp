@@ -526,28 +526,19 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
         << camera.width << "x" << camera.height;
     result.reason = msg.str();
     Reset();
-    result.times.total_ms = MillisecondsSince(start);
-    result.times.cpu_ms = ThreadCpuMilliseconds() - cpu_start;
-    return result;
+  } else {
+    const cv::Mat gray = resolution_.Reduce(full_gray);
+    const FramePose posed = options_.tracking.background ? FramePose{TrackWithoutWaiting(gray, timestamp, &result)}
+                                                         : PoseInLine(gray, timestamp, &result);
+    EndFrame(gray, timestamp, posed, &result);
   }
+  result.times.total_ms = MillisecondsSince(start);
+  result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;  // with a prefetch's worker CPU
+  return result;
+}
 
-  const cv::Mat gray = resolution_.Reduce(full_gray);
-  if (options_.tracking.background) {
-    const Track2D3D inliers = TrackWithoutWaiting(gray, timestamp, &result);
-    if (result.status == TrackStatus::kLost) {
-      ForgetPrior();
-    } else {
-      RefineOnFullCamera(inliers, &result);
-      Remember(result, timestamp, inliers);
-      MaybePrefetch(gray, result);
-      result.center = result.pose.Center();
-      result.smoothed_center = smoother_.Filter(result.center, timestamp);
-      NameRoom(&result);
-    }
-    result.times.total_ms = MillisecondsSince(start);
-    result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;
-    return result;
-  }
+Tracker::FramePose Tracker::PoseInLine(const cv::Mat& gray, double timestamp, FrameResult* result_out) {
+  FrameResult& result = *result_out;
   const std::vector<cv::Mat> reference_pyramid = last_pyramid_;  // the last posed frame's (shared)
   bool tracked = false;
   std::string tracking_reason;
@@ -595,24 +586,24 @@ FrameResult Tracker::Track(const cv::Mat& image, double timestamp) {
       }
     }
   }
+  // A relocalization on its own SIFT (no features were extracted before it) may hold weaker
+  // keypoints than flow should follow (relocalization_keypoints_followed_).
+  const bool followed_by_flow =
+      result.status != TrackStatus::kRelocalized || features.has_value() || relocalization_keypoints_followed_;
+  return {std::move(inliers), followed_by_flow};
+}
 
-  if (result.status == TrackStatus::kLost) {
-    Reset();
-  } else {
-    RefineOnFullCamera(inliers, &result);
-    // A relocalization on its own SIFT (no features were extracted before it) may hold weaker
-    // keypoints than flow should follow (relocalization_keypoints_followed_).
-    const bool followed_by_flow =
-        result.status != TrackStatus::kRelocalized || features.has_value() || relocalization_keypoints_followed_;
-    Remember(result, timestamp, followed_by_flow ? inliers : Track2D3D{});
-    MaybePrefetch(gray, result);
-    result.center = result.pose.Center();
-    result.smoothed_center = smoother_.Filter(result.center, timestamp);
-    NameRoom(&result);
+void Tracker::EndFrame(const cv::Mat& gray, double timestamp, const FramePose& posed, FrameResult* result) {
+  if (result->status == TrackStatus::kLost) {
+    ForgetPrior();  // a relocalization pending on the worker is kept
+    return;
   }
-  result.times.total_ms = MillisecondsSince(start);
-  result.times.cpu_ms += ThreadCpuMilliseconds() - cpu_start;  // with a prefetch's worker CPU
-  return result;
+  RefineOnFullCamera(posed.inliers, result);
+  Remember(*result, timestamp, posed.followed_by_flow ? posed.inliers : Track2D3D{});
+  MaybePrefetch(gray, *result);
+  result->center = result->pose.Center();
+  result->smoothed_center = smoother_.Filter(result->center, timestamp);
+  NameRoom(result);
 }
 
 }  // namespace arview::tracker

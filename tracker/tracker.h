@@ -338,6 +338,18 @@ class Tracker {
   // Starts extracting this frame's guided features on a worker thread when its flow tracks are
   // thinning (TrackingOptions::prefetch_below).
   void MaybePrefetch(const cv::Mat& gray, const FrameResult& result);
+  // What a frame's pose rests on: its correspondences, and whether the flow follows them into
+  // the next frame.
+  struct FramePose {
+    Track2D3D inliers;
+    bool followed_by_flow = true;
+  };
+  // Every step in line (TrackingOptions::background off): flow, guided matching, the wide search,
+  // relocalization, image alignment, as each before it fails.
+  FramePose PoseInLine(const cv::Mat& gray, double timestamp, FrameResult* result);
+  // The end of every frame, in line or with the worker: a lost frame forgets the prior; a posed
+  // one is refined on the full camera, remembered, smoothed and given its room.
+  void EndFrame(const cv::Mat& gray, double timestamp, const FramePose& posed, FrameResult* result);
   // TrackingOptions::background: one frame, with no step that waits for SIFT or relocalization.
   // Returns the correspondences the pose rests on (empty when lost or aligned).
   Track2D3D TrackWithoutWaiting(const cv::Mat& gray, double timestamp, FrameResult* result);
