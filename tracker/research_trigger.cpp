@@ -29,9 +29,7 @@ int ResearchTrigger::Credit(std::uint32_t frame) const {
 }
 
 bool ResearchTrigger::Due(std::uint32_t frame, std::span<const Eigen::Vector2d> followed, cv::Size size) const {
-  if (options_.max_frames_between > 0 && last_search_ &&
-      frame - *last_search_ >= static_cast<std::uint32_t>(options_.max_frames_between))
-    return true;
+  if (AgeDue(frame)) return true;
   const int n = static_cast<int>(followed.size());
   if (n >= replenish_below_) return false;
   if (options_.occlusion_credit_frames == 0) return true;

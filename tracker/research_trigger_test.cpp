@@ -61,11 +61,26 @@ TEST(ResearchTrigger, EveryMaxFramesBetweenAFrameReSearchesWhateverItsCount) {
   EXPECT_FALSE(trigger.Due(100, Tracks(300), kImage)) << "no re-search yet to count from";
   trigger.Searched(10);
   EXPECT_FALSE(trigger.Due(54, Tracks(300), kImage));
+  EXPECT_FALSE(trigger.AgeDue(54));
   EXPECT_TRUE(trigger.Due(55, Tracks(300), kImage));
+  EXPECT_TRUE(trigger.AgeDue(55)) << "what a live session extracts SIFT ahead for";
   trigger.Searched(55);
   EXPECT_FALSE(trigger.Due(56, Tracks(300), kImage));
   trigger.Clear();
   EXPECT_FALSE(trigger.Due(200, Tracks(300), kImage)) << "a lost prior forgets the last re-search";
+}
+
+TEST(ResearchTrigger, ByDefaultEveryTenthFrameReSearchesAndZeroNever) {
+  ResearchTrigger trigger({}, 150);
+  trigger.Searched(0);
+  EXPECT_FALSE(trigger.Due(9, Tracks(300), kImage));
+  EXPECT_TRUE(trigger.Due(10, Tracks(300), kImage));
+  ResearchTriggerOptions never;
+  never.max_frames_between = 0;
+  ResearchTrigger off(never, 150);
+  off.Searched(0);
+  EXPECT_FALSE(off.Due(1000, Tracks(300), kImage));
+  EXPECT_FALSE(off.AgeDue(1000));
 }
 
 TEST(ResearchTrigger, TooFewTracksFollowedOrAllOnOneSideReSearchWhateverTheCredit) {

@@ -220,7 +220,12 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   }
   // Tracks thinned by someone walking through: the points they hid followed back first.
   if (thinning && from_flow) result->recovered_tracks = RecoverHiddenPoints(pyramid, *from_flow, lk_errors, &c);
-  const bool extract_here = !opt.background && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
+  // Not on the frame a light switched on or off while the flow still pins the pose: its SIFT sees
+  // the new light (a lamp on under a raised exposure clips, and guided matches sit on the white
+  // blobs' edges); the next frame searches instead.
+  const bool light_switched_now = timestamp == last_light_switch_timestamp_ && result->flow_tracks >= opt.min_inliers;
+  const bool extract_here =
+      !opt.background && !light_switched_now && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
   const std::size_t before_search = c.pixels.size();  // the flow tracks and the hidden points followed back
   if (prefetch_due || extract_here) {
     research_trigger_.Searched(frame_counter_);

@@ -23,7 +23,10 @@ void Tracker::MaybePrefetch(const cv::Mat& gray, const FrameResult& result) {
   // follows less exactly (relocalization_keypoints_followed_), and it may be followed only thinly.
   const bool fresh_tracks_wanted = opt.background && result.status == TrackStatus::kRelocalized;
   if (result.status != TrackStatus::kTracking && !fresh_tracks_wanted) return;
-  if (!fresh_tracks_wanted && static_cast<int>(last_inliers_.pixels.size()) >= opt.prefetch_below) return;
+  // Or when the tracks are thinning, or the next frame is due a re-search by age
+  // (ResearchTriggerOptions::max_frames_between).
+  const bool thinning = static_cast<int>(last_inliers_.pixels.size()) < opt.prefetch_below;
+  if (!fresh_tracks_wanted && !thinning && !research_trigger_.AgeDue(frame_counter_ + 1)) return;
   if (last_pyramid_.empty()) return;
   auto prefetch = std::make_unique<Prefetch>();
   prefetch->frame = frames_tracked_;

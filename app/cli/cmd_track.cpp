@@ -311,7 +311,8 @@ void AddTrackCommand(CLI::App& app) {
       ->check(CLI::Range(0, 100000));
   f.Add(cmd, "--research-every", ARVIEW_OPTION_FIELD(o, tracking.research.max_frames_between),
         "A tracked frame this many frames after the last re-search (guided matching) re-searches whatever "
-        "its flow tracks' count: tracks followed for seconds drift together; 0: never")
+        "its flow tracks' count: tracks followed for a while drift together (a live session extracts its "
+        "SIFT ahead); 0: never")
       ->check(CLI::Range(0, 100000));
   f.Add(cmd, "--clipped-window-share", ARVIEW_OPTION_FIELD(o, tracking.clipped.max_share),
         "Drop a flow track before the pose when more than this share of its LK window is clipped white "
