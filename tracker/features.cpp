@@ -52,8 +52,8 @@ Features SiftExtractor::Extract(const cv::Mat& image) const {
   // OpenCV's SIFT finds keypoints in the image doubled (first octave -1) by a bilinear resize
   // whose pixel centres are half-pixel aligned, so a point at x of the image lies at 2x + 0.5 of
   // the doubled one; OpenCV halves that, and every keypoint lands a quarter of a pixel right and
-  // down of where it is (a blob at (60, 120) is found at (60.24, 120.24); COLMAP's keypoints of
-  // the map's own frames, the same quarter: docs/tracker.md, "SIFT's quarter pixel").
+  // down of where it is, and of where COLMAP's SIFT puts it in the map (docs/tracker.md, "Sixth
+  // round (issue 58): SIFT's quarter pixel").
   for (cv::KeyPoint& keypoint : features.keypoints) keypoint.pt -= cv::Point2f(kOpenCvSiftOffsetPx, kOpenCvSiftOffsetPx);
   features.descriptors = ToColmapDescriptors(descriptors);
   return features;
