@@ -216,6 +216,11 @@ class MapBuild {
                              "map", colmap_.log(), {});
     }
     options_.cancel.ThrowIfCancelled("COLMAP's stages are finished and kept; the map file was not written");
+    ReadResultModel();
+  }
+
+  // The model in result_.model_dir as the result's map, with its self-check.
+  void ReadResultModel() {
     CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
     result_.map = std::move(model.map);
     result_.map.camera.focus = recording_.camera.focus;  // COLMAP's camera has no focus: the calibration's
@@ -230,11 +235,7 @@ class MapBuild {
     const std::vector<RePosedImage> re_posed = RePoseOutlyingImagesIn(result_.model_dir);
     for (const RePosedImage& image : re_posed)
       if (cb_.note) cb_.note(Describe(image));
-    if (std::none_of(re_posed.begin(), re_posed.end(), [](const RePosedImage& r) { return r.kept; })) return;
-    CheckedModel model = ReadCheckedModel(result_.model_dir, database_, images_.lookup, options_.cancel);
-    result_.map = std::move(model.map);
-    result_.map.camera.focus = recording_.camera.focus;
-    result_.check = std::move(model.check);
+    if (std::any_of(re_posed.begin(), re_posed.end(), [](const RePosedImage& r) { return r.kept; })) ReadResultModel();
   }
 
   // A model that leaves a stretch of the walk out (a fast turn): the mapper once more at a lower

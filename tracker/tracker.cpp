@@ -194,7 +194,8 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // poses through (docs/tracker.md, "Third round").
   const double light_step = lit.gain / last_light_gain_;
   last_light_gain_ = lit.gain;
-  if (std::abs(std::log2(light_step)) >= opt.light_switch_ev) last_light_switch_timestamp_ = timestamp;
+  const bool light_switched = std::abs(std::log2(light_step)) >= opt.light_switch_ev;
+  if (light_switched) last_light_switch_timestamp_ = timestamp;
   if (std::abs(light_step - 1) > opt.flow_brightness_tolerance || LightSwitchHeld(timestamp))
     pose_options.max_rms_px = std::max(pose_options.max_rms_px, rms_gate_.options().max_px);
   result->rms_gate_px = pose_options.max_rms_px;
@@ -223,9 +224,9 @@ bool Tracker::TrackWithPrior(const cv::Mat& gray, double timestamp, FrameResult*
   // Not on the frame a light switched on or off while the flow still pins the pose: its SIFT sees
   // the new light (a lamp on under a raised exposure clips, and guided matches sit on the white
   // blobs' edges); the next frame searches instead.
-  const bool light_switched_now = timestamp == last_light_switch_timestamp_ && result->flow_tracks >= opt.min_inliers;
+  const bool search_next_frame = light_switched && result->flow_tracks >= opt.min_inliers;
   const bool extract_here =
-      !opt.background && !light_switched_now && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
+      !opt.background && !search_next_frame && research_trigger_.Due(frame_counter_, c.pixels, camera.Size());
   const std::size_t before_search = c.pixels.size();  // the flow tracks and the hidden points followed back
   if (prefetch_due || extract_here) {
     research_trigger_.Searched(frame_counter_);
