@@ -222,6 +222,8 @@ TEST(Cli, NonFiniteAndNegativeNumbersAreRefusedNamingTheFlag) {
        "--tracking-ransac-threshold"},
       {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--inlier-threshold", "-1"},
        "--inlier-threshold"},
+      {{"track", "/nonexistent/rec", "--map", "/nonexistent/map", "--out", tmp + "/t.txt", "--keyframe-matching", "-1"},
+       "--keyframe-matching"},
       {{"render", "--scene", "s.yaml", "--camera", "c.yaml", "--pose", "0 0 0 0 0 0 1", "--out", tmp + "/o.png", "--time",
         "nan"},
        "--time"},

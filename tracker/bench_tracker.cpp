@@ -325,7 +325,25 @@ void BM_SiftExtract(benchmark::State& state) {
 }
 BENCHMARK(BM_SiftExtract)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond);
 
-// One relocalization per frame: the tracker forgets its prior before each.
+// One relocalization per frame: the tracker forgets its prior before each. Counts the frames
+// localized and the inliers, per iteration. Returns the tracker's working camera.
+calib::Camera RelocalizeEveryFrame(benchmark::State& state, const RealFrames& real, const TrackerOptions& options) {
+  Tracker tracker(real.map, options);
+  size_t i = 0;
+  int localized = 0;
+  double inliers = 0;
+  for (auto _ : state) {
+    tracker.Reset();
+    const FrameResult r = tracker.Track(real.frames[i % real.frames.size()], static_cast<double>(i));
+    ++i;
+    localized += r.status != TrackStatus::kLost;
+    inliers += r.inliers;
+  }
+  state.counters["localized_ratio"] = static_cast<double>(localized) / state.iterations();
+  state.counters["inliers"] = inliers / static_cast<double>(state.iterations());
+  return tracker.working_camera();
+}
+
 void BM_Relocalize(benchmark::State& state) {
   const RealFrames* real = Real();
   if (!real) return state.SkipWithError("no frames (opencv-doc missing, no --map)");
@@ -334,17 +352,8 @@ void BM_Relocalize(benchmark::State& state) {
   options.relocalization.reduced_features.max_features = static_cast<int>(state.range(1));
   options.relocalization.sift_long_side = static_cast<int>(state.range(2));
   options.relocalization.reloc_sift_long_side = static_cast<int>(state.range(3));
-  Tracker tracker(real->map, options);
-  size_t i = 0;
-  int localized = 0;
-  for (auto _ : state) {
-    tracker.Reset();
-    const FrameResult r = tracker.Track(real->frames[i % real->frames.size()], static_cast<double>(i));
-    ++i;
-    localized += r.status != TrackStatus::kLost;
-  }
-  state.counters["localized_ratio"] = static_cast<double>(localized) / state.iterations();
-  const int reloc_side = RelocSiftLongSide(tracker.working_camera(), options.relocalization);
+  const calib::Camera working = RelocalizeEveryFrame(state, *real, options);
+  const int reloc_side = RelocSiftLongSide(working, options.relocalization);
   state.SetLabel(real->source + ", SIFT at longest side " +
                  (reloc_side > 0 ? std::to_string(reloc_side) : std::string("working")));
 }
@@ -359,6 +368,18 @@ BENCHMARK(BM_Relocalize)
     ->Args({2000, 1000, 640, 0})
     ->Args({2000, 1000, 0, 0})
     ->Unit(benchmark::kMillisecond);
+
+// One relocalization per frame with the default options, matched again keyframe by keyframe to
+// this many keyframes (RelocalizerOptions::keyframe_matching; 0: the global matches alone).
+void BM_RelocalizeKeyframeMatching(benchmark::State& state) {
+  const RealFrames* real = Real();
+  if (!real) return state.SkipWithError("no frames (opencv-doc missing, no --map)");
+  TrackerOptions options;
+  options.relocalization.keyframe_matching = static_cast<int>(state.range(0));
+  RelocalizeEveryFrame(state, *real, options);
+  state.SetLabel(real->source);
+}
+BENCHMARK(BM_RelocalizeKeyframeMatching)->Arg(0)->Arg(5)->Unit(benchmark::kMillisecond);
 
 // Continuous tracking over the frames in order, back and forth (no jump at the ends).
 void BM_TrackContinuous(benchmark::State& state) {

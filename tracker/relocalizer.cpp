@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <unordered_map>
 
 namespace arview::tracker {
@@ -37,6 +38,24 @@ std::vector<MapMatch> MatchToMap(const Features& features, const map::Map& map,
     else if (match.distance < matches[it->second].distance) matches[it->second] = match;
   }
   return matches;
+}
+
+std::vector<int> KeyframesSeeingMost(const map::Map& map, const std::vector<std::uint32_t>& points, int count) {
+  std::vector<char> wanted(map.points.size(), 0);
+  for (std::uint32_t p : points)
+    if (p < wanted.size()) wanted[p] = 1;
+  std::vector<std::pair<int, int>> seen;  // (observed points, keyframe)
+  for (size_t k = 0; k < map.keyframes.size(); ++k) {
+    int n = 0;
+    for (const map::KeyframeObservation& o : map.keyframes[k].observations) n += o.point < wanted.size() && wanted[o.point];
+    if (n > 0) seen.emplace_back(n, static_cast<int>(k));
+  }
+  std::sort(seen.begin(), seen.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  });
+  std::vector<int> keyframes;
+  for (size_t i = 0; i < seen.size() && static_cast<int>(i) < count; ++i) keyframes.push_back(seen[i].second);
+  return keyframes;
 }
 
 void GatherCorrespondences(const Features& features, const map::Map& map,
@@ -153,8 +172,68 @@ RelocalizationResult Relocalizer::Relocalize(const Features& given) const {
       result.inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
       result.inliers.points.push_back(matches[i].point);
     }
+    if (options_.keyframe_matching > 0) MatchKeyframesAndPose(features, matches, &result);
   }
   return result;
+}
+
+std::vector<MapMatch> MatchToKeyframes(const Features& features, const map::Map& map,
+                                       const map::DescriptorIndex& index, const std::vector<int>& keyframes,
+                                       int knn, double ratio) {
+  std::vector<MapMatch> matches;
+  // A map without each row's keyframe (one built by hand) has nothing to match keyframe by keyframe.
+  const bool rows_have_keyframes = map.descriptor_keyframe.size() == static_cast<size_t>(map.descriptors.rows);
+  if (features.descriptors.empty() || index.empty() || keyframes.empty() || !rows_have_keyframes) return matches;
+  std::vector<int> slot(map.keyframes.size(), -1);
+  for (size_t i = 0; i < keyframes.size(); ++i) slot[keyframes[i]] = static_cast<int>(i);
+  const auto neighbours = index.Knn(features.descriptors, knn);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (size_t q = 0; q < neighbours.size(); ++q) {
+    const auto& nn = neighbours[q];
+    if (nn.empty()) continue;
+    // Per chosen keyframe: its nearest row and the distance to its second (the last neighbour
+    // bounds a second that is not among the k).
+    std::vector<std::pair<int, float>> best(keyframes.size(), {-1, inf});
+    std::vector<float> second(keyframes.size(), nn.size() == static_cast<size_t>(knn) ? nn.back().distance : inf);
+    std::vector<char> seen_second(keyframes.size(), 0);
+    for (const map::Neighbor& n : nn) {
+      const int k = slot[map.descriptor_keyframe[n.row]];
+      if (k < 0) continue;
+      if (best[k].first < 0) best[k] = {static_cast<int>(n.row), n.distance};
+      else if (!seen_second[k]) { second[k] = n.distance; seen_second[k] = 1; }
+    }
+    for (size_t k = 0; k < keyframes.size(); ++k) {
+      if (best[k].first < 0 || !(best[k].second <= ratio * second[k])) continue;
+      matches.push_back({static_cast<int>(q), map.descriptor_point[best[k].first], best[k].second});
+    }
+  }
+  return matches;
+}
+
+void Relocalizer::MatchKeyframesAndPose(const Features& features, const std::vector<MapMatch>& global,
+                                        RelocalizationResult* result) const {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<MapMatch> matches = global;
+  std::set<std::pair<int, std::uint32_t>> known;  // (keypoint, point)
+  for (const MapMatch& m : global) known.emplace(m.keypoint, m.point);
+  const std::vector<int> keyframes = KeyframesSeeingMost(map_, result->inliers.points, options_.keyframe_matching);
+  for (const MapMatch& m : MatchToKeyframes(features, map_, index_, keyframes, options_.keyframe_knn, options_.matching.ratio))
+    if (known.emplace(m.keypoint, m.point).second) matches.push_back(m);
+  result->match_ms += MillisecondsSince(start);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  GatherCorrespondences(features, map_, matches, &pixels, &points);
+  AbsolutePoseResult pose = EstimateAbsolutePose(camera_, pixels, points, options_.pose);
+  if (!pose.ok) return;  // the first pose stands
+  result->matches = static_cast<int>(matches.size());
+  result->inliers = {};
+  std::set<int> followed;  // a keypoint matched to two points is followed once
+  for (int i : pose.inliers) {
+    if (!followed.insert(matches[i].keypoint).second) continue;
+    result->inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
+    result->inliers.points.push_back(matches[i].point);
+  }
+  result->pose = std::move(pose);
 }
 
 }  // namespace arview::tracker

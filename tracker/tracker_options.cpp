@@ -54,6 +54,8 @@ void RelocalizerOptions::Check(const OptionNames& names) const {
   RequireSideOrZero(reloc_sift_long_side, names("reloc_sift_long_side"), "as " + names("sift_long_side"));
   RequireOption(sift_own_size_up_to >= 0, names("sift_own_size_up_to"), "0 or more", sift_own_size_up_to);
   matching.Check(names.Nested("matching"));
+  RequireOption(keyframe_matching >= 0, names("keyframe_matching"), "0 or more", keyframe_matching);
+  RequireOption(keyframe_knn >= 2, names("keyframe_knn"), "at least 2", keyframe_knn);
   pose.Check(names.Nested("pose"));
 }
 

@@ -139,6 +139,12 @@ TEST(TrackerOptionsCheck, TrackerOptionsNameTheFieldByItsPathThroughEveryMember)
   o.relocalization.matching.ratio = 0;
   EXPECT_EQ(Refusal([&] { o.Check(); }), "relocalization.matching.ratio must be in (0, 1] (got 0)");
   o = {};
+  o.relocalization.keyframe_matching = -1;
+  EXPECT_EQ(Refusal([&] { o.Check(); }), "relocalization.keyframe_matching must be 0 or more (got -1)");
+  o = {};
+  o.relocalization.keyframe_knn = 1;
+  EXPECT_EQ(Refusal([&] { o.Check(); }), "relocalization.keyframe_knn must be at least 2 (got 1)");
+  o = {};
   o.tracking.guided_ratio = 2;
   EXPECT_EQ(Refusal([&] { o.Check(); }), "tracking.guided_ratio must be in (0, 1] (got 2)");
   o = {};

@@ -271,6 +271,10 @@ void AddTrackCommand(CLI::App& app) {
       ->check(CLI::Range(0.001, 0.5));
   f.Add(cmd, "--ratio", ARVIEW_OPTION_FIELD(o, relocalization.matching.ratio), "Ratio test of global matching")
       ->check(CLI::Range(0.1, 1.0));
+  f.Add(cmd, "--keyframe-matching", ARVIEW_OPTION_FIELD(o, relocalization.keyframe_matching),
+        "A relocalised frame is matched again to this many keyframes, those that see most of its "
+        "pose's inliers, each with a ratio test among its own keypoints, and posed again (0: off)")
+      ->check(CLI::Range(0, 1000));
   f.Add(cmd, "--ransac-threshold", ARVIEW_OPTION_FIELD(o, relocalization.pose.ransac_threshold_px),
         "RANSAC's inlier threshold when relocalising, working pixels (the pose is refined on its inliers)")
       ->check(CLI::Range(0.1, 50.0));
