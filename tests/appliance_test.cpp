@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <string>
 #include <vector>
@@ -130,15 +131,30 @@ TEST(Appliance, TempleRingReplayCompositesEveryFrameAndTheHeadFollowsTheCamera) 
 
   // What the viewer sees, from the replay's own files: the character's anchor and box corners
   // projected with the estimated and the true pose, the smoothed centres read from its stats.
-  const auto seen = run({"eval", (dir / "traj.txt").string(), (dir / "temple" / "groundtruth.txt").string(), "--align-with",
+  // Only the frames before templeR0032: from there on the data's true rotations are turned 180°
+  // about the optical axis against what the images show (COLMAP's own keyframes as well as the
+  // tracked frames; docs/tracker.md, "Seventh round"), and would score hundreds of pixels.
+  const fs::path upright_truth = dir / "groundtruth_to_0031.txt";
+  {
+    std::ifstream in(dir / "temple" / "groundtruth.txt");
+    std::ofstream out(upright_truth);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] != '#' && std::stod(line) > 30.5) continue;  // timestamps are frame indices
+      out << line << "\n";
+    }
+  }
+  const auto seen = run({"eval", (dir / "traj.txt").string(), upright_truth.string(), "--align-with",
                          (dir / "map" / "keyframes.txt").string(), "--camera", (dir / "temple" / "camera.yaml").string(),
                          "--scene", (dir / "scene.yaml").string(), "--smoothed", (dir / "stats.json").string()});
-  EXPECT_NE(seen.out.find("registration 9 points, 23 frames"), std::string::npos) << seen.out;
+  EXPECT_NE(seen.out.find("registration 9 points, 15 frames"), std::string::npos) << seen.out;
   EXPECT_NE(seen.out.find("smoothing   lags the raw centre by"), std::string::npos) << seen.out;
   ASSERT_TRUE(std::regex_search(seen.out, m, std::regex(R"(mean per frame median ([0-9.]+) px)"))) << seen.out;
-  // The map is a fresh COLMAP run: on four default maps of the even frames the median was
-  // 4.62-5.05 px (docs/tracker.md, "Seventh round"), so the bound leaves that draw room.
-  EXPECT_LT(std::stod(m[1]), 6.0) << "templeRing's poses are within a few mm: a few pixels at most";
+  // A fresh COLMAP map each run: on four default maps of the even frames the median was 4.9-5.4 px,
+  // most of it the ~0.2° between the map's orientation and the data's (f = 1520 px).
+  EXPECT_LT(std::stod(m[1]), 7.0) << "templeRing's poses are within a few mm and tenths of a degree";
+  ASSERT_TRUE(std::regex_search(seen.out, m, std::regex(R"(mean per frame median [0-9.]+ px  p95 [0-9.]+ px  max ([0-9.]+) px)")))
+      << seen.out;
+  EXPECT_LT(std::stod(m[1]), 30.0) << "no frame far off";
 
   // The HUD is drawn on the sink's thread (FrameCompositor::DeferredOverlay): the same frames
   // with and without it differ, and only in the HUD's places, the character's pixels the same.
