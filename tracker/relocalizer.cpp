@@ -224,7 +224,12 @@ void Relocalizer::MatchKeyframesAndPose(const Features& features, const std::vec
   std::vector<Eigen::Vector3d> points;
   GatherCorrespondences(features, map_, matches, &pixels, &points);
   AbsolutePoseResult pose = EstimateAbsolutePose(camera_, pixels, points, options_.pose);
+  // The frame's time is both poses'.
+  result->pose.stats.ransac_ms += pose.stats.ransac_ms;
+  result->pose.stats.refine_ms += pose.stats.refine_ms;
   if (!pose.ok) return;  // the first pose stands
+  pose.stats.ransac_ms = result->pose.stats.ransac_ms;
+  pose.stats.refine_ms = result->pose.stats.refine_ms;
   result->matches = static_cast<int>(matches.size());
   result->inliers = {};
   std::set<int> followed;  // a keypoint matched to two points is followed once

@@ -149,7 +149,7 @@ class PngSequenceSink final : public FrameSink {
   void Write(const cv::Mat& bgr) override {
     CheckFrame(bgr, size_, folder_.string());
     char name[32];
-    std::snprintf(name, sizeof name, "%06d.png", index_++);
+    std::snprintf(name, sizeof name, kPngFramePattern, index_++);
     const fs::path file = folder_ / name;
     WriteImageAtomically(file, bgr, {cv::IMWRITE_PNG_COMPRESSION, 1});
   }

@@ -20,6 +20,10 @@
 
 namespace arview::video {
 
+// The names of a PNG folder's frames, as a printf pattern of the frame's index (000000.png, ...):
+// also how cv::VideoCapture reads the folder back as an image sequence.
+inline constexpr const char* kPngFramePattern = "%06d.png";
+
 class FrameSink {
  public:
   virtual ~FrameSink() = default;

@@ -204,13 +204,15 @@ mapping::MapBuildResult MapFirstLap(const recordings::Recording& walk, int half,
   mapping::MapBuildOptions map_options;
   map_options.frames_spec = "0-" + std::to_string(half - 1) + ":" + std::to_string(o.map_every);
   map_options.matcher = mapping::MatcherKind::kSequential;
-  // `arview map --preset fast --max-features 2048`: a rendered room at 640x480 has plenty of
-  // texture; 2048 features a frame with one orientation each, and fewer bundle adjustments, map
-  // its 96 frames in 74 s where two orientations and COLMAP's adjustments took 99 s, the
-  // keyframes as exact (1.11 and 1.45 mm median against 1.49 mm; docs/mapping.md, "The demo's
-  // room in 80 s"). Fewer features cost accuracy: 1536 gave 1.85 mm, 1024 2.61 mm.
+  // `arview map --preset fast --max-features 4096`: a rendered room at 640x480 has plenty of
+  // texture; one orientation a feature and fewer bundle adjustments map its 96 frames in about
+  // 70 s where two orientations and COLMAP's adjustments took 99 s (docs/mapping.md, "The demo's
+  // room in 80 s"). 4096 features, not 2048: the second lap's registration error on four maps
+  // of each, three RANSAC seeds each, median 0.424-0.463 px against 0.433-0.519 px and p95
+  // 1.07-1.26 against 1.28-1.57 px, for ~5 s more (docs/tracker.md, "Seventh round").
+  // Fewer features cost accuracy: 1536 gave 1.85 mm, 1024 2.61 mm.
   map_options.UseFastPreset();
-  map_options.max_num_features = 2048;
+  map_options.max_num_features = 4096;
   // arview's matcher for these sequential pairs, not `auto`'s COLMAP matcher for 640x480 frames:
   // on this room it maps 1.6x faster and no less exactly (2026-12-05, 96 frames: 132 s against
   // 211 s, keyframes 1.42 against 1.64 mm median; docs/mapping.md, "Matching"). `auto` keeps

@@ -1,16 +1,19 @@
 #include "app/demo/demo_figures.h"
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
 #include "anim_authoring/lookat.h"
 #include "anim/pose.h"
 #include "base/stats.h"
+#include "video/sinks.h"
 
 namespace arview::app {
 
@@ -97,14 +100,36 @@ std::vector<int> SheetFrames(int n, int frames, std::optional<int> include) {
   return picked;
 }
 
+// Every frame of a video file. Frame counts from container metadata can be approximate: read
+// them all, the caller keeps the chosen.
+std::vector<cv::Mat> ReadVideoFrames(const std::filesystem::path& video) {
+  cv::VideoCapture capture(video.string());
+  if (!capture.isOpened()) throw std::runtime_error(video.string() + ": cannot open the video for the contact sheet");
+  std::vector<cv::Mat> frames;
+  for (cv::Mat frame; capture.read(frame);) frames.push_back(frame.clone());
+  return frames;
+}
+
+// The frames of a PNG folder as a FrameSink writes it (`--out <folder>`, video/sinks.h), in order
+// up to the first index missing.
+std::vector<cv::Mat> ReadPngFrames(const std::filesystem::path& folder) {
+  std::vector<cv::Mat> frames;
+  for (int index = 0;; ++index) {
+    char name[32];
+    std::snprintf(name, sizeof name, video::kPngFramePattern, index);
+    const std::filesystem::path file = folder / name;
+    if (!std::filesystem::exists(file)) break;
+    cv::Mat frame = cv::imread(file.string(), cv::IMREAD_COLOR);
+    if (frame.empty()) throw std::runtime_error(file.string() + ": cannot read the frame for the contact sheet");
+    frames.push_back(std::move(frame));
+  }
+  return frames;
+}
+
 }  // namespace
 
 cv::Mat ContactSheet(const std::filesystem::path& video, int count, int columns, int tile_width, std::optional<int> include) {
-  cv::VideoCapture capture(video.string());
-  if (!capture.isOpened()) throw std::runtime_error(video.string() + ": cannot open the video for the contact sheet");
-  // Frame counts from container metadata can be approximate: read every frame, keep the chosen.
-  std::vector<cv::Mat> frames;
-  for (cv::Mat frame; capture.read(frame);) frames.push_back(frame.clone());
+  const std::vector<cv::Mat> frames = std::filesystem::is_directory(video) ? ReadPngFrames(video) : ReadVideoFrames(video);
   if (frames.empty()) throw std::runtime_error(video.string() + ": no frames to make a contact sheet of");
   const int n = std::min<int>(count, static_cast<int>(frames.size()));
   const int tile_height = tile_width * frames[0].rows / frames[0].cols;

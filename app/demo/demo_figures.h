@@ -42,7 +42,8 @@ struct InViewSummary {
 InViewSummary MeasureInView(const calib::Camera& camera, const std::vector<std::optional<calib::Pose>>& poses,
                             const CharacterMarkers& markers);
 
-// `count` frames spread evenly over `video` (first to last), each scaled to `tile_width`,
+// `count` frames spread evenly over `video` (a video file, or a folder of PNG frames as `--out
+// <folder>` writes them; first to last), each scaled to `tile_width`,
 // tiled `columns` wide, each labelled with its frame number. `include`, a frame of the video,
 // takes the place of the evenly spread frame nearest it (the demo's open mouth: a line lasts a
 // second, which twelve frames over 22 s can miss). Throws std::runtime_error naming the video

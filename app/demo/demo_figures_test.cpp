@@ -7,6 +7,8 @@
 
 #include <filesystem>
 
+#include "video/sinks.h"
+
 namespace arview::app {
 namespace {
 
@@ -65,6 +67,24 @@ TEST(DemoFigures, ContactSheetSpreadsFramesOverTheVideo) {
   }
   std::filesystem::remove(video);
   EXPECT_THROW(ContactSheet(video, 12, 4, 80), std::runtime_error);
+}
+
+// `arview demo --out <folder>` writes PNG frames (video/sinks.h); the sheet reads them back.
+TEST(DemoFigures, ContactSheetReadsAFolderOfPngFrames) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "arview_contact_sheet_png_test";
+  std::filesystem::remove_all(folder);
+  {
+    const auto sink = video::OpenSink(folder.string(), {160, 120}, 30);
+    for (int i = 0; i < 23; ++i) sink->Write(cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(10 * i)));
+    sink->Close();
+  }
+  const cv::Mat sheet = ContactSheet(folder, 12, 4, 80);
+  ASSERT_EQ(sheet.cols, 4 * 80);
+  for (int k = 0; k < 12; ++k) {
+    const cv::Vec3b centre = sheet.at<cv::Vec3b>((k / 4) * 60 + 20, (k % 4) * 80 + 40);
+    EXPECT_EQ(centre[0], 20 * k) << "tile " << k;  // PNG: exact
+  }
+  std::filesystem::remove_all(folder);
 }
 
 // A frame to include takes the place of the spread frame nearest it, and only that one.
