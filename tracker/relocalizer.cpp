@@ -188,14 +188,17 @@ std::vector<MapMatch> MatchToKeyframes(const Features& features, const map::Map&
   for (size_t i = 0; i < keyframes.size(); ++i) slot[keyframes[i]] = static_cast<int>(i);
   const auto neighbours = index.Knn(features.descriptors, knn);
   const float inf = std::numeric_limits<float>::infinity();
+  // Per chosen keyframe, for the keypoint at hand: its nearest row and the distance to its second
+  // (the last neighbour bounds a second that is not among the k).
+  std::vector<std::pair<int, float>> best(keyframes.size());
+  std::vector<float> second(keyframes.size());
+  std::vector<char> seen_second(keyframes.size());
   for (size_t q = 0; q < neighbours.size(); ++q) {
     const auto& nn = neighbours[q];
     if (nn.empty()) continue;
-    // Per chosen keyframe: its nearest row and the distance to its second (the last neighbour
-    // bounds a second that is not among the k).
-    std::vector<std::pair<int, float>> best(keyframes.size(), {-1, inf});
-    std::vector<float> second(keyframes.size(), nn.size() == static_cast<size_t>(knn) ? nn.back().distance : inf);
-    std::vector<char> seen_second(keyframes.size(), 0);
+    std::fill(best.begin(), best.end(), std::pair<int, float>{-1, inf});
+    std::fill(second.begin(), second.end(), nn.size() == static_cast<size_t>(knn) ? nn.back().distance : inf);
+    std::fill(seen_second.begin(), seen_second.end(), 0);
     for (const map::Neighbor& n : nn) {
       const int k = slot[map.descriptor_keyframe[n.row]];
       if (k < 0) continue;
