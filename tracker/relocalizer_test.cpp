@@ -3,7 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <utility>
+
+#include "tests/support/test_data.h"
+#include "tracker/test_planar_scene.h"
+#include "tracker/test_scene.h"
 
 namespace arview::tracker {
 namespace {
@@ -113,6 +118,38 @@ TEST(MatchToKeyframes, TheLastNeighbourBoundsASecondNotAmongThem) {
   EXPECT_NEAR(two[0].distance, 8.f, 1e-3);
   // A ratio the bound does not clear drops it.
   EXPECT_TRUE(MatchToKeyframes(frame, map, index, {0}, 2, 0.1).empty());
+}
+
+// The graffiti plane's map makes every keypoint of every keyframe its own point, so each place seen
+// by several keyframes is several points: the global ratio test drops it, matching keyframe by
+// keyframe keeps it. A view between the keyframes is posed on more inliers, as exactly.
+TEST(Relocalizer, MatchingKeyframeByKeyframeKeepsThePlacesTheMapHoldsSeveralTimes) {
+  ARVIEW_REQUIRE_DATA_PATH(testing::kGraffitiTexture, "Debian package opencv-doc");
+  const testing::GraffitiPlane* plane = testing::SharedGraffitiPlane();
+  ASSERT_NE(plane, nullptr);
+  const map::DescriptorIndex index(plane->map.descriptors);
+  const calib::Pose truth = testing::LookAt({0.12, 0.06, -0.82}, {0.02, 0, 0});
+  const cv::Mat frame = plane->world.Render(truth);
+
+  RelocalizerOptions global_only;
+  global_only.keyframe_matching = 0;
+  RelocalizerOptions by_keyframe;
+  by_keyframe.keyframe_matching = 5;
+  const RelocalizationResult before = Relocalizer(plane->map, plane->map.camera, index, global_only).Relocalize(frame);
+  const RelocalizationResult after = Relocalizer(plane->map, plane->map.camera, index, by_keyframe).Relocalize(frame);
+  ASSERT_TRUE(before.pose.ok) << before.pose.reason;
+  ASSERT_TRUE(after.pose.ok) << after.pose.reason;
+  EXPECT_GT(after.matches, before.matches);
+  EXPECT_GT(after.inliers.points.size(), before.inliers.points.size() * 3 / 2)
+      << before.inliers.points.size() << " inliers matched globally, " << after.inliers.points.size() << " by keyframe";
+  EXPECT_LT((after.pose.pose.Center() - truth.Center()).norm(), 0.002);
+  EXPECT_LT(testing::RotationErrorDeg(after.pose.pose, truth), 0.1);
+  // Each keypoint is followed once, whatever points it matched in the keyframes: no more followed
+  // than the frame has keypoints, fewer than the pose's inliers.
+  EXPECT_LE(after.inliers.points.size(), static_cast<size_t>(after.keypoints));
+  EXPECT_LE(static_cast<int>(after.inliers.points.size()), after.pose.stats.inliers);
+  std::printf("inliers: %zu matched globally, %zu by keyframe (pose on %d)\n", before.inliers.points.size(),
+              after.inliers.points.size(), after.pose.stats.inliers);
 }
 
 TEST(KeyframesSeeingMost, MostFirstTiesByIndexNoneLeftOut) {
