@@ -75,6 +75,20 @@ void GatherCorrespondences(const Features& features, const map::Map& map,
 
 namespace {
 
+// The pose's inliers as the flow follows them: each keypoint once, with the first point it was
+// matched to among the inliers (a keypoint matched in several keyframes may name several).
+Track2D3D FollowedInliers(const AbsolutePoseResult& pose, const std::vector<MapMatch>& matches,
+                          const std::vector<Eigen::Vector2d>& pixels) {
+  Track2D3D followed;
+  std::set<int> keypoints;
+  for (int i : pose.inliers) {
+    if (!keypoints.insert(matches[i].keypoint).second) continue;
+    followed.pixels.emplace_back(pixels[i].x(), pixels[i].y());
+    followed.points.push_back(matches[i].point);
+  }
+  return followed;
+}
+
 bool SiftReducesFrame(const calib::Camera& camera, const RelocalizerOptions& options) {
   return WorkingResolution(camera, SiftLongSide(camera, options)).reduced();
 }
@@ -168,10 +182,7 @@ RelocalizationResult Relocalizer::Relocalize(const Features& given) const {
   GatherCorrespondences(features, map_, matches, &pixels, &points);
   result.pose = EstimateAbsolutePose(camera_, pixels, points, options_.pose);
   if (result.pose.ok) {
-    for (int i : result.pose.inliers) {
-      result.inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
-      result.inliers.points.push_back(matches[i].point);
-    }
+    result.inliers = FollowedInliers(result.pose, matches, pixels);
     if (options_.keyframe_matching > 0) MatchKeyframesAndPose(features, matches, &result);
   }
   return result;
@@ -234,13 +245,7 @@ void Relocalizer::MatchKeyframesAndPose(const Features& features, const std::vec
   pose.stats.ransac_ms = result->pose.stats.ransac_ms;
   pose.stats.refine_ms = result->pose.stats.refine_ms;
   result->matches = static_cast<int>(matches.size());
-  result->inliers = {};
-  std::set<int> followed;  // a keypoint matched to two points is followed once
-  for (int i : pose.inliers) {
-    if (!followed.insert(matches[i].keypoint).second) continue;
-    result->inliers.pixels.emplace_back(pixels[i].x(), pixels[i].y());
-    result->inliers.points.push_back(matches[i].point);
-  }
+  result->inliers = FollowedInliers(pose, matches, pixels);
   result->pose = std::move(pose);
 }
 

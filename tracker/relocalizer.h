@@ -113,7 +113,7 @@ struct RelocalizerOptions {
   // point: a façade's repeated ornament, or one point COLMAP split into two tracks, fails it
   // where one photo holds it once. Over the odd frames of Herz-Jesus-P25 (3 maps), templeRing (4)
   // and phone-fox (4), the pooled centre error's mean 7.74 -> 7.54 mm, 0.985 -> 0.966 mm and
-  // 0.00247 -> 0.00235 units, phone-fox's inliers +27 % (docs/tracker.md, "Seventh round").
+  // 0.00247 -> 0.00235 units, phone-fox's inliers +23-26 % (docs/tracker.md, "Seventh round").
   int keyframe_matching = 5;
   // Index neighbours of a keypoint looked among for a keyframe's nearest two rows (MatchToKeyframes).
   int keyframe_knn = 16;

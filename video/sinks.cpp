@@ -148,9 +148,7 @@ class PngSequenceSink final : public FrameSink {
   }
   void Write(const cv::Mat& bgr) override {
     CheckFrame(bgr, size_, folder_.string());
-    char name[32];
-    std::snprintf(name, sizeof name, kPngFramePattern, index_++);
-    const fs::path file = folder_ / name;
+    const fs::path file = PngFrameFile(folder_, index_++);
     WriteImageAtomically(file, bgr, {cv::IMWRITE_PNG_COMPRESSION, 1});
   }
   void Close() override {}
@@ -189,6 +187,12 @@ bool HasDisplay() {
 
 void FrameSink::WriteAudio(std::int64_t, std::span<const std::int16_t>) {
   throw VideoError(Describe() + ": has no audio track");
+}
+
+std::filesystem::path PngFrameFile(const std::filesystem::path& folder, int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d.png", index);
+  return folder / name;
 }
 
 std::unique_ptr<FrameSink> OpenSink(const std::string& target, cv::Size frame_size, double fps,

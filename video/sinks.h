@@ -12,6 +12,7 @@
 #include "video/window.h"
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -20,9 +21,8 @@
 
 namespace arview::video {
 
-// The names of a PNG folder's frames, as a printf pattern of the frame's index (000000.png, ...):
-// also how cv::VideoCapture reads the folder back as an image sequence.
-inline constexpr const char* kPngFramePattern = "%06d.png";
+// Frame `index` of a PNG folder the sink writes (<folder>/000000.png, ...), for whoever reads it back.
+std::filesystem::path PngFrameFile(const std::filesystem::path& folder, int index);
 
 class FrameSink {
  public:

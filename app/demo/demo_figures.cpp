@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -115,9 +114,7 @@ std::vector<cv::Mat> ReadVideoFrames(const std::filesystem::path& video) {
 std::vector<cv::Mat> ReadPngFrames(const std::filesystem::path& folder) {
   std::vector<cv::Mat> frames;
   for (int index = 0;; ++index) {
-    char name[32];
-    std::snprintf(name, sizeof name, video::kPngFramePattern, index);
-    const std::filesystem::path file = folder / name;
+    const std::filesystem::path file = video::PngFrameFile(folder, index);
     if (!std::filesystem::exists(file)) break;
     cv::Mat frame = cv::imread(file.string(), cv::IMREAD_COLOR);
     if (frame.empty()) throw std::runtime_error(file.string() + ": cannot read the frame for the contact sheet");
